@@ -1,0 +1,37 @@
+# whitted: the two Quick start commands are `make demo` and `make test`.
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+# Numba's on-disk JIT cache: compiled kernels are kept here between runs.
+export NUMBA_CACHE_DIR ?= $(CURDIR)/.cache/numba
+
+.PHONY: demo test lint install install-test bench clean
+
+$(BIN)/whitted: pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e .
+	@touch $@
+
+$(VENV)/.test-deps: $(BIN)/whitted
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	@touch $@
+
+install: $(BIN)/whitted
+
+install-test: $(VENV)/.test-deps
+
+## Install, then render the built-in default scene to render.png
+demo: install
+	$(BIN)/whitted render -o render.png
+
+## Install the test dependencies, lint, then run the whole test suite
+test: install-test
+	$(BIN)/ruff check src tests
+	$(BIN)/python -m pytest -q
+
+lint: install-test
+	$(BIN)/ruff check src tests
+
+clean:
+	rm -rf $(VENV) .cache build *.egg-info src/*.egg-info

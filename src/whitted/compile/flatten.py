@@ -1,0 +1,375 @@
+"""Scene description -> flat NumPy arrays (+ BVH) that the kernels read.
+
+Transforms are baked into the shape's numbers wherever the shape family is closed under them
+(planes, rectangles, triangles and boxes under any affine map; spheres, disks, cylinders and
+cones under similarities). Only a quadric under a non-uniform scale or shear keeps a
+world-to-object matrix and is intersected in its own space.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..kernels.layout import (
+    FALLOFF_CODES,
+    LIGHT_DIRECTION,
+    LIGHT_DISK,
+    LIGHT_DISK_U,
+    LIGHT_DISK_V,
+    LIGHT_DIST_SCALE,
+    LIGHT_FALLOFF,
+    LIGHT_POINT,
+    LIGHT_POSITION,
+    LIGHT_RADIANCE,
+    LIGHT_RADIUS,
+    LIGHT_SAMPLES,
+    LIGHT_TYPE,
+    MAT_AMBIENT,
+    MAT_ATTEN,
+    MAT_BLINN,
+    MAT_COLOR,
+    MAT_FRESNEL,
+    MAT_IOR,
+    MAT_KA,
+    MAT_KD,
+    MAT_KR,
+    MAT_KS,
+    MAT_KT,
+    MAT_SHININESS,
+    MAT_SPECULAR,
+    N_LIGHT_PARAMS,
+    N_MAT_PARAMS,
+    N_PRIM_PARAMS,
+    SHAPE_BOX,
+    SHAPE_DISK,
+    SHAPE_FRUSTUM,
+    SHAPE_PLANE,
+    SHAPE_RECTANGLE,
+    SHAPE_SPHERE,
+    SHAPE_TRIANGLE,
+    GeometryArrays,
+    RenderParams,
+)
+from ..scene.lights import AmbientLight, DirectionalLight, DiskLight, PointLight
+from ..scene.materials import Material
+from ..scene.scene import RenderSettings, Scene
+from ..scene.shapes import Box, Cone, Cylinder, Disk, Plane, Rectangle, Sphere, Triangle
+from .bvh import build_bvh
+
+
+@dataclass
+class CompiledScene:
+    """The scene as the kernels see it, plus what the Python side reports about it."""
+
+    geometry: GeometryArrays
+    materials: np.ndarray  # (M, N_MAT_PARAMS) float64
+    lights: np.ndarray  # (L, N_LIGHT_PARAMS) float64, ambient lights excluded
+    ambient: tuple[float, float, float]
+    bounds_min: np.ndarray  # (3,) of all bounded primitives (inf when there are none)
+    bounds_max: np.ndarray
+    build_seconds: float
+
+
+class _Builder:
+    def __init__(self) -> None:
+        self.types: list[int] = []
+        self.params: list[np.ndarray] = []
+        self.xform_index: list[int] = []
+        self.xforms: list[np.ndarray] = []
+        self.material: list[int] = []
+        self.object: list[int] = []
+        self.solid: list[int] = []
+        self.lo: list[np.ndarray] = []
+        self.hi: list[np.ndarray] = []
+
+    def add(self, typ, values, lo, hi, *, material, obj, solid, world_to_object=None):
+        row = np.zeros(N_PRIM_PARAMS)
+        row[: len(values)] = values
+        self.types.append(typ)
+        self.params.append(row)
+        if world_to_object is None:
+            self.xform_index.append(-1)
+        else:
+            self.xform_index.append(len(self.xforms))
+            self.xforms.append(world_to_object[:3, :4])
+        self.material.append(material)
+        self.object.append(obj)
+        self.solid.append(int(solid))
+        self.lo.append(np.asarray(lo, dtype=np.float64))
+        self.hi.append(np.asarray(hi, dtype=np.float64))
+
+
+def _similarity_scale(linear: np.ndarray) -> float | None:
+    """s when ``linear`` is s times a rotation (or reflection), else None."""
+    gram = linear.T @ linear
+    s2 = gram[0, 0]
+    if np.allclose(gram, s2 * np.eye(3), rtol=1e-12, atol=1e-12 * max(s2, 1e-300)):
+        return math.sqrt(s2)
+    return None
+
+
+def _unit(v) -> np.ndarray:
+    v = np.asarray(v, dtype=np.float64)
+    return v / np.linalg.norm(v)
+
+
+def _disk_bounds(center, normal, radius):
+    n = _unit(normal)
+    ext = radius * np.sqrt(np.clip(1.0 - n * n, 0.0, None))
+    return center - ext, center + ext
+
+
+def _corners_bounds(points: np.ndarray, matrix: np.ndarray | None = None):
+    pts = np.asarray(points, dtype=np.float64)
+    if matrix is not None:
+        pts = pts @ matrix[:3, :3].T + matrix[:3, 3]
+    return pts.min(axis=0), pts.max(axis=0)
+
+
+def _box_corners(lo, hi):
+    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+
+
+def _add_shape(b: _Builder, shape, m: np.ndarray, material: int, obj: int) -> None:
+    lin = m[:3, :3]
+    to_world = m
+    inv = np.linalg.inv(m)
+    s = _similarity_scale(lin)
+
+    def point(p):
+        return lin @ np.asarray(p, dtype=np.float64) + m[:3, 3]
+
+    def normal(n):
+        return _unit(inv[:3, :3].T @ np.asarray(n, dtype=np.float64))
+
+    if isinstance(shape, Sphere):
+        c, r = np.array(shape.center), shape.radius
+        if s is not None:
+            cw = point(c)
+            b.add(SHAPE_SPHERE, [*cw, r * s], cw - r * s, cw + r * s,
+                  material=material, obj=obj, solid=True)
+        else:
+            cw = point(c)
+            ext = r * np.linalg.norm(lin, axis=1)
+            b.add(SHAPE_SPHERE, [*c, r], cw - ext, cw + ext, material=material, obj=obj,
+                  solid=True, world_to_object=inv)
+    elif isinstance(shape, Plane):
+        b.add(SHAPE_PLANE, [*point(shape.point), *normal(shape.normal)], [-np.inf] * 3,
+              [np.inf] * 3, material=material, obj=obj, solid=False)
+    elif isinstance(shape, Rectangle):
+        corner = point(shape.corner)
+        e1, e2 = lin @ np.array(shape.edge1), lin @ np.array(shape.edge2)
+        n = _unit(np.cross(e1, e2))
+        du = np.cross(e2, n) / np.dot(e1, np.cross(e2, n))
+        dv = np.cross(n, e1) / np.dot(e2, np.cross(n, e1))
+        lo, hi = _corners_bounds([corner, corner + e1, corner + e2, corner + e1 + e2])
+        b.add(SHAPE_RECTANGLE, [*corner, *e1, *e2, *n, *du, *dv], lo, hi, material=material,
+              obj=obj, solid=False)
+    elif isinstance(shape, Triangle):
+        v0, v1, v2 = (point(v) for v in shape.vertices)
+        e1, e2 = v1 - v0, v2 - v0
+        n = _unit(np.cross(e1, e2))
+        lo, hi = _corners_bounds([v0, v1, v2])
+        b.add(SHAPE_TRIANGLE, [*v0, *e1, *e2, *n], lo, hi, material=material, obj=obj,
+              solid=False)
+    elif isinstance(shape, Disk):
+        c, n, r = np.array(shape.center), _unit(shape.normal), shape.radius
+        if s is not None:
+            cw, nw = point(c), normal(n)
+            lo, hi = _disk_bounds(cw, nw, r * s)
+            b.add(SHAPE_DISK, [*cw, *nw, r * s], lo, hi, material=material, obj=obj,
+                  solid=False)
+        else:
+            lo, hi = _disk_bounds(c, n, r)
+            lo, hi = _corners_bounds(_box_corners(lo, hi), to_world)
+            b.add(SHAPE_DISK, [*c, *n, r], lo, hi, material=material, obj=obj, solid=False,
+                  world_to_object=inv)
+    elif isinstance(shape, Box):
+        corner, edges = shape.corner_and_edges()
+        corner_w = point(corner)
+        edges_w = (lin @ edges.T).T  # rows are the three edge vectors
+        inv_e = np.linalg.inv(edges_w.T)  # local = inv_e @ (p - corner)
+        pts = [corner_w + i * edges_w[0] + j * edges_w[1] + k * edges_w[2]
+               for i in (0, 1) for j in (0, 1) for k in (0, 1)]
+        lo, hi = _corners_bounds(pts)
+        b.add(SHAPE_BOX, [*corner_w, *inv_e.reshape(-1)], lo, hi, material=material, obj=obj,
+              solid=True)
+    elif isinstance(shape, Cylinder | Cone):
+        base, top = np.array(shape.base), np.array(shape.top)
+        r0 = shape.radius
+        r1 = shape.radius if isinstance(shape, Cylinder) else shape.top_radius
+        capped = shape.capped
+        xf = None
+        if s is not None:
+            base, top, r0, r1 = point(base), point(top), r0 * s, r1 * s
+        else:
+            xf = inv
+        axis = top - base
+        h = float(np.linalg.norm(axis))
+        axis = axis / h
+        lo0, hi0 = _disk_bounds(base, axis, r0) if r0 > 0 else (base, base)
+        lo1, hi1 = _disk_bounds(top, axis, r1) if r1 > 0 else (top, top)
+        lo, hi = np.minimum(lo0, lo1), np.maximum(hi0, hi1)
+        if xf is not None:
+            lo, hi = _corners_bounds(_box_corners(lo, hi), to_world)
+        b.add(SHAPE_FRUSTUM, [*base, *axis, h, r0, r1, float(capped)], lo, hi,
+              material=material, obj=obj, solid=capped, world_to_object=xf)
+    else:  # pragma: no cover - the scene model admits no other shape
+        raise TypeError(f"cannot compile {type(shape).__name__}")
+
+
+def material_row(mat: Material) -> np.ndarray:
+    row = np.zeros(N_MAT_PARAMS)
+    row[MAT_COLOR : MAT_COLOR + 3] = mat.color
+    row[MAT_AMBIENT : MAT_AMBIENT + 3] = mat.ambient_color or mat.color
+    row[MAT_SPECULAR : MAT_SPECULAR + 3] = mat.specular_color or (1.0, 1.0, 1.0)
+    row[MAT_KA] = mat.ka
+    row[MAT_KD] = mat.kd
+    row[MAT_KS] = mat.ks
+    row[MAT_SHININESS] = mat.shininess
+    row[MAT_BLINN] = 1.0 if mat.specular_model == "blinn" else 0.0
+    row[MAT_KR] = mat.kr
+    row[MAT_KT] = mat.kt
+    row[MAT_IOR] = mat.ior
+    row[MAT_ATTEN : MAT_ATTEN + 3] = mat.attenuation_rgb()
+    row[MAT_FRESNEL] = 1.0 if mat.fresnel else 0.0
+    return row
+
+
+def _light_rows(scene: Scene) -> tuple[np.ndarray, tuple[float, float, float]]:
+    rows = []
+    ambient = np.zeros(3)
+    for light in scene.lights:
+        radiance = np.array(light.color) * light.intensity
+        if isinstance(light, AmbientLight):
+            ambient += radiance
+            continue
+        row = np.zeros(N_LIGHT_PARAMS)
+        row[LIGHT_RADIANCE : LIGHT_RADIANCE + 3] = radiance
+        if isinstance(light, PointLight):
+            row[LIGHT_TYPE] = LIGHT_POINT
+            row[LIGHT_POSITION : LIGHT_POSITION + 3] = light.position
+        elif isinstance(light, DirectionalLight):
+            row[LIGHT_TYPE] = 2
+            row[LIGHT_DIRECTION : LIGHT_DIRECTION + 3] = _unit(light.direction)
+        elif isinstance(light, DiskLight):
+            row[LIGHT_TYPE] = LIGHT_DISK
+            n = _unit(light.normal)
+            helper = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
+            u = _unit(np.cross(n, helper))
+            row[LIGHT_POSITION : LIGHT_POSITION + 3] = light.center
+            row[LIGHT_DIRECTION : LIGHT_DIRECTION + 3] = n
+            row[LIGHT_RADIUS] = light.radius
+            row[LIGHT_SAMPLES] = light.samples or scene.render.shadow_samples
+            row[LIGHT_DISK_U : LIGHT_DISK_U + 3] = u
+            row[LIGHT_DISK_V : LIGHT_DISK_V + 3] = np.cross(n, u)
+        if isinstance(light, PointLight | DiskLight):
+            row[LIGHT_FALLOFF] = FALLOFF_CODES[light.falloff]
+            row[LIGHT_DIST_SCALE] = light.dist_scale
+        rows.append(row)
+    table = np.array(rows, dtype=np.float64).reshape(len(rows), N_LIGHT_PARAMS)
+    return table, (float(ambient[0]), float(ambient[1]), float(ambient[2]))
+
+
+def compile_scene(scene: Scene) -> CompiledScene:
+    """Flatten ``scene`` into the kernel layout and build the BVH over its bounded shapes."""
+    import time
+
+    start = time.perf_counter()
+    b = _Builder()
+    mat_rows: list[np.ndarray] = []
+    mat_index: dict[bytes, int] = {}
+    for obj_index, shape in enumerate(scene.objects):
+        row = material_row(scene.material_of(obj_index))
+        key = row.tobytes()
+        if key not in mat_index:
+            mat_index[key] = len(mat_rows)
+            mat_rows.append(row)
+        m = shape.transform.matrix() if shape.transform is not None else np.eye(4)
+        _add_shape(b, shape, m, mat_index[key], obj_index)
+
+    n = len(b.types)
+    prim_type = np.array(b.types, dtype=np.int32)
+    params = np.array(b.params, dtype=np.float64).reshape(n, N_PRIM_PARAMS)
+    lo = np.array(b.lo, dtype=np.float64).reshape(n, 3)
+    hi = np.array(b.hi, dtype=np.float64).reshape(n, 3)
+    bounded = np.flatnonzero(np.all(np.isfinite(lo) & np.isfinite(hi), axis=1)).astype(np.int32)
+    unbounded = np.flatnonzero(~np.all(np.isfinite(lo) & np.isfinite(hi), axis=1))
+    bvh = build_bvh(lo[bounded], hi[bounded])
+    geometry = GeometryArrays(
+        prim_type=prim_type,
+        prim_params=params,
+        prim_xform=np.array(b.xform_index, dtype=np.int32),
+        xforms=np.array(b.xforms, dtype=np.float64).reshape(len(b.xforms), 3, 4),
+        prim_material=np.array(b.material, dtype=np.int32),
+        prim_object=np.array(b.object, dtype=np.int32),
+        prim_solid=np.array(b.solid, dtype=np.int32),
+        node_min=np.ascontiguousarray(bvh.node_min, dtype=np.float64),
+        node_max=np.ascontiguousarray(bvh.node_max, dtype=np.float64),
+        node_offset=np.ascontiguousarray(bvh.node_offset, dtype=np.int32),
+        node_count=np.ascontiguousarray(bvh.node_count, dtype=np.int32),
+        node_axis=np.ascontiguousarray(bvh.node_axis, dtype=np.int8),
+        node_prims=np.ascontiguousarray(bounded[bvh.prim_order], dtype=np.int32),
+        unbounded=unbounded.astype(np.int32),
+    )
+    materials = np.array(mat_rows, dtype=np.float64).reshape(len(mat_rows), N_MAT_PARAMS)
+    lights, ambient = _light_rows(scene)
+    if len(bounded):
+        bmin, bmax = lo[bounded].min(axis=0), hi[bounded].max(axis=0)
+    else:
+        bmin, bmax = np.full(3, np.inf), np.full(3, -np.inf)
+    return CompiledScene(
+        geometry=geometry,
+        materials=materials,
+        lights=lights,
+        ambient=ambient,
+        bounds_min=bmin,
+        bounds_max=bmax,
+        build_seconds=time.perf_counter() - start,
+    )
+
+
+def auto_epsilon(scene: Scene, compiled: CompiledScene) -> float:
+    """Offset of secondary-ray origins: the user's, or 1e-7 of the scene's coordinate scale."""
+    if scene.render.epsilon > 0:
+        return scene.render.epsilon
+    scale = max(1.0, float(np.max(np.abs(scene.camera.position))))
+    if np.all(np.isfinite(compiled.bounds_min)):
+        scale = max(scale, float(np.max(np.abs(compiled.bounds_min))),
+                    float(np.max(np.abs(compiled.bounds_max))))
+    for i in compiled.geometry.unbounded:
+        scale = max(scale, float(np.max(np.abs(compiled.geometry.prim_params[i, :3]))))
+    return 1e-7 * scale
+
+
+def render_params(scene: Scene, compiled: CompiledScene, settings: RenderSettings) -> RenderParams:
+    cam = scene.camera
+    right, up, forward = cam.basis()
+    hw, hh = cam.half_extents(settings.width, settings.height)
+    bg = scene.background
+    top = bg.gradient.top if bg.gradient else bg.color
+    bottom = bg.gradient.bottom if bg.gradient else bg.color
+
+    def t3(v) -> tuple[float, float, float]:
+        return (float(v[0]), float(v[1]), float(v[2]))
+
+    return RenderParams(
+        width=int(settings.width),
+        height=int(settings.height),
+        samples=int(settings.samples),
+        max_depth=int(settings.max_depth),
+        min_weight=float(settings.min_weight),
+        epsilon=float(auto_epsilon(scene, compiled)),
+        seed=int(settings.seed),
+        ambient=t3(compiled.ambient),
+        background_top=t3(top),
+        background_bottom=t3(bottom),
+        camera_origin=t3(cam.position),
+        camera_right=t3(np.asarray(right) * hw),
+        camera_up=t3(np.asarray(up) * hh),
+        camera_forward=t3(forward),
+        orthographic=int(cam.projection == "orthographic"),
+    )

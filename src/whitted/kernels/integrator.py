@@ -1,0 +1,193 @@
+"""The Whitted integrator: follow a camera ray through reflections and refractions with an
+explicit ray stack (no recursion), tracking the media each ray travels in."""
+
+from __future__ import annotations
+
+import math
+
+from .accel import closest_hit, world_normal
+from .jit import kernel
+from .layout import (
+    MAT_AMBIENT,
+    MAT_ATTEN,
+    MAT_COLOR,
+    MAT_FRESNEL,
+    MAT_IOR,
+    MAT_KA,
+    MAT_KR,
+    MAT_KT,
+    MAX_MEDIA,
+    RAY_REFLECTION,
+    RAY_REFRACTION,
+)
+from .lighting import direct_light
+from .vec import dot, madd
+
+# ray-stack columns: float part
+F_ORIGIN = 0
+F_DIR = 3
+F_WEIGHT = 6
+N_STACK_F = 9
+# int part: depth, number of media, then the media (material rows), innermost last
+I_DEPTH = 0
+I_NMEDIA = 1
+I_MEDIA = 2
+N_STACK_I = 2 + MAX_MEDIA
+# dimensions of the random sequence reserved per path vertex for area-light samples
+RNG_DIMS_PER_HIT = 1 << 16
+
+
+@kernel
+def background(params, d):
+    """Colour of a ray that escapes: the gradient from bottom (d.y = -1) to top (d.y = +1)."""
+    t = 0.5 * (d[1] + 1.0)
+    top = params.background_top
+    bottom = params.background_bottom
+    return (
+        bottom[0] + t * (top[0] - bottom[0]),
+        bottom[1] + t * (top[1] - bottom[1]),
+        bottom[2] + t * (top[2] - bottom[2]),
+    )
+
+
+@kernel
+def refract(d, n, eta):
+    """Snell's law for unit ``d`` arriving at unit ``n`` (n·d < 0), eta = n1/n2.
+    Returns (ok, T); ok is False on total internal reflection."""
+    cos_i = -dot(d, n)
+    k = 1.0 - eta * eta * (1.0 - cos_i * cos_i)
+    if k < 0.0:
+        return False, (0.0, 0.0, 0.0)
+    c = eta * cos_i - math.sqrt(k)
+    return True, (eta * d[0] + c * n[0], eta * d[1] + c * n[1], eta * d[2] + c * n[2])
+
+
+@kernel
+def schlick(cos_i, n1, n2, cos_t):
+    """Schlick's Fresnel reflectance; uses the cosine on the denser side."""
+    r0 = (n1 - n2) / (n1 + n2)
+    r0 *= r0
+    c = cos_i if n1 <= n2 else cos_t
+    x = 1.0 - c
+    return r0 + (1.0 - r0) * x * x * x * x * x
+
+
+@kernel
+def _push(st_f, st_i, top, o, d, w, depth, media_src, n_media):
+    top += 1
+    for k in range(3):
+        st_f[top, F_ORIGIN + k] = o[k]
+        st_f[top, F_DIR + k] = d[k]
+        st_f[top, F_WEIGHT + k] = w[k]
+    st_i[top, I_DEPTH] = depth
+    st_i[top, I_NMEDIA] = n_media
+    for k in range(n_media):
+        st_i[top, I_MEDIA + k] = media_src[k]
+    return top
+
+
+@kernel
+def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media, scratch,
+               stack, counters):
+    """Radiance arriving along the camera ray (o, d) with unit d: I = ka·Ia + direct light +
+    kr·Ir + kt·It, the secondary terms traced while their weight stays above min_weight."""
+    r = 0.0
+    g = 0.0
+    b = 0.0
+    top = _push(st_f, st_i, -1, o, d, (1.0, 1.0, 1.0), 0, media, 0)
+    vertex = 0
+    while top >= 0:
+        o = (st_f[top, 0], st_f[top, 1], st_f[top, 2])
+        d = (st_f[top, 3], st_f[top, 4], st_f[top, 5])
+        w = (st_f[top, 6], st_f[top, 7], st_f[top, 8])
+        depth = st_i[top, I_DEPTH]
+        n_media = st_i[top, I_NMEDIA]
+        for k in range(n_media):
+            media[k] = st_i[top, I_MEDIA + k]
+        top -= 1
+        t, prim = closest_hit(geo, o, d, 0.0, math.inf, stack)
+        if n_media > 0:  # Beer-Lambert absorption in the medium the ray crossed
+            cur = media[n_media - 1]
+            w = (
+                w[0] * math.exp(-mats[cur, MAT_ATTEN] * t),
+                w[1] * math.exp(-mats[cur, MAT_ATTEN + 1] * t),
+                w[2] * math.exp(-mats[cur, MAT_ATTEN + 2] * t),
+            )
+        if prim < 0:
+            bg = background(params, d)
+            r += w[0] * bg[0]
+            g += w[1] * bg[1]
+            b += w[2] * bg[2]
+            continue
+        m = geo.prim_material[prim]
+        p = madd(o, d, t)
+        n_geo = world_normal(geo, prim, p)
+        entering = dot(d, n_geo) < 0.0
+        n = n_geo if entering else (-n_geo[0], -n_geo[1], -n_geo[2])  # faces the ray
+        v = (-d[0], -d[1], -d[2])
+        ka = mats[m, MAT_KA]
+        amb = params.ambient
+        local = direct_light(geo, mats, lights, params, p, n, v, m, media, n_media, scratch,
+                             stack, counters, (pixel, sample, 2 + vertex * RNG_DIMS_PER_HIT))
+        vertex += 1
+        r += w[0] * (ka * amb[0] * mats[m, MAT_AMBIENT] + local[0])
+        g += w[1] * (ka * amb[1] * mats[m, MAT_AMBIENT + 1] + local[1])
+        b += w[2] * (ka * amb[2] * mats[m, MAT_AMBIENT + 2] + local[2])
+        if depth >= params.max_depth:
+            continue
+        kr = mats[m, MAT_KR]
+        kt = mats[m, MAT_KT]
+        if kr == 0.0 and kt == 0.0:
+            continue
+        cos_i = -dot(d, n)
+        reflect_dir = madd(d, n, 2.0 * cos_i)
+        kr_eff = kr
+        if kt > 0.0:
+            # media on the far side: entering a solid pushes its material, leaving pops it
+            n_out = n_media
+            for k in range(n_media):
+                scratch[k] = media[k]
+            if geo.prim_solid[prim]:
+                n1 = mats[media[n_media - 1], MAT_IOR] if n_media > 0 else 1.0
+                if entering:
+                    if n_out < MAX_MEDIA:
+                        scratch[n_out] = m
+                        n_out += 1
+                    n2 = mats[m, MAT_IOR]
+                else:
+                    for k in range(n_out - 1, -1, -1):
+                        if scratch[k] == m:
+                            for q in range(k, n_out - 1):
+                                scratch[q] = scratch[q + 1]
+                            n_out -= 1
+                            break
+                    n1 = mats[m, MAT_IOR]
+                    n2 = mats[scratch[n_out - 1], MAT_IOR] if n_out > 0 else 1.0
+            else:  # a thin sheet: light passes straight through
+                n1 = 1.0
+                n2 = 1.0
+            ok, tdir = refract(d, n, n1 / n2)
+            if not ok:  # total internal reflection: the reflected ray carries it all
+                kr_eff = kr + kt
+            else:
+                kt_eff = kt
+                if mats[m, MAT_FRESNEL] != 0.0:
+                    f = schlick(cos_i, n1, n2, -dot(tdir, n))
+                    kr_eff = kr + kt * f
+                    kt_eff = kt * (1.0 - f)
+                wt = (
+                    w[0] * kt_eff * mats[m, MAT_COLOR],
+                    w[1] * kt_eff * mats[m, MAT_COLOR + 1],
+                    w[2] * kt_eff * mats[m, MAT_COLOR + 2],
+                )
+                if max(wt[0], max(wt[1], wt[2])) >= params.min_weight:
+                    counters[RAY_REFRACTION] += 1
+                    top = _push(st_f, st_i, top, madd(p, n, -params.epsilon), tdir, wt,
+                                depth + 1, scratch, n_out)
+        if kr_eff > 0.0:
+            wr = (w[0] * kr_eff, w[1] * kr_eff, w[2] * kr_eff)
+            if max(wr[0], max(wr[1], wr[2])) >= params.min_weight:
+                counters[RAY_REFLECTION] += 1
+                top = _push(st_f, st_i, top, madd(p, n, params.epsilon), reflect_dir, wr,
+                            depth + 1, media, n_media)
+    return r, g, b

@@ -1,0 +1,277 @@
+"""Exact ray/shape intersection and surface normals, one function per shape.
+
+Every ``intersect_*`` takes the parameter table ``P`` and a row ``i`` (see :mod:`.layout`), a ray
+origin ``o`` and direction ``d`` (tuples; ``d`` need not be unit length) and the open interval
+``(tmin, tmax)``; it returns the nearest ray parameter in that interval, or ``INF`` on a miss.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .jit import kernel
+from .layout import (
+    SHAPE_BOX,
+    SHAPE_DISK,
+    SHAPE_FRUSTUM,
+    SHAPE_PLANE,
+    SHAPE_RECTANGLE,
+    SHAPE_SPHERE,
+    SHAPE_TRIANGLE,
+)
+from .vec import cross, dot, normalize, sub, vload
+
+INF = math.inf
+
+
+@kernel
+def _nearest_root(a, b, c, tmin, tmax):
+    """Nearest root in (tmin, tmax) of a·t² + 2b·t + c = 0 (numerically stable form)."""
+    if a == 0.0:
+        if b == 0.0:
+            return INF
+        t = -c / (2.0 * b)
+        return t if tmin < t < tmax else INF
+    disc = b * b - a * c
+    if disc < 0.0:
+        return INF
+    sq = math.sqrt(disc)
+    q = -(b + sq) if b >= 0.0 else -(b - sq)
+    if q == 0.0:
+        t0 = -b / a
+        t1 = t0
+    else:
+        t0 = q / a
+        t1 = c / q
+    if t0 > t1:
+        t0, t1 = t1, t0
+    if tmin < t0 < tmax:
+        return t0
+    if tmin < t1 < tmax:
+        return t1
+    return INF
+
+
+@kernel
+def intersect_sphere(P, i, o, d, tmin, tmax):
+    c = vload(P, i, 0)
+    r = P[i, 3]
+    oc = sub(o, c)
+    return _nearest_root(dot(d, d), dot(oc, d), dot(oc, oc) - r * r, tmin, tmax)
+
+
+@kernel
+def _plane_t(p0, n, o, d):
+    denom = dot(n, d)
+    if denom == 0.0:
+        return INF
+    return dot(sub(p0, o), n) / denom
+
+
+@kernel
+def intersect_plane(P, i, o, d, tmin, tmax):
+    t = _plane_t(vload(P, i, 0), vload(P, i, 3), o, d)
+    return t if tmin < t < tmax else INF
+
+
+@kernel
+def intersect_rectangle(P, i, o, d, tmin, tmax):
+    corner = vload(P, i, 0)
+    t = _plane_t(corner, vload(P, i, 9), o, d)
+    if not (tmin < t < tmax):
+        return INF
+    q = (o[0] + t * d[0] - corner[0], o[1] + t * d[1] - corner[1], o[2] + t * d[2] - corner[2])
+    u = dot(q, vload(P, i, 12))
+    if u < 0.0 or u > 1.0:
+        return INF
+    v = dot(q, vload(P, i, 15))
+    if v < 0.0 or v > 1.0:
+        return INF
+    return t
+
+
+@kernel
+def intersect_disk(P, i, o, d, tmin, tmax):
+    c = vload(P, i, 0)
+    t = _plane_t(c, vload(P, i, 3), o, d)
+    if not (tmin < t < tmax):
+        return INF
+    q = (o[0] + t * d[0] - c[0], o[1] + t * d[1] - c[1], o[2] + t * d[2] - c[2])
+    r = P[i, 6]
+    return t if dot(q, q) <= r * r else INF
+
+
+@kernel
+def intersect_triangle(P, i, o, d, tmin, tmax):
+    """Möller–Trumbore with the edges precomputed."""
+    e1 = vload(P, i, 3)
+    e2 = vload(P, i, 6)
+    pv = cross(d, e2)
+    det = dot(e1, pv)
+    if det == 0.0:
+        return INF
+    inv = 1.0 / det
+    tv = sub(o, vload(P, i, 0))
+    u = dot(tv, pv) * inv
+    if u < 0.0 or u > 1.0:
+        return INF
+    qv = cross(tv, e1)
+    v = dot(d, qv) * inv
+    if v < 0.0 or u + v > 1.0:
+        return INF
+    t = dot(e2, qv) * inv
+    return t if tmin < t < tmax else INF
+
+
+@kernel
+def _box_local(P, i, x):
+    """Row-vector product M^-1 x with the inverse edge matrix stored row-major at 3:12."""
+    return (
+        P[i, 3] * x[0] + P[i, 4] * x[1] + P[i, 5] * x[2],
+        P[i, 6] * x[0] + P[i, 7] * x[1] + P[i, 8] * x[2],
+        P[i, 9] * x[0] + P[i, 10] * x[1] + P[i, 11] * x[2],
+    )
+
+
+@kernel
+def intersect_box(P, i, o, d, tmin, tmax):
+    """Slab test in the box's own coordinates, where it is the unit cube [0, 1]^3."""
+    lo = _box_local(P, i, sub(o, vload(P, i, 0)))
+    ld = _box_local(P, i, d)
+    t_near = -INF
+    t_far = INF
+    for k in range(3):
+        if ld[k] == 0.0:
+            if lo[k] < 0.0 or lo[k] > 1.0:
+                return INF
+            continue
+        inv = 1.0 / ld[k]
+        t0 = -lo[k] * inv
+        t1 = (1.0 - lo[k]) * inv
+        if t0 > t1:
+            t0, t1 = t1, t0
+        t_near = max(t_near, t0)
+        t_far = min(t_far, t1)
+        if t_near > t_far:
+            return INF
+    if tmin < t_near < tmax:
+        return t_near
+    if tmin < t_far < tmax:
+        return t_far
+    return INF
+
+
+@kernel
+def intersect_frustum(P, i, o, d, tmin, tmax):
+    """A finite cone/cylinder about ``axis``: radius r(z) = r0 + k·z for z in [0, h], plus caps."""
+    base = vload(P, i, 0)
+    axis = vload(P, i, 3)
+    h = P[i, 6]
+    r0 = P[i, 7]
+    k = (P[i, 8] - r0) / h
+    q = sub(o, base)
+    oz = dot(q, axis)
+    dz = dot(d, axis)
+    qp = (q[0] - oz * axis[0], q[1] - oz * axis[1], q[2] - oz * axis[2])
+    dp = (d[0] - dz * axis[0], d[1] - dz * axis[1], d[2] - dz * axis[2])
+    rq = r0 + k * oz
+    a = dot(dp, dp) - k * k * dz * dz
+    b = dot(qp, dp) - k * rq * dz
+    c = dot(qp, qp) - rq * rq
+    best = INF
+    # side: up to two roots, keep the nearest whose height lies on the body
+    lo = tmin
+    for _ in range(2):
+        t = _nearest_root(a, b, c, lo, tmax)
+        if t == INF:
+            break
+        z = oz + t * dz
+        if 0.0 <= z <= h and r0 + k * z >= 0.0:
+            best = t
+            break
+        lo = t
+    if P[i, 9] != 0.0 and dz != 0.0:
+        for z_cap, r_cap in ((0.0, r0), (h, P[i, 8])):
+            if r_cap <= 0.0:
+                continue
+            t = (z_cap - oz) / dz
+            if tmin < t < min(best, tmax):
+                x = qp[0] + t * dp[0]
+                y = qp[1] + t * dp[1]
+                w = qp[2] + t * dp[2]
+                if x * x + y * y + w * w <= r_cap * r_cap:
+                    best = t
+    return best
+
+
+@kernel
+def intersect_local(typ, P, i, o, d, tmin, tmax):
+    """Dispatch on the shape code; ``o`` and ``d`` in the primitive's own space."""
+    if typ == SHAPE_SPHERE:
+        return intersect_sphere(P, i, o, d, tmin, tmax)
+    if typ == SHAPE_TRIANGLE:
+        return intersect_triangle(P, i, o, d, tmin, tmax)
+    if typ == SHAPE_RECTANGLE:
+        return intersect_rectangle(P, i, o, d, tmin, tmax)
+    if typ == SHAPE_BOX:
+        return intersect_box(P, i, o, d, tmin, tmax)
+    if typ == SHAPE_PLANE:
+        return intersect_plane(P, i, o, d, tmin, tmax)
+    if typ == SHAPE_DISK:
+        return intersect_disk(P, i, o, d, tmin, tmax)
+    if typ == SHAPE_FRUSTUM:
+        return intersect_frustum(P, i, o, d, tmin, tmax)
+    return INF
+
+
+@kernel
+def normal_local(typ, P, i, p):
+    """Outward unit normal at point ``p`` (in the primitive's own space)."""
+    if typ == SHAPE_SPHERE:
+        return normalize(sub(p, vload(P, i, 0)))
+    if typ == SHAPE_TRIANGLE or typ == SHAPE_RECTANGLE:
+        return vload(P, i, 9)
+    if typ == SHAPE_PLANE or typ == SHAPE_DISK:
+        return vload(P, i, 3)
+    if typ == SHAPE_BOX:
+        lp = _box_local(P, i, sub(p, vload(P, i, 0)))
+        best_k = 0
+        best_side = -1.0
+        best_dist = INF
+        for k in range(3):
+            if abs(lp[k]) < best_dist:
+                best_dist = abs(lp[k])
+                best_k = k
+                best_side = -1.0
+            if abs(1.0 - lp[k]) < best_dist:
+                best_dist = abs(1.0 - lp[k])
+                best_k = k
+                best_side = 1.0
+        row = 3 + 3 * best_k
+        return normalize((best_side * P[i, row], best_side * P[i, row + 1], best_side * P[i, row + 2]))
+    if typ == SHAPE_FRUSTUM:
+        base = vload(P, i, 0)
+        axis = vload(P, i, 3)
+        h = P[i, 6]
+        r0 = P[i, 7]
+        r1 = P[i, 8]
+        k = (r1 - r0) / h
+        q = sub(p, base)
+        z = dot(q, axis)
+        qp = (q[0] - z * axis[0], q[1] - z * axis[1], q[2] - z * axis[2])
+        rho = math.sqrt(dot(qp, qp))
+        tol = 1e-7 * max(h, max(r0, r1))
+        if P[i, 9] != 0.0:
+            r_here = r0 + k * z
+            side_gap = abs(rho - r_here)
+            if abs(z) < tol and abs(z) <= side_gap:
+                return (-axis[0], -axis[1], -axis[2])
+            if abs(z - h) < tol and abs(z - h) <= side_gap and r1 > 0.0:
+                return axis
+        if rho == 0.0:
+            return axis
+        inv = 1.0 / rho
+        return normalize(
+            (qp[0] * inv - k * axis[0], qp[1] * inv - k * axis[1], qp[2] * inv - k * axis[2])
+        )
+    return (0.0, 1.0, 0.0)

@@ -1,0 +1,107 @@
+"""The flat array layout shared by the compiler (which writes it) and the kernels (which read it).
+
+Primitives: ``prim_type[i]`` is one of the ``SHAPE_*`` codes and ``prim_params[i]`` holds the
+shape's numbers in the order listed next to each code. All positions are in the primitive's own
+space; ``prim_xform[i] >= 0`` names a 3x4 world-to-object matrix in ``xforms`` (used only for
+quadrics under a non-similarity transform, every other transform is baked into the numbers).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+# shape codes and their parameters (prim_params columns)
+SHAPE_SPHERE = 0  # center 0:3, radius 3
+SHAPE_PLANE = 1  # point 0:3, unit normal 3:6
+SHAPE_RECTANGLE = 2  # corner 0:3, edge1 3:6, edge2 6:9, unit normal 9:12, dual u 12:15, dual v 15:18
+SHAPE_DISK = 3  # center 0:3, unit normal 3:6, radius 6
+SHAPE_TRIANGLE = 4  # v0 0:3, edge1 3:6, edge2 6:9, unit normal 9:12
+SHAPE_BOX = 5  # corner 0:3, inverse edge matrix rows 3:12 (local = M^-1 (p - corner) in [0,1]^3)
+SHAPE_FRUSTUM = 6  # base 0:3, unit axis 3:6, height 6, base radius 7, top radius 8, capped 9
+
+N_PRIM_PARAMS = 18
+
+# material columns
+MAT_COLOR = 0
+MAT_AMBIENT = 3
+MAT_SPECULAR = 6
+MAT_KA = 9
+MAT_KD = 10
+MAT_KS = 11
+MAT_SHININESS = 12
+MAT_BLINN = 13
+MAT_KR = 14
+MAT_KT = 15
+MAT_IOR = 16
+MAT_ATTEN = 17
+MAT_FRESNEL = 20
+N_MAT_PARAMS = 21
+
+# light columns (ambient lights are summed into one colour and not stored here)
+LIGHT_POINT = 1
+LIGHT_DIRECTIONAL = 2
+LIGHT_DISK = 3
+
+LIGHT_TYPE = 0
+LIGHT_RADIANCE = 1  # colour * intensity, 1:4
+LIGHT_POSITION = 4  # point position / disk centre, 4:7
+LIGHT_DIRECTION = 7  # directional: unit travel direction; disk: unit normal, 7:10
+LIGHT_RADIUS = 10
+LIGHT_SAMPLES = 11
+LIGHT_FALLOFF = 12  # 0 none, 1 linear (dist_scale / d), 2 inverse square
+LIGHT_DIST_SCALE = 13
+LIGHT_DISK_U = 14  # 14:17, unit tangent of the disk
+LIGHT_DISK_V = 17  # 17:20, unit bitangent
+N_LIGHT_PARAMS = 20
+
+FALLOFF_CODES = {"none": 0, "linear": 1, "inverse_square": 2}
+
+# ray counters (columns of the per-tile counter array)
+RAY_PRIMARY = 0
+RAY_SHADOW = 1
+RAY_REFLECTION = 2
+RAY_REFRACTION = 3
+N_RAY_KINDS = 4
+
+MAX_MEDIA = 8  # nesting depth of media a ray can be inside
+
+
+class GeometryArrays(NamedTuple):
+    """Everything a ray needs to find what it hits (all NumPy arrays, read-only in kernels)."""
+
+    prim_type: np.ndarray  # (P,) int32 shape code
+    prim_params: np.ndarray  # (P, N_PRIM_PARAMS) float64
+    prim_xform: np.ndarray  # (P,) int32 index into xforms, -1 when the numbers are in world space
+    xforms: np.ndarray  # (X, 3, 4) float64 world-to-object affine matrices
+    prim_material: np.ndarray  # (P,) int32 row of the material table
+    prim_object: np.ndarray  # (P,) int32 index of the scene object it came from
+    prim_solid: np.ndarray  # (P,) int32 1 when it bounds a volume (rays enter and leave media)
+    node_min: np.ndarray  # (M, 3) float64 BVH node boxes
+    node_max: np.ndarray  # (M, 3) float64
+    node_offset: np.ndarray  # (M,) int32 leaf: first entry in node_prims; interior: right child
+    node_count: np.ndarray  # (M,) int32 leaf: primitive count; interior: 0
+    node_axis: np.ndarray  # (M,) int8 split axis of interior nodes
+    node_prims: np.ndarray  # (N,) int32 primitive indices in leaf order
+    unbounded: np.ndarray  # (U,) int32 primitives outside the BVH (infinite planes)
+
+
+class RenderParams(NamedTuple):
+    """Scalars of one render (every field always has the same type, so one compiled kernel)."""
+
+    width: int
+    height: int
+    samples: int
+    max_depth: int
+    min_weight: float
+    epsilon: float
+    seed: int
+    ambient: tuple[float, float, float]  # sum of ambient lights (colour x intensity)
+    background_top: tuple[float, float, float]
+    background_bottom: tuple[float, float, float]
+    camera_origin: tuple[float, float, float]
+    camera_right: tuple[float, float, float]  # scaled by the half width of the image plane
+    camera_up: tuple[float, float, float]  # scaled by the half height
+    camera_forward: tuple[float, float, float]
+    orthographic: int

@@ -1,0 +1,256 @@
+"""Direct illumination: ambient, Lambert diffuse and Phong/Blinn specular from every light,
+with shadow rays that pass through transparent bodies (tinted, absorbed) and stop at opaque ones.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .accel import closest_hit, hit_primitive, world_normal
+from .intersect import INF
+from .jit import kernel
+from .layout import (
+    LIGHT_DIRECTION,
+    LIGHT_DISK,
+    LIGHT_DISK_U,
+    LIGHT_DISK_V,
+    LIGHT_DIST_SCALE,
+    LIGHT_FALLOFF,
+    LIGHT_POINT,
+    LIGHT_POSITION,
+    LIGHT_RADIANCE,
+    LIGHT_RADIUS,
+    LIGHT_SAMPLES,
+    LIGHT_TYPE,
+    MAT_ATTEN,
+    MAT_BLINN,
+    MAT_COLOR,
+    MAT_KD,
+    MAT_KS,
+    MAT_KT,
+    MAT_SHININESS,
+    MAT_SPECULAR,
+    MAX_MEDIA,
+    RAY_SHADOW,
+)
+from .sampling import concentric_disk, random01, stratum
+from .vec import dot, madd, normalize, sub, vload
+
+OPAQUE_KT = 0.01  # the lecture's rule: an occluder with kt below this blocks the light
+
+
+@kernel
+def any_occluder(geo, mats, o, d, tmax, stack):
+    """0: nothing between o and o + tmax·d; 1: an opaque occluder; 2: only transparent ones."""
+    seen_transparent = 0
+    for j in range(geo.unbounded.shape[0]):
+        i = geo.unbounded[j]
+        if hit_primitive(geo, i, o, d, 0.0, tmax) < INF:
+            if mats[geo.prim_material[i], MAT_KT] < OPAQUE_KT:
+                return 1
+            seen_transparent = 2
+    if geo.node_min.shape[0] == 0:
+        return seen_transparent
+    top = 0
+    stack[0] = 0
+    while top >= 0:
+        node = stack[top]
+        top -= 1
+        lo = geo.node_min[node]
+        hi = geo.node_max[node]
+        tn = 0.0
+        tf = tmax
+        inside = True
+        for k in range(3):
+            if d[k] == 0.0:
+                if o[k] < lo[k] or o[k] > hi[k]:
+                    inside = False
+                    break
+                continue
+            inv = 1.0 / d[k]
+            t0 = (lo[k] - o[k]) * inv
+            t1 = (hi[k] - o[k]) * inv
+            if t0 > t1:
+                t0, t1 = t1, t0
+            tn = max(tn, t0)
+            tf = min(tf, t1)
+        if not inside or tn > tf * (1.0 + 1e-9) + 1e-12:
+            continue
+        count = geo.node_count[node]
+        if count > 0:
+            first = geo.node_offset[node]
+            for j in range(first, first + count):
+                i = geo.node_prims[j]
+                if hit_primitive(geo, i, o, d, 0.0, tmax) < INF:
+                    if mats[geo.prim_material[i], MAT_KT] < OPAQUE_KT:
+                        return 1
+                    seen_transparent = 2
+            continue
+        top += 1
+        stack[top] = node + 1
+        top += 1
+        stack[top] = geo.node_offset[node]
+    return seen_transparent
+
+
+@kernel
+def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch, stack):
+    """Fraction of light (per channel) that reaches ``o`` from ``dist`` along unit ``d``.
+
+    Each transparent occluder multiplies by its ``kt·color`` where the ray enters it, and the
+    medium the shadow ray is in absorbs ``exp(-attenuation·length)`` segment by segment (the
+    ray starts in the media ``media[:n_media]`` of the point being shaded)."""
+    state = any_occluder(geo, mats, o, d, dist, stack)
+    if state == 0:
+        return (1.0, 1.0, 1.0)
+    if state == 1:
+        return (0.0, 0.0, 0.0)
+    for k in range(n_media):
+        scratch[k] = media[k]
+    count = n_media
+    tr = 1.0
+    tg = 1.0
+    tb = 1.0
+    t_from = 0.0
+    for _ in range(64):
+        t, prim = closest_hit(geo, o, d, t_from, dist, stack)
+        seg_end = t if prim >= 0 else dist
+        if count > 0:
+            m = scratch[count - 1]
+            length = seg_end - t_from
+            tr *= math.exp(-mats[m, MAT_ATTEN] * length)
+            tg *= math.exp(-mats[m, MAT_ATTEN + 1] * length)
+            tb *= math.exp(-mats[m, MAT_ATTEN + 2] * length)
+        if prim < 0:
+            break
+        m = geo.prim_material[prim]
+        kt = mats[m, MAT_KT]
+        if kt < OPAQUE_KT:
+            return (0.0, 0.0, 0.0)
+        entering = True
+        if geo.prim_solid[prim]:
+            n = world_normal(geo, prim, madd(o, d, t))
+            entering = dot(d, n) < 0.0
+            if entering:
+                if count < MAX_MEDIA:
+                    scratch[count] = m
+                    count += 1
+            else:
+                for k in range(count - 1, -1, -1):
+                    if scratch[k] == m:
+                        for q in range(k, count - 1):
+                            scratch[q] = scratch[q + 1]
+                        count -= 1
+                        break
+        if entering:
+            tr *= kt * mats[m, MAT_COLOR]
+            tg *= kt * mats[m, MAT_COLOR + 1]
+            tb *= kt * mats[m, MAT_COLOR + 2]
+        if max(tr, max(tg, tb)) < 1e-4:
+            return (0.0, 0.0, 0.0)
+        t_from = t * (1.0 + 1e-12) + params.epsilon
+    return (tr, tg, tb)
+
+
+@kernel
+def _falloff(lights, j, dist):
+    mode = lights[j, LIGHT_FALLOFF]
+    if mode == 1.0:
+        return lights[j, LIGHT_DIST_SCALE] / dist
+    if mode == 2.0:
+        return 1.0 / (dist * dist)
+    return 1.0
+
+
+@kernel
+def _brdf(mats, m, n, v, ldir):
+    """Diffuse + specular response (per channel) for unit light direction ``ldir``; n·l > 0."""
+    ndl = dot(n, ldir)
+    kd = mats[m, MAT_KD] * ndl
+    ks = mats[m, MAT_KS]
+    spec = 0.0
+    if ks > 0.0:
+        shin = mats[m, MAT_SHININESS]
+        if mats[m, MAT_BLINN] != 0.0:
+            h = normalize((ldir[0] + v[0], ldir[1] + v[1], ldir[2] + v[2]))
+            c = dot(n, h)
+        else:
+            r = (2.0 * ndl * n[0] - ldir[0], 2.0 * ndl * n[1] - ldir[1], 2.0 * ndl * n[2] - ldir[2])
+            c = dot(r, v)
+        if c > 0.0:
+            spec = ks * c**shin
+    return (
+        kd * mats[m, MAT_COLOR] + spec * mats[m, MAT_SPECULAR],
+        kd * mats[m, MAT_COLOR + 1] + spec * mats[m, MAT_SPECULAR + 1],
+        kd * mats[m, MAT_COLOR + 2] + spec * mats[m, MAT_SPECULAR + 2],
+    )
+
+
+@kernel
+def direct_light(
+    geo, mats, lights, params, p, n, v, m, media, n_media, scratch, stack, counters, rng
+):
+    """Light reflected toward ``v`` at point ``p`` with shading normal ``n`` (facing ``v``) by
+    every non-ambient light. ``rng`` = (pixel, sample, first dimension) for area-light samples."""
+    r = 0.0
+    g = 0.0
+    b = 0.0
+    if mats[m, MAT_KD] == 0.0 and mats[m, MAT_KS] == 0.0:
+        return (r, g, b)
+    origin = madd(p, n, params.epsilon)
+    dim = rng[2]
+    for j in range(lights.shape[0]):
+        kind = lights[j, LIGHT_TYPE]
+        radiance = vload(lights, j, LIGHT_RADIANCE)
+        if kind == LIGHT_POINT or kind == LIGHT_DISK:
+            n_samples = 1
+            if kind == LIGHT_DISK:
+                n_samples = int(lights[j, LIGHT_SAMPLES])
+            share = 1.0 / n_samples
+            centre = vload(lights, j, LIGHT_POSITION)
+            for s in range(n_samples):
+                target = centre
+                if kind == LIGHT_DISK:
+                    cx, cy, m_cols, m_rows = stratum(s, n_samples)
+                    u = (cx + random01(params.seed, rng[0], rng[1], dim)) / m_cols
+                    w = (cy + random01(params.seed, rng[0], rng[1], dim + 1)) / m_rows
+                    dim += 2
+                    dx, dy = concentric_disk(u, w)
+                    rad = lights[j, LIGHT_RADIUS]
+                    target = madd(madd(centre, vload(lights, j, LIGHT_DISK_U), dx * rad),
+                                  vload(lights, j, LIGHT_DISK_V), dy * rad)
+                to_light = sub(target, p)
+                dist = math.sqrt(dot(to_light, to_light))
+                if dist == 0.0:
+                    continue
+                ldir = (to_light[0] / dist, to_light[1] / dist, to_light[2] / dist)
+                if dot(n, ldir) <= 0.0:
+                    continue
+                counters[RAY_SHADOW] += 1
+                vis = shadow_transmittance(
+                    geo, mats, params, origin, ldir, dist - params.epsilon, media, n_media,
+                    scratch, stack,
+                )
+                if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
+                    continue
+                f = _brdf(mats, m, n, v, ldir)
+                k = share * _falloff(lights, j, dist)
+                r += k * radiance[0] * vis[0] * f[0]
+                g += k * radiance[1] * vis[1] * f[1]
+                b += k * radiance[2] * vis[2] * f[2]
+        else:  # directional
+            ldir = vload(lights, j, LIGHT_DIRECTION)
+            ldir = (-ldir[0], -ldir[1], -ldir[2])
+            if dot(n, ldir) <= 0.0:
+                continue
+            counters[RAY_SHADOW] += 1
+            vis = shadow_transmittance(
+                geo, mats, params, origin, ldir, INF, media, n_media, scratch, stack
+            )
+            if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
+                continue
+            f = _brdf(mats, m, n, v, ldir)
+            r += radiance[0] * vis[0] * f[0]
+            g += radiance[1] * vis[1] * f[1]
+            b += radiance[2] * vis[2] * f[2]
+    return (r, g, b)

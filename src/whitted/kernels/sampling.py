@@ -1,0 +1,57 @@
+"""Deterministic random numbers (a counter-based hash, so every pixel draws the same numbers
+whatever thread renders it) and the sample warps that use them."""
+
+from __future__ import annotations
+
+import math
+
+from .jit import kernel
+
+MASK32 = 0xFFFFFFFF
+INV_2_32 = 1.0 / 4294967296.0
+
+
+@kernel
+def mix32(x):
+    """A 32-bit integer finaliser with good avalanche (xor-shift-multiply, 'lowbias32')."""
+    x &= MASK32
+    x ^= x >> 16
+    x = (x * 0x7FEB352D) & MASK32
+    x ^= x >> 15
+    x = (x * 0x846CA68B) & MASK32
+    x ^= x >> 16
+    return x
+
+
+@kernel
+def random01(seed, pixel, sample, dim):
+    """Uniform number in [0, 1) determined only by (seed, pixel, sample, dim)."""
+    h = mix32(sample * 0x27D4EB2F + dim)
+    h = mix32(pixel * 0x85EBCA77 + h)
+    h = mix32(seed * 0x9E3779B1 + h)
+    return h * INV_2_32
+
+
+@kernel
+def stratum(index, count):
+    """Cell (column, row) and grid size (m, rows) of sample ``index`` out of ``count`` on a
+    near-square grid, for stratified sampling of the unit square."""
+    m = int(math.ceil(math.sqrt(count)))
+    rows = (count + m - 1) // m
+    return index % m, index // m, m, rows
+
+
+@kernel
+def concentric_disk(u, v):
+    """Shirley–Chiu map of the unit square onto the unit disk (keeps strata compact)."""
+    a = 2.0 * u - 1.0
+    b = 2.0 * v - 1.0
+    if a == 0.0 and b == 0.0:
+        return 0.0, 0.0
+    if abs(a) > abs(b):
+        r = a
+        phi = (math.pi / 4.0) * (b / a)
+    else:
+        r = b
+        phi = (math.pi / 2.0) - (math.pi / 4.0) * (a / b)
+    return r * math.cos(phi), r * math.sin(phi)

@@ -1,0 +1,102 @@
+"""Entry points called from Python: render a batch of tiles in parallel, or the AOVs.
+
+The kernels release the GIL, so the render API runs one *lane* per Python thread: lane k renders
+tiles k, k + lanes, k + 2·lanes, ... so cheap sky tiles and expensive glass tiles spread evenly.
+Each pixel's value depends only on the scene, the seed and its coordinates, so the image is
+bit-identical whatever the thread count.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from .accel import closest_hit, world_normal
+from .integrator import N_STACK_F, N_STACK_I, trace_path
+from .jit import kernel
+from .layout import MAX_MEDIA, RAY_PRIMARY
+from .sampling import random01, stratum
+from .vec import madd, normalize
+
+BVH_STACK = 128
+
+
+@kernel
+def camera_ray(params, x, y):
+    """Ray through image-plane position (x, y) in pixels from the top-left corner."""
+    sx = 2.0 * x / params.width - 1.0
+    sy = 1.0 - 2.0 * y / params.height
+    right = params.camera_right
+    up = params.camera_up
+    fwd = params.camera_forward
+    offset = (sx * right[0] + sy * up[0], sx * right[1] + sy * up[1], sx * right[2] + sy * up[2])
+    if params.orthographic:
+        return madd(params.camera_origin, offset, 1.0), fwd
+    return params.camera_origin, normalize(
+        (fwd[0] + offset[0], fwd[1] + offset[1], fwd[2] + offset[2])
+    )
+
+
+@kernel
+def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, lane, lanes):
+    """Render this lane's share of ``tiles`` (rows of x0, y0, x1, y1) into ``framebuffer``
+    (H, W, 3 float32); ``counters[t]`` receives the rays traced for tile t by kind."""
+    n_tiles = tiles.shape[0]
+    spp = params.samples
+    st_f = np.empty((params.max_depth + 2, N_STACK_F))
+    st_i = np.empty((params.max_depth + 2, N_STACK_I), np.int32)
+    media = np.empty(MAX_MEDIA, np.int32)
+    scratch = np.empty(MAX_MEDIA, np.int32)
+    stack = np.empty(BVH_STACK, np.int32)
+    for t in range(lane, n_tiles, lanes):
+        cnt = counters[t]
+        for py in range(tiles[t, 1], tiles[t, 3]):
+            for px in range(tiles[t, 0], tiles[t, 2]):
+                pixel = py * params.width + px
+                r = 0.0
+                g = 0.0
+                b = 0.0
+                for s in range(spp):
+                    if spp == 1:
+                        jx = 0.5
+                        jy = 0.5
+                    else:
+                        cx, cy, m, rows = stratum(s, spp)
+                        jx = (cx + random01(params.seed, pixel, s, 0)) / m
+                        jy = (cy + random01(params.seed, pixel, s, 1)) / rows
+                    o, d = camera_ray(params, px + jx, py + jy)
+                    cnt[RAY_PRIMARY] += 1
+                    c = trace_path(geo, mats, lights, params, o, d, pixel, s, st_f, st_i,
+                                   media, scratch, stack, cnt)
+                    r += c[0]
+                    g += c[1]
+                    b += c[2]
+                inv = 1.0 / spp
+                framebuffer[py, px, 0] = r * inv
+                framebuffer[py, px, 1] = g * inv
+                framebuffer[py, px, 2] = b * inv
+
+
+@kernel
+def render_aovs(geo, params, depth, normal, object_id, lane, lanes):
+    """Depth (distance along the unit primary ray, inf on a miss), outward geometric normal
+    (zeros on a miss) and object index (-1 on a miss) through every pixel centre of the rows
+    lane, lane + lanes, ..."""
+    for py in range(lane, params.height, lanes):
+        stack = np.empty(BVH_STACK, np.int32)
+        for px in range(params.width):
+            o, d = camera_ray(params, px + 0.5, py + 0.5)
+            t, prim = closest_hit(geo, o, d, 0.0, math.inf, stack)
+            if prim < 0:
+                depth[py, px] = math.inf
+                object_id[py, px] = -1
+                for k in range(3):
+                    normal[py, px, k] = 0.0
+                continue
+            depth[py, px] = t
+            object_id[py, px] = geo.prim_object[prim]
+            n = world_normal(geo, prim, madd(o, d, t))
+            for k in range(3):
+                normal[py, px, k] = n[k]
+
+

@@ -1,0 +1,506 @@
+"""Pure encoding functions and file writers/readers for framebuffers.
+
+The renderer hands over a float32 *linear* HDR framebuffer of shape (H, W, 3), row 0 at the
+top of the picture. This module turns it into files:
+
+* HDR formats (``.exr``, ``.pfm``, ``.npy``) always store the raw linear float32 data: no tone
+  mapping, no transfer curve, NaN and infinities kept as they are.
+* LDR formats (``.png``, ``.jpg``/``.jpeg``) go through tonemap -> transfer -> quantize.
+
+Every file is written atomically (see :func:`atomic_write`): a reader never sees a partial file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import pathlib
+import tempfile
+from collections.abc import Callable
+
+import numpy as np
+
+__all__ = [
+    "FORMATS",
+    "HDR_FORMATS",
+    "LDR_FORMATS",
+    "TONEMAPS",
+    "TRANSFERS",
+    "atomic_write",
+    "check_bit_depth",
+    "check_pixels",
+    "check_tonemap",
+    "check_transfer",
+    "encode_ldr",
+    "image_format",
+    "linear_to_srgb",
+    "quantize",
+    "read_image",
+    "srgb_to_linear",
+    "tonemap",
+    "write_image",
+]
+
+PathLike = str | os.PathLike[str]
+
+#: Transfer functions applied to LDR output: "srgb" (IEC 61966-2-1) or "linear" (none).
+TRANSFERS: tuple[str, ...] = ("srgb", "linear")
+#: Tone-mapping operators, see :func:`tonemap`.
+TONEMAPS: tuple[str, ...] = ("clamp", "reinhard", "aces")
+#: File extension (lower case) -> format name.
+FORMATS: dict[str, str] = {
+    ".png": "png",
+    ".jpg": "jpeg",
+    ".jpeg": "jpeg",
+    ".exr": "exr",
+    ".pfm": "pfm",
+    ".npy": "npy",
+}
+HDR_FORMATS: frozenset[str] = frozenset({"exr", "pfm", "npy"})
+LDR_FORMATS: frozenset[str] = frozenset({"png", "jpeg"})
+
+JPEG_QUALITY = 95  # written with 4:4:4 chroma (no subsampling): renders have sharp colour edges
+
+# sRGB (IEC 61966-2-1) constants.
+_SRGB_LINEAR_CUTOFF = 0.0031308  # in linear light
+_SRGB_ENCODED_CUTOFF = 0.04045  # in encoded values
+_SRGB_SLOPE = 12.92
+_SRGB_A = 0.055
+_SRGB_GAMMA = 2.4
+
+# Rec. 709 luminance weights (linear RGB).
+_REC709 = (0.2126, 0.7152, 0.0722)
+
+# Narkowicz 2015 ACES filmic fit: x(ax + b) / (x(cx + d) + e).
+_ACES_A, _ACES_B, _ACES_C, _ACES_D, _ACES_E = 2.51, 0.03, 2.43, 0.59, 0.14
+
+# Stand-in for +inf in the tone mappers: large enough to saturate, small enough not to overflow
+# float64 arithmetic (x * x stays finite).
+_HUGE = 1e30
+
+
+# --------------------------------------------------------------------------------------------
+# validation helpers
+
+
+def check_transfer(name: str) -> str:
+    """Return ``name`` if it is a known transfer function, else raise ValueError."""
+    if name not in TRANSFERS:
+        raise ValueError(f"unknown transfer {name!r} (use 'srgb' or 'linear')")
+    return name
+
+
+def check_tonemap(name: str) -> str:
+    """Return ``name`` if it is a known tone-mapping mode, else raise ValueError."""
+    if name not in TONEMAPS:
+        raise ValueError(f"unknown tonemap {name!r} (use 'clamp', 'reinhard' or 'aces')")
+    return name
+
+
+def check_bit_depth(bit_depth: int, fmt: str | None = None) -> int:
+    """Validate an output bit depth: 8, or 16 (PNG only). ``fmt`` is a format name."""
+    if isinstance(bit_depth, bool) or bit_depth not in (8, 16):
+        raise ValueError(f"bit_depth must be 8 or 16, got {bit_depth!r}")
+    if bit_depth == 16 and fmt is not None and fmt != "png":
+        raise ValueError(
+            f"bit_depth=16 is only supported for .png (got {fmt} output; "
+            ".exr, .pfm and .npy always store float32)"
+        )
+    return int(bit_depth)
+
+
+def image_format(path: PathLike) -> str:
+    """Format name ("png", "jpeg", "exr", "pfm", "npy") chosen by the (case-insensitive)
+    extension of ``path``; ValueError for any other extension."""
+    suffix = pathlib.Path(path).suffix
+    try:
+        return FORMATS[suffix.lower()]
+    except KeyError:
+        raise ValueError(
+            f"unsupported image format '{suffix}' (use .png, .jpg, .exr, .pfm or .npy)"
+        ) from None
+
+
+def check_pixels(pixels: object) -> np.ndarray:
+    """Return ``pixels`` as a float32 C-contiguous (H, W, 3) array (no copy when it already is
+    one); ValueError for anything else (wrong shape, empty, non-numeric)."""
+    try:
+        arr = np.asarray(pixels)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"pixels must be a numeric (H, W, 3) array: {exc}") from exc
+    if not (np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)):
+        raise ValueError(
+            f"pixels must be a numeric (integer or float) array, got dtype {arr.dtype}"
+        )
+    if arr.ndim != 3 or arr.shape[2] != 3:
+        raise ValueError(f"pixels must have shape (H, W, 3), got {arr.shape}")
+    if arr.shape[0] == 0 or arr.shape[1] == 0:
+        raise ValueError(f"pixels must not be empty, got shape {arr.shape}")
+    return np.ascontiguousarray(arr, dtype=np.float32)
+
+
+# --------------------------------------------------------------------------------------------
+# pure encoding functions
+
+
+def _clean_unit(x: np.ndarray) -> np.ndarray:
+    """float64 copy of ``x`` with NaN -> 0, clamped to [0, 1]."""
+    a = np.array(x, dtype=np.float64)
+    np.nan_to_num(a, copy=False, nan=0.0, posinf=1.0, neginf=0.0)
+    np.clip(a, 0.0, 1.0, out=a)
+    return a
+
+
+def linear_to_srgb(x: np.ndarray) -> np.ndarray:
+    """Encode linear values with the exact IEC 61966-2-1 sRGB curve.
+
+    ``12.92 * x`` below 0.0031308, else ``1.055 * x ** (1/2.4) - 0.055``. The input is clamped
+    to [0, 1] first and NaN is treated as 0. Evaluated in float64, returned as float32 (so 1
+    maps to exactly 1).
+    """
+    a = _clean_unit(x)
+    low = a * _SRGB_SLOPE
+    high = (1.0 + _SRGB_A) * np.power(a, 1.0 / _SRGB_GAMMA) - _SRGB_A
+    return np.where(a < _SRGB_LINEAR_CUTOFF, low, high).astype(np.float32)
+
+
+def srgb_to_linear(x: np.ndarray) -> np.ndarray:
+    """Decode sRGB-encoded values to linear light (inverse of :func:`linear_to_srgb`).
+
+    ``x / 12.92`` up to 0.04045, else ``((x + 0.055) / 1.055) ** 2.4``. The input is clamped to
+    [0, 1] first and NaN is treated as 0. Evaluated in float64, returned as float32.
+    """
+    a = _clean_unit(x)
+    low = a / _SRGB_SLOPE
+    high = np.power((a + _SRGB_A) / (1.0 + _SRGB_A), _SRGB_GAMMA)
+    return np.where(a <= _SRGB_ENCODED_CUTOFF, low, high).astype(np.float32)
+
+
+def _non_negative_finite(x: np.ndarray) -> np.ndarray:
+    """float64 copy of ``x`` with NaN -> 0, -inf and negatives -> 0, +inf -> a huge value."""
+    a = np.array(x, dtype=np.float64)
+    np.nan_to_num(a, copy=False, nan=0.0, posinf=_HUGE, neginf=0.0)
+    np.clip(a, 0.0, _HUGE, out=a)
+    return a
+
+
+def tonemap(x: np.ndarray, mode: str = "clamp") -> np.ndarray:
+    """Map linear HDR values to display-referred [0, 1] (float32, same shape).
+
+    In every mode NaN is treated as 0 and negative values as 0; +inf saturates to 1.
+
+    * ``"clamp"`` (default): clip to [0, 1]; values above 1 are lost.
+    * ``"reinhard"``: Reinhard's ``L / (1 + L)`` applied to the Rec. 709 luminance
+      ``L = 0.2126 R + 0.7152 G + 0.0722 B``, keeping hue: every channel is scaled by
+      ``L' / L = 1 / (1 + L)``. Grey values map [0, inf) into [0, 1) monotonically; a very
+      bright saturated colour can still have one channel above 1 after the scale, which is then
+      clipped to 1. Arrays whose last axis is not 3 are treated as luminance values.
+    * ``"aces"``: the common Narkowicz (2015) fit of the ACES filmic curve, per channel,
+      ``x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14)`` clipped to [0, 1] (no exposure
+      pre-scale is applied). It is monotonic, maps [0, ~7.24) into [0, 1) and saturates to
+      exactly 1 above x ~ 7.24, where the rational fit reaches 1.
+    """
+    check_tonemap(mode)
+    if mode == "clamp":
+        a = np.nan_to_num(np.asarray(x, dtype=np.float32), nan=0.0, posinf=1.0, neginf=0.0)
+        return np.clip(a, 0.0, 1.0).astype(np.float32, copy=False)
+    a = _non_negative_finite(x)
+    if mode == "reinhard":
+        if a.ndim >= 1 and a.shape[-1] == 3:
+            lum = a[..., 0] * _REC709[0] + a[..., 1] * _REC709[1] + a[..., 2] * _REC709[2]
+            out = a / (1.0 + lum)[..., None]
+        else:
+            out = a / (1.0 + a)
+    else:  # "aces"
+        out = (a * (_ACES_A * a + _ACES_B)) / (a * (_ACES_C * a + _ACES_D) + _ACES_E)
+    return np.clip(out, 0.0, 1.0).astype(np.float32)
+
+
+def quantize(x: np.ndarray, bits: int) -> np.ndarray:
+    """Quantize float values in [0, 1] to uint8 (``bits=8``) or uint16 (``bits=16``).
+
+    Rounds half up, ``floor(x * maxv + 0.5)``, and clips to [0, maxv]; NaN becomes 0.
+    """
+    check_bit_depth(bits)
+    maxv = (1 << bits) - 1
+    a = np.nan_to_num(np.asarray(x, dtype=np.float64), nan=0.0, posinf=1.0, neginf=0.0)
+    q = np.clip(np.floor(a * maxv + 0.5), 0, maxv)
+    return q.astype(np.uint8 if bits == 8 else np.uint16)
+
+
+def encode_ldr(
+    pixels: np.ndarray, *, bits: int = 8, transfer: str = "srgb", tonemap: str = "clamp"
+) -> np.ndarray:
+    """tonemap -> transfer -> quantize: linear float pixels to uint8/uint16 display values."""
+    check_transfer(transfer)
+    check_tonemap(tonemap)
+    check_bit_depth(bits)
+    t = _apply_tonemap(pixels, tonemap)
+    if transfer == "srgb":
+        t = linear_to_srgb(t)
+    return quantize(t, bits)
+
+
+_apply_tonemap = tonemap  # the name ``tonemap`` is shadowed by keyword parameters below
+
+
+# --------------------------------------------------------------------------------------------
+# atomic writing
+
+
+def _current_umask() -> int:
+    """The process umask, read without changing it where the platform allows."""
+    with contextlib.suppress(OSError, ValueError), open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _fsync_dir(directory: pathlib.Path) -> None:
+    if os.name == "nt":
+        return
+    with contextlib.suppress(OSError):
+        fd = os.open(directory, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+def atomic_write(path: PathLike, write_fn: Callable[[str], object]) -> pathlib.Path:
+    """Write a file atomically: ``path`` either keeps its old content or gets the complete new one.
+
+    ``write_fn(tmp_path)`` is called with the path (str) of a fresh temporary file created with
+    :func:`tempfile.mkstemp` in the same directory as ``path`` and with the same suffix, so a
+    writer that picks its format from the extension still works. The temporary file is then
+    fsynced, given the permissions of the file it replaces (or the umask default for a new
+    file) and moved onto ``path`` with :func:`os.replace`. If anything raises, the temporary
+    file is removed and the exception propagates. Returns ``path`` as a :class:`pathlib.Path`.
+    """
+    target = pathlib.Path(path)
+    directory = target.parent
+    fd, tmp = tempfile.mkstemp(suffix=target.suffix, prefix=f".{target.name}.", dir=directory)
+    os.close(fd)
+    try:
+        write_fn(tmp)
+        fd = os.open(tmp, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+        try:
+            mode = os.stat(target).st_mode & 0o7777
+        except OSError:
+            mode = 0o666 & ~_current_umask()
+        with contextlib.suppress(OSError):
+            os.chmod(tmp, mode)
+        os.replace(tmp, target)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+    _fsync_dir(directory)
+    return target
+
+
+# --------------------------------------------------------------------------------------------
+# writers (each takes the temporary path and already-encoded data)
+
+
+def _write_png8(tmp: str, data: np.ndarray) -> None:
+    from PIL import Image as PILImage
+
+    PILImage.fromarray(data).save(tmp, format="PNG")
+
+
+def _write_png16(tmp: str, data: np.ndarray) -> None:
+    import png
+
+    h, w, _ = data.shape
+    writer = png.Writer(width=w, height=h, greyscale=False, alpha=False, bitdepth=16)
+    with open(tmp, "wb") as f:
+        writer.write(f, data.reshape(h, w * 3))
+
+
+def _write_jpeg(tmp: str, data: np.ndarray) -> None:
+    from PIL import Image as PILImage
+
+    PILImage.fromarray(data).save(tmp, format="JPEG", quality=JPEG_QUALITY, subsampling=0)
+
+
+def _write_exr(tmp: str, data: np.ndarray) -> None:
+    import OpenEXR
+
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    OpenEXR.File(header, {"RGB": data}).write(tmp)
+
+
+def _write_pfm(tmp: str, data: np.ndarray) -> None:
+    h, w, _ = data.shape
+    with open(tmp, "wb") as f:
+        f.write(f"PF\n{w} {h}\n-1.0\n".encode("ascii"))
+        # PFM stores scanlines bottom-to-top; a negative scale means little-endian.
+        f.write(np.ascontiguousarray(data[::-1], dtype="<f4").tobytes())
+
+
+def _write_npy(tmp: str, data: np.ndarray) -> None:
+    # A file object, not a path: np.save would append ".npy" to a path ending in ".NPY".
+    with open(tmp, "wb") as f:
+        np.save(f, data, allow_pickle=False)
+
+
+def write_image(
+    path: PathLike,
+    pixels: np.ndarray,
+    *,
+    bit_depth: int = 8,
+    transfer: str = "srgb",
+    tonemap: str = "clamp",
+) -> pathlib.Path:
+    """Write linear float pixels (H, W, 3) to ``path`` atomically, format by extension.
+
+    ``.exr`` / ``.pfm`` / ``.npy`` get the raw linear float32 data (``transfer`` and
+    ``tonemap`` are ignored); ``.png`` (8-bit via Pillow or 16-bit via pypng) and
+    ``.jpg``/``.jpeg`` (8-bit, quality 95) get tonemap -> transfer -> quantize. Everything is
+    validated before the disk is touched. Returns ``path`` as a :class:`pathlib.Path`.
+    """
+    fmt = image_format(path)
+    check_transfer(transfer)
+    check_tonemap(tonemap)
+    check_bit_depth(bit_depth, fmt)
+    data = check_pixels(pixels)
+
+    if fmt in HDR_FORMATS:
+        writer = {"exr": _write_exr, "pfm": _write_pfm, "npy": _write_npy}[fmt]
+    else:
+        data = encode_ldr(data, bits=bit_depth, transfer=transfer, tonemap=tonemap)
+        if fmt == "jpeg":
+            writer = _write_jpeg
+        else:
+            writer = _write_png16 if bit_depth == 16 else _write_png8
+    return atomic_write(path, lambda tmp: writer(tmp, data))
+
+
+# --------------------------------------------------------------------------------------------
+# readers
+
+
+def _to_rgb(arr: np.ndarray, source: object) -> np.ndarray:
+    """(H, W), (H, W, 1), (H, W, 2) grey+alpha, (H, W, 3) or (H, W, 4) -> (H, W, 3)."""
+    if arr.ndim == 2:
+        arr = arr[:, :, None]
+    if arr.ndim != 3 or arr.shape[2] not in (1, 2, 3, 4):
+        raise ValueError(f"{source}: cannot use image data of shape {arr.shape} as RGB")
+    if arr.shape[2] in (1, 2):
+        arr = np.repeat(arr[:, :, :1], 3, axis=2)
+    return np.ascontiguousarray(arr[:, :, :3], dtype=np.float32)
+
+
+def _read_exr(path: str) -> np.ndarray:
+    import OpenEXR
+
+    f = OpenEXR.File(path, separate_channels=True)
+    channels = {name: np.asarray(ch.pixels) for name, ch in f.channels().items()}
+    if all(c in channels for c in "RGB"):
+        arr = np.stack([channels["R"], channels["G"], channels["B"]], axis=-1)
+    elif "Y" in channels:
+        arr = channels["Y"]
+    elif len(channels) == 1:
+        arr = next(iter(channels.values()))
+    else:
+        raise ValueError(f"{path}: no R, G, B or Y channels in EXR (has {sorted(channels)})")
+    return _to_rgb(arr.astype(np.float32), path)
+
+
+def _read_pfm(path: str) -> np.ndarray:
+    with open(path, "rb") as f:
+        raw = f.read()
+    tokens: list[bytes] = []
+    pos = 0
+    while len(tokens) < 4:
+        while pos < len(raw) and raw[pos : pos + 1].isspace():
+            pos += 1
+        start = pos
+        while pos < len(raw) and not raw[pos : pos + 1].isspace():
+            pos += 1
+        if start == pos:
+            raise ValueError(f"{path}: truncated PFM header")
+        tokens.append(raw[start:pos])
+    pos += 1  # exactly one whitespace character ends the header
+    magic = tokens[0]
+    if magic not in (b"PF", b"Pf"):
+        raise ValueError(f"{path}: not a PFM file (magic {magic!r})")
+    try:
+        width, height, scale = int(tokens[1]), int(tokens[2]), float(tokens[3])
+    except ValueError:
+        raise ValueError(f"{path}: bad PFM header {b' '.join(tokens)!r}") from None
+    if width <= 0 or height <= 0 or scale == 0.0:
+        raise ValueError(f"{path}: bad PFM header {b' '.join(tokens)!r}")
+    nchan = 3 if magic == b"PF" else 1
+    count = width * height * nchan
+    dtype = "<f4" if scale < 0 else ">f4"
+    if len(raw) - pos < count * 4:
+        raise ValueError(f"{path}: truncated PFM data")
+    arr = np.frombuffer(raw, dtype=dtype, count=count, offset=pos)
+    arr = arr.reshape(height, width, nchan)[::-1]  # stored bottom-to-top
+    return _to_rgb(arr.astype(np.float32), path)
+
+
+def _read_npy(path: str) -> np.ndarray:
+    arr = np.load(path, allow_pickle=False)
+    if not (np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)):
+        raise ValueError(f"{path}: not a numeric array (dtype {arr.dtype})")
+    return _to_rgb(arr, path)
+
+
+def _read_png(path: str) -> np.ndarray:
+    with open(path, "rb") as f:
+        head = f.read(26)
+    # IHDR is the first chunk: signature (8), length (4), "IHDR" (4), width, height, bit depth.
+    if len(head) < 26 or head[:8] != b"\x89PNG\r\n\x1a\n" or head[12:16] != b"IHDR":
+        raise ValueError(f"{path}: not a PNG file")
+    if head[24] == 16:
+        # Pillow cannot give 16-bit RGB, so 16-bit files go through pypng.
+        import png
+
+        with open(path, "rb") as f:
+            width, height, rows, info = png.Reader(file=f).asDirect()
+            arr = np.vstack([np.asarray(row, dtype=np.float32) for row in rows])
+        arr = arr.reshape(height, width, info["planes"]) / np.float32(65535.0)
+        return _to_rgb(arr, path)
+    return _read_pillow(path)
+
+
+def _read_pillow(path: str) -> np.ndarray:
+    """8-bit (or lower) PNG or JPEG of any colour type, as float32 RGB in [0, 1]."""
+    from PIL import Image as PILImage
+
+    with PILImage.open(path) as im:
+        arr = np.asarray(im.convert("RGB"), dtype=np.float32) / np.float32(255.0)
+    return _to_rgb(arr, path)
+
+
+def read_image(path: PathLike, *, transfer: str = "srgb") -> np.ndarray:
+    """Read an image file as a float32 (H, W, 3) linear array, row 0 at the top.
+
+    ``.exr``, ``.pfm`` and ``.npy`` are returned as stored. ``.png`` (8- or 16-bit, any colour
+    type) and ``.jpg``/``.jpeg`` are normalised to [0, 1] and decoded with ``transfer``: the
+    sRGB curve by default, or ``"linear"`` for files holding linear data (e.g. written with
+    ``transfer="linear"``). Grey images are expanded to RGB and alpha is dropped.
+    """
+    check_transfer(transfer)
+    fmt = image_format(path)
+    p = os.fspath(path)
+    if fmt == "exr":
+        return _read_exr(p)
+    if fmt == "pfm":
+        return _read_pfm(p)
+    if fmt == "npy":
+        return _read_npy(p)
+    arr = _read_png(p) if fmt == "png" else _read_pillow(p)
+    if transfer == "srgb":
+        arr = srgb_to_linear(arr)
+    return arr

@@ -1,0 +1,5 @@
+"""The render API shared by the CLI, the editor and the farm."""
+
+from .api import CancelToken, Progress, RenderJob, RenderStats, render, render_aovs
+
+__all__ = ["CancelToken", "Progress", "RenderJob", "RenderStats", "render", "render_aovs"]

@@ -1,0 +1,305 @@
+"""The one render API every client uses (CLI, editor, farm): tile-based, progressive,
+cancellable, with progress callbacks.
+
+>>> job = RenderJob(scene, progress=print)       # doctest: +SKIP
+>>> image = job.run()                             # blocking; or job.start() for a thread
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..compile.flatten import CompiledScene, compile_scene, render_params
+from ..kernels.layout import (
+    N_RAY_KINDS,
+    RAY_PRIMARY,
+    RAY_REFLECTION,
+    RAY_REFRACTION,
+    RAY_SHADOW,
+)
+from ..output.image import Image
+from ..scene.scene import RenderSettings, Scene
+
+RAY_KIND_NAMES = {
+    RAY_PRIMARY: "primary",
+    RAY_SHADOW: "shadow",
+    RAY_REFLECTION: "reflection",
+    RAY_REFRACTION: "refraction",
+}
+DEFAULT_TILE = 16
+
+
+class CancelToken:
+    """Set it from any thread to stop a render after the tiles in flight."""
+
+    def __init__(self) -> None:
+        self._event = threading.Event()
+
+    def cancel(self) -> None:
+        self._event.set()
+
+    @property
+    def cancelled(self) -> bool:
+        return self._event.is_set()
+
+
+@dataclass
+class Progress:
+    """What a progress callback receives after each batch of tiles."""
+
+    tiles_done: int
+    tiles_total: int
+    rays: int
+    elapsed: float
+    eta: float | None
+    #: the tiles finished in this batch, rows of (x0, y0, x1, y1): repaint just these
+    new_tiles: np.ndarray = field(repr=False, default_factory=lambda: np.zeros((0, 4), np.int32))
+
+    @property
+    def fraction(self) -> float:
+        return self.tiles_done / self.tiles_total if self.tiles_total else 1.0
+
+
+@dataclass
+class RenderStats:
+    width: int
+    height: int
+    threads: int
+    samples: int
+    max_depth: int
+    build_seconds: float = 0.0
+    compile_seconds: float = 0.0
+    render_seconds: float = 0.0
+    wall_seconds: float = 0.0
+    rays: dict[str, int] = field(default_factory=dict)
+    tiles_done: int = 0
+    tiles_total: int = 0
+    cancelled: bool = False
+
+    @property
+    def total_rays(self) -> int:
+        return sum(self.rays.values())
+
+    @property
+    def mrays_per_second(self) -> float:
+        return self.total_rays / self.render_seconds / 1e6 if self.render_seconds > 0 else 0.0
+
+    def summary(self) -> str:
+        state = " (cancelled)" if self.cancelled else ""
+        return (
+            f"{self.width}x{self.height}{state}: wall {self.wall_seconds:.2f} s, "
+            f"compile {self.compile_seconds:.2f} s, render {self.render_seconds:.3f} s, "
+            f"{self.total_rays:,} rays, {self.mrays_per_second:.1f} Mrays/s, "
+            f"{self.threads} thread{'s' if self.threads != 1 else ''}"
+        )
+
+
+def available_threads() -> int:
+    """Cores this process may use (the default thread count)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def run_lanes(fn: Callable[[int, int], object], lanes: int, pool: ThreadPoolExecutor | None):
+    """Call ``fn(lane, lanes)`` for every lane, concurrently on ``pool`` (the kernels release
+    the GIL), and wait for all of them."""
+    if lanes == 1 or pool is None:
+        for lane in range(lanes):
+            fn(lane, lanes)
+        return
+    for future in [pool.submit(fn, lane, lanes) for lane in range(lanes)]:
+        future.result()
+
+
+def tile_grid(width: int, height: int, tile: int = DEFAULT_TILE) -> np.ndarray:
+    """All tiles of the image in row-major order, rows of (x0, y0, x1, y1)."""
+    xs = np.arange(0, width, tile)
+    ys = np.arange(0, height, tile)
+    grid = [(x, y, min(x + tile, width), min(y + tile, height)) for y in ys for x in xs]
+    return np.array(grid, dtype=np.int32).reshape(-1, 4)
+
+
+_kernel_lock = threading.Lock()
+_kernels_ready = False
+
+
+def warm_up_kernels() -> float:
+    """Compile (first run) or load from the on-disk cache (later runs) the render kernels.
+    Returns the seconds it took; 0 when they were already loaded in this process."""
+    global _kernels_ready
+    with _kernel_lock:
+        if _kernels_ready:
+            return 0.0
+        start = time.perf_counter()
+        from ..kernels.tiles import render_aovs, render_tiles
+
+        scene = Scene()
+        compiled = compile_scene(scene)
+        params = render_params(scene, compiled, scene.render.model_copy(update={"width": 1,
+                                                                                 "height": 1}))
+        fb = np.zeros((1, 1, 3), np.float32)
+        counters = np.zeros((1, N_RAY_KINDS), np.int64)
+        render_tiles(np.zeros((1, 4), np.int32), fb, compiled.geometry, compiled.materials,
+                     compiled.lights, params, counters, 0, 1)
+        render_aovs(compiled.geometry, params, np.zeros((1, 1), np.float32),
+                    np.zeros((1, 1, 3), np.float32), np.zeros((1, 1), np.int32), 0, 1)
+        _kernels_ready = True
+        return time.perf_counter() - start
+
+
+class RenderJob:
+    """One render of one scene. ``framebuffer`` fills in tile by tile while it runs, so a UI
+    can show it; ``run()`` blocks, ``start()`` runs it on a background thread."""
+
+    def __init__(
+        self,
+        scene: Scene,
+        *,
+        progress: Callable[[Progress], None] | None = None,
+        cancel: CancelToken | None = None,
+        threads: int | None = None,
+        tile_size: int = DEFAULT_TILE,
+    ) -> None:
+        self.scene = scene
+        self.settings: RenderSettings = scene.render
+        self.progress = progress
+        self.cancel_token = cancel or CancelToken()
+        n = threads if threads is not None else self.settings.threads
+        self.threads = max(1, n or available_threads())
+        self.tile_size = tile_size
+        self.framebuffer = np.zeros((self.settings.height, self.settings.width, 3), np.float32)
+        self.stats = RenderStats(
+            width=self.settings.width,
+            height=self.settings.height,
+            threads=self.threads,
+            samples=self.settings.samples,
+            max_depth=self.settings.max_depth,
+        )
+        self.image: Image | None = None
+        self.error: BaseException | None = None
+        self._thread: threading.Thread | None = None
+
+    def cancel(self) -> None:
+        self.cancel_token.cancel()
+
+    def start(self) -> threading.Thread:
+        def target() -> None:
+            try:
+                self.run()
+            except BaseException as exc:  # noqa: BLE001 - handed to whoever joins
+                self.error = exc
+
+        self._thread = threading.Thread(target=target, name="whitted-render", daemon=True)
+        self._thread.start()
+        return self._thread
+
+    def wait(self, timeout: float | None = None) -> Image | None:
+        if self._thread is not None:
+            self._thread.join(timeout)
+            if self._thread.is_alive():
+                return None
+        if self.error is not None:
+            raise self.error
+        return self.image
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    def _report(self, done, total, counters, start, chunk) -> None:
+        if self.progress is None:
+            return
+        elapsed = time.perf_counter() - start
+        eta = elapsed / done * (total - done) if done else None
+        self.progress(Progress(done, total, int(counters[:done].sum()), elapsed, eta, chunk))
+
+    def run(self) -> Image:
+        from ..kernels.tiles import render_tiles
+
+        wall_start = time.perf_counter()
+        stats = self.stats
+        stats.compile_seconds = warm_up_kernels()
+        compiled: CompiledScene = compile_scene(self.scene)
+        stats.build_seconds = compiled.build_seconds
+        params = render_params(self.scene, compiled, self.settings)
+        tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size)
+        counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
+        stats.tiles_total = len(tiles)
+        lanes = self.threads
+        # batches small enough for frequent progress, large enough to keep threads busy
+        batch = max(lanes * 8, len(tiles) // 64)
+        render_start = time.perf_counter()
+        done = 0
+        pool = ThreadPoolExecutor(lanes, thread_name_prefix="whitted-lane") if lanes > 1 else None
+        try:
+            while done < len(tiles) and not self.cancel_token.cancelled:
+                chunk = tiles[done : done + batch]
+                chunk_counters = counters[done : done + batch]
+
+                def lane_work(lane: int, n: int, chunk=chunk, chunk_counters=chunk_counters):
+                    render_tiles(chunk, self.framebuffer, compiled.geometry, compiled.materials,
+                                 compiled.lights, params, chunk_counters, lane, n)
+
+                run_lanes(lane_work, lanes, pool)
+                done += len(chunk)
+                self._report(done, len(tiles), counters, render_start, chunk)
+        finally:
+            if pool is not None:
+                pool.shutdown()
+        stats.render_seconds = time.perf_counter() - render_start
+        stats.tiles_done = done
+        stats.cancelled = done < len(tiles)
+        totals = counters.sum(axis=0)
+        stats.rays = {RAY_KIND_NAMES[k]: int(totals[k]) for k in range(N_RAY_KINDS)}
+        stats.wall_seconds = time.perf_counter() - wall_start
+        self.image = Image(self.framebuffer, transfer=self.settings.transfer,
+                           tonemap=self.settings.tonemap, meta={"stats": stats})
+        return self.image
+
+
+def render(
+    scene: Scene,
+    *,
+    progress: Callable[[Progress], None] | None = None,
+    cancel: CancelToken | None = None,
+    **overrides: object,
+) -> Image:
+    """Render ``scene`` and return the :class:`~whitted.output.Image` (float32 linear HDR).
+
+    Keyword overrides replace render settings for this call (``width``, ``height``,
+    ``samples``, ``max_depth``, ``threads``, ``seed``, ...)."""
+    if overrides:
+        scene = scene.with_settings(**overrides)
+    return RenderJob(scene, progress=progress, cancel=cancel).run()
+
+
+def render_aovs(scene: Scene, **overrides: object) -> dict[str, np.ndarray]:
+    """Depth, normal and object-id images through the pixel centres (see the CLI's --aov)."""
+    from ..kernels.tiles import render_aovs as aov_kernel
+
+    if overrides:
+        scene = scene.with_settings(**overrides)
+    warm_up_kernels()
+    compiled = compile_scene(scene)
+    s = scene.render
+    params = render_params(scene, compiled, s)
+    depth = np.empty((s.height, s.width), np.float32)
+    normal = np.empty((s.height, s.width, 3), np.float32)
+    ids = np.empty((s.height, s.width), np.int32)
+    lanes = max(1, s.threads or available_threads())
+
+    def lane_work(lane: int, n: int) -> None:
+        aov_kernel(compiled.geometry, params, depth, normal, ids, lane, n)
+
+    with ThreadPoolExecutor(lanes) as pool:
+        run_lanes(lane_work, lanes, pool)
+    return {"depth": depth, "normal": normal, "id": ids}

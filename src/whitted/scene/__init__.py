@@ -1,0 +1,16 @@
+"""The scene description: pure, validated data (no rendering code)."""
+
+from .camera import Camera
+from .io import load_scene, save_scene
+from .lights import AmbientLight, DirectionalLight, DiskLight, PointLight
+from .materials import PRESETS, Material
+from .scene import RenderSettings, Scene
+from .shapes import Box, Cone, Cylinder, Disk, Plane, Rectangle, Sphere, Triangle
+from .types import AxisAngle, Background, Gradient, Transform
+
+__all__ = [
+    "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera", "Cone", "Cylinder",
+    "DirectionalLight", "Disk", "DiskLight", "Gradient", "Material", "Plane", "PointLight",
+    "Rectangle", "RenderSettings", "Scene", "Sphere", "Transform", "Triangle", "load_scene",
+    "save_scene",
+]

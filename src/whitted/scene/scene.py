@@ -1,0 +1,89 @@
+"""The scene: render settings, camera, background, materials, lights and objects. Pure data."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Literal
+
+from pydantic import Field, model_validator
+
+from .camera import Camera
+from .lights import Light
+from .materials import PRESETS, Material
+from .shapes import Shape
+from .types import Background, Strict
+
+MAX_PIXELS = 100_000_000
+MAX_DEPTH = 64
+
+
+class RenderSettings(Strict):
+    """How to render. ``threads = 0`` uses every core. ``epsilon = 0`` picks the ray offset
+    from the scene's size. ``transfer``: ``srgb`` (display images) or ``linear`` (raw values,
+    to compare with hand-computed numbers). ``tonemap``: ``clamp``, ``reinhard`` or ``aces``."""
+
+    width: int = Field(default=640, ge=1, le=100_000)
+    height: int = Field(default=480, ge=1, le=100_000)
+    samples: int = Field(default=1, ge=1, le=4096)
+    max_depth: int = Field(default=5, ge=0, le=MAX_DEPTH)
+    min_weight: float = Field(default=0.01, ge=0.0, le=1.0)
+    shadow_samples: int = Field(default=16, ge=1, le=4096)
+    seed: int = Field(default=0, ge=0, le=2**31 - 1)
+    threads: int = Field(default=0, ge=0, le=1024)
+    epsilon: float = Field(default=0.0, ge=0.0, le=1.0)
+    transfer: Literal["srgb", "linear"] = "srgb"
+    tonemap: Literal["clamp", "reinhard", "aces"] = "clamp"
+
+    @model_validator(mode="after")
+    def _size(self) -> RenderSettings:
+        if self.width * self.height > MAX_PIXELS:
+            raise ValueError(
+                f"{self.width}x{self.height} is over {MAX_PIXELS // 1_000_000} megapixels"
+            )
+        return self
+
+
+class Scene(Strict):
+    """A whole scene. Build it in Python or load it with :func:`whitted.load_scene`."""
+
+    render: RenderSettings = Field(default_factory=RenderSettings)
+    camera: Camera = Field(default_factory=Camera)
+    background: Background = Field(default_factory=Background)
+    materials: dict[str, Material] = Field(default_factory=dict)
+    lights: list[Light] = Field(default_factory=list)
+    objects: list[Shape] = Field(default_factory=list)
+
+    @model_validator(mode="after")
+    def _material_names_resolve(self) -> Scene:
+        for i, obj in enumerate(self.objects):
+            if isinstance(obj.material, str) and obj.material not in self.materials:
+                if obj.material not in PRESETS:
+                    known = sorted(set(self.materials) | set(PRESETS))
+                    raise ValueError(
+                        f"objects[{i}].material: unknown material {obj.material!r}"
+                        f" (known: {', '.join(known)})"
+                    )
+        return self
+
+    def material_of(self, index: int) -> Material:
+        """The resolved material of object ``index`` (named, preset, inline or the default)."""
+        ref = self.objects[index].material
+        if ref is None:
+            return Material()
+        if isinstance(ref, Material):
+            return ref
+        if ref in self.materials:
+            return self.materials[ref]
+        return Material(preset=ref)
+
+    def save(self, path: str | Path) -> Path:
+        """Write the scene as TOML or JSON (by extension), atomically."""
+        from .io import save_scene
+
+        return save_scene(self, path)
+
+    def with_settings(self, **overrides: object) -> Scene:
+        """A copy with some render settings replaced (validated)."""
+        data = self.render.model_dump()
+        data.update({k: v for k, v in overrides.items() if v is not None})
+        return self.model_copy(update={"render": RenderSettings(**data)})

@@ -1,0 +1,158 @@
+"""Validated value types shared by the scene model: vectors, colours, transforms."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated
+
+import numpy as np
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
+
+
+class Strict(BaseModel):
+    """Base of every scene model: unknown keys are errors, values are re-validated on assignment."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True, frozen=False)
+
+
+def _finite_vector(value: object) -> tuple[float, float, float]:
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if not isinstance(value, list | tuple) or len(value) != 3:
+        raise ValueError("expected a list of 3 numbers")
+    out = []
+    for v in value:
+        if isinstance(v, bool) or not isinstance(v, int | float):
+            raise ValueError(f"expected a number, got {v!r}")
+        if not math.isfinite(v):
+            raise ValueError(f"expected a finite number, got {v!r}")
+        out.append(float(v))
+    return (out[0], out[1], out[2])
+
+
+def _nonzero_vector(value: object) -> tuple[float, float, float]:
+    v = _finite_vector(value)
+    if math.sqrt(v[0] ** 2 + v[1] ** 2 + v[2] ** 2) < 1e-12:
+        raise ValueError("must not be the zero vector")
+    return v
+
+
+def srgb_channel_to_linear(c: float) -> float:
+    """The sRGB transfer curve (IEC 61966-2-1) inverted: 8-bit style colour to linear."""
+    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+
+
+def _colour(value: object) -> tuple[float, float, float]:
+    """Colours are ``"#rrggbb"`` (sRGB-encoded, as colour pickers give them) or linear [r, g, b]."""
+    if isinstance(value, str):
+        text = value.strip()
+        if len(text) != 7 or text[0] != "#":
+            raise ValueError(f"colour {value!r} is not '#rrggbb' or [r, g, b]")
+        try:
+            channels = [int(text[i : i + 2], 16) / 255.0 for i in (1, 3, 5)]
+        except ValueError:
+            raise ValueError(f"colour {value!r} has non-hex digits") from None
+        r, g, b = (srgb_channel_to_linear(c) for c in channels)
+        return (r, g, b)
+    v = _finite_vector(value)
+    for c in v:
+        if c < 0.0 or c > 1.0:
+            raise ValueError(f"colour channel {c} is outside 0..1")
+    return v
+
+
+Vec3 = Annotated[tuple[float, float, float], BeforeValidator(_finite_vector)]
+Direction = Annotated[tuple[float, float, float], BeforeValidator(_nonzero_vector)]
+Colour = Annotated[tuple[float, float, float], BeforeValidator(_colour)]
+
+
+def _finite(value: object) -> object:
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ValueError(f"expected a finite number, got {value!r}")
+    return value
+
+
+Finite = Annotated[float, BeforeValidator(_finite)]
+Positive = Annotated[float, BeforeValidator(_finite), Field(gt=0)]
+Unit = Annotated[float, BeforeValidator(_finite), Field(ge=0, le=1)]
+
+
+class AxisAngle(Strict):
+    """A rotation by ``angle`` degrees about ``axis`` (right-hand rule)."""
+
+    axis: Direction
+    angle: Finite
+
+
+class Transform(Strict):
+    """An object's placement: scale, then rotate about x, y, z (in that order), then about an
+    arbitrary axis, then translate. Angles in degrees; rotations are about the world origin."""
+
+    scale: Finite | Vec3 = 1.0
+    rotate: Vec3 = (0.0, 0.0, 0.0)
+    axis_angle: AxisAngle | None = None
+    translate: Vec3 = (0.0, 0.0, 0.0)
+
+    @field_validator("scale")
+    @classmethod
+    def _scale_nonzero(cls, v: float | tuple[float, float, float]) -> object:
+        values = v if isinstance(v, tuple) else (v,)
+        if any(abs(s) < 1e-12 for s in values):
+            raise ValueError("scale must not be zero")
+        return v
+
+    def is_identity(self) -> bool:
+        return bool(np.allclose(self.matrix(), np.eye(4), rtol=0, atol=0))
+
+    def matrix(self) -> np.ndarray:
+        """The 4x4 object-to-world matrix."""
+        s = self.scale
+        sx, sy, sz = (s, s, s) if isinstance(s, int | float) else s
+        m = np.diag([sx, sy, sz, 1.0])
+        rx, ry, rz = (math.radians(a) for a in self.rotate)
+        m = _rotation(np.array([1.0, 0, 0]), rx) @ m
+        m = _rotation(np.array([0, 1.0, 0]), ry) @ m
+        m = _rotation(np.array([0, 0, 1.0]), rz) @ m
+        if self.axis_angle is not None:
+            m = _rotation(np.array(self.axis_angle.axis), math.radians(self.axis_angle.angle)) @ m
+        t = np.eye(4)
+        t[:3, 3] = self.translate
+        return t @ m
+
+
+def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rodrigues' rotation matrix (4x4) for a right-handed rotation of ``angle`` radians."""
+    a = axis / np.linalg.norm(axis)
+    c, s = math.cos(angle), math.sin(angle)
+    x, y, z = a
+    r = np.array(
+        [
+            [c + x * x * (1 - c), x * y * (1 - c) - z * s, x * z * (1 - c) + y * s],
+            [y * x * (1 - c) + z * s, c + y * y * (1 - c), y * z * (1 - c) - x * s],
+            [z * x * (1 - c) - y * s, z * y * (1 - c) + x * s, c + z * z * (1 - c)],
+        ]
+    )
+    # snap the tiny residues of cos(90 deg) etc. so axis-aligned rotations stay exact
+    r[np.abs(r) < 1e-15] = 0.0
+    m = np.eye(4)
+    m[:3, :3] = r
+    return m
+
+
+class Gradient(Strict):
+    """A vertical background gradient: ``bottom`` at the horizon-down direction, ``top`` up."""
+
+    top: Colour
+    bottom: Colour
+
+
+class Background(Strict):
+    color: Colour = (0.0, 0.0, 0.0)
+    gradient: Gradient | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _accept_plain_colour(cls, data: object) -> object:
+        if isinstance(data, str | list | tuple):
+            return {"color": data}
+        return data
