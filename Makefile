@@ -2,8 +2,8 @@
 PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
-# Numba's on-disk JIT cache: compiled kernels are kept here between runs.
-export NUMBA_CACHE_DIR ?= $(CURDIR)/.cache/numba
+# Compiled kernels are kept here between runs (see src/whitted/_cache.py).
+export WHITTED_CACHE_DIR ?= $(CURDIR)/.cache
 
 .PHONY: demo test lint install install-test bench clean
 

@@ -8,6 +8,10 @@
 
 from importlib.metadata import PackageNotFoundError, version
 
+from ._cache import configure_kernel_cache
+
+configure_kernel_cache()  # before any kernel module imports numba
+
 from .errors import SceneError, WhittedError
 from .output import Image
 from .render import CancelToken, Progress, RenderJob, RenderStats, render, render_aovs

@@ -29,11 +29,11 @@ LEAF_HARD_CAP = 16  # a node with more primitives than this is always split
 MAX_DEPTH = 60  # root has depth 0; no leaf is deeper than this
 TRAVERSAL_COST = 1.0
 INTERSECTION_COST = 1.0
+SAH_ALL_AXES = False  # bin only the axis of largest centroid extent
 _BIN_SCALE_SHRINK = 1.0 - 1e-9  # keeps the largest centroid inside the last bin
 
-# working rows: columns 0-2 lower corner, 3-5 upper corner (centroids are recomputed on the fly,
-# which is cheaper than moving three more numbers per primitive through memory)
-_NCOL = 6
+# working rows: columns 0-2 lower corner, 3-5 upper corner, 6-8 centroid
+_NCOL = 9
 
 
 class BVH(NamedTuple):
@@ -75,7 +75,7 @@ def _range_bounds(rows, start, end, out):
         for k in range(3):
             lo = rows[j, k]
             hi = rows[j, 3 + k]
-            c = 0.5 * lo + 0.5 * hi
+            c = rows[j, 6 + k]
             if lo < out[k]:
                 out[k] = lo
             if hi > out[3 + k]:
@@ -88,8 +88,7 @@ def _range_bounds(rows, start, end, out):
 
 @njit(cache=True, nogil=True)
 def _centroid(rows, j, k):
-    """Centroid of row j on axis k (halves first, so huge finite bounds cannot overflow)."""
-    return 0.5 * rows[j, k] + 0.5 * rows[j, 3 + k]
+    return rows[j, 6 + k]
 
 
 @njit(cache=True, nogil=True)
@@ -113,16 +112,17 @@ def _grow_centroids(f, rows, j):
 
 
 @njit(cache=True, nogil=True)
-def _pack(bmin, bmax):
-    n = bmin.shape[0]
-    rows = np.empty((n, _NCOL), np.float64)
-    idx = np.empty(n, np.int32)
-    for i in range(n):
+def _pack(bmin, bmax, rows, idx):
+    """Fill the working rows (caller-allocated: NumPy's large allocations fault in faster)."""
+    for i in range(bmin.shape[0]):
         idx[i] = i
         for k in range(3):
-            rows[i, k] = bmin[i, k]
-            rows[i, 3 + k] = bmax[i, k]
-    return rows, idx
+            lo = bmin[i, k]
+            hi = bmax[i, k]
+            rows[i, k] = lo
+            rows[i, 3 + k] = hi
+            # halves first, so huge finite bounds cannot overflow
+            rows[i, 6 + k] = 0.5 * lo + 0.5 * hi
 
 
 @njit(cache=True, nogil=True)
@@ -153,14 +153,85 @@ def _sort_range(rows, idx, start, end, axis):
 
 
 @njit(cache=True, nogil=True)
+def _sah_axis(rows, start, end, axis, cmin, scale, nb, bin_cnt, bin_box, r_area, r_cnt):
+    """Bin rows[start:end] by centroid on ``axis`` into nb bins (filling bin_cnt and bin_box)
+    and score every bin boundary. Returns (s, cost, imbalance) of the cheapest boundary, where
+    boundary s puts bins < s on the left and cost is A_L * N_L + A_R * N_R (unnormalised);
+    s is -1 when no boundary has primitives on both sides."""
+    for b in range(nb):
+        bin_cnt[b] = 0
+        for k in range(3):
+            bin_box[b, k] = np.inf
+            bin_box[b, 3 + k] = -np.inf
+    for j in range(start, end):
+        b = _bin_of(rows, j, axis, cmin, scale, nb)
+        bin_cnt[b] += 1
+        bb = bin_box[b]
+        bb[0] = min(bb[0], rows[j, 0])
+        bb[1] = min(bb[1], rows[j, 1])
+        bb[2] = min(bb[2], rows[j, 2])
+        bb[3] = max(bb[3], rows[j, 3])
+        bb[4] = max(bb[4], rows[j, 4])
+        bb[5] = max(bb[5], rows[j, 5])
+    # sweep from the right: r_area[s], r_cnt[s] describe bins s..nb-1
+    lx = np.inf
+    ly = np.inf
+    lz = np.inf
+    hx = -np.inf
+    hy = -np.inf
+    hz = -np.inf
+    rc = 0
+    for s in range(nb - 1, 0, -1):
+        lx = min(lx, bin_box[s, 0])
+        ly = min(ly, bin_box[s, 1])
+        lz = min(lz, bin_box[s, 2])
+        hx = max(hx, bin_box[s, 3])
+        hy = max(hy, bin_box[s, 4])
+        hz = max(hz, bin_box[s, 5])
+        rc += bin_cnt[s]
+        r_cnt[s] = rc
+        r_area[s] = _half_area(lx, ly, lz, hx, hy, hz) if rc > 0 else 0.0
+    # sweep from the left, scoring the boundary before bin s
+    lx = np.inf
+    ly = np.inf
+    lz = np.inf
+    hx = -np.inf
+    hy = -np.inf
+    hz = -np.inf
+    lc = 0
+    count = end - start
+    best_s = -1
+    best_cost = np.inf
+    best_imb = count + 1
+    for s in range(1, nb):
+        lx = min(lx, bin_box[s - 1, 0])
+        ly = min(ly, bin_box[s - 1, 1])
+        lz = min(lz, bin_box[s - 1, 2])
+        hx = max(hx, bin_box[s - 1, 3])
+        hy = max(hy, bin_box[s - 1, 4])
+        hz = max(hz, bin_box[s - 1, 5])
+        lc += bin_cnt[s - 1]
+        rc = r_cnt[s]
+        if lc == 0 or rc == 0:
+            continue
+        cost = (_half_area(lx, ly, lz, hx, hy, hz) * lc + r_area[s] * rc) * INTERSECTION_COST
+        imb = abs(lc - rc)
+        if cost < best_cost or (cost == best_cost and imb < best_imb):
+            best_cost = cost
+            best_s = s
+            best_imb = imb
+    return best_s, best_cost, best_imb
+
+
+@njit(cache=True, nogil=True)
 def _build(rows, idx, n_bins, leaf_cap, node_min, node_max, node_offset, node_count, node_axis):
     """Build the tree in place; returns the number of nodes written."""
     n = rows.shape[0]
     if n == 0:
         return 0
 
-    bin_cnt = np.zeros(n_bins, np.int64)
-    bin_box = np.empty((n_bins, 6), np.float64)
+    bin_cnt = np.zeros((3, n_bins), np.int64)
+    bin_box = np.empty((3, n_bins, 6), np.float64)
     r_area = np.empty(n_bins, np.float64)
     r_cnt = np.empty(n_bins, np.int64)
 
@@ -225,70 +296,41 @@ def _build(rows, idx, n_bins, leaf_cap, node_min, node_max, node_offset, node_co
                 balanced = depth + _ceil_log2(count) >= MAX_DEPTH
 
                 if binnable and not balanced:
-                    cmin = cur[6 + axis]
-                    for b in range(nb):
-                        bin_cnt[b] = 0
-                        for k in range(3):
-                            bin_box[b, k] = np.inf
-                            bin_box[b, 3 + k] = -np.inf
-                    for j in range(start, end):
-                        b = _bin_of(rows, j, axis, cmin, scale, nb)
-                        bin_cnt[b] += 1
-                        bb = bin_box[b]
-                        bb[0] = min(bb[0], rows[j, 0])
-                        bb[1] = min(bb[1], rows[j, 1])
-                        bb[2] = min(bb[2], rows[j, 2])
-                        bb[3] = max(bb[3], rows[j, 3])
-                        bb[4] = max(bb[4], rows[j, 4])
-                        bb[5] = max(bb[5], rows[j, 5])
-                    # sweep from the right: r_area[s], r_cnt[s] describe bins s..nb-1
-                    rlx = np.inf
-                    rly = np.inf
-                    rlz = np.inf
-                    rhx = -np.inf
-                    rhy = -np.inf
-                    rhz = -np.inf
-                    rc = 0
-                    for s in range(nb - 1, 0, -1):
-                        rlx = min(rlx, bin_box[s, 0])
-                        rly = min(rly, bin_box[s, 1])
-                        rlz = min(rlz, bin_box[s, 2])
-                        rhx = max(rhx, bin_box[s, 3])
-                        rhy = max(rhy, bin_box[s, 4])
-                        rhz = max(rhz, bin_box[s, 5])
-                        rc += bin_cnt[s]
-                        r_cnt[s] = rc
-                        r_area[s] = _half_area(rlx, rly, rlz, rhx, rhy, rhz) if rc > 0 else 0.0
-                    # sweep from the left, scoring the boundary before bin s
-                    llx = np.inf
-                    lly = np.inf
-                    llz = np.inf
-                    lhx = -np.inf
-                    lhy = -np.inf
-                    lhz = -np.inf
-                    lc = 0
+                    best_axis = -1
                     best_s = -1
                     best_cost = np.inf
                     best_imb = count + 1
-                    for s in range(1, nb):
-                        llx = min(llx, bin_box[s - 1, 0])
-                        lly = min(lly, bin_box[s - 1, 1])
-                        llz = min(llz, bin_box[s - 1, 2])
-                        lhx = max(lhx, bin_box[s - 1, 3])
-                        lhy = max(lhy, bin_box[s - 1, 4])
-                        lhz = max(lhz, bin_box[s - 1, 5])
-                        lc += bin_cnt[s - 1]
-                        rc = r_cnt[s]
-                        if lc == 0 or rc == 0:
+                    for a in range(3):
+                        if not SAH_ALL_AXES and a != axis:
                             continue
-                        cost = (
-                            _half_area(llx, lly, llz, lhx, lhy, lhz) * lc + r_area[s] * rc
-                        ) * INTERSECTION_COST
-                        imb = abs(lc - rc)
-                        if cost < best_cost or (cost == best_cost and imb < best_imb):
-                            best_cost = cost
-                            best_s = s
-                            best_imb = imb
+                        ea = cur[9 + a] - cur[6 + a]
+                        if not ea > 0.0:
+                            continue
+                        sc = nb * _BIN_SCALE_SHRINK / ea
+                        if not np.isfinite(sc):
+                            continue
+                        s_a, c_a, i_a = _sah_axis(
+                            rows,
+                            start,
+                            end,
+                            a,
+                            cur[6 + a],
+                            sc,
+                            nb,
+                            bin_cnt[a],
+                            bin_box[a],
+                            r_area,
+                            r_cnt,
+                        )
+                        if s_a >= 0 and (c_a < best_cost or (c_a == best_cost and i_a < best_imb)):
+                            best_axis = a
+                            best_s = s_a
+                            best_cost = c_a
+                            best_imb = i_a
+                    if best_axis >= 0:
+                        axis = best_axis
+                    cmin = cur[6 + axis]
+                    scale = nb * _BIN_SCALE_SHRINK / (cur[9 + axis] - cur[6 + axis])
                     area = _half_area(cur[0], cur[1], cur[2], cur[3], cur[4], cur[5])
                     split_cost = area * TRAVERSAL_COST + best_cost
                     leaf_cost = area * INTERSECTION_COST * count
@@ -310,10 +352,10 @@ def _build(rows, idx, n_bins, leaf_cap, node_min, node_max, node_offset, node_co
                         for b in range(nb):
                             side = left_f if b < best_s else right_f
                             for k in range(3):
-                                if bin_box[b, k] < side[k]:
-                                    side[k] = bin_box[b, k]
-                                if bin_box[b, 3 + k] > side[3 + k]:
-                                    side[3 + k] = bin_box[b, 3 + k]
+                                if bin_box[axis, b, k] < side[k]:
+                                    side[k] = bin_box[axis, b, k]
+                                if bin_box[axis, b, 3 + k] > side[3 + k]:
+                                    side[3 + k] = bin_box[axis, b, 3 + k]
                         # partition (same bin formula as above), gathering centroid bounds
                         i = start
                         jr = end - 1
@@ -405,8 +447,7 @@ def build_bvh(
         bmax = bmax.reshape(0, 3)
     if bmin.ndim != 2 or bmin.shape[1] != 3 or bmin.shape != bmax.shape:
         raise ValueError(
-            f"bounds must be two (N, 3) arrays of the same shape, got {bmin.shape} and "
-            f"{bmax.shape}"
+            f"bounds must be two (N, 3) arrays of the same shape, got {bmin.shape} and {bmax.shape}"
         )
     if int(max_leaf_size) < 1:
         raise ValueError(f"max_leaf_size must be >= 1, got {max_leaf_size}")
@@ -422,7 +463,9 @@ def build_bvh(
     if not (bmin <= bmax).all():
         raise ValueError("primitive bounds must have bounds_min <= bounds_max on every axis")
 
-    rows, idx = _pack(bmin, bmax)
+    rows = np.empty((n, _NCOL), np.float64)
+    prim_order = np.empty(n, np.int32)
+    _pack(bmin, bmax, rows, prim_order)
     m_cap = 2 * n - 1
     node_min = np.empty((m_cap, 3), np.float64)
     node_max = np.empty((m_cap, 3), np.float64)
@@ -431,16 +474,32 @@ def build_bvh(
     node_axis = np.empty(m_cap, np.int8)
     leaf_cap = max(int(max_leaf_size), LEAF_HARD_CAP)
     m = _build(
-        rows, idx, int(n_bins), leaf_cap, node_min, node_max, node_offset, node_count, node_axis
+        rows,
+        prim_order,
+        int(n_bins),
+        leaf_cap,
+        node_min,
+        node_max,
+        node_offset,
+        node_count,
+        node_axis,
     )
+    del rows
     return BVH(
-        node_min=node_min[:m].copy(),
-        node_max=node_max[:m].copy(),
-        node_offset=node_offset[:m].copy(),
-        node_count=node_count[:m].copy(),
-        node_axis=node_axis[:m].copy(),
-        prim_order=idx,
+        node_min=_trim(node_min, m),
+        node_max=_trim(node_max, m),
+        node_offset=_trim(node_offset, m),
+        node_count=_trim(node_count, m),
+        node_axis=_trim(node_axis, m),
+        prim_order=prim_order,
     )
+
+
+def _trim(a: np.ndarray, m: int) -> np.ndarray:
+    """The first m rows: a view when that is most of the array (no copy), else a compact copy."""
+    if 4 * m >= 3 * a.shape[0]:
+        return a[:m]
+    return a[:m].copy()
 
 
 def bvh_stats(bvh: BVH) -> dict:

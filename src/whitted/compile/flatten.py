@@ -130,7 +130,8 @@ def _corners_bounds(points: np.ndarray, matrix: np.ndarray | None = None):
 
 
 def _box_corners(lo, hi):
-    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    xs, ys, zs = (lo[0], hi[0]), (lo[1], hi[1]), (lo[2], hi[2])
+    return np.array([[x, y, z] for x in xs for y in ys for z in zs])
 
 
 def _add_shape(b: _Builder, shape, m: np.ndarray, material: int, obj: int) -> None:

@@ -22,6 +22,9 @@ from .layout import (
 from .vec import cross, dot, normalize, sub, vload
 
 INF = math.inf
+# Flat shapes accept hits a hair outside their edges (in parametric units): rays through a
+# shared edge of two rectangles or triangles never slip between them.
+EDGE_TOL = 1e-9
 
 
 @kernel
@@ -82,10 +85,10 @@ def intersect_rectangle(P, i, o, d, tmin, tmax):
         return INF
     q = (o[0] + t * d[0] - corner[0], o[1] + t * d[1] - corner[1], o[2] + t * d[2] - corner[2])
     u = dot(q, vload(P, i, 12))
-    if u < 0.0 or u > 1.0:
+    if u < -EDGE_TOL or u > 1.0 + EDGE_TOL:
         return INF
     v = dot(q, vload(P, i, 15))
-    if v < 0.0 or v > 1.0:
+    if v < -EDGE_TOL or v > 1.0 + EDGE_TOL:
         return INF
     return t
 
@@ -98,7 +101,7 @@ def intersect_disk(P, i, o, d, tmin, tmax):
         return INF
     q = (o[0] + t * d[0] - c[0], o[1] + t * d[1] - c[1], o[2] + t * d[2] - c[2])
     r = P[i, 6]
-    return t if dot(q, q) <= r * r else INF
+    return t if dot(q, q) <= r * r * (1.0 + EDGE_TOL) else INF
 
 
 @kernel
@@ -113,11 +116,11 @@ def intersect_triangle(P, i, o, d, tmin, tmax):
     inv = 1.0 / det
     tv = sub(o, vload(P, i, 0))
     u = dot(tv, pv) * inv
-    if u < 0.0 or u > 1.0:
+    if u < -EDGE_TOL or u > 1.0 + EDGE_TOL:
         return INF
     qv = cross(tv, e1)
     v = dot(d, qv) * inv
-    if v < 0.0 or u + v > 1.0:
+    if v < -EDGE_TOL or u + v > 1.0 + EDGE_TOL:
         return INF
     t = dot(e2, qv) * inv
     return t if tmin < t < tmax else INF
@@ -248,7 +251,9 @@ def normal_local(typ, P, i, p):
                 best_k = k
                 best_side = 1.0
         row = 3 + 3 * best_k
-        return normalize((best_side * P[i, row], best_side * P[i, row + 1], best_side * P[i, row + 2]))
+        return normalize(
+            (best_side * P[i, row], best_side * P[i, row + 1], best_side * P[i, row + 2])
+        )
     if typ == SHAPE_FRUSTUM:
         base = vload(P, i, 0)
         axis = vload(P, i, 3)

@@ -15,7 +15,8 @@ import numpy as np
 # shape codes and their parameters (prim_params columns)
 SHAPE_SPHERE = 0  # center 0:3, radius 3
 SHAPE_PLANE = 1  # point 0:3, unit normal 3:6
-SHAPE_RECTANGLE = 2  # corner 0:3, edge1 3:6, edge2 6:9, unit normal 9:12, dual u 12:15, dual v 15:18
+# corner 0:3, edge1 3:6, edge2 6:9, unit normal 9:12, dual u 12:15, dual v 15:18
+SHAPE_RECTANGLE = 2
 SHAPE_DISK = 3  # center 0:3, unit normal 3:6, radius 6
 SHAPE_TRIANGLE = 4  # v0 0:3, edge1 3:6, edge2 6:9, unit normal 9:12
 SHAPE_BOX = 5  # corner 0:3, inverse edge matrix rows 3:12 (local = M^-1 (p - corner) in [0,1]^3)

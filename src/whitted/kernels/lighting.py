@@ -40,12 +40,13 @@ OPAQUE_KT = 0.01  # the lecture's rule: an occluder with kt below this blocks th
 
 
 @kernel
-def any_occluder(geo, mats, o, d, tmax, stack):
-    """0: nothing between o and o + tmax·d; 1: an opaque occluder; 2: only transparent ones."""
+def any_occluder(geo, mats, o, d, tmin, tmax, stack):
+    """0: nothing on the segment (tmin, tmax) of the ray; 1: an opaque occluder; 2: only
+    transparent ones."""
     seen_transparent = 0
     for j in range(geo.unbounded.shape[0]):
         i = geo.unbounded[j]
-        if hit_primitive(geo, i, o, d, 0.0, tmax) < INF:
+        if hit_primitive(geo, i, o, d, tmin, tmax) < INF:
             if mats[geo.prim_material[i], MAT_KT] < OPAQUE_KT:
                 return 1
             seen_transparent = 2
@@ -81,7 +82,7 @@ def any_occluder(geo, mats, o, d, tmax, stack):
             first = geo.node_offset[node]
             for j in range(first, first + count):
                 i = geo.node_prims[j]
-                if hit_primitive(geo, i, o, d, 0.0, tmax) < INF:
+                if hit_primitive(geo, i, o, d, tmin, tmax) < INF:
                     if mats[geo.prim_material[i], MAT_KT] < OPAQUE_KT:
                         return 1
                     seen_transparent = 2
@@ -97,10 +98,14 @@ def any_occluder(geo, mats, o, d, tmax, stack):
 def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch, stack):
     """Fraction of light (per channel) that reaches ``o`` from ``dist`` along unit ``d``.
 
+    The segment starts at ``epsilon`` along the ray (not offset along the normal), so a
+    shadow ray from a surface point passes exactly where the geometry says: a point whose
+    light path grazes an occluder's edge is shadowed as the lecture computes it.
+
     Each transparent occluder multiplies by its ``kt·color`` where the ray enters it, and the
     medium the shadow ray is in absorbs ``exp(-attenuation·length)`` segment by segment (the
     ray starts in the media ``media[:n_media]`` of the point being shaded)."""
-    state = any_occluder(geo, mats, o, d, dist, stack)
+    state = any_occluder(geo, mats, o, d, params.epsilon, dist, stack)
     if state == 0:
         return (1.0, 1.0, 1.0)
     if state == 1:
@@ -111,7 +116,7 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
     tr = 1.0
     tg = 1.0
     tb = 1.0
-    t_from = 0.0
+    t_from = params.epsilon
     for _ in range(64):
         t, prim = closest_hit(geo, o, d, t_from, dist, stack)
         seg_end = t if prim >= 0 else dist
@@ -197,7 +202,6 @@ def direct_light(
     b = 0.0
     if mats[m, MAT_KD] == 0.0 and mats[m, MAT_KS] == 0.0:
         return (r, g, b)
-    origin = madd(p, n, params.epsilon)
     dim = rng[2]
     for j in range(lights.shape[0]):
         kind = lights[j, LIGHT_TYPE]
@@ -228,7 +232,7 @@ def direct_light(
                     continue
                 counters[RAY_SHADOW] += 1
                 vis = shadow_transmittance(
-                    geo, mats, params, origin, ldir, dist - params.epsilon, media, n_media,
+                    geo, mats, params, p, ldir, dist - params.epsilon, media, n_media,
                     scratch, stack,
                 )
                 if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
@@ -245,7 +249,7 @@ def direct_light(
                 continue
             counters[RAY_SHADOW] += 1
             vis = shadow_transmittance(
-                geo, mats, params, origin, ldir, INF, media, n_media, scratch, stack
+                geo, mats, params, p, ldir, INF, media, n_media, scratch, stack
             )
             if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
                 continue

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
 from .accel import closest_hit, world_normal
 from .integrator import N_STACK_F, N_STACK_I, trace_path
 from .jit import kernel

@@ -191,7 +191,9 @@ def save_scene(scene: Scene, path: str | Path) -> Path:
     elif suffix == ".json":
         payload = (json.dumps(data, indent=2) + "\n").encode()
     else:
-        raise SceneError(f"unknown scene format {path.suffix!r} (use .toml or .json)", file=str(path))
+        raise SceneError(
+            f"unknown scene format {path.suffix!r} (use .toml or .json)", file=str(path)
+        )
 
     def write(tmp: str) -> None:
         Path(tmp).write_bytes(payload)

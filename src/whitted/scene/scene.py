@@ -56,13 +56,13 @@ class Scene(Strict):
     @model_validator(mode="after")
     def _material_names_resolve(self) -> Scene:
         for i, obj in enumerate(self.objects):
-            if isinstance(obj.material, str) and obj.material not in self.materials:
-                if obj.material not in PRESETS:
-                    known = sorted(set(self.materials) | set(PRESETS))
-                    raise ValueError(
-                        f"objects[{i}].material: unknown material {obj.material!r}"
-                        f" (known: {', '.join(known)})"
-                    )
+            name = obj.material
+            if isinstance(name, str) and name not in self.materials and name not in PRESETS:
+                known = sorted(set(self.materials) | set(PRESETS))
+                raise ValueError(
+                    f"objects[{i}].material: unknown material {name!r}"
+                    f" (known: {', '.join(known)})"
+                )
         return self
 
     def material_of(self, index: int) -> Material:

@@ -1,0 +1,242 @@
+"""The ``whitted`` command: a thin client of the render API."""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeRemainingColumn
+
+from .. import __version__
+from ..errors import WhittedError
+from ..scene import Scene, load_scene
+from ..scene.default import default_scene
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=False,
+    help="whitted: a fast Whitted ray tracer. Render scene files (TOML/JSON) to images.",
+    pretty_exceptions_enable=False,
+)
+err = Console(stderr=True, highlight=False)
+out = Console(highlight=False, soft_wrap=True)
+
+AOV_NAMES = ("depth", "normal", "id")
+EXIT_USER_ERROR = 2
+EXIT_INTERRUPTED = 130
+
+
+def fail(message: str) -> typer.Exit:
+    """One line on stderr, exit status 2: the way every user mistake ends."""
+    err.print(f"[bold red]error:[/] {message}", soft_wrap=True)
+    return typer.Exit(EXIT_USER_ERROR)
+
+
+def _version(value: bool) -> None:
+    if value:
+        out.print(f"whitted {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main_options(
+    version: Annotated[
+        bool, typer.Option("--version", callback=_version, is_eager=True, help="Show the version.")
+    ] = False,
+) -> None:
+    """whitted: a fast Whitted ray tracer."""
+
+
+def _load(scene_path: Path | None) -> tuple[Scene, str]:
+    if scene_path is None:
+        return default_scene(), "<default scene>"
+    return load_scene(scene_path), str(scene_path)
+
+
+def _parse_aovs(text: str | None) -> list[str]:
+    if not text:
+        return []
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    for n in names:
+        if n not in AOV_NAMES:
+            raise fail(f"--aov: unknown AOV {n!r} (choose from {', '.join(AOV_NAMES)})")
+    return names
+
+
+@app.command()
+def render(
+    scene_path: Annotated[
+        Path | None, typer.Argument(metavar="[SCENE]", help="Scene file; default: built-in scene")
+    ] = None,
+    output: Annotated[Path, typer.Option("-o", "--output", help="Image to write")] = Path(
+        "render.png"
+    ),
+    width: Annotated[int | None, typer.Option("--width", "-W", help="Image width")] = None,
+    height: Annotated[int | None, typer.Option("--height", "-H", help="Image height")] = None,
+    samples: Annotated[int | None, typer.Option("--samples", "-s", help="Samples/pixel")] = None,
+    max_depth: Annotated[int | None, typer.Option("--max-depth", "-d", help="Recursion")] = None,
+    threads: Annotated[int | None, typer.Option("--threads", "-t", help="0 = all cores")] = None,
+    seed: Annotated[int | None, typer.Option("--seed", help="Random seed")] = None,
+    aov: Annotated[str | None, typer.Option("--aov", help="Also write depth,normal,id")] = None,
+    bit_depth: Annotated[int, typer.Option("--bit-depth", help="PNG bits: 8 or 16")] = 8,
+    transfer: Annotated[
+        str | None, typer.Option("--transfer", help="srgb or linear (default: the scene's)")
+    ] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
+) -> None:
+    """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG)."""
+    from ..output.encode import check_bit_depth, image_format
+    from ..render.api import RenderJob, render_aovs
+
+    process_start = time.perf_counter()
+    aovs = _parse_aovs(aov)
+    try:
+        image_format(output)
+        check_bit_depth(bit_depth, output)
+    except ValueError as exc:
+        raise fail(f"{output}: {exc}") from None
+    if transfer not in (None, "srgb", "linear"):
+        raise fail(f"--transfer: unknown transfer {transfer!r} (use srgb or linear)")
+    try:
+        scene, name = _load(scene_path)
+        scene = scene.with_settings(width=width, height=height, samples=samples,
+                                    max_depth=max_depth, threads=threads, seed=seed,
+                                    transfer=transfer)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    except ValueError as exc:  # an override out of range
+        raise fail(f"{name}: {_first_line(exc)}") from None
+    if not output.parent.exists():
+        raise fail(f"{output}: the folder {output.parent} does not exist")
+
+    job = RenderJob(scene)
+    interrupted = threading.Event()
+    previous = signal.getsignal(signal.SIGINT)
+
+    def on_interrupt(signum, frame) -> None:  # Ctrl-C: stop after the tiles in flight
+        interrupted.set()
+        job.cancel()
+
+    signal.signal(signal.SIGINT, on_interrupt)
+    try:
+        _run_with_progress(job, quiet)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    image = job.image
+    assert image is not None
+    stats = job.stats
+    image.save(output, bit_depth=bit_depth)
+    written = [str(output)]
+    if aovs and not interrupted.is_set():
+        planes = render_aovs(scene)
+        for aov_name in aovs:
+            path = output.with_name(f"{output.stem}.{aov_name}.npy")
+            _save_npy(path, planes[aov_name])
+            written.append(str(path))
+    stats.wall_seconds = time.perf_counter() - process_start
+    if not quiet or interrupted.is_set():
+        out.print(f"{stats.summary()} -> {', '.join(written)}")
+    if interrupted.is_set():
+        err.print(f"interrupted: kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")
+        raise typer.Exit(EXIT_INTERRUPTED)
+
+
+def _save_npy(path: Path, array: np.ndarray) -> None:
+    from ..output.encode import atomic_write
+
+    atomic_write(path, lambda tmp: np.save(tmp, array))
+
+
+def _first_line(exc: Exception) -> str:
+    from pydantic import ValidationError
+
+    if isinstance(exc, ValidationError):
+        e = exc.errors()[0]
+        loc = ".".join(str(p) for p in e["loc"])
+        return f"render.{loc}: {e['msg'].lower()}"
+    return str(exc).splitlines()[0]
+
+
+def _run_with_progress(job, quiet: bool) -> None:
+    if quiet or not err.is_terminal:
+        job.start()
+        while job.wait(0.1) is None and job.running:
+            pass
+        job.wait()
+        return
+    columns = (
+        TextColumn("[bold]rendering"),
+        BarColumn(),
+        TaskProgressColumn(),
+        TextColumn("{task.fields[rays]} rays"),
+        TimeRemainingColumn(),
+    )
+    with Progress(*columns, console=err, transient=True) as bar:
+        task = bar.add_task("render", total=1.0, rays="0")
+
+        def update(p) -> None:
+            bar.update(task, completed=p.fraction, rays=f"{p.rays:,}")
+
+        job.progress = update
+        job.start()
+        while job.wait(0.1) is None and job.running:
+            pass
+        job.wait()
+
+
+@app.command()
+def info(
+    scene_path: Annotated[Path | None, typer.Argument(metavar="[SCENE]")] = None,
+) -> None:
+    """Print a scene's objects, lights, bounds and an estimate of the work."""
+    from ..compile.flatten import compile_scene
+
+    try:
+        scene, name = _load(scene_path)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    compiled = compile_scene(scene)
+    r = scene.render
+    out.print(f"[bold]{name}[/]")
+    out.print(f"image: {r.width}x{r.height}, {r.samples} sample(s)/pixel, max depth "
+              f"{r.max_depth}, min weight {r.min_weight}")
+    out.print(f"objects: {len(scene.objects)}")
+    for i, obj in enumerate(scene.objects):
+        mat = obj.material if isinstance(obj.material, str) else (
+            "inline" if obj.material is not None else "default")
+        label = f" '{obj.name}'" if obj.name else ""
+        out.print(f"  [{i}] {obj.type}{label} material={mat}")
+    out.print(f"lights: {len(scene.lights)}")
+    for i, light in enumerate(scene.lights):
+        out.print(f"  [{i}] {light.type} intensity={light.intensity}")
+    out.print(f"materials: {len(compiled.materials)} distinct")
+    if np.all(np.isfinite(compiled.bounds_min)):
+        lo = ", ".join(f"{v:.3g}" for v in compiled.bounds_min)
+        hi = ", ".join(f"{v:.3g}" for v in compiled.bounds_max)
+        out.print(f"bounds: ({lo}) .. ({hi}) (infinite planes: {len(compiled.geometry.unbounded)})")
+    else:
+        out.print("bounds: no bounded objects")
+    out.print(f"bvh: {len(compiled.geometry.node_min)} nodes over "
+              f"{len(compiled.geometry.node_prims)} primitives")
+    shadow = sum(
+        (light.samples or r.shadow_samples) if light.type == "disk" else 1
+        for light in scene.lights if light.type != "ambient"
+    )
+    primary = r.width * r.height * r.samples
+    out.print(f"work: {primary:,} primary rays, up to {shadow} shadow ray(s) per hit, "
+              f"secondary rays up to depth {r.max_depth}")
+
+
+def main() -> None:
+    """Console entry point."""
+    try:
+        app()
+    except KeyboardInterrupt:
+        sys.exit(EXIT_INTERRUPTED)
