@@ -1,0 +1,154 @@
+"""Refraction: Snell's law, total internal reflection, Fresnel, slab displacement, nested media
+(water inside ice) and Beer–Lambert absorption, checked against hand-computed values."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import whitted
+from whitted.kernels.integrator import refract, schlick
+
+
+def test_snell_30_degrees_air_to_glass():
+    # incidence 30 deg onto a surface with normal +y: sin(theta_t) = sin 30 / 1.5 = 1/3
+    d = (math.sin(math.radians(30)), -math.cos(math.radians(30)), 0.0)
+    ok, t = refract(d, (0.0, 1.0, 0.0), 1.0 / 1.5)
+    assert ok
+    assert t[0] == pytest.approx(1.0 / 3.0, abs=1e-12)
+    assert t[1] == pytest.approx(-math.sqrt(1 - 1 / 9), abs=1e-12)
+    assert math.hypot(*t) == pytest.approx(1.0, abs=1e-12)
+
+
+def test_normal_incidence_goes_straight():
+    ok, t = refract((0.0, 0.0, -1.0), (0.0, 0.0, 1.0), 1.0 / 1.333)
+    assert ok and t == pytest.approx((0.0, 0.0, -1.0))
+
+
+def test_total_internal_reflection_beyond_critical_angle():
+    critical = math.degrees(math.asin(1 / 1.5))  # 41.81 deg from glass into air
+    for angle, expect_ok in ((critical - 0.5, True), (critical + 0.5, False), (80.0, False)):
+        d = (math.sin(math.radians(angle)), -math.cos(math.radians(angle)), 0.0)
+        ok, _ = refract(d, (0.0, 1.0, 0.0), 1.5)
+        assert ok is expect_ok
+
+
+def test_schlick_values():
+    assert schlick(1.0, 1.0, 1.5, 1.0) == pytest.approx(0.04)  # ((1-1.5)/2.5)^2
+    assert schlick(0.0, 1.0, 1.5, 0.5) == pytest.approx(1.0)  # grazing: all reflected
+    # leaving the denser medium uses the transmitted cosine
+    assert schlick(0.2, 1.5, 1.0, 1.0) == pytest.approx(0.04)
+
+
+# --- end to end: an orthographic camera looks through slabs at a small bright target --------
+
+PIXEL = 0.01  # world units per pixel
+TARGET = (0.0, 0.0, -3.0)
+
+
+def _glass(ior: float, attenuation: float = 0.0) -> whitted.Material:
+    return whitted.Material(color=(1, 1, 1), ka=0, kd=0, ks=0, kr=0, kt=1, ior=ior,
+                            attenuation=attenuation, fresnel=False)
+
+
+def _target_scene(slabs: list[whitted.Box], theta_deg: float, samples: int = 9) -> whitted.Scene:
+    th = math.radians(theta_deg)
+    direction = np.array([math.sin(th), 0.0, -math.cos(th)])
+    position = np.array(TARGET) - 10.0 * direction
+    bright = whitted.Material(color=(1, 1, 1), ka=1, kd=0, ks=0)
+    return whitted.Scene(
+        render=whitted.RenderSettings(width=401, height=61, samples=samples, max_depth=12,
+                                      min_weight=0.0),
+        camera=whitted.Camera(position=tuple(position), look_at=TARGET,
+                              projection="orthographic", ortho_height=61 * PIXEL),
+        lights=[whitted.AmbientLight(intensity=1.0)],
+        objects=[whitted.Sphere(center=TARGET, radius=0.1, material=bright), *slabs],
+    )
+
+
+def _centroid_x(scene: whitted.Scene) -> tuple[float, float]:
+    img = whitted.render(scene).pixels[..., 1]
+    cols = np.arange(img.shape[1])
+    weight = img.sum(axis=0)
+    centre = (cols * weight).sum() / weight.sum()
+    return (centre - (img.shape[1] - 1) / 2) * PIXEL, float(img.max())
+
+
+def _parallel_shift(theta: float, layers: list[tuple[float, float]]) -> float:
+    """Perpendicular displacement of a ray crossing parallel layers (thickness, ior) at
+    incidence theta (radians): n·sin is conserved across parallel interfaces."""
+    along = sum(t * (math.tan(theta) - math.tan(math.asin(math.sin(theta) / n)))
+                for t, n in layers)
+    return along * math.cos(theta)
+
+
+def test_glass_slab_shifts_the_ray_by_the_analytic_offset():
+    theta = 30.0
+    slab = whitted.Box(min=(-5, -5, -0.5), max=(5, 5, 0.5), material=_glass(1.5))
+    base, _ = _centroid_x(_target_scene([], theta))
+    shifted, _ = _centroid_x(_target_scene([slab], theta))
+    # d = t sin(theta - theta_t) / cos(theta_t) = sin(10.529°) / cos(19.471°) = 0.19381
+    expected = _parallel_shift(math.radians(theta), [(1.0, 1.5)])
+    assert expected == pytest.approx(0.19381, abs=1e-5)
+    assert abs(base) < 0.2 * PIXEL
+    assert abs(shifted - base) == pytest.approx(expected, abs=0.3 * PIXEL)
+
+
+def test_water_inside_ice_uses_the_ratio_of_their_indices():
+    """Ice slab (n = 1.309, 2 thick) holding a water slab (n = 1.333, 1 thick): the ray bends at
+    the ice/water interfaces by n_ice/n_water, not by 1/n_water."""
+    theta = 40.0
+    ice = whitted.Box(min=(-5, -5, -1), max=(5, 5, 1), material=_glass(1.309))
+    water = whitted.Box(min=(-4, -4, -0.5), max=(4, 4, 0.5), material=_glass(1.333))
+    base, _ = _centroid_x(_target_scene([], theta))
+    shifted, _ = _centroid_x(_target_scene([ice, water], theta))
+    th = math.radians(theta)
+    right = _parallel_shift(th, [(1.0, 1.309), (1.0, 1.333)])
+    # a renderer that forgets the ice around the water bends at the ice/water interface with
+    # eta = 1/1.333 instead of 1.309/1.333: inside the water tan(theta) differs by ~0.154
+    sin_ice = math.sin(th) / 1.309
+    tan_right = math.tan(math.asin(sin_ice * 1.309 / 1.333))
+    tan_wrong = math.tan(math.asin(sin_ice / 1.333))
+    assert (tan_right - tan_wrong) * math.cos(th) > 10 * PIXEL  # the test can tell them apart
+    assert abs(shifted - base) == pytest.approx(right, abs=0.3 * PIXEL)
+
+
+def test_beer_lambert_absorption_along_the_path():
+    # normal incidence through 2 units with attenuation 0.5: exp(-1)
+    slab = whitted.Box(min=(-5, -5, -1), max=(5, 5, 1), material=_glass(1.5, attenuation=0.5))
+    scene = _target_scene([slab], 0.0, samples=1)
+    value = whitted.render(scene).pixels[30, 200]
+    assert value == pytest.approx([math.exp(-1.0)] * 3, rel=1e-6)
+
+
+def test_nested_absorption_adds_per_segment():
+    # ice 0.5 thick on each side (attenuation 0.2), water 1 thick inside (attenuation 1.0)
+    ice = whitted.Box(min=(-5, -5, -1), max=(5, 5, 1), material=_glass(1.309, 0.2))
+    water = whitted.Box(min=(-4, -4, -0.5), max=(4, 4, 0.5), material=_glass(1.333, 1.0))
+    scene = _target_scene([ice, water], 0.0, samples=1)
+    value = whitted.render(scene).pixels[30, 200]
+    assert value == pytest.approx([math.exp(-(0.2 * 1.0 + 1.0 * 1.0))] * 3, rel=1e-6)
+
+
+def test_coloured_absorption_tints_shadows():
+    """A point light shining through an absorbing cube onto a white floor: the shadow is tinted
+    by exp(-attenuation * path) per channel."""
+    atten = (0.1, 0.5, 1.0)
+    cube = whitted.Box(min=(-1, 1, -1), max=(1, 2, 1),
+                       material=whitted.Material(color=(1, 1, 1), ka=0, kd=0, ks=0, kt=1.0, ior=1.0,
+                                                 attenuation=atten))
+    floor = whitted.Plane(point=(0, 0, 0), normal=(0, 1, 0),
+                          material=whitted.Material(color=(1, 1, 1), ka=0, kd=1, ks=0))
+    scene = whitted.Scene(
+        render=whitted.RenderSettings(width=1, height=1, max_depth=0),
+        camera=whitted.Camera(position=(0.0, 0.5, 0.001), look_at=(0.0, 0.0, 0.0), fov=0.1),
+        lights=[whitted.PointLight(position=(0, 10, 0))],
+        objects=[cube, floor],
+    )
+    value = whitted.render(scene).pixels[0, 0]
+    hit = np.array([0.0, 0.0, 0.0])  # the pixel sees the floor straight below the camera
+    expected = np.exp(-np.array(atten) * 1.0)  # 1 unit of cube on the vertical light path
+    n_dot_l = (np.array([0, 10, 0]) - hit)[1] / 10.0
+    assert value == pytest.approx(expected * n_dot_l, rel=2e-3)
