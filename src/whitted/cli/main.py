@@ -11,8 +11,15 @@ from typing import Annotated
 
 import numpy as np
 import typer
+from pydantic import ValidationError
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeRemainingColumn
+
+try:  # typer vendors click from 0.2x on; older releases depend on click itself
+    from typer._click.exceptions import UsageError
+except ImportError:  # pragma: no cover - depends on the installed typer
+    from click.exceptions import UsageError
 
 from .. import __version__
 from ..errors import WhittedError
@@ -35,7 +42,7 @@ EXIT_INTERRUPTED = 130
 
 def fail(message: str) -> typer.Exit:
     """One line on stderr, exit status 2: the way every user mistake ends."""
-    err.print(f"[bold red]error:[/] {message}", soft_wrap=True)
+    err.print(f"[bold red]error:[/] {escape(message)}", soft_wrap=True)
     return typer.Exit(EXIT_USER_ERROR)
 
 
@@ -111,8 +118,8 @@ def render(
                                     transfer=transfer)
     except WhittedError as exc:
         raise fail(str(exc)) from None
-    except ValueError as exc:  # an override out of range
-        raise fail(f"{name}: {_first_line(exc)}") from None
+    except ValidationError as exc:  # a command-line override out of range
+        raise fail(_override_error(exc)) from None
     if not output.parent.exists():
         raise fail(f"{output}: the folder {output.parent} does not exist")
 
@@ -154,14 +161,16 @@ def _save_npy(path: Path, array: np.ndarray) -> None:
     atomic_write(path, lambda tmp: np.save(tmp, array))
 
 
-def _first_line(exc: Exception) -> str:
-    from pydantic import ValidationError
+def _override_error(exc: ValidationError) -> str:
+    """One line for a command-line value the render settings reject."""
+    from ..scene.io import _clean_message
 
-    if isinstance(exc, ValidationError):
-        e = exc.errors()[0]
-        loc = ".".join(str(p) for p in e["loc"])
-        return f"render.{loc}: {e['msg'].lower()}"
-    return str(exc).splitlines()[0]
+    e = exc.errors()[0]
+    if e["loc"]:
+        option = "--" + str(e["loc"][0]).replace("_", "-")
+    else:  # the only whole-settings check is the image size
+        option = "--width/--height"
+    return f"{option}: {_clean_message(e)}"
 
 
 def _run_with_progress(job, quiet: bool) -> None:
@@ -235,8 +244,18 @@ def info(
 
 
 def main() -> None:
-    """Console entry point."""
+    """Console entry point: usage mistakes end as one ``error:`` line and status 2."""
     try:
-        app()
+        code = app(standalone_mode=False)
+    except UsageError as exc:
+        command = "whitted" if exc.ctx is None or exc.ctx.parent is None else (
+            f"whitted {exc.ctx.info_name}"
+        )
+        hint = f" (see '{command} --help')"
+        err.print(f"[bold red]error:[/] {escape(exc.format_message())}{hint}", soft_wrap=True)
+        sys.exit(EXIT_USER_ERROR)
+    except typer.Abort:
+        sys.exit(EXIT_INTERRUPTED)
     except KeyboardInterrupt:
         sys.exit(EXIT_INTERRUPTED)
+    sys.exit(code if isinstance(code, int) else 0)

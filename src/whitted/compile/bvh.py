@@ -515,27 +515,19 @@ def bvh_stats(bvh: BVH) -> dict:
         }
     is_leaf = bvh.node_count > 0
     leaf_sizes = bvh.node_count[is_leaf]
-    # depth of each node: children inherit parent depth + 1. In the depth-first layout every
-    # child has a larger index than its parent, so one pass per tree level settles all depths.
-    depth = np.zeros(m, np.int64)
-    interior = np.flatnonzero(~is_leaf)
-    left = interior + 1
-    right = bvh.node_offset[interior].astype(np.int64)
-    known = np.zeros(m, bool)
-    known[0] = True
+    # walk the tree level by level (vectorised over each level's nodes)
+    max_depth = 0
+    level = np.zeros(1, np.int64)
     while True:
-        ready = known[interior] & ~(known[left] & known[right])
-        if not ready.any():
+        inner = level[~is_leaf[level]]
+        if inner.size == 0:
             break
-        p = interior[ready]
-        depth[left[ready]] = depth[p] + 1
-        depth[right[ready]] = depth[p] + 1
-        known[left[ready]] = True
-        known[right[ready]] = True
+        level = np.concatenate([inner + 1, bvh.node_offset[inner].astype(np.int64)])
+        max_depth += 1
     return {
         "nodes": m,
         "leaves": int(is_leaf.sum()),
-        "max_depth": int(depth.max()),
+        "max_depth": max_depth,
         "mean_leaf_size": float(leaf_sizes.mean()),
         "max_leaf_size": int(leaf_sizes.max()),
     }

@@ -15,16 +15,24 @@ TINY_DIRECTION = 1e-30  # stands in for a zero direction component in the slab t
 @kernel
 def to_object(xforms, xf, o, d):
     """Ray (o, d) mapped by the world-to-object matrix ``xforms[xf]``; t is unchanged."""
-    m = xforms[xf]
     lo = (
-        m[0, 0] * o[0] + m[0, 1] * o[1] + m[0, 2] * o[2] + m[0, 3],
-        m[1, 0] * o[0] + m[1, 1] * o[1] + m[1, 2] * o[2] + m[1, 3],
-        m[2, 0] * o[0] + m[2, 1] * o[1] + m[2, 2] * o[2] + m[2, 3],
+        xforms[xf, 0, 0] * o[0]
+        + xforms[xf, 0, 1] * o[1]
+        + xforms[xf, 0, 2] * o[2]
+        + xforms[xf, 0, 3],
+        xforms[xf, 1, 0] * o[0]
+        + xforms[xf, 1, 1] * o[1]
+        + xforms[xf, 1, 2] * o[2]
+        + xforms[xf, 1, 3],
+        xforms[xf, 2, 0] * o[0]
+        + xforms[xf, 2, 1] * o[1]
+        + xforms[xf, 2, 2] * o[2]
+        + xforms[xf, 2, 3],
     )
     ld = (
-        m[0, 0] * d[0] + m[0, 1] * d[1] + m[0, 2] * d[2],
-        m[1, 0] * d[0] + m[1, 1] * d[1] + m[1, 2] * d[2],
-        m[2, 0] * d[0] + m[2, 1] * d[1] + m[2, 2] * d[2],
+        xforms[xf, 0, 0] * d[0] + xforms[xf, 0, 1] * d[1] + xforms[xf, 0, 2] * d[2],
+        xforms[xf, 1, 0] * d[0] + xforms[xf, 1, 1] * d[1] + xforms[xf, 1, 2] * d[2],
+        xforms[xf, 2, 0] * d[0] + xforms[xf, 2, 1] * d[1] + xforms[xf, 2, 2] * d[2],
     )
     return lo, ld
 
@@ -45,14 +53,14 @@ def world_normal(geo, i, p):
     xf = geo.prim_xform[i]
     if xf < 0:
         return normal_local(geo.prim_type[i], geo.prim_params, i, p)
-    m = geo.xforms[xf]
-    lp, _ = to_object(geo.xforms, xf, p, p)
+    m = geo.xforms
+    lp, _ = to_object(m, xf, p, p)
     n = normal_local(geo.prim_type[i], geo.prim_params, i, lp)
     return normalize(
         (
-            m[0, 0] * n[0] + m[1, 0] * n[1] + m[2, 0] * n[2],
-            m[0, 1] * n[0] + m[1, 1] * n[1] + m[2, 1] * n[2],
-            m[0, 2] * n[0] + m[1, 2] * n[1] + m[2, 2] * n[2],
+            m[xf, 0, 0] * n[0] + m[xf, 1, 0] * n[1] + m[xf, 2, 0] * n[2],
+            m[xf, 0, 1] * n[0] + m[xf, 1, 1] * n[1] + m[xf, 2, 1] * n[2],
+            m[xf, 0, 2] * n[0] + m[xf, 1, 2] * n[1] + m[xf, 2, 2] * n[2],
         )
     )
 
@@ -65,24 +73,29 @@ def _safe_inverse(x):
 
 
 @kernel
-def _box_entry(geo, node, o, inv, tmax):
-    """Entry distance of the ray into node's box, or INF when it misses within (0, tmax)."""
-    lo = geo.node_min[node]
-    hi = geo.node_max[node]
-    t0 = (lo[0] - o[0]) * inv[0]
-    t1 = (hi[0] - o[0]) * inv[0]
+def inverse_direction(d):
+    """1/d per component, with zero components replaced by a huge finite value so the slab
+    test never computes 0·inf."""
+    return (_safe_inverse(d[0]), _safe_inverse(d[1]), _safe_inverse(d[2]))
+
+
+@kernel
+def box_entry(bmin, bmax, node, o, inv, tmin, tmax):
+    """Entry distance of the ray into box ``node`` when it overlaps (tmin, tmax), else INF."""
+    t0 = (bmin[node, 0] - o[0]) * inv[0]
+    t1 = (bmax[node, 0] - o[0]) * inv[0]
     tn = min(t0, t1)
     tf = max(t0, t1)
-    t0 = (lo[1] - o[1]) * inv[1]
-    t1 = (hi[1] - o[1]) * inv[1]
+    t0 = (bmin[node, 1] - o[1]) * inv[1]
+    t1 = (bmax[node, 1] - o[1]) * inv[1]
     tn = max(tn, min(t0, t1))
     tf = min(tf, max(t0, t1))
-    t0 = (lo[2] - o[2]) * inv[2]
-    t1 = (hi[2] - o[2]) * inv[2]
+    t0 = (bmin[node, 2] - o[2]) * inv[2]
+    t1 = (bmax[node, 2] - o[2]) * inv[2]
     tn = max(tn, min(t0, t1))
     tf = min(tf, max(t0, t1))
-    # the 1e-9 relative slack keeps flat boxes (a rectangle in a plane) from being missed
-    if tf * (1.0 + 1e-9) + 1e-12 < max(tn, 0.0) or tn > tmax:
+    # the relative slack keeps flat boxes (a rectangle in a plane) from being missed
+    if tf * (1.0 + 1e-9) + 1e-12 < max(tn, tmin) or tn > tmax:
         return INF
     return tn
 
@@ -101,8 +114,10 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
             best = i
     if geo.node_min.shape[0] == 0:
         return best_t, best
-    inv = (_safe_inverse(d[0]), _safe_inverse(d[1]), _safe_inverse(d[2]))
-    if _box_entry(geo, 0, o, inv, best_t) == INF:
+    bmin = geo.node_min
+    bmax = geo.node_max
+    inv = inverse_direction(d)
+    if box_entry(bmin, bmax, 0, o, inv, tmin, best_t) == INF:
         return best_t, best
     top = 0
     stack[0] = 0
@@ -121,8 +136,8 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
             continue
         left = node + 1
         right = geo.node_offset[node]
-        t_left = _box_entry(geo, left, o, inv, best_t)
-        t_right = _box_entry(geo, right, o, inv, best_t)
+        t_left = box_entry(bmin, bmax, left, o, inv, tmin, best_t)
+        t_right = box_entry(bmin, bmax, right, o, inv, tmin, best_t)
         # push the farther child first so the nearer one is visited next
         if t_left <= t_right:
             if t_right != INF:

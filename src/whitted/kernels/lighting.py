@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from .accel import closest_hit, hit_primitive, world_normal
+from .accel import box_entry, closest_hit, hit_primitive, inverse_direction, world_normal
 from .intersect import INF
 from .jit import kernel
 from .layout import (
@@ -52,30 +52,15 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
             seen_transparent = 2
     if geo.node_min.shape[0] == 0:
         return seen_transparent
+    bmin = geo.node_min
+    bmax = geo.node_max
+    inv = inverse_direction(d)
     top = 0
     stack[0] = 0
     while top >= 0:
         node = stack[top]
         top -= 1
-        lo = geo.node_min[node]
-        hi = geo.node_max[node]
-        tn = 0.0
-        tf = tmax
-        inside = True
-        for k in range(3):
-            if d[k] == 0.0:
-                if o[k] < lo[k] or o[k] > hi[k]:
-                    inside = False
-                    break
-                continue
-            inv = 1.0 / d[k]
-            t0 = (lo[k] - o[k]) * inv
-            t1 = (hi[k] - o[k]) * inv
-            if t0 > t1:
-                t0, t1 = t1, t0
-            tn = max(tn, t0)
-            tf = min(tf, t1)
-        if not inside or tn > tf * (1.0 + 1e-9) + 1e-12:
+        if box_entry(bmin, bmax, node, o, inv, tmin, tmax) == INF:
             continue
         count = geo.node_count[node]
         if count > 0:

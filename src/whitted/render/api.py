@@ -140,7 +140,7 @@ def warm_up_kernels() -> float:
         if _kernels_ready:
             return 0.0
         start = time.perf_counter()
-        from ..kernels.tiles import render_aovs, render_tiles
+        from ..kernels.tiles import lane_workspace, render_aovs, render_tiles
 
         scene = Scene()
         compiled = compile_scene(scene)
@@ -149,9 +149,10 @@ def warm_up_kernels() -> float:
         fb = np.zeros((1, 1, 3), np.float32)
         counters = np.zeros((1, N_RAY_KINDS), np.int64)
         render_tiles(np.zeros((1, 4), np.int32), fb, compiled.geometry, compiled.materials,
-                     compiled.lights, params, counters, 0, 1)
+                     compiled.lights, params, counters, lane_workspace(params.max_depth), 0, 1)
         render_aovs(compiled.geometry, params, np.zeros((1, 1), np.float32),
-                    np.zeros((1, 1, 3), np.float32), np.zeros((1, 1), np.int32), 0, 1)
+                    np.zeros((1, 1, 3), np.float32), np.zeros((1, 1), np.int32),
+                    lane_workspace(0), 0, 1)
         _kernels_ready = True
         return time.perf_counter() - start
 
@@ -223,7 +224,7 @@ class RenderJob:
         self.progress(Progress(done, total, int(counters[:done].sum()), elapsed, eta, chunk))
 
     def run(self) -> Image:
-        from ..kernels.tiles import render_tiles
+        from ..kernels.tiles import lane_workspace, render_tiles
 
         wall_start = time.perf_counter()
         stats = self.stats
@@ -240,6 +241,7 @@ class RenderJob:
         render_start = time.perf_counter()
         done = 0
         pool = ThreadPoolExecutor(lanes, thread_name_prefix="whitted-lane") if lanes > 1 else None
+        workspaces = [lane_workspace(params.max_depth) for _ in range(lanes)]
         try:
             while done < len(tiles) and not self.cancel_token.cancelled:
                 chunk = tiles[done : done + batch]
@@ -247,7 +249,8 @@ class RenderJob:
 
                 def lane_work(lane: int, n: int, chunk=chunk, chunk_counters=chunk_counters):
                     render_tiles(chunk, self.framebuffer, compiled.geometry, compiled.materials,
-                                 compiled.lights, params, chunk_counters, lane, n)
+                                 compiled.lights, params, chunk_counters, workspaces[lane],
+                                 lane, n)
 
                 run_lanes(lane_work, lanes, pool)
                 done += len(chunk)
@@ -284,6 +287,7 @@ def render(
 
 def render_aovs(scene: Scene, **overrides: object) -> dict[str, np.ndarray]:
     """Depth, normal and object-id images through the pixel centres (see the CLI's --aov)."""
+    from ..kernels.tiles import lane_workspace
     from ..kernels.tiles import render_aovs as aov_kernel
 
     if overrides:
@@ -298,7 +302,7 @@ def render_aovs(scene: Scene, **overrides: object) -> dict[str, np.ndarray]:
     lanes = max(1, s.threads or available_threads())
 
     def lane_work(lane: int, n: int) -> None:
-        aov_kernel(compiled.geometry, params, depth, normal, ids, lane, n)
+        aov_kernel(compiled.geometry, params, depth, normal, ids, lane_workspace(0), lane, n)
 
     with ThreadPoolExecutor(lanes) as pool:
         run_lanes(lane_work, lanes, pool)
