@@ -21,6 +21,7 @@ from .layout import (
     RAY_REFRACTION,
 )
 from .lighting import direct_light
+from .media import media_enter, media_leave
 from .vec import dot, madd
 
 # ray-stack columns: float part
@@ -150,17 +151,10 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
             if geo.prim_solid[prim]:
                 n1 = mats[media[n_media - 1], MAT_IOR] if n_media > 0 else 1.0
                 if entering:
-                    if n_out < MAX_MEDIA:
-                        scratch[n_out] = m
-                        n_out += 1
+                    n_out = media_enter(scratch, n_out, m)
                     n2 = mats[m, MAT_IOR]
                 else:
-                    for k in range(n_out - 1, -1, -1):
-                        if scratch[k] == m:
-                            for q in range(k, n_out - 1):
-                                scratch[q] = scratch[q + 1]
-                            n_out -= 1
-                            break
+                    n_out = media_leave(scratch, n_out, m)
                     n1 = mats[m, MAT_IOR]
                     n2 = mats[scratch[n_out - 1], MAT_IOR] if n_out > 0 else 1.0
             else:  # a thin sheet: light passes straight through

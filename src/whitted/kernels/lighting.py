@@ -30,9 +30,9 @@ from .layout import (
     MAT_KT,
     MAT_SHININESS,
     MAT_SPECULAR,
-    MAX_MEDIA,
     RAY_SHADOW,
 )
+from .media import media_enter, media_leave
 from .sampling import concentric_disk, random01, stratum
 from .vec import dot, madd, normalize, sub, vload
 
@@ -122,16 +122,9 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
             n = world_normal(geo, prim, madd(o, d, t))
             entering = dot(d, n) < 0.0
             if entering:
-                if count < MAX_MEDIA:
-                    scratch[count] = m
-                    count += 1
+                count = media_enter(scratch, count, m)
             else:
-                for k in range(count - 1, -1, -1):
-                    if scratch[k] == m:
-                        for q in range(k, count - 1):
-                            scratch[q] = scratch[q + 1]
-                        count -= 1
-                        break
+                count = media_leave(scratch, count, m)
         if entering:
             tr *= kt * mats[m, MAT_COLOR]
             tg *= kt * mats[m, MAT_COLOR + 1]
