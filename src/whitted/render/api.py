@@ -221,7 +221,7 @@ class RenderJob:
             return
         elapsed = time.perf_counter() - start
         eta = elapsed / done * (total - done) if done else None
-        self.progress(Progress(done, total, int(counters[:done].sum()), elapsed, eta, chunk))
+        self.progress(Progress(done, total, int(counters.sum()), elapsed, eta, chunk))
 
     def run(self) -> Image:
         from ..kernels.tiles import lane_workspace, render_tiles
@@ -236,25 +236,33 @@ class RenderJob:
         counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
         stats.tiles_total = len(tiles)
         lanes = self.threads
-        # batches small enough for frequent progress, large enough to keep threads busy
-        batch = max(lanes * 8, len(tiles) // 64)
         render_start = time.perf_counter()
         done = 0
+        lock = threading.Lock()
+
+        def lane_work(lane: int, n: int) -> None:
+            """Lane ``lane`` renders tiles lane, lane + n, ... in small calls, with no barrier
+            between lanes, checking for cancellation and reporting progress between calls."""
+            nonlocal done
+            mine = np.arange(lane, len(tiles), n)
+            per_call = max(1, -(-len(mine) // 64))  # ~64 progress updates per lane
+            work = lane_workspace(params.max_depth)
+            for start in range(0, len(mine), per_call):
+                if self.cancel_token.cancelled:
+                    return
+                idx = mine[start : start + per_call]
+                part = np.ascontiguousarray(tiles[idx])
+                part_counters = np.zeros((len(idx), N_RAY_KINDS), np.int64)
+                render_tiles(part, self.framebuffer, compiled.geometry, compiled.materials,
+                             compiled.lights, params, part_counters, work, 0, 1)
+                with lock:
+                    counters[idx] = part_counters
+                    done += len(idx)
+                    self._report(done, len(tiles), counters, render_start, part)
+
         pool = ThreadPoolExecutor(lanes, thread_name_prefix="whitted-lane") if lanes > 1 else None
-        workspaces = [lane_workspace(params.max_depth) for _ in range(lanes)]
         try:
-            while done < len(tiles) and not self.cancel_token.cancelled:
-                chunk = tiles[done : done + batch]
-                chunk_counters = counters[done : done + batch]
-
-                def lane_work(lane: int, n: int, chunk=chunk, chunk_counters=chunk_counters):
-                    render_tiles(chunk, self.framebuffer, compiled.geometry, compiled.materials,
-                                 compiled.lights, params, chunk_counters, workspaces[lane],
-                                 lane, n)
-
-                run_lanes(lane_work, lanes, pool)
-                done += len(chunk)
-                self._report(done, len(tiles), counters, render_start, chunk)
+            run_lanes(lane_work, lanes, pool)
         finally:
             if pool is not None:
                 pool.shutdown()
