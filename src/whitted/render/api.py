@@ -141,8 +141,9 @@ def warm_up_kernels() -> float:
             return 0.0
         start = time.perf_counter()
         from ..kernels.tiles import lane_workspace, render_aovs, render_tiles
+        from ..scene.shapes import Sphere
 
-        scene = Scene()
+        scene = Scene(objects=[Sphere(radius=1.0)])  # one bounded shape: the BVH builder too
         compiled = compile_scene(scene)
         params = render_params(scene, compiled, scene.render.model_copy(update={"width": 1,
                                                                                  "height": 1}))
