@@ -14,6 +14,7 @@ import tomli_w
 from pydantic import BaseModel, ValidationError
 
 from ..errors import SceneError
+from .materials import Material
 from .scene import Scene
 
 SCENE_SUFFIXES = (".toml", ".json")
@@ -21,7 +22,8 @@ SCENE_SUFFIXES = (".toml", ".json")
 # Names pydantic puts into an error location for union members; they are not scene keys.
 _UNION_TAGS = {"str", "int", "float", "bool", "Material", "Transform", "Gradient", "AxisAngle"}
 _SHAPE_AND_LIGHT_TAGS = {
-    "sphere", "plane", "rectangle", "disk", "triangle", "box", "cylinder", "cone",
+    "sphere", "plane", "rectangle", "disk", "triangle", "box", "cylinder", "cone", "mesh",
+    "image", "checker", "gradient",
     "ambient", "point", "directional",
 }
 
@@ -50,7 +52,33 @@ def load_scene(path: str | Path) -> Scene:
     except OSError as exc:
         raise SceneError(f"cannot read: {exc.strerror}", file=name) from None
     data = parse_scene_text(text, path.suffix.lower(), name)
-    return scene_from_dict(data, file=name, text=text)
+    scene = scene_from_dict(data, file=name, text=text).with_base_dir(path.parent)
+    _check_files(scene, name, text, data)
+    return scene
+
+
+def _check_files(scene: Scene, name: str | None, text: str | None, data: Any) -> None:
+    """Every model and texture file the scene names exists (read later, when compiled)."""
+    named: list[tuple[list[str | int], str]] = []
+    for i, obj in enumerate(scene.objects):
+        if getattr(obj, "file", None):
+            named.append((["objects", i, "file"], obj.file))
+        mat = obj.material
+        if isinstance(mat, Material) and getattr(mat.texture, "file", None):
+            named.append((["objects", i, "material", "texture", "file"], mat.texture.file))
+    for key, mat in scene.materials.items():
+        if mat.texture is not None and getattr(mat.texture, "file", None):
+            named.append((["materials", key, "texture", "file"], mat.texture.file))
+    for keys, file in named:
+        target = scene.resolve_path(file)
+        if not target.is_file():
+            line = None
+            if text is not None:
+                line = (_json_line(text, keys, data) if name and name.endswith(".json")
+                        else _toml_line(text, keys))
+            problem = "is a directory" if target.is_dir() else "no such file"
+            raise SceneError(f"{problem}: {file!r} (looked in {target.parent})", file=name,
+                             where=_format_path(keys), line=line)
 
 
 def parse_scene_text(text: str, suffix: str, name: str | None = None) -> dict[str, Any]:
@@ -153,7 +181,9 @@ def _clean_loc(loc: tuple[Any, ...]) -> list[str | int]:
             if not dict_key and (item in _UNION_TAGS or "[" in item or "-" in item):
                 continue
             # the discriminator tag pydantic inserts after objects[i] / lights[i]
-            if item in _SHAPE_AND_LIGHT_TAGS and i >= 1 and isinstance(loc[i - 1], int):
+            if item in _SHAPE_AND_LIGHT_TAGS and i >= 1 and (
+                isinstance(loc[i - 1], int) or loc[i - 1] == "texture"
+            ):
                 continue
         out.append(item)
     return out

@@ -6,6 +6,7 @@ from typing import Literal
 
 from pydantic import Field, model_validator
 
+from .textures import Texture
 from .types import Colour, Finite, Strict, Unit
 
 
@@ -16,6 +17,9 @@ class Material(Strict):
     kr·Ir + kt·It`` where ``spec`` is ``(r·v)^shininess`` (phong) or ``(n·h)^shininess`` (blinn).
     ``attenuation`` is the Beer–Lambert absorption coefficient per unit length inside the body
     (``exp(-attenuation·distance)``), a number or a colour-wise triple.
+
+    ``texture`` multiplies ``color`` by a texture's value at the hit's (u, v); when a texture
+    is given and ``color`` is not, ``color`` is white, so the texture shows as it is.
     """
 
     preset: str | None = None
@@ -32,6 +36,7 @@ class Material(Strict):
     ior: float = Field(default=1.0, gt=0.0, le=10.0)
     attenuation: Finite | tuple[Finite, Finite, Finite] = 0.0
     fresnel: bool = False
+    texture: Texture | None = None
 
     @model_validator(mode="before")
     @classmethod
@@ -50,6 +55,12 @@ class Material(Strict):
         values = self.attenuation if isinstance(self.attenuation, tuple) else (self.attenuation,)
         if any(v < 0 for v in values):
             raise ValueError("attenuation must be >= 0")
+        return self
+
+    @model_validator(mode="after")
+    def _white_under_texture(self) -> Material:
+        if self.texture is not None and "color" not in self.model_fields_set:
+            object.__setattr__(self, "color", (1.0, 1.0, 1.0))
         return self
 
     def attenuation_rgb(self) -> tuple[float, float, float]:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, PrivateAttr, model_validator
 
 from .camera import Camera
 from .lights import Light
@@ -52,6 +52,23 @@ class Scene(Strict):
     materials: dict[str, Material] = Field(default_factory=dict)
     lights: list[Light] = Field(default_factory=list)
     objects: list[Shape] = Field(default_factory=list)
+    # folder that relative file names (models, textures) are relative to: the scene file's
+    # folder when loaded from a file, else the current directory
+    _base_dir: Path | None = PrivateAttr(default=None)
+
+    @property
+    def base_dir(self) -> Path:
+        return self._base_dir if self._base_dir is not None else Path.cwd()
+
+    def with_base_dir(self, folder: str | Path | None) -> Scene:
+        """This scene with relative file names taken relative to ``folder``."""
+        self._base_dir = None if folder is None else Path(folder).resolve()
+        return self
+
+    def resolve_path(self, name: str | Path) -> Path:
+        """The file a scene names: absolute as given, else relative to :attr:`base_dir`."""
+        p = Path(name).expanduser()
+        return p if p.is_absolute() else self.base_dir / p
 
     @model_validator(mode="after")
     def _material_names_resolve(self) -> Scene:

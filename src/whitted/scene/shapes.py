@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from pathlib import Path
+from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import BeforeValidator, Field, PlainSerializer, model_validator
 
 from .materials import Material
 from .types import Direction, Strict, Transform, Vec3
@@ -135,7 +136,127 @@ class Cone(_Shape):
         return self
 
 
+class ArrayData:
+    """An immutable NumPy array inside a scene model: compares by value, saves as a list."""
+
+    __slots__ = ("array",)
+
+    def __init__(self, array: np.ndarray) -> None:
+        array = np.ascontiguousarray(array)
+        array.setflags(write=False)
+        self.array = array
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, ArrayData):
+            return self.array.shape == other.array.shape and bool(
+                np.array_equal(self.array, other.array)
+            )
+        return NotImplemented
+
+    def __hash__(self) -> int:
+        return hash((self.array.shape, self.array.tobytes()))
+
+    def __len__(self) -> int:
+        return len(self.array)
+
+    def __array__(self, dtype=None, copy=None):
+        return self.array if dtype is None else self.array.astype(dtype)
+
+    def __repr__(self) -> str:
+        return f"ArrayData(shape={self.array.shape}, dtype={self.array.dtype})"
+
+
+def _array_of(columns: int, kind: str):
+    def convert(value: object) -> ArrayData:
+        if isinstance(value, ArrayData):
+            value = value.array
+        try:
+            a = np.asarray(value, dtype=np.float64 if kind == "f" else np.int64)
+        except (TypeError, ValueError):
+            raise ValueError(f"expected a list of [{columns} numbers] rows") from None
+        if kind == "i" and np.asarray(value).dtype.kind == "f":
+            raise ValueError("indices must be whole numbers")
+        if a.size == 0:
+            a = a.reshape(0, columns)
+        if a.ndim != 2 or a.shape[1] != columns:
+            raise ValueError(f"expected rows of {columns} numbers, got shape {a.shape}")
+        if kind == "f" and not np.isfinite(a).all():
+            raise ValueError("values must be finite")
+        return ArrayData(a.astype(np.float64 if kind == "f" else np.int64))
+
+    return Annotated[
+        Any,
+        BeforeValidator(convert),
+        PlainSerializer(lambda v: v.array.tolist(), return_type=list),
+    ]
+
+
+Points3 = _array_of(3, "f")
+Points2 = _array_of(2, "f")
+Indices3 = _array_of(3, "i")
+
+
+class Mesh(_Shape):
+    """A triangle mesh: from a model ``file`` (OBJ with its MTL, PLY, STL, OFF, glTF/GLB; path
+    relative to the scene file) or from arrays: ``vertices`` (N x 3), ``faces`` (M x 3,
+    0-based), optional per-vertex ``normals`` (N x 3) and ``uvs`` (N x 2).
+
+    ``material`` overrides every material of the file. ``smooth``: unset uses the file's
+    normals where it has them (flat shading where not); ``true`` computes smooth normals where
+    the file has none, keeping edges sharper than ``crease_angle`` degrees; ``false`` shades
+    flat. ``solid``: the mesh bounds a volume, so rays refract into and out of it (media).
+    The same file used by several objects is loaded and stored once (instanced).
+    """
+
+    type: Literal["mesh"] = "mesh"
+    file: str | None = Field(default=None, min_length=1)
+    vertices: Points3 | None = None
+    faces: Indices3 | None = None
+    normals: Points3 | None = None
+    uvs: Points2 | None = None
+    smooth: bool | None = None
+    crease_angle: float = Field(default=60.0, ge=0.0, le=180.0)
+    solid: bool = True
+
+    def __init__(self, vertices: Any = None, faces: Any = None, normals: Any = None,
+                 uvs: Any = None, **data: Any) -> None:
+        for key, value in (("vertices", vertices), ("faces", faces), ("normals", normals),
+                           ("uvs", uvs)):
+            if value is not None:
+                data[key] = value
+        super().__init__(**data)
+
+    @classmethod
+    def from_file(cls, path: str | Path, **fields: Any) -> Mesh:
+        """A mesh object for the model at ``path``, loaded now so a bad file fails here."""
+        from ..assets import load_mesh
+
+        load_mesh(path)
+        return cls(file=str(path), **fields)
+
+    @model_validator(mode="after")
+    def _one_source(self) -> Mesh:
+        inline = self.vertices is not None or self.faces is not None
+        if (self.file is not None) == inline:
+            raise ValueError("give either file, or vertices + faces")
+        if inline:
+            if self.vertices is None or self.faces is None:
+                raise ValueError("vertices and faces go together")
+            n = len(self.vertices)
+            f = self.faces.array
+            if f.size and (f.min() < 0 or f.max() >= n):
+                raise ValueError(f"faces index vertices 0..{n - 1}; found {int(f.min())}.."
+                                 f"{int(f.max())}")
+            for key in ("normals", "uvs"):
+                extra = getattr(self, key)
+                if extra is not None and len(extra) != n:
+                    raise ValueError(f"{key} has {len(extra)} rows, vertices has {n}")
+        elif self.normals is not None or self.uvs is not None:
+            raise ValueError("normals and uvs go with vertices + faces, not with file")
+        return self
+
+
 Shape = Annotated[
-    Sphere | Plane | Rectangle | Disk | Triangle | Box | Cylinder | Cone,
+    Sphere | Plane | Rectangle | Disk | Triangle | Box | Cylinder | Cone | Mesh,
     Field(discriminator="type"),
 ]
