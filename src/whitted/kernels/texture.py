@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .jit import kernel
 from .texture_layout import (
     AXIS_U,
@@ -46,11 +48,13 @@ from .texture_layout import (
 @kernel
 def _unit_coordinate(t, wrap):
     """A finite texture coordinate brought into [0, 1]: its fractional part (repeat, period 1)
-    or clamped (clamp). Both keep every later texel index small, whatever the size of t."""
+    or clamped (clamp). Both keep every later texel index small, whatever the size of t.
+
+    (``np.floor`` throughout: Numba's ``math.floor`` returns an int64, which overflows.)"""
     if wrap == WRAP_CLAMP:
         return min(max(t, 0.0), 1.0)
     # t - floor(t) is in [0, 1), except that it rounds up to 1.0 for tiny negative t
-    return min(t - math.floor(t), 1.0)
+    return min(t - np.floor(t), 1.0)
 
 
 @kernel
@@ -87,13 +91,13 @@ def _image_color(tex_info, tex_pixels, k, us, vs):
     s = _unit_coordinate(us, wrap)
     t = 1.0 - _unit_coordinate(vs, wrap)  # measured down from the top row
     if int(tex_info[k, TEX_FILTER]) == FILTER_NEAREST:
-        col = _texel_index(int(math.floor(s * width)), width, wrap)
-        row = _texel_index(int(math.floor(t * height)), height, wrap)
+        col = _texel_index(int(np.floor(s * width)), width, wrap)
+        row = _texel_index(int(np.floor(t * height)), height, wrap)
         return _texel(tex_pixels, base, width, row, col)
     x = s * width - 0.5
     y = t * height - 0.5
-    x_floor = math.floor(x)
-    y_floor = math.floor(y)
+    x_floor = np.floor(x)
+    y_floor = np.floor(y)
     fx = x - x_floor
     fy = y - y_floor
     col0 = _texel_index(int(x_floor), width, wrap)
@@ -116,7 +120,7 @@ def _image_color(tex_info, tex_pixels, k, us, vs):
 @kernel
 def _parity(f):
     """0.0 for an even integer-valued float, 1.0 for an odd one (exact for any finite f)."""
-    return f - 2.0 * math.floor(f * 0.5)
+    return f - 2.0 * np.floor(f * 0.5)
 
 
 @kernel
@@ -142,7 +146,7 @@ def texture_color(tex_info, tex_pixels, k, u, v):
         b = vs * checks
         if not (math.isfinite(a) and math.isfinite(b)):
             return _color(tex_info, k, TEX_COLOR1)
-        if _parity(math.floor(a)) != _parity(math.floor(b)):
+        if _parity(np.floor(a)) != _parity(np.floor(b)):
             return _color(tex_info, k, TEX_COLOR2)
         return _color(tex_info, k, TEX_COLOR1)
     if kind == TEX_GRADIENT:
