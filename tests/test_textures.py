@@ -366,3 +366,26 @@ def test_any_finite_uv_gives_a_colour_of_the_texture(random_textures, u: float, 
     assert lookup(arrays, u, v, 4) in ((0.9, 0.9, 0.9), (0.1, 0.1, 0.1))
     gradient = np.array(lookup(arrays, u, v, 5))
     assert np.all(gradient >= 0.0) and np.all(gradient <= 1.0)
+
+
+# --- called from another kernel ------------------------------------------------------------
+
+
+def test_texture_color_inside_a_kernel_without_allocation(quad_png: Path):
+    """The integrator calls texture_color from compiled code built without the Numba runtime."""
+    from whitted.kernels.jit import kernel
+
+    @kernel(cache=False)
+    def shade_all(tex_info, tex_pixels, k, uv, out):
+        for i in range(uv.shape[0]):
+            r, g, b = texture_color(tex_info, tex_pixels, k, uv[i, 0], uv[i, 1])
+            out[i, 0] = r
+            out[i, 1] = g
+            out[i, 2] = b
+
+    arrays = quad(quad_png)
+    uv = np.array([[0.25, 0.75], [0.5, 0.5], [-3.2, 9.1], [np.nan, 0.0]])
+    out = np.zeros((len(uv), 3))
+    shade_all(arrays.tex_info, arrays.tex_pixels, 0, uv, out)
+    for i, (u, v) in enumerate(uv):
+        assert tuple(out[i]) == lookup(arrays, u, v)

@@ -28,8 +28,15 @@ class _Texture(Strict):
 
 
 class ImageTexture(_Texture):
-    """An image file (PNG, JPEG, ...), path relative to the scene file. ``colorspace = "srgb"``
-    decodes 8-bit colour to linear (right for photographs and painted maps)."""
+    """An image file (PNG, JPEG, BMP, TGA, ...; 8 or 16 bits; grey, palette or RGB, alpha is
+    ignored), path relative to the scene file. ``colorspace = "srgb"`` decodes the stored values
+    with the sRGB curve to linear (right for photographs and painted maps), ``"linear"`` takes
+    them as they are (data maps).
+
+    ``v = 0`` is the bottom edge of the image and ``v = 1`` its top (the OBJ / OpenGL
+    convention), ``u`` runs left to right. ``wrap = "repeat"`` tiles the image with period 1 in
+    both directions, ``"clamp"`` extends its edge pixels. ``filter = "bilinear"`` blends the four
+    nearest pixels, ``"nearest"`` takes the pixel under the point."""
 
     type: Literal["image"] = "image"
     file: str = Field(min_length=1)
