@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from whitted.compile.flatten import compile_scene
-from whitted.kernels.accel import closest_hit, world_normal
+from whitted.kernels.accel import closest_hit, surface_normals
 from whitted.scene import (
     AxisAngle,
     Box,
@@ -59,11 +59,11 @@ class Compiled:
         geo = self.compiled.geometry
         o = tuple(float(x) for x in origin)
         d = tuple(float(x) for x in direction)
-        t, prim = closest_hit(geo, o, d, float(tmin), float(tmax), self.stack)
+        t, prim, tri, b1, b2 = closest_hit(geo, o, d, float(tmin), float(tmax), self.stack)
         if prim < 0:
             return None
         p = tuple(oi + t * di for oi, di in zip(o, d, strict=True))
-        n = world_normal(geo, prim, p)
+        n, _ = surface_normals(geo, prim, tri, b1, b2, p)
         return Hit(float(t), np.array(p), np.array(n), int(geo.prim_object[prim]))
 
 

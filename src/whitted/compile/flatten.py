@@ -40,12 +40,14 @@ from ..kernels.layout import (
     MAT_KT,
     MAT_SHININESS,
     MAT_SPECULAR,
+    MAT_TEXTURE,
     N_LIGHT_PARAMS,
     N_MAT_PARAMS,
     N_PRIM_PARAMS,
     SHAPE_BOX,
     SHAPE_DISK,
     SHAPE_FRUSTUM,
+    SHAPE_MESH,
     SHAPE_PLANE,
     SHAPE_RECTANGLE,
     SHAPE_SPHERE,
@@ -56,8 +58,10 @@ from ..kernels.layout import (
 from ..scene.lights import AmbientLight, DirectionalLight, DiskLight, PointLight
 from ..scene.materials import Material
 from ..scene.scene import RenderSettings, Scene
-from ..scene.shapes import Box, Cone, Cylinder, Disk, Plane, Rectangle, Sphere, Triangle
+from ..scene.shapes import Box, Cone, Cylinder, Disk, Mesh, Plane, Rectangle, Sphere, Triangle
 from .bvh import build_bvh
+from .meshes import MeshSource, MeshTable
+from .textures import compile_textures
 
 
 @dataclass
@@ -71,6 +75,9 @@ class CompiledScene:
     bounds_min: np.ndarray  # (3,) of all bounded primitives (inf when there are none)
     bounds_max: np.ndarray
     build_seconds: float
+    warnings: list[str]  # things the user should know (dropped triangles, missing textures)
+    triangles: int = 0  # distinct mesh triangles stored (instances not multiplied)
+    instanced_triangles: int = 0  # triangles in the scene counting every instance
 
 
 class _Builder:
@@ -134,6 +141,23 @@ def _box_corners(lo, hi):
     return np.array([[x, y, z] for x in xs for y in ys for z in zs])
 
 
+def _tangent(normal) -> np.ndarray:
+    """The u direction of planar texture mapping on a surface with this normal: world x made
+    perpendicular to it (or -z for surfaces facing along x), so that seen from the front u
+    runs right and v = normal x tangent runs up."""
+    n = _unit(normal)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 0.0, -np.sign(n[0])])
+    return _unit(helper - np.dot(helper, n) * n)
+
+
+def _world_tangent(lin: np.ndarray, local_normal, world_normal) -> np.ndarray:
+    """The object's own tangent carried by its transform, so a rotated shape turns its
+    texture with it."""
+    t = lin @ _tangent(local_normal)
+    n = _unit(world_normal)
+    return _unit(t - np.dot(t, n) * n)
+
+
 def _add_shape(b: _Builder, shape, m: np.ndarray, material: int, obj: int) -> None:
     lin = m[:3, :3]
     to_world = m
@@ -150,16 +174,18 @@ def _add_shape(b: _Builder, shape, m: np.ndarray, material: int, obj: int) -> No
         c, r = np.array(shape.center), shape.radius
         if s is not None:
             cw = point(c)
-            b.add(SHAPE_SPHERE, [*cw, r * s], cw - r * s, cw + r * s,
+            frame = (lin / s).T.reshape(-1)  # rows: the object's x, y, z axes in the world
+            b.add(SHAPE_SPHERE, [*cw, r * s, *frame], cw - r * s, cw + r * s,
                   material=material, obj=obj, solid=True)
         else:
             cw = point(c)
             ext = r * np.linalg.norm(lin, axis=1)
-            b.add(SHAPE_SPHERE, [*c, r], cw - ext, cw + ext, material=material, obj=obj,
-                  solid=True, world_to_object=inv)
+            b.add(SHAPE_SPHERE, [*c, r, *np.eye(3).reshape(-1)], cw - ext, cw + ext,
+                  material=material, obj=obj, solid=True, world_to_object=inv)
     elif isinstance(shape, Plane):
-        b.add(SHAPE_PLANE, [*point(shape.point), *normal(shape.normal)], [-np.inf] * 3,
-              [np.inf] * 3, material=material, obj=obj, solid=False)
+        nw = normal(shape.normal)
+        b.add(SHAPE_PLANE, [*point(shape.point), *nw, *_world_tangent(lin, shape.normal, nw)],
+              [-np.inf] * 3, [np.inf] * 3, material=material, obj=obj, solid=False)
     elif isinstance(shape, Rectangle):
         corner = point(shape.corner)
         e1, e2 = lin @ np.array(shape.edge1), lin @ np.array(shape.edge2)
@@ -174,20 +200,21 @@ def _add_shape(b: _Builder, shape, m: np.ndarray, material: int, obj: int) -> No
         e1, e2 = v1 - v0, v2 - v0
         n = _unit(np.cross(e1, e2))
         lo, hi = _corners_bounds([v0, v1, v2])
-        b.add(SHAPE_TRIANGLE, [*v0, *e1, *e2, *n], lo, hi, material=material, obj=obj,
+        uvs = np.array(shape.uvs, dtype=np.float64).reshape(-1)
+        b.add(SHAPE_TRIANGLE, [*v0, *e1, *e2, *n, *uvs], lo, hi, material=material, obj=obj,
               solid=False)
     elif isinstance(shape, Disk):
         c, n, r = np.array(shape.center), _unit(shape.normal), shape.radius
         if s is not None:
             cw, nw = point(c), normal(n)
             lo, hi = _disk_bounds(cw, nw, r * s)
-            b.add(SHAPE_DISK, [*cw, *nw, r * s], lo, hi, material=material, obj=obj,
-                  solid=False)
+            b.add(SHAPE_DISK, [*cw, *nw, r * s, *_world_tangent(lin, n, nw)], lo, hi,
+                  material=material, obj=obj, solid=False)
         else:
             lo, hi = _disk_bounds(c, n, r)
             lo, hi = _corners_bounds(_box_corners(lo, hi), to_world)
-            b.add(SHAPE_DISK, [*c, *n, r], lo, hi, material=material, obj=obj, solid=False,
-                  world_to_object=inv)
+            b.add(SHAPE_DISK, [*c, *n, r, *_tangent(n)], lo, hi, material=material, obj=obj,
+                  solid=False, world_to_object=inv)
     elif isinstance(shape, Box):
         corner, edges = shape.corner_and_edges()
         corner_w = point(corner)
@@ -204,7 +231,9 @@ def _add_shape(b: _Builder, shape, m: np.ndarray, material: int, obj: int) -> No
         r1 = shape.radius if isinstance(shape, Cylinder) else shape.top_radius
         capped = shape.capped
         xf = None
+        tangent = _tangent(top - base)
         if s is not None:
+            tangent = _world_tangent(lin, top - base, lin @ (top - base))
             base, top, r0, r1 = point(base), point(top), r0 * s, r1 * s
         else:
             xf = inv
@@ -216,13 +245,14 @@ def _add_shape(b: _Builder, shape, m: np.ndarray, material: int, obj: int) -> No
         lo, hi = np.minimum(lo0, lo1), np.maximum(hi0, hi1)
         if xf is not None:
             lo, hi = _corners_bounds(_box_corners(lo, hi), to_world)
-        b.add(SHAPE_FRUSTUM, [*base, *axis, h, r0, r1, float(capped)], lo, hi,
+        b.add(SHAPE_FRUSTUM, [*base, *axis, h, r0, r1, float(capped), *tangent], lo, hi,
               material=material, obj=obj, solid=capped, world_to_object=xf)
     else:  # pragma: no cover - the scene model admits no other shape
         raise TypeError(f"cannot compile {type(shape).__name__}")
 
 
-def material_row(mat: Material) -> np.ndarray:
+def material_row(mat: Material, texture: int = -1) -> np.ndarray:
+    """The material table row of ``mat``; ``texture`` is its row in the texture table."""
     row = np.zeros(N_MAT_PARAMS)
     row[MAT_COLOR : MAT_COLOR + 3] = mat.color
     row[MAT_AMBIENT : MAT_AMBIENT + 3] = mat.ambient_color or mat.color
@@ -237,7 +267,63 @@ def material_row(mat: Material) -> np.ndarray:
     row[MAT_IOR] = mat.ior
     row[MAT_ATTEN : MAT_ATTEN + 3] = mat.attenuation_rgb()
     row[MAT_FRESNEL] = 1.0 if mat.fresnel else 0.0
+    row[MAT_TEXTURE] = texture
     return row
+
+
+class _MaterialTable:
+    """Material rows and the textures they use, each stored once."""
+
+    def __init__(self) -> None:
+        self.rows: list[np.ndarray] = []
+        self.index: dict[bytes, int] = {}
+        self.textures: list = []
+        self.texture_index: dict[str, int] = {}
+
+    def add(self, mat: Material) -> int:
+        tex = -1
+        if mat.texture is not None:
+            key = mat.texture.model_dump_json()
+            if key not in self.texture_index:
+                self.texture_index[key] = len(self.textures)
+                self.textures.append(mat.texture)
+            tex = self.texture_index[key]
+        row = material_row(mat, tex)
+        key = row.tobytes()
+        if key not in self.index:
+            self.index[key] = len(self.rows)
+            self.rows.append(row)
+        return self.index[key]
+
+
+def _mesh_source(scene: Scene, obj_index: int, shape: Mesh, warnings: list[str]) -> MeshSource:
+    if shape.file is not None:
+        from ..assets import load_mesh
+
+        data = load_mesh(scene.resolve_path(shape.file))
+        warnings.extend(data.warnings)
+        return MeshSource(label=shape.file, vertices=data.vertices, faces=data.faces,
+                          normals=data.normals, uvs=data.uvs, face_material=data.face_material,
+                          materials=list(data.materials))
+    assert shape.vertices is not None and shape.faces is not None
+    return MeshSource(
+        label=f"objects[{obj_index}]",
+        vertices=shape.vertices.array,
+        faces=shape.faces.array,
+        normals=None if shape.normals is None else shape.normals.array,
+        uvs=None if shape.uvs is None else shape.uvs.array,
+        face_material=np.zeros(len(shape.faces), np.int32),
+        materials=[Material()],
+    )
+
+
+def _mesh_key(scene: Scene, shape: Mesh) -> tuple:
+    """Objects with equal keys share one stored mesh (instancing)."""
+    shading = (shape.smooth, shape.crease_angle)
+    if shape.file is not None:
+        return ("file", str(scene.resolve_path(shape.file).resolve()), *shading)
+    return ("arrays", id(shape.vertices), id(shape.faces), id(shape.normals), id(shape.uvs),
+            *shading)
 
 
 def _light_rows(scene: Scene) -> tuple[np.ndarray, tuple[float, float, float]]:
@@ -281,16 +367,32 @@ def compile_scene(scene: Scene) -> CompiledScene:
 
     start = time.perf_counter()
     b = _Builder()
-    mat_rows: list[np.ndarray] = []
-    mat_index: dict[bytes, int] = {}
+    materials = _MaterialTable()
+    meshes = MeshTable()
+    mesh_of: dict[tuple, object] = {}
+    warnings: list[str] = []
+    instanced = 0
     for obj_index, shape in enumerate(scene.objects):
-        row = material_row(scene.material_of(obj_index))
-        key = row.tobytes()
-        if key not in mat_index:
-            mat_index[key] = len(mat_rows)
-            mat_rows.append(row)
         m = shape.transform.matrix() if shape.transform is not None else np.eye(4)
-        _add_shape(b, shape, m, mat_index[key], obj_index)
+        if isinstance(shape, Mesh):
+            key = _mesh_key(scene, shape)
+            if key not in mesh_of:
+                src = _mesh_source(scene, obj_index, shape, warnings)
+                rows = np.array([materials.add(mat) for mat in src.materials], np.int32)
+                mesh_of[key] = meshes.add(src, rows, shape.smooth, shape.crease_angle)
+            stored = mesh_of[key]
+            if stored is None:
+                continue
+            override = -1 if shape.material is None else materials.add(
+                scene.material_of(obj_index))
+            identity = np.array_equal(m, np.eye(4))
+            lo, hi = _corners_bounds(_box_corners(stored.lo, stored.hi), None if identity else m)
+            b.add(SHAPE_MESH, [stored.index], lo, hi, material=override, obj=obj_index,
+                  solid=shape.solid, world_to_object=None if identity else np.linalg.inv(m))
+            instanced += stored.triangles
+            continue
+        _add_shape(b, shape, m, materials.add(scene.material_of(obj_index)), obj_index)
+    warnings.extend(meshes.warnings)
 
     n = len(b.types)
     prim_type = np.array(b.types, dtype=np.int32)
@@ -315,8 +417,11 @@ def compile_scene(scene: Scene) -> CompiledScene:
         node_axis=np.ascontiguousarray(bvh.node_axis, dtype=np.int8),
         node_prims=np.ascontiguousarray(bounded[bvh.prim_order], dtype=np.int32),
         unbounded=unbounded.astype(np.int32),
+        **meshes.arrays(),
+        **compile_textures(materials.textures, scene.resolve_path)._asdict(),
     )
-    materials = np.array(mat_rows, dtype=np.float64).reshape(len(mat_rows), N_MAT_PARAMS)
+    mat_table = np.array(materials.rows, dtype=np.float64).reshape(len(materials.rows),
+                                                                    N_MAT_PARAMS)
     lights, ambient = _light_rows(scene)
     if len(bounded):
         bmin, bmax = lo[bounded].min(axis=0), hi[bounded].max(axis=0)
@@ -324,12 +429,15 @@ def compile_scene(scene: Scene) -> CompiledScene:
         bmin, bmax = np.full(3, np.inf), np.full(3, -np.inf)
     return CompiledScene(
         geometry=geometry,
-        materials=materials,
+        materials=mat_table,
         lights=lights,
         ambient=ambient,
         bounds_min=bmin,
         bounds_max=bmax,
         build_seconds=time.perf_counter() - start,
+        warnings=warnings,
+        triangles=meshes.n_tris,
+        instanced_triangles=instanced,
     )
 
 

@@ -1,5 +1,11 @@
 """Scene-level ray queries: nearest hit through the BVH (plus the unbounded planes), and the
-surface normal of a hit in world space."""
+surface normals of a hit in world space.
+
+Two levels: the scene BVH holds the analytic shapes and the mesh *instances*; an instance
+maps the ray into its mesh's space and walks the mesh's own BVH (:mod:`.mesh`). A hit is
+(t, primitive, triangle, b1, b2): ``triangle`` is -1 for analytic shapes, and (b1, b2) are
+the barycentric coordinates on the triangle.
+"""
 
 from __future__ import annotations
 
@@ -7,9 +13,12 @@ import math
 
 from .intersect import INF, intersect_local, normal_local
 from .jit import kernel
+from .layout import MAT_KT, SHAPE_MESH
+from .mesh import OPAQUE_KT, mesh_closest_hit, mesh_normals, mesh_occlusion
 from .vec import normalize
 
 TINY_DIRECTION = 1e-30  # stands in for a zero direction component in the slab test
+MESH_STACK_BASE = 64  # traversal stack entries [0, 64) for the scene BVH, the rest for meshes
 
 
 @kernel
@@ -38,24 +47,49 @@ def to_object(xforms, xf, o, d):
 
 
 @kernel
-def hit_primitive(geo, i, o, d, tmin, tmax):
+def hit_primitive(geo, i, o, d, tmin, tmax, stack):
+    """(t, triangle, b1, b2) of the ray with primitive ``i``; t = INF on a miss."""
     xf = geo.prim_xform[i]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
-    return intersect_local(geo.prim_type[i], geo.prim_params, i, o, d, tmin, tmax)
+    typ = geo.prim_type[i]
+    if typ == SHAPE_MESH:
+        mesh = int(geo.prim_params[i, 0])
+        return mesh_closest_hit(geo, mesh, o, d, inverse_direction(d), tmin, tmax, stack,
+                                MESH_STACK_BASE)
+    return intersect_local(typ, geo.prim_params, i, o, d, tmin, tmax), -1, 0.0, 0.0
 
 
 @kernel
-def world_normal(geo, i, p):
-    """Outward unit geometric normal of primitive ``i`` at world point ``p``. Under an affine
-    transform normals map by the transpose of the world-to-object matrix, which keeps them
-    perpendicular to the surface even under non-uniform scale."""
+def occludes(geo, mats, i, o, d, tmin, tmax, stack):
+    """Does primitive ``i`` block the segment (tmin, tmax)? 0: no; 1: opaquely; 2: only
+    through transparent surfaces."""
     xf = geo.prim_xform[i]
-    if xf < 0:
-        return normal_local(geo.prim_type[i], geo.prim_params, i, p)
-    m = geo.xforms
-    lp, _ = to_object(m, xf, p, p)
-    n = normal_local(geo.prim_type[i], geo.prim_params, i, lp)
+    if xf >= 0:
+        o, d = to_object(geo.xforms, xf, o, d)
+    typ = geo.prim_type[i]
+    if typ == SHAPE_MESH:
+        return mesh_occlusion(geo, mats, int(geo.prim_params[i, 0]), geo.prim_material[i], o, d,
+                              inverse_direction(d), tmin, tmax, stack, MESH_STACK_BASE)
+    if intersect_local(typ, geo.prim_params, i, o, d, tmin, tmax) == INF:
+        return 0
+    return 1 if mats[geo.prim_material[i], MAT_KT] < OPAQUE_KT else 2
+
+
+@kernel
+def hit_material(geo, prim, tri):
+    """Material row of a hit: the primitive's, or for meshes without an override the
+    triangle's own."""
+    m = geo.prim_material[prim]
+    if m < 0 and tri >= 0:
+        return geo.tri_material[tri]
+    return m
+
+
+@kernel
+def _normal_to_world(m, xf, n):
+    """Normals map by the transpose of the world-to-object matrix, which keeps them
+    perpendicular to the surface even under non-uniform scale."""
     return normalize(
         (
             m[xf, 0, 0] * n[0] + m[xf, 1, 0] * n[1] + m[xf, 2, 0] * n[2],
@@ -63,6 +97,31 @@ def world_normal(geo, i, p):
             m[xf, 0, 2] * n[0] + m[xf, 1, 2] * n[1] + m[xf, 2, 2] * n[2],
         )
     )
+
+
+@kernel
+def world_normal(geo, i, p):
+    """Outward unit geometric normal of analytic primitive ``i`` at world point ``p``."""
+    xf = geo.prim_xform[i]
+    if xf < 0:
+        return normal_local(geo.prim_type[i], geo.prim_params, i, p)
+    lp, _ = to_object(geo.xforms, xf, p, p)
+    return _normal_to_world(geo.xforms, xf,
+                            normal_local(geo.prim_type[i], geo.prim_params, i, lp))
+
+
+@kernel
+def surface_normals(geo, prim, tri, b1, b2, p):
+    """(geometric, shading) unit normals in world space of a hit at ``p``. They differ only on
+    smooth-shaded meshes; the geometric one decides which side a ray is on."""
+    if tri < 0:
+        n = world_normal(geo, prim, p)
+        return n, n
+    ng, ns = mesh_normals(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
+    xf = geo.prim_xform[prim]
+    if xf < 0:
+        return ng, ns
+    return _normal_to_world(geo.xforms, xf, ng), _normal_to_world(geo.xforms, xf, ns)
 
 
 @kernel
@@ -102,23 +161,29 @@ def box_entry(bmin, bmax, node, o, inv, tmin, tmax):
 
 @kernel
 def closest_hit(geo, o, d, tmin, tmax, stack):
-    """Nearest primitive hit by the ray in (tmin, tmax): returns (t, primitive) or (tmax, -1).
-    ``stack`` is caller-owned int32 scratch space (64 entries suffice for any SAH tree)."""
+    """Nearest hit in (tmin, tmax): (t, primitive, triangle, b1, b2), or (tmax, -1, -1, 0, 0).
+    ``stack`` is caller-owned int32 scratch space (128 entries: two levels of 64)."""
     best_t = tmax
     best = -1
+    best_tri = -1
+    best_b1 = 0.0
+    best_b2 = 0.0
     for j in range(geo.unbounded.shape[0]):
         i = geo.unbounded[j]
-        t = hit_primitive(geo, i, o, d, tmin, best_t)
+        t, tri, b1, b2 = hit_primitive(geo, i, o, d, tmin, best_t, stack)
         if t < best_t:
             best_t = t
             best = i
+            best_tri = tri
+            best_b1 = b1
+            best_b2 = b2
     if geo.node_min.shape[0] == 0:
-        return best_t, best
+        return best_t, best, best_tri, best_b1, best_b2
     bmin = geo.node_min
     bmax = geo.node_max
     inv = inverse_direction(d)
     if box_entry(bmin, bmax, 0, o, inv, tmin, best_t) == INF:
-        return best_t, best
+        return best_t, best, best_tri, best_b1, best_b2
     top = 0
     stack[0] = 0
     while top >= 0:
@@ -129,10 +194,13 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
             first = geo.node_offset[node]
             for j in range(first, first + count):
                 i = geo.node_prims[j]
-                t = hit_primitive(geo, i, o, d, tmin, best_t)
+                t, tri, b1, b2 = hit_primitive(geo, i, o, d, tmin, best_t, stack)
                 if t < best_t:
                     best_t = t
                     best = i
+                    best_tri = tri
+                    best_b1 = b1
+                    best_b2 = b2
             continue
         left = node + 1
         right = geo.node_offset[node]
@@ -153,4 +221,4 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
             if t_right != INF:
                 top += 1
                 stack[top] = right
-    return best_t, best
+    return best_t, best, best_tri, best_b1, best_b2

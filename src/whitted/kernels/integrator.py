@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from .accel import closest_hit, world_normal
+from .accel import closest_hit, hit_material, surface_normals
 from .jit import kernel
 from .layout import (
     MAT_AMBIENT,
@@ -16,12 +16,15 @@ from .layout import (
     MAT_KA,
     MAT_KR,
     MAT_KT,
+    MAT_TEXTURE,
     MAX_MEDIA,
     RAY_REFLECTION,
     RAY_REFRACTION,
 )
 from .lighting import direct_light
 from .media import media_enter, media_leave
+from .texture import texture_color
+from .uv import surface_uv
 from .vec import dot, madd
 
 # ray-stack columns: float part
@@ -74,6 +77,22 @@ def schlick(cos_i, n1, n2, cos_t):
 
 
 @kernel
+def surface_colour(geo, mats, m, prim, tri, b1, b2, p):
+    """(texture factor, diffuse colour) at a hit: the material's colour times its texture's
+    value at the point's (u, v); the factor is white when the material has no texture."""
+    k = int(mats[m, MAT_TEXTURE])
+    if k < 0:
+        return (1.0, 1.0, 1.0), (mats[m, MAT_COLOR], mats[m, MAT_COLOR + 1], mats[m, MAT_COLOR + 2])
+    u, v = surface_uv(geo, prim, tri, b1, b2, p)
+    tex = texture_color(geo.tex_info, geo.tex_pixels, k, u, v)
+    return tex, (
+        tex[0] * mats[m, MAT_COLOR],
+        tex[1] * mats[m, MAT_COLOR + 1],
+        tex[2] * mats[m, MAT_COLOR + 2],
+    )
+
+
+@kernel
 def _push(st_f, st_i, top, o, d, w, depth, media_src, n_media):
     top += 1
     for k in range(3):
@@ -106,7 +125,7 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
         for k in range(n_media):
             media[k] = st_i[top, I_MEDIA + k]
         top -= 1
-        t, prim = closest_hit(geo, o, d, 0.0, math.inf, stack)
+        t, prim, tri, b1, b2 = closest_hit(geo, o, d, 0.0, math.inf, stack)
         if n_media > 0:  # Beer-Lambert absorption in the medium the ray crossed
             cur = media[n_media - 1]
             w = (
@@ -120,35 +139,43 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
             g += w[1] * bg[1]
             b += w[2] * bg[2]
             continue
-        m = geo.prim_material[prim]
+        m = hit_material(geo, prim, tri)
         p = madd(o, d, t)
-        n_geo = world_normal(geo, prim, p)
+        n_geo, n_shade = surface_normals(geo, prim, tri, b1, b2, p)
         entering = dot(d, n_geo) < 0.0
-        n = n_geo if entering else (-n_geo[0], -n_geo[1], -n_geo[2])  # faces the ray
+        if entering:  # both normals turned to face the ray
+            n = n_geo
+        else:
+            n = (-n_geo[0], -n_geo[1], -n_geo[2])
+            n_shade = (-n_shade[0], -n_shade[1], -n_shade[2])
         v = (-d[0], -d[1], -d[2])
+        if dot(n_shade, v) <= 0.0:  # interpolated normal turned away from the eye
+            n_shade = n
+        tex, albedo = surface_colour(geo, mats, m, prim, tri, b1, b2, p)
         ka = mats[m, MAT_KA]
         amb = params.ambient
-        local = direct_light(geo, mats, lights, params, p, n, v, m, media, n_media, scratch,
-                             stack, counters, (pixel, sample, 2 + vertex * RNG_DIMS_PER_HIT))
+        local = direct_light(geo, mats, lights, params, p, n_shade, v, m, albedo, media,
+                             n_media, scratch, stack, counters,
+                             (pixel, sample, 2 + vertex * RNG_DIMS_PER_HIT))
         vertex += 1
-        r += w[0] * (ka * amb[0] * mats[m, MAT_AMBIENT] + local[0])
-        g += w[1] * (ka * amb[1] * mats[m, MAT_AMBIENT + 1] + local[1])
-        b += w[2] * (ka * amb[2] * mats[m, MAT_AMBIENT + 2] + local[2])
+        r += w[0] * (ka * amb[0] * tex[0] * mats[m, MAT_AMBIENT] + local[0])
+        g += w[1] * (ka * amb[1] * tex[1] * mats[m, MAT_AMBIENT + 1] + local[1])
+        b += w[2] * (ka * amb[2] * tex[2] * mats[m, MAT_AMBIENT + 2] + local[2])
         if depth >= params.max_depth:
             continue
         kr = mats[m, MAT_KR]
         kt = mats[m, MAT_KT]
         if kr == 0.0 and kt == 0.0:
             continue
-        cos_i = -dot(d, n)
-        reflect_dir = madd(d, n, 2.0 * cos_i)
+        cos_i = -dot(d, n_shade)
+        reflect_dir = madd(d, n_shade, 2.0 * cos_i)
         kr_eff = kr
         if kt > 0.0:
             # media on the far side: entering a solid pushes its material, leaving pops it
             n_out = n_media
             for k in range(n_media):
                 scratch[k] = media[k]
-            if geo.prim_solid[prim]:
+            if geo.prim_solid[prim]:  # media are keyed by material row
                 n1 = mats[media[n_media - 1], MAT_IOR] if n_media > 0 else 1.0
                 if entering:
                     n_out = media_enter(scratch, n_out, m)
@@ -160,13 +187,13 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
             else:  # a thin sheet: light passes straight through
                 n1 = 1.0
                 n2 = 1.0
-            ok, tdir = refract(d, n, n1 / n2)
+            ok, tdir = refract(d, n_shade, n1 / n2)
             if not ok:  # total internal reflection: the reflected ray carries it all
                 kr_eff = kr + kt
             else:
                 kt_eff = kt
                 if mats[m, MAT_FRESNEL] != 0.0:
-                    f = schlick(cos_i, n1, n2, -dot(tdir, n))
+                    f = schlick(cos_i, n1, n2, -dot(tdir, n_shade))
                     kr_eff = kr + kt * f
                     kt_eff = kt * (1.0 - f)
                 wt = (

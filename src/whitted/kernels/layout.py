@@ -21,6 +21,14 @@ SHAPE_DISK = 3  # center 0:3, unit normal 3:6, radius 6
 SHAPE_TRIANGLE = 4  # v0 0:3, edge1 3:6, edge2 6:9, unit normal 9:12
 SHAPE_BOX = 5  # corner 0:3, inverse edge matrix rows 3:12 (local = M^-1 (p - corner) in [0,1]^3)
 SHAPE_FRUSTUM = 6  # base 0:3, unit axis 3:6, height 6, base radius 7, top radius 8, capped 9
+SHAPE_MESH = 7  # an instance of a triangle mesh: mesh index 0 (a row of mesh_info)
+
+# texture-space frames of the analytic shapes (after their own numbers above)
+SPHERE_FRAME = 4  # 4:13 the object's x, y, z axes in world space (unit), for spherical uv
+PLANE_TANGENT = 6  # 6:9 unit tangent (u direction); v = normal x tangent
+DISK_TANGENT = 7  # 7:10
+TRIANGLE_UV = 12  # 12:18 texture coordinates of the three corners
+FRUSTUM_TANGENT = 10  # 10:13 unit vector perpendicular to the axis where u = 0
 
 N_PRIM_PARAMS = 18
 
@@ -38,7 +46,16 @@ MAT_KT = 15
 MAT_IOR = 16
 MAT_ATTEN = 17
 MAT_FRESNEL = 20
-N_MAT_PARAMS = 21
+MAT_TEXTURE = 21  # row of the texture table multiplying the colour, -1 for none
+N_MAT_PARAMS = 22
+
+# mesh_info columns (one row per distinct mesh; instances point at a row)
+MESH_ROOT = 0  # root node in the mesh_node_* arrays
+MESH_TRI_OFFSET = 1  # first triangle in mesh_faces
+MESH_TRI_COUNT = 2
+MESH_NORMALS = 3  # row of tri_normals holding triangle 0's corner normals, -1: flat shading
+MESH_UVS = 4  # row of tri_uvs holding triangle 0's corner uvs, -1: none
+N_MESH_INFO = 5
 
 # light columns (ambient lights are summed into one colour and not stored here)
 LIGHT_POINT = 1
@@ -86,6 +103,22 @@ class GeometryArrays(NamedTuple):
     node_axis: np.ndarray  # (M,) int8 split axis of interior nodes
     node_prims: np.ndarray  # (N,) int32 primitive indices in leaf order
     unbounded: np.ndarray  # (U,) int32 primitives outside the BVH (infinite planes)
+    # triangle meshes, each stored once in its own space with its own BVH (the bottom level);
+    # SHAPE_MESH primitives instance them (their prim_xform maps world to mesh space)
+    mesh_info: np.ndarray  # (K, N_MESH_INFO) int32
+    mesh_vertices: np.ndarray  # (V, 3) float32 positions
+    mesh_faces: np.ndarray  # (T, 3) int32 rows of mesh_vertices, counter-clockwise = front
+    tri_material: np.ndarray  # (T,) int32 material row of each triangle
+    tri_normals: np.ndarray  # (Tn, 3, 3) float32 corner normals of smooth-shaded meshes
+    tri_uvs: np.ndarray  # (Tu, 3, 2) float32 corner texture coordinates
+    mesh_node_min: np.ndarray  # (N, 3) float32 bottom-level node boxes (rounded outward)
+    mesh_node_max: np.ndarray  # (N, 3) float32
+    mesh_node_offset: np.ndarray  # (N,) int32 leaf: first entry in mesh_node_tris; else right
+    mesh_node_count: np.ndarray  # (N,) int32 leaf: triangle count; interior: 0
+    mesh_node_tris: np.ndarray  # (T,) int32 triangle indices in leaf order
+    # textures (see texture_layout.py): one row per texture, all image texels in one array
+    tex_info: np.ndarray  # (X, N_TEX_PARAMS) float64
+    tex_pixels: np.ndarray  # (P,) float32 linear RGB
 
 
 class RenderParams(NamedTuple):

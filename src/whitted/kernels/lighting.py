@@ -6,7 +6,14 @@ from __future__ import annotations
 
 import math
 
-from .accel import box_entry, closest_hit, hit_primitive, inverse_direction, world_normal
+from .accel import (
+    box_entry,
+    closest_hit,
+    hit_material,
+    inverse_direction,
+    occludes,
+    surface_normals,
+)
 from .intersect import INF
 from .jit import kernel
 from .layout import (
@@ -33,10 +40,9 @@ from .layout import (
     RAY_SHADOW,
 )
 from .media import media_enter, media_leave
+from .mesh import OPAQUE_KT
 from .sampling import concentric_disk, random01, stratum
 from .vec import dot, madd, normalize, sub, vload
-
-OPAQUE_KT = 0.01  # the lecture's rule: an occluder with kt below this blocks the light
 
 
 @kernel
@@ -45,11 +51,10 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
     transparent ones."""
     seen_transparent = 0
     for j in range(geo.unbounded.shape[0]):
-        i = geo.unbounded[j]
-        if hit_primitive(geo, i, o, d, tmin, tmax) < INF:
-            if mats[geo.prim_material[i], MAT_KT] < OPAQUE_KT:
-                return 1
-            seen_transparent = 2
+        state = occludes(geo, mats, geo.unbounded[j], o, d, tmin, tmax, stack)
+        if state == 1:
+            return 1
+        seen_transparent = max(seen_transparent, state)
     if geo.node_min.shape[0] == 0:
         return seen_transparent
     bmin = geo.node_min
@@ -66,11 +71,10 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
         if count > 0:
             first = geo.node_offset[node]
             for j in range(first, first + count):
-                i = geo.node_prims[j]
-                if hit_primitive(geo, i, o, d, tmin, tmax) < INF:
-                    if mats[geo.prim_material[i], MAT_KT] < OPAQUE_KT:
-                        return 1
-                    seen_transparent = 2
+                state = occludes(geo, mats, geo.node_prims[j], o, d, tmin, tmax, stack)
+                if state == 1:
+                    return 1
+                seen_transparent = max(seen_transparent, state)
             continue
         top += 1
         stack[top] = node + 1
@@ -103,7 +107,7 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
     tb = 1.0
     t_from = params.epsilon
     for _ in range(64):
-        t, prim = closest_hit(geo, o, d, t_from, dist, stack)
+        t, prim, tri, b1, b2 = closest_hit(geo, o, d, t_from, dist, stack)
         seg_end = t if prim >= 0 else dist
         if count > 0:
             m = scratch[count - 1]
@@ -113,13 +117,13 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
             tb *= math.exp(-mats[m, MAT_ATTEN + 2] * length)
         if prim < 0:
             break
-        m = geo.prim_material[prim]
+        m = hit_material(geo, prim, tri)
         kt = mats[m, MAT_KT]
         if kt < OPAQUE_KT:
             return (0.0, 0.0, 0.0)
         entering = True
         if geo.prim_solid[prim]:
-            n = world_normal(geo, prim, madd(o, d, t))
+            n, _ = surface_normals(geo, prim, tri, b1, b2, madd(o, d, t))
             entering = dot(d, n) < 0.0
             if entering:
                 count = media_enter(scratch, count, m)
@@ -146,8 +150,9 @@ def _falloff(lights, j, dist):
 
 
 @kernel
-def _brdf(mats, m, n, v, ldir):
-    """Diffuse + specular response (per channel) for unit light direction ``ldir``; n·l > 0."""
+def _brdf(mats, m, albedo, n, v, ldir):
+    """Diffuse + specular response (per channel) for unit light direction ``ldir``; n·l > 0.
+    ``albedo`` is the diffuse colour at the point (the material's, times its texture)."""
     ndl = dot(n, ldir)
     kd = mats[m, MAT_KD] * ndl
     ks = mats[m, MAT_KS]
@@ -163,18 +168,19 @@ def _brdf(mats, m, n, v, ldir):
         if c > 0.0:
             spec = ks * c**shin
     return (
-        kd * mats[m, MAT_COLOR] + spec * mats[m, MAT_SPECULAR],
-        kd * mats[m, MAT_COLOR + 1] + spec * mats[m, MAT_SPECULAR + 1],
-        kd * mats[m, MAT_COLOR + 2] + spec * mats[m, MAT_SPECULAR + 2],
+        kd * albedo[0] + spec * mats[m, MAT_SPECULAR],
+        kd * albedo[1] + spec * mats[m, MAT_SPECULAR + 1],
+        kd * albedo[2] + spec * mats[m, MAT_SPECULAR + 2],
     )
 
 
 @kernel
 def direct_light(
-    geo, mats, lights, params, p, n, v, m, media, n_media, scratch, stack, counters, rng
+    geo, mats, lights, params, p, n, v, m, albedo, media, n_media, scratch, stack, counters, rng
 ):
     """Light reflected toward ``v`` at point ``p`` with shading normal ``n`` (facing ``v``) by
-    every non-ambient light. ``rng`` = (pixel, sample, first dimension) for area-light samples."""
+    every non-ambient light; ``albedo`` is the diffuse colour there. ``rng`` = (pixel, sample,
+    first dimension) for area-light samples."""
     r = 0.0
     g = 0.0
     b = 0.0
@@ -215,7 +221,7 @@ def direct_light(
                 )
                 if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
                     continue
-                f = _brdf(mats, m, n, v, ldir)
+                f = _brdf(mats, m, albedo, n, v, ldir)
                 k = share * _falloff(lights, j, dist)
                 r += k * radiance[0] * vis[0] * f[0]
                 g += k * radiance[1] * vis[1] * f[1]
@@ -231,7 +237,7 @@ def direct_light(
             )
             if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
                 continue
-            f = _brdf(mats, m, n, v, ldir)
+            f = _brdf(mats, m, albedo, n, v, ldir)
             r += radiance[0] * vis[0] * f[0]
             g += radiance[1] * vis[1] * f[1]
             b += radiance[2] * vis[2] * f[2]

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from .accel import closest_hit, world_normal
+from .accel import closest_hit, surface_normals
 from .integrator import N_STACK_F, N_STACK_I, trace_path
 from .jit import kernel
 from .layout import MAX_MEDIA, RAY_PRIMARY
@@ -97,7 +97,7 @@ def render_aovs(geo, params, depth, normal, object_id, work, lane, lanes):
         stack = work[4]
         for px in range(params.width):
             o, d = camera_ray(params, px + 0.5, py + 0.5)
-            t, prim = closest_hit(geo, o, d, 0.0, math.inf, stack)
+            t, prim, tri, b1, b2 = closest_hit(geo, o, d, 0.0, math.inf, stack)
             if prim < 0:
                 depth[py, px] = math.inf
                 object_id[py, px] = -1
@@ -106,7 +106,7 @@ def render_aovs(geo, params, depth, normal, object_id, work, lane, lanes):
                 continue
             depth[py, px] = t
             object_id[py, px] = geo.prim_object[prim]
-            n = world_normal(geo, prim, madd(o, d, t))
+            n, _ = surface_normals(geo, prim, tri, b1, b2, madd(o, d, t))
             for k in range(3):
                 normal[py, px, k] = n[k]
 

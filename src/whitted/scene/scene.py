@@ -56,6 +56,14 @@ class Scene(Strict):
     # folder when loaded from a file, else the current directory
     _base_dir: Path | None = PrivateAttr(default=None)
 
+    def __eq__(self, other: object) -> bool:
+        """Equal content; where relative file names are resolved from does not count."""
+        if not isinstance(other, Scene):
+            return NotImplemented
+        return type(self) is type(other) and self.__dict__ == other.__dict__
+
+    __hash__ = None  # mutable model
+
     @property
     def base_dir(self) -> Path:
         return self._base_dir if self._base_dir is not None else Path.cwd()

@@ -9,7 +9,7 @@ import numpy as np
 from pydantic import BeforeValidator, Field, PlainSerializer, model_validator
 
 from .materials import Material
-from .types import Direction, Strict, Transform, Vec3
+from .types import Direction, Finite, Strict, Transform, Vec3
 
 
 class _Shape(Strict):
@@ -56,8 +56,13 @@ class Disk(_Shape):
 
 
 class Triangle(_Shape):
+    """Three corners, front side counter-clockwise; ``uvs`` are the corners' texture
+    coordinates (a texture is mapped by barycentric weight)."""
+
     type: Literal["triangle"] = "triangle"
     vertices: tuple[Vec3, Vec3, Vec3]
+    uvs: tuple[tuple[Finite, Finite], tuple[Finite, Finite], tuple[Finite, Finite]] = (
+        (0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
 
     @model_validator(mode="after")
     def _not_degenerate(self) -> Triangle:

@@ -1,0 +1,185 @@
+"""Triangle meshes -> the bottom level of the two-level BVH.
+
+Every distinct mesh (one model file with one normal setting, or one set of inline arrays) is
+stored once, in its own space: float32 positions, int32 triangles, per-triangle material rows,
+corner normals when it is smooth-shaded, corner uvs when it has texture coordinates, and a
+binned-SAH BVH with float32 boxes rounded outward. Scene objects that use it become instances
+(:data:`SHAPE_MESH` primitives of the scene BVH) with their own transform and material.
+Degenerate triangles (zero area, non-finite corners) are dropped here, with a warning that
+counts them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..kernels.layout import (
+    MESH_NORMALS,
+    MESH_ROOT,
+    MESH_TRI_COUNT,
+    MESH_TRI_OFFSET,
+    MESH_UVS,
+    N_MESH_INFO,
+)
+from .bvh import build_bvh
+from .normals import smooth_corner_normals
+
+
+@dataclass
+class MeshSource:
+    """One mesh as read: what the compiler needs, from a model file or from arrays."""
+
+    label: str  # file name or "objects[i]" for inline arrays
+    vertices: np.ndarray  # (V, 3)
+    faces: np.ndarray  # (T, 3) 0-based
+    normals: np.ndarray | None  # (V, 3) per vertex
+    uvs: np.ndarray | None  # (V, 2) per vertex
+    face_material: np.ndarray  # (T,) index into materials
+    materials: list  # whitted Material objects
+    warnings: list[str] = field(default_factory=list)
+
+
+@dataclass
+class CompiledMesh:
+    index: int  # row of mesh_info
+    lo: np.ndarray  # (3,) bounds in mesh space
+    hi: np.ndarray
+    triangles: int
+
+
+def _round_down32(a: np.ndarray) -> np.ndarray:
+    out = a.astype(np.float32)
+    over = out.astype(np.float64) > a
+    out[over] = np.nextafter(out[over], np.float32(-np.inf))
+    return out
+
+
+def _round_up32(a: np.ndarray) -> np.ndarray:
+    out = a.astype(np.float32)
+    under = out.astype(np.float64) < a
+    out[under] = np.nextafter(out[under], np.float32(np.inf))
+    return out
+
+
+class MeshTable:
+    """Accumulates meshes; :meth:`arrays` returns the flat arrays for GeometryArrays."""
+
+    def __init__(self) -> None:
+        self.info: list[list[int]] = []
+        self.vertices: list[np.ndarray] = []
+        self.faces: list[np.ndarray] = []
+        self.tri_material: list[np.ndarray] = []
+        self.tri_normals: list[np.ndarray] = []
+        self.tri_uvs: list[np.ndarray] = []
+        self.node_min: list[np.ndarray] = []
+        self.node_max: list[np.ndarray] = []
+        self.node_offset: list[np.ndarray] = []
+        self.node_count: list[np.ndarray] = []
+        self.node_tris: list[np.ndarray] = []
+        self.n_vertices = 0
+        self.n_tris = 0
+        self.n_nodes = 0
+        self.n_normal_rows = 0
+        self.n_uv_rows = 0
+        self.warnings: list[str] = []
+
+    def add(self, src: MeshSource, material_rows: np.ndarray, smooth: bool | None,
+            crease_angle: float) -> CompiledMesh | None:
+        """Store ``src`` (``material_rows[k]`` = material-table row of ``src.materials[k]``).
+        Returns None when no triangle is left to draw."""
+        verts32 = np.ascontiguousarray(src.vertices, dtype=np.float32)
+        faces = np.ascontiguousarray(src.faces, dtype=np.int64).reshape(-1, 3)
+        v = verts32.astype(np.float64)  # exactly the positions the kernels will see
+        corners = v[faces]  # (T, 3, 3)
+        area2 = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
+                                        corners[:, 2] - corners[:, 0]), axis=1)
+        keep = np.isfinite(corners).all(axis=(1, 2)) & (area2 > 0.0)
+        dropped = int(len(faces) - keep.sum())
+        if dropped:
+            self.warnings.append(f"{src.label}: dropped {dropped} degenerate triangle"
+                                 f"{'s' if dropped != 1 else ''} (zero area or not finite)")
+        if not keep.all():
+            faces = faces[keep]
+            corners = corners[keep]
+            face_material = np.asarray(src.face_material)[keep]
+        else:
+            face_material = np.asarray(src.face_material)
+        if len(faces) == 0:
+            self.warnings.append(f"{src.label}: no triangles to draw")
+            return None
+        t = len(faces)
+        lo_tri = corners.min(axis=1)
+        hi_tri = corners.max(axis=1)
+        del corners
+        bvh = build_bvh(lo_tri, hi_tri)
+        del lo_tri, hi_tri
+
+        normal_row = -1
+        corner_normals = None
+        if smooth is not False:
+            if src.normals is not None:
+                n = np.asarray(src.normals, dtype=np.float32)[faces]
+                corner_normals = n
+            elif smooth:
+                corner_normals = smooth_corner_normals(v, faces, crease_angle)
+        if corner_normals is not None:
+            normal_row = self.n_normal_rows
+            self.tri_normals.append(np.ascontiguousarray(corner_normals, dtype=np.float32))
+            self.n_normal_rows += t
+        uv_row = -1
+        if src.uvs is not None:
+            uv_row = self.n_uv_rows
+            self.tri_uvs.append(np.asarray(src.uvs, dtype=np.float32)[faces])
+            self.n_uv_rows += t
+
+        index = len(self.info)
+        row = [0] * N_MESH_INFO
+        row[MESH_ROOT] = self.n_nodes
+        row[MESH_TRI_OFFSET] = self.n_tris
+        row[MESH_TRI_COUNT] = t
+        row[MESH_NORMALS] = normal_row
+        row[MESH_UVS] = uv_row
+        self.info.append(row)
+        self.vertices.append(verts32)
+        self.faces.append((faces + self.n_vertices).astype(np.int32))
+        self.tri_material.append(np.asarray(material_rows, np.int32)[face_material])
+        self.node_min.append(_round_down32(bvh.node_min))
+        self.node_max.append(_round_up32(bvh.node_max))
+        leaf = bvh.node_count > 0
+        # global indices: interior nodes name their right child among all meshes' nodes,
+        # leaves their first entry among all meshes' node_tris
+        offset = np.where(leaf, bvh.node_offset + self.n_tris, bvh.node_offset + self.n_nodes)
+        self.node_offset.append(offset.astype(np.int32))
+        self.node_count.append(bvh.node_count.astype(np.int32))
+        self.node_tris.append((bvh.prim_order + self.n_tris).astype(np.int32))
+        lo = np.array(bvh.node_min[0], np.float64)  # the root box: all triangles
+        hi = np.array(bvh.node_max[0], np.float64)
+        self.n_vertices += len(verts32)
+        self.n_tris += t
+        self.n_nodes += len(bvh.node_count)
+        return CompiledMesh(index, lo, hi, t)
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        def cat(parts, shape, dtype):
+            if not parts:
+                return np.zeros(shape, dtype)
+            if len(parts) == 1:  # one mesh: no copy
+                return np.ascontiguousarray(parts[0], dtype=dtype)
+            return np.ascontiguousarray(np.concatenate(parts), dtype=dtype)
+
+        return {
+            "mesh_info": np.array(self.info, np.int32).reshape(len(self.info), N_MESH_INFO),
+            "mesh_vertices": cat(self.vertices, (0, 3), np.float32),
+            "mesh_faces": cat(self.faces, (0, 3), np.int32),
+            "tri_material": cat(self.tri_material, (0,), np.int32),
+            "tri_normals": cat(self.tri_normals, (0, 3, 3), np.float32),
+            "tri_uvs": cat(self.tri_uvs, (0, 3, 2), np.float32),
+            "mesh_node_min": cat(self.node_min, (0, 3), np.float32),
+            "mesh_node_max": cat(self.node_max, (0, 3), np.float32),
+            "mesh_node_offset": cat(self.node_offset, (0,), np.int32),
+            "mesh_node_count": cat(self.node_count, (0,), np.int32),
+            "mesh_node_tris": cat(self.node_tris, (0,), np.int32),
+        }
+

@@ -1,0 +1,233 @@
+"""Triangle meshes: watertight ray/triangle intersection and the bottom-level BVH walk.
+
+A mesh is stored once in its own space (``mesh_vertices``, ``mesh_faces``) with its own BVH;
+the caller maps the ray into that space (instancing). Triangles are intersected with the
+watertight algorithm of Woop, Benthin and Wald (JCGT 2013): the ray is sheared so it runs
+along +z, and each edge's 2D edge function is evaluated from the same two vertices whichever
+triangle it belongs to. Two triangles sharing an edge therefore compute exactly opposite
+values there and a ray through the edge (or a shared vertex) hits at least one of them: no
+cracks, whatever the floating-point rounding.
+"""
+
+from __future__ import annotations
+
+from .intersect import INF
+from .jit import kernel
+from .layout import MAT_KT, MESH_NORMALS, MESH_ROOT, MESH_TRI_OFFSET, MESH_UVS
+from .vec import cross, normalize
+
+OPAQUE_KT = 0.01  # the lecture's rule: an occluder with kt below this blocks the light
+
+
+@kernel
+def shear_setup(d):
+    """Per-ray constants of the watertight test: the axis permutation (kx, ky, kz) that makes
+    |d[kz]| largest (and keeps the winding), and the shear (sx, sy, sz)."""
+    ax = abs(d[0])
+    ay = abs(d[1])
+    az = abs(d[2])
+    kz = 0
+    if ay > ax and ay >= az:
+        kz = 1
+    elif az > ax and az > ay:
+        kz = 2
+    kx = kz + 1 if kz < 2 else 0
+    ky = kx + 1 if kx < 2 else 0
+    if d[kz] < 0.0:
+        kx, ky = ky, kx
+    dz = d[kz]
+    return kx, ky, kz, d[kx] / dz, d[ky] / dz, 1.0 / dz
+
+
+@kernel
+def intersect_mesh_triangle(verts, faces, tri, o, kx, ky, kz, sx, sy, sz, tmin, tmax):
+    """(t, b1, b2) of the ray with triangle ``tri``: hit point = (1-b1-b2)·v0 + b1·v1 + b2·v2;
+    t = INF on a miss. ``kx..sz`` come from :func:`shear_setup` of the ray direction."""
+    i0 = faces[tri, 0]
+    i1 = faces[tri, 1]
+    i2 = faces[tri, 2]
+    az = verts[i0, kz] - o[kz]
+    bz = verts[i1, kz] - o[kz]
+    cz = verts[i2, kz] - o[kz]
+    ax = verts[i0, kx] - o[kx] - sx * az
+    ay = verts[i0, ky] - o[ky] - sy * az
+    bx = verts[i1, kx] - o[kx] - sx * bz
+    by = verts[i1, ky] - o[ky] - sy * bz
+    cx = verts[i2, kx] - o[kx] - sx * cz
+    cy = verts[i2, ky] - o[ky] - sy * cz
+    e0 = cx * by - cy * bx  # weight of v0
+    e1 = ax * cy - ay * cx  # weight of v1
+    e2 = bx * ay - by * ax  # weight of v2
+    if (e0 < 0.0 or e1 < 0.0 or e2 < 0.0) and (e0 > 0.0 or e1 > 0.0 or e2 > 0.0):
+        return INF, 0.0, 0.0
+    det = e0 + e1 + e2
+    if det == 0.0:
+        return INF, 0.0, 0.0
+    inv = 1.0 / det
+    t = (e0 * az + e1 * bz + e2 * cz) * sz * inv
+    if not (tmin < t < tmax):
+        return INF, 0.0, 0.0
+    return t, e1 * inv, e2 * inv
+
+
+@kernel
+def _node_entry(bmin, bmax, node, o, inv, tmin, tmax):
+    """Entry distance of the ray into node box ``node`` when it overlaps (tmin, tmax), else
+    INF. Boxes are stored rounded outward, so the plain slab test never misses a triangle."""
+    t0 = (bmin[node, 0] - o[0]) * inv[0]
+    t1 = (bmax[node, 0] - o[0]) * inv[0]
+    tn = min(t0, t1)
+    tf = max(t0, t1)
+    t0 = (bmin[node, 1] - o[1]) * inv[1]
+    t1 = (bmax[node, 1] - o[1]) * inv[1]
+    tn = max(tn, min(t0, t1))
+    tf = min(tf, max(t0, t1))
+    t0 = (bmin[node, 2] - o[2]) * inv[2]
+    t1 = (bmax[node, 2] - o[2]) * inv[2]
+    tn = max(tn, min(t0, t1))
+    tf = min(tf, max(t0, t1))
+    if tf * (1.0 + 1e-9) + 1e-12 < max(tn, tmin) or tn > tmax:
+        return INF
+    return tn
+
+
+@kernel
+def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
+    """Nearest triangle of mesh ``mesh`` hit by the ray (mesh space) in (tmin, tmax):
+    (t, triangle, b1, b2), t = INF on a miss. ``stack[base:]`` is scratch."""
+    kx, ky, kz, sx, sy, sz = shear_setup(d)
+    verts = geo.mesh_vertices
+    faces = geo.mesh_faces
+    bmin = geo.mesh_node_min
+    bmax = geo.mesh_node_max
+    best_t = tmax
+    best = -1
+    best_b1 = 0.0
+    best_b2 = 0.0
+    root = geo.mesh_info[mesh, MESH_ROOT]
+    if _node_entry(bmin, bmax, root, o, inv, tmin, best_t) == INF:
+        return INF, -1, 0.0, 0.0
+    top = base
+    stack[top] = root
+    while top >= base:
+        node = stack[top]
+        top -= 1
+        count = geo.mesh_node_count[node]
+        if count > 0:
+            first = geo.mesh_node_offset[node]
+            for j in range(first, first + count):
+                tri = geo.mesh_node_tris[j]
+                t, b1, b2 = intersect_mesh_triangle(verts, faces, tri, o, kx, ky, kz, sx, sy,
+                                                    sz, tmin, best_t)
+                if t < best_t:
+                    best_t = t
+                    best = tri
+                    best_b1 = b1
+                    best_b2 = b2
+            continue
+        left = node + 1
+        right = geo.mesh_node_offset[node]
+        t_left = _node_entry(bmin, bmax, left, o, inv, tmin, best_t)
+        t_right = _node_entry(bmin, bmax, right, o, inv, tmin, best_t)
+        if t_left <= t_right:
+            if t_right != INF:
+                top += 1
+                stack[top] = right
+            if t_left != INF:
+                top += 1
+                stack[top] = left
+        else:
+            if t_left != INF:
+                top += 1
+                stack[top] = left
+            if t_right != INF:
+                top += 1
+                stack[top] = right
+    if best < 0:
+        return INF, -1, 0.0, 0.0
+    return best_t, best, best_b1, best_b2
+
+
+@kernel
+def mesh_occlusion(geo, mats, mesh, material, o, d, inv, tmin, tmax, stack, base):
+    """Any triangle of the mesh on the segment (tmin, tmax)? 0: none; 1: an opaque one (the
+    walk stops there); 2: only transparent ones. ``material`` >= 0 overrides the triangles'."""
+    if material >= 0 and mats[material, MAT_KT] >= OPAQUE_KT:
+        # one transparent material: any hit is a transparent one
+        t, tri, _, _ = mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base)
+        return 2 if tri >= 0 else 0
+    kx, ky, kz, sx, sy, sz = shear_setup(d)
+    verts = geo.mesh_vertices
+    faces = geo.mesh_faces
+    bmin = geo.mesh_node_min
+    bmax = geo.mesh_node_max
+    seen = 0
+    top = base
+    stack[top] = geo.mesh_info[mesh, MESH_ROOT]
+    while top >= base:
+        node = stack[top]
+        top -= 1
+        if _node_entry(bmin, bmax, node, o, inv, tmin, tmax) == INF:
+            continue
+        count = geo.mesh_node_count[node]
+        if count > 0:
+            first = geo.mesh_node_offset[node]
+            for j in range(first, first + count):
+                tri = geo.mesh_node_tris[j]
+                t, _, _ = intersect_mesh_triangle(verts, faces, tri, o, kx, ky, kz, sx, sy, sz,
+                                                  tmin, tmax)
+                if t < INF:
+                    m = material if material >= 0 else geo.tri_material[tri]
+                    if mats[m, MAT_KT] < OPAQUE_KT:
+                        return 1
+                    seen = 2
+            continue
+        top += 1
+        stack[top] = node + 1
+        top += 1
+        stack[top] = geo.mesh_node_offset[node]
+    return seen
+
+
+@kernel
+def mesh_normals(geo, mesh, tri, b1, b2):
+    """(geometric, shading) unit normals of triangle ``tri`` in mesh space at barycentric
+    (b1, b2). The geometric normal follows the winding (v1 - v0) x (v2 - v0); the shading one
+    interpolates the corner normals of smooth meshes (else it is the geometric one)."""
+    verts = geo.mesh_vertices
+    i0 = geo.mesh_faces[tri, 0]
+    i1 = geo.mesh_faces[tri, 1]
+    i2 = geo.mesh_faces[tri, 2]
+    e1 = (verts[i1, 0] - verts[i0, 0], verts[i1, 1] - verts[i0, 1], verts[i1, 2] - verts[i0, 2])
+    e2 = (verts[i2, 0] - verts[i0, 0], verts[i2, 1] - verts[i0, 1], verts[i2, 2] - verts[i0, 2])
+    ng = normalize(cross(e1, e2))
+    row = geo.mesh_info[mesh, MESH_NORMALS]
+    if row < 0:
+        return ng, ng
+    r = row + tri - geo.mesh_info[mesh, MESH_TRI_OFFSET]
+    n = geo.tri_normals
+    b0 = 1.0 - b1 - b2
+    ns = (
+        b0 * n[r, 0, 0] + b1 * n[r, 1, 0] + b2 * n[r, 2, 0],
+        b0 * n[r, 0, 1] + b1 * n[r, 1, 1] + b2 * n[r, 2, 1],
+        b0 * n[r, 0, 2] + b1 * n[r, 1, 2] + b2 * n[r, 2, 2],
+    )
+    if ns[0] == 0.0 and ns[1] == 0.0 and ns[2] == 0.0:
+        return ng, ng
+    return ng, normalize(ns)
+
+
+@kernel
+def mesh_uv(geo, mesh, tri, b1, b2):
+    """Texture coordinates at barycentric (b1, b2): the corners' uvs interpolated, or (b1, b2)
+    itself when the mesh has none."""
+    row = geo.mesh_info[mesh, MESH_UVS]
+    if row < 0:
+        return b1, b2
+    r = row + tri - geo.mesh_info[mesh, MESH_TRI_OFFSET]
+    t = geo.tri_uvs
+    b0 = 1.0 - b1 - b2
+    return (
+        b0 * t[r, 0, 0] + b1 * t[r, 1, 0] + b2 * t[r, 2, 0],
+        b0 * t[r, 0, 1] + b1 * t[r, 1, 1] + b2 * t[r, 2, 1],
+    )

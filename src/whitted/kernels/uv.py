@@ -1,0 +1,134 @@
+"""Texture coordinates (u, v) of a surface point, one mapping per shape.
+
+- sphere: spherical, in the sphere's own frame: u = 0.5 + atan2(x, z)/2π (u = 0.5 faces +z,
+  and grows to the right seen from there), v = 0.5 + asin(y)/π (v = 1 at the +y pole);
+- plane: planar, in scene units from the plane's point: u along its tangent, v along
+  normal × tangent;
+- rectangle: u, v in 0..1 along edge1 and edge2;
+- disk: planar, the disk inscribed in the unit square (centre at (0.5, 0.5));
+- triangle: the corners' uvs (default (0,0), (1,0), (0,1)) blended by barycentric weight;
+- box: per face, the two in-face box coordinates in 0..1;
+- cylinder, cone: u = angle about the axis / 2π from the tangent, v = height / length;
+- mesh: the corners' ``vt`` blended by barycentric weight, else the barycentric (b1, b2).
+"""
+
+from __future__ import annotations
+
+import math
+
+from .accel import to_object
+from .intersect import _box_local
+from .jit import kernel
+from .layout import (
+    DISK_TANGENT,
+    FRUSTUM_TANGENT,
+    PLANE_TANGENT,
+    SHAPE_BOX,
+    SHAPE_DISK,
+    SHAPE_FRUSTUM,
+    SHAPE_MESH,
+    SHAPE_PLANE,
+    SHAPE_RECTANGLE,
+    SHAPE_SPHERE,
+    SHAPE_TRIANGLE,
+    SPHERE_FRAME,
+    TRIANGLE_UV,
+)
+from .mesh import mesh_uv
+from .vec import cross, dot, sub, vload
+
+INV_TWO_PI = 0.5 / math.pi
+
+
+@kernel
+def _sphere_uv(P, i, p):
+    r = P[i, 3]
+    q = sub(p, vload(P, i, 0))
+    x = dot(q, vload(P, i, SPHERE_FRAME)) / r
+    y = dot(q, vload(P, i, SPHERE_FRAME + 3)) / r
+    z = dot(q, vload(P, i, SPHERE_FRAME + 6)) / r
+    y = min(1.0, max(-1.0, y))
+    return 0.5 + math.atan2(x, z) * INV_TWO_PI, 0.5 + math.asin(y) / math.pi
+
+
+@kernel
+def _triangle_uv(P, i, p):
+    q = sub(p, vload(P, i, 0))
+    e1 = vload(P, i, 3)
+    e2 = vload(P, i, 6)
+    d00 = dot(e1, e1)
+    d01 = dot(e1, e2)
+    d11 = dot(e2, e2)
+    d20 = dot(q, e1)
+    d21 = dot(q, e2)
+    denom = d00 * d11 - d01 * d01
+    b1 = (d11 * d20 - d01 * d21) / denom
+    b2 = (d00 * d21 - d01 * d20) / denom
+    b0 = 1.0 - b1 - b2
+    c = TRIANGLE_UV
+    return (
+        b0 * P[i, c] + b1 * P[i, c + 2] + b2 * P[i, c + 4],
+        b0 * P[i, c + 1] + b1 * P[i, c + 3] + b2 * P[i, c + 5],
+    )
+
+
+@kernel
+def _box_uv(P, i, p):
+    lp = _box_local(P, i, sub(p, vload(P, i, 0)))
+    best_k = 0
+    best_dist = math.inf
+    for k in range(3):
+        gap = min(abs(lp[k]), abs(1.0 - lp[k]))
+        if gap < best_dist:
+            best_dist = gap
+            best_k = k
+    if best_k == 0:  # faces across x: u along z, v along y
+        return lp[2], lp[1]
+    if best_k == 1:  # faces across y: u along x, v along z
+        return lp[0], lp[2]
+    return lp[0], lp[1]
+
+
+@kernel
+def _frustum_uv(P, i, p):
+    q = sub(p, vload(P, i, 0))
+    axis = vload(P, i, 3)
+    z = dot(q, axis)
+    qp = (q[0] - z * axis[0], q[1] - z * axis[1], q[2] - z * axis[2])
+    t = vload(P, i, FRUSTUM_TANGENT)
+    b = cross(axis, t)
+    angle = math.atan2(dot(qp, b), dot(qp, t))
+    return angle * INV_TWO_PI + 0.5, z / P[i, 6]
+
+
+@kernel
+def surface_uv(geo, prim, tri, b1, b2, p):
+    """Texture coordinates of the hit at world point ``p`` (see the module docstring)."""
+    typ = geo.prim_type[prim]
+    if typ == SHAPE_MESH:
+        return mesh_uv(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
+    xf = geo.prim_xform[prim]
+    if xf >= 0:
+        p, _ = to_object(geo.xforms, xf, p, p)
+    P = geo.prim_params
+    if typ == SHAPE_SPHERE:
+        return _sphere_uv(P, prim, p)
+    if typ == SHAPE_RECTANGLE:
+        q = sub(p, vload(P, prim, 0))
+        return dot(q, vload(P, prim, 12)), dot(q, vload(P, prim, 15))
+    if typ == SHAPE_PLANE:
+        q = sub(p, vload(P, prim, 0))
+        t = vload(P, prim, PLANE_TANGENT)
+        return dot(q, t), dot(q, cross(vload(P, prim, 3), t))
+    if typ == SHAPE_DISK:
+        q = sub(p, vload(P, prim, 0))
+        t = vload(P, prim, DISK_TANGENT)
+        s = 0.5 / P[prim, 6]
+        return 0.5 + dot(q, t) * s, 0.5 + dot(q, cross(vload(P, prim, 3), t)) * s
+    if typ == SHAPE_TRIANGLE:
+        return _triangle_uv(P, prim, p)
+    if typ == SHAPE_BOX:
+        return _box_uv(P, prim, p)
+    if typ == SHAPE_FRUSTUM:
+        return _frustum_uv(P, prim, p)
+    return 0.0, 0.0
