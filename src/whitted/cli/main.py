@@ -243,6 +243,28 @@ def info(
               f"secondary rays up to depth {r.max_depth}")
 
 
+@app.command()
+def gui(
+    scene_path: Annotated[
+        Path | None, typer.Argument(metavar="[SCENE]", help="Scene file; a new one if missing")
+    ] = None,
+) -> None:
+    """Open the scene editor (a desktop window) on SCENE, or on the built-in default scene."""
+    scene = None
+    if scene_path is not None and scene_path.exists():
+        try:
+            scene = load_scene(scene_path)
+        except WhittedError as exc:
+            raise fail(str(exc)) from None
+    elif scene_path is not None and scene_path.suffix.lower() not in (".toml", ".json"):
+        raise fail(f"{scene_path}: unknown scene format {scene_path.suffix!r} (use .toml or .json)")
+    try:  # Qt is imported here only, so the other commands start without it
+        from ..gui.app import run_editor
+    except ImportError as exc:
+        raise fail(f"the editor needs PySide6 (pip install PySide6-Essentials): {exc}") from None
+    raise typer.Exit(run_editor(scene, scene_path))
+
+
 def main() -> None:
     """Console entry point: usage mistakes end as one ``error:`` line and status 2."""
     try:

@@ -1,0 +1,258 @@
+"""The edited scene: the current :class:`~whitted.Scene` snapshot, its file, the selection and
+the undo stack. Every edit builds a new validated scene; nothing invalid is ever stored."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, ValidationError
+from PySide6.QtCore import QObject, Signal
+from PySide6.QtGui import QUndoStack
+
+from ..scene import Scene
+from ..scene.io import _clean_message, _format_path
+from .commands import SceneEdit
+
+#: what is selected: ("camera",), ("render",), ("background",), ("lights", i), ("objects", i)
+SelectionKey = tuple
+CAMERA: SelectionKey = ("camera",)
+RENDER: SelectionKey = ("render",)
+BACKGROUND: SelectionKey = ("background",)
+SINGLETONS = (CAMERA, RENDER, BACKGROUND)
+
+
+class EditRefused(ValueError):
+    """An edit the scene model rejects; the message is one short line for the field."""
+
+
+def validation_message(exc: ValidationError) -> str:
+    """One line for the first problem of a pydantic error, in the scene files' words."""
+    e = exc.errors()[0]
+    msg = _clean_message(e)
+    keys = [k for k in e["loc"] if not (isinstance(k, str) and ("[" in k or k in _TAGS))]
+    where = _format_path(keys) if keys else ""
+    return f"{where}: {msg}" if where and not msg.startswith(where) else msg
+
+
+_TAGS = {"str", "int", "float", "bool", "Material", "Transform", "Gradient", "AxisAngle",
+         "function-after", "function-before", "function-plain", "tuple"}
+
+
+def scene_fields(scene: Scene) -> dict[str, Any]:
+    return {name: getattr(scene, name) for name in Scene.model_fields}
+
+
+def rebuild_scene(scene: Scene, **update: Any) -> Scene:
+    """A new validated scene with some top-level fields replaced; same base folder."""
+    fields = scene_fields(scene)
+    fields.update(update)
+    try:
+        new = Scene(**fields)
+    except ValidationError as exc:
+        raise EditRefused(validation_message(exc)) from None
+    return new.with_base_dir(getattr(scene, "_base_dir", None))
+
+
+def item_of(scene: Scene, key: SelectionKey) -> BaseModel | None:
+    if key in SINGLETONS:
+        return getattr(scene, key[0])
+    if len(key) == 2 and key[0] in ("lights", "objects"):
+        items = getattr(scene, key[0])
+        return items[key[1]] if 0 <= key[1] < len(items) else None
+    return None
+
+
+def with_item(scene: Scene, key: SelectionKey, item: BaseModel) -> Scene:
+    """``scene`` with the item at ``key`` replaced by ``item``."""
+    if key in SINGLETONS:
+        return rebuild_scene(scene, **{key[0]: item})
+    kind, index = key
+    items = list(getattr(scene, kind))
+    items[index] = item
+    return rebuild_scene(scene, **{kind: items})
+
+
+def validate_like(model: BaseModel, data: dict[str, Any]) -> BaseModel:
+    """A new model of ``model``'s class from ``data``; EditRefused with one line if invalid."""
+    try:
+        return type(model).model_validate(data)
+    except ValidationError as exc:
+        raise EditRefused(validation_message(exc)) from None
+
+
+def set_path(data: Any, path: tuple, value: Any) -> Any:
+    """A deep copy of nested dicts/lists/tuples ``data`` with ``path`` set to ``value``
+    (missing dicts on the way are created)."""
+    if not path:
+        return value
+    head, rest = path[0], path[1:]
+    if isinstance(data, tuple):
+        data = list(data)
+    elif isinstance(data, dict | list):
+        data = copy.copy(data)
+    elif data is None:
+        data = {}
+    else:
+        raise TypeError(f"cannot set {path} in {data!r}")
+    child = data[head] if (isinstance(data, dict) and head in data) or isinstance(data, list) \
+        else None
+    data[head] = set_path(child, rest, value)
+    return data
+
+
+def get_path(data: Any, path: tuple) -> Any:
+    for key in path:
+        if data is None:
+            return None
+        if isinstance(data, BaseModel):
+            data = getattr(data, key, None)
+        elif isinstance(data, dict):
+            data = data.get(key)
+        else:
+            data = data[key]
+    return data
+
+
+class SceneDocument(QObject):
+    """The scene being edited. ``changed`` fires after every replacement (edit, undo, redo,
+    open) with the key to select; ``reset`` after New/Open."""
+
+    changed = Signal(object)  # selection key
+    reset = Signal()
+    path_changed = Signal()
+
+    def __init__(self, scene: Scene | None = None, path: Path | None = None, parent=None):
+        super().__init__(parent)
+        self.undo_stack = QUndoStack(self)
+        self.undo_stack.setUndoLimit(500)
+        self.scene: Scene = scene if scene is not None else Scene()
+        self.path: Path | None = path
+        self.selection: SelectionKey = CAMERA
+        self.revision = 0  # bumped on every scene replacement
+
+    # ------------------------------------------------------------------ state
+
+    @property
+    def dirty(self) -> bool:
+        return not self.undo_stack.isClean()
+
+    def set_scene(self, scene: Scene, path: Path | None, *, dirty: bool = False) -> None:
+        """Start over with ``scene`` (New, Open); forgets the undo history."""
+        self.undo_stack.clear()
+        self.scene = scene
+        self.path = path
+        self.selection = CAMERA
+        self.revision += 1
+        if dirty:  # a recovered autosave: not what the file on disk says
+            self.undo_stack.resetClean()
+        self.path_changed.emit()
+        self.reset.emit()
+        self.changed.emit(self.selection)
+
+    def mark_saved(self, path: Path, scene: Scene) -> None:
+        self.scene = scene
+        self.path = path
+        self.undo_stack.setClean()
+        self.path_changed.emit()
+
+    def item(self, key: SelectionKey | None = None) -> BaseModel | None:
+        return item_of(self.scene, self.selection if key is None else key)
+
+    def select(self, key: SelectionKey) -> None:
+        self.selection = key
+
+    # ------------------------------------------------------------------ edits
+
+    def apply(self, scene: Scene, text: str, *, select: SelectionKey | None = None,
+              merge_key: object = None) -> bool:
+        """Make ``scene`` (already validated) current as one undoable step."""
+        if scene == self.scene:
+            return False
+        after = select if select is not None else self.selection
+        self.undo_stack.push(SceneEdit(self, self.scene, scene, text, select_before=self.selection,
+                                       select_after=after, merge_key=merge_key))
+        return True
+
+    def edit_item(self, key: SelectionKey, data: dict[str, Any], text: str, *,
+                  merge_key: object = None) -> None:
+        """Replace the item at ``key`` by one built from ``data``; raises EditRefused."""
+        old = item_of(self.scene, key)
+        if old is None:
+            raise EditRefused("nothing selected")
+        new_item = validate_like(old, data)
+        self.apply(with_item(self.scene, key, new_item), text, select=key, merge_key=merge_key)
+
+    def set_field(self, key: SelectionKey, path: tuple, value: Any, text: str, *,
+                  merge_key: object = None) -> None:
+        old = item_of(self.scene, key)
+        if old is None:
+            raise EditRefused("nothing selected")
+        data = old.model_dump()
+        self.edit_item(key, set_path(data, path, value), text, merge_key=merge_key)
+
+    def add(self, kind: str, item: BaseModel, text: str) -> SelectionKey:
+        items = [*getattr(self.scene, kind), item]
+        key = (kind, len(items) - 1)
+        self.apply(rebuild_scene(self.scene, **{kind: items}), text, select=key)
+        return key
+
+    def delete(self, key: SelectionKey) -> bool:
+        if key in SINGLETONS or item_of(self.scene, key) is None:
+            return False
+        kind, index = key
+        items = list(getattr(self.scene, kind))
+        removed = items.pop(index)
+        if items:
+            after = (kind, min(index, len(items) - 1))
+        else:
+            after = CAMERA
+        self.apply(rebuild_scene(self.scene, **{kind: items}), f"Delete {label_of(removed)}",
+                   select=after)
+        return True
+
+    def duplicate(self, key: SelectionKey) -> SelectionKey | None:
+        item = item_of(self.scene, key)
+        if key in SINGLETONS or item is None:
+            return None
+        kind, index = key
+        names = {getattr(i, "name", None) for i in getattr(self.scene, kind)}
+        base = (item.name or item.type) + " copy"
+        name, n = base, 2
+        while name in names:
+            name, n = f"{base} {n}", n + 1
+        copy_ = item.model_copy(update={"name": name}, deep=True)
+        items = list(getattr(self.scene, kind))
+        items.insert(index + 1, copy_)
+        self.apply(rebuild_scene(self.scene, **{kind: items}), f"Duplicate {label_of(item)}",
+                   select=(kind, index + 1))
+        return (kind, index + 1)
+
+    def rename(self, key: SelectionKey, name: str) -> None:
+        item = item_of(self.scene, key)
+        if key in SINGLETONS or item is None:
+            return
+        name = name.strip() or None
+        if name == item.name:
+            return
+        self.set_field(key, ("name",), name, f"Rename {label_of(item)}")
+
+    def _replace(self, scene: Scene, select: SelectionKey | None) -> None:
+        """Called by the undo commands only."""
+        self.scene = scene
+        self.revision += 1
+        if select is not None and item_of(scene, select) is not None:
+            self.selection = select
+        elif item_of(scene, self.selection) is None:
+            self.selection = CAMERA
+        self.changed.emit(self.selection)
+
+
+def label_of(item: Any) -> str:
+    """How the tree and the undo history name an item."""
+    name = getattr(item, "name", None)
+    kind = getattr(item, "type", None)
+    if name:
+        return f"{name}"
+    return f"{kind}" if kind else type(item).__name__

@@ -1,0 +1,218 @@
+"""Which properties each kind of item shows and with which editor. Pure data: a list of
+:class:`Spec` per item, computed from the item (a box given by min/max shows min/max, one
+given by corner + edges shows those)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..scene import PRESETS
+
+# editor kinds
+TEXT, NUMBER, INT, OPT_INT, VEC3, ANGLES, SCALE, COLOUR, COEF, CHOICE, BOOL, FILE, ATTEN = (
+    "text", "number", "int", "opt_int", "vec3", "angles", "scale", "colour", "coef", "choice",
+    "bool", "file", "attenuation",
+)
+# the headings the panel groups fields under
+GEOMETRY, TRANSFORM, MATERIAL, TEXTURE, LIGHT, VIEW, IMAGE, QUALITY, OUTPUT = (
+    "Shape", "Placement (transform)", "Material", "Texture", "Light", "View", "Image", "Quality",
+    "Output",
+)
+
+
+@dataclass(frozen=True)
+class Spec:
+    """One property: where it lives in the item (``path`` of keys), its label and editor.
+    ``lo``/``hi`` are the slider's range for COEF (the box takes any valid value)."""
+
+    path: tuple
+    label: str
+    kind: str
+    group: str = ""
+    lo: float = 0.0
+    hi: float = 1.0
+    choices: tuple = ()
+    tip: str = ""
+    filters: str = field(default="", compare=False)
+
+    @property
+    def name(self) -> str:
+        return ".".join(str(p) for p in self.path)
+
+
+def _name() -> list[Spec]:
+    return [Spec(("name",), "Name", TEXT, tip="shown in the scene tree; optional")]
+
+
+def transform_specs(item: Any) -> list[Spec]:
+    t = ("transform",)
+    specs = [
+        Spec((*t, "translate"), "Move by", VEC3, TRANSFORM, tip="translation, scene units"),
+        Spec((*t, "rotate"), "Rotate (°)", ANGLES, TRANSFORM,
+             tip="degrees about x, then y, then z (about the world origin)"),
+        Spec((*t, "scale"), "Scale", SCALE, TRANSFORM,
+             tip="one number, or x, y, z for a non-uniform scale"),
+    ]
+    tr = getattr(item, "transform", None)
+    if tr is not None and tr.axis_angle is not None:
+        specs += [
+            Spec((*t, "axis_angle", "axis"), "Extra axis", VEC3, TRANSFORM),
+            Spec((*t, "axis_angle", "angle"), "Extra angle (°)", NUMBER, TRANSFORM),
+        ]
+    return specs
+
+
+TEXTURE_KINDS = ("none", "image", "checker", "gradient")
+IMAGE_FILTER = "Images (*.png *.jpg *.jpeg *.bmp *.tga *.tif *.tiff *.exr *.hdr);;All files (*)"
+
+
+def material_specs(material: Any) -> list[Spec]:
+    m = ("material",)
+    g = MATERIAL
+    specs = [
+        Spec((*m, "color"), "Colour", COLOUR, g, tip="diffuse colour Cd"),
+        Spec((*m, "ka"), "Ambient ka", COEF, g),
+        Spec((*m, "kd"), "Diffuse kd", COEF, g),
+        Spec((*m, "ks"), "Specular ks", COEF, g),
+        Spec((*m, "shininess"), "Shininess", COEF, g, 1.0, 1000.0,
+             tip="Phong exponent, 0..100000 (the slider covers 1..1000)"),
+        Spec((*m, "specular_model"), "Highlight model", CHOICE, g, choices=("blinn", "phong")),
+        Spec((*m, "specular_color"), "Specular colour", COLOUR, g, tip="Cs (default white)"),
+        Spec((*m, "kr"), "Reflection kr", COEF, g),
+        Spec((*m, "kt"), "Transparency kt", COEF, g),
+        Spec((*m, "ior"), "Refractive index", COEF, g, 1.0, 3.0, tip="ior, 0..10 (glass 1.5)"),
+        Spec((*m, "attenuation"), "Attenuation", ATTEN, g, 0.0, 2.0,
+             tip="absorption per unit length inside; a number or r, g, b"),
+        Spec((*m, "fresnel"), "Fresnel", BOOL, g, tip="split kt into reflection by Schlick"),
+    ]
+    tex = getattr(material, "texture", None)
+    if "texture" not in type(material).model_fields:
+        return specs
+    t = (*m, "texture")
+    specs.append(Spec((*t, "type"), "Texture", CHOICE, TEXTURE, choices=TEXTURE_KINDS))
+    kind = getattr(tex, "type", "none")
+    if kind == "image":
+        specs += [Spec((*t, "file"), "Image file", FILE, TEXTURE, filters=IMAGE_FILTER),
+                  Spec((*t, "wrap"), "Wrap", CHOICE, TEXTURE, choices=("repeat", "clamp"))]
+    elif kind == "checker":
+        specs += [Spec((*t, "color1"), "Colour 1", COLOUR, TEXTURE),
+                  Spec((*t, "color2"), "Colour 2", COLOUR, TEXTURE),
+                  Spec((*t, "checks"), "Checks per unit", COEF, TEXTURE, 1.0, 64.0)]
+    elif kind == "gradient":
+        specs += [Spec((*t, "color1"), "Colour at 0", COLOUR, TEXTURE),
+                  Spec((*t, "color2"), "Colour at 1", COLOUR, TEXTURE),
+                  Spec((*t, "axis"), "Along", CHOICE, TEXTURE, choices=("u", "v"))]
+    return specs
+
+
+MODEL_FILTER = ("3D models (*.obj *.ply *.stl *.off *.glb *.gltf);;All files (*)")
+
+
+def object_specs(obj: Any) -> list[Spec]:
+    g = GEOMETRY
+    kind = obj.type
+    specs = _name()
+    if kind == "sphere":
+        specs += [Spec(("center",), "Centre", VEC3, g), Spec(("radius",), "Radius", NUMBER, g)]
+    elif kind == "plane":
+        specs += [Spec(("point",), "Point", VEC3, g), Spec(("normal",), "Normal", VEC3, g)]
+    elif kind == "rectangle":
+        specs += [Spec(("corner",), "Corner", VEC3, g, tip="Q1"),
+                  Spec(("edge1",), "Edge 1", VEC3, g, tip="Q2 − Q1"),
+                  Spec(("edge2",), "Edge 2", VEC3, g, tip="Q3 − Q1")]
+    elif kind == "disk":
+        specs += [Spec(("center",), "Centre", VEC3, g), Spec(("normal",), "Normal", VEC3, g),
+                  Spec(("radius",), "Radius", NUMBER, g)]
+    elif kind == "triangle":
+        specs += [Spec(("vertices", i), f"Vertex {'abc'[i]}", VEC3, g) for i in range(3)]
+    elif kind == "box":
+        if obj.min is not None:
+            specs += [Spec(("min",), "Min corner", VEC3, g), Spec(("max",), "Max corner", VEC3, g)]
+        else:
+            specs += [Spec(("corner",), "Corner", VEC3, g)]
+            specs += [Spec(("edges", i), f"Edge {i + 1}", VEC3, g) for i in range(3)]
+    elif kind in ("cylinder", "cone"):
+        specs += [Spec(("base",), "Base centre", VEC3, g), Spec(("top",), "Top centre", VEC3, g),
+                  Spec(("radius",), "Radius" if kind == "cylinder" else "Base radius", NUMBER, g)]
+        if kind == "cone":
+            specs.append(Spec(("top_radius",), "Top radius", NUMBER, g, tip="> 0: a frustum"))
+        specs.append(Spec(("capped",), "Capped", BOOL, g))
+    elif kind == "mesh":
+        if getattr(obj, "file", None) is not None:
+            specs.append(Spec(("file",), "Model file", FILE, g, filters=MODEL_FILTER))
+        specs += [Spec(("smooth",), "Smooth shading", CHOICE, g, choices=("auto", "on", "off")),
+                  Spec(("crease_angle",), "Crease angle (°)", COEF, g, 0.0, 180.0),
+                  Spec(("solid",), "Solid (refracts)", BOOL, g)]
+    return specs + transform_specs(obj)
+
+
+def light_specs(light: Any) -> list[Spec]:
+    g = LIGHT
+    specs = _name() + [
+        Spec(("color",), "Colour", COLOUR, g),
+        Spec(("intensity",), "Intensity", COEF, g, 0.0, 2.0, tip="0..1e9 (slider 0..2)"),
+    ]
+    kind = light.type
+    if kind == "point":
+        specs.append(Spec(("position",), "Position", VEC3, g))
+    elif kind == "directional":
+        specs.append(Spec(("direction",), "Direction", VEC3, g, tip="where the light travels"))
+    elif kind == "disk":
+        specs += [Spec(("center",), "Centre", VEC3, g), Spec(("normal",), "Normal", VEC3, g),
+                  Spec(("radius",), "Radius", NUMBER, g),
+                  Spec(("samples",), "Shadow samples", OPT_INT, g,
+                       tip="empty: the render setting")]
+    if kind in ("point", "disk"):
+        specs += [Spec(("falloff",), "Falloff", CHOICE, g,
+                       choices=("none", "linear", "inverse_square")),
+                  Spec(("dist_scale",), "Distance scale", NUMBER, g, tip="for linear falloff")]
+    return specs
+
+
+def camera_specs(camera: Any) -> list[Spec]:
+    g = VIEW
+    specs = [Spec(("position",), "Position", VEC3, g, tip="the eye")]
+    if camera.rotate is not None or camera.axis_angle is not None:
+        specs.append(Spec(("rotate",), "Rotate (°)", ANGLES, g, tip="about x, then y, then z"))
+    else:
+        specs += [Spec(("look_at",), "Look at", VEC3, g), Spec(("up",), "Up", VEC3, g)]
+    specs += [
+        Spec(("fov",), "Field of view (°)", COEF, g, 5.0, 150.0, tip="0 < fov < 180"),
+        Spec(("fov_axis",), "Field of view is", CHOICE, g, choices=("y", "x"),
+             tip="y: vertical, x: horizontal"),
+        Spec(("projection",), "Projection", CHOICE, g, choices=("perspective", "orthographic")),
+    ]
+    if camera.projection == "orthographic":
+        specs.append(Spec(("ortho_height",), "Visible height", NUMBER, g))
+    return specs
+
+
+def render_specs(settings: Any) -> list[Spec]:
+    return [
+        Spec(("width",), "Width (px)", INT, IMAGE),
+        Spec(("height",), "Height (px)", INT, IMAGE),
+        Spec(("max_depth",), "Recursion depth", INT, QUALITY, tip="0..64"),
+        Spec(("samples",), "Samples per pixel", INT, QUALITY, tip="anti-aliasing, 1..4096"),
+        Spec(("shadow_samples",), "Soft-shadow samples", INT, QUALITY,
+             tip="per disk light, 1..4096"),
+        Spec(("min_weight",), "Min ray weight", COEF, QUALITY, 0.0, 0.1),
+        Spec(("threads",), "Threads", INT, QUALITY, tip="0 = every core"),
+        Spec(("seed",), "Seed", INT, QUALITY),
+        Spec(("transfer",), "Transfer", CHOICE, OUTPUT, choices=("srgb", "linear")),
+        Spec(("tonemap",), "Tone map", CHOICE, OUTPUT, choices=("clamp", "reinhard", "aces")),
+    ]
+
+
+def background_specs(background: Any) -> list[Spec]:
+    g = "Background"
+    specs = [Spec(("mode",), "Kind", CHOICE, g, choices=("colour", "gradient"))]
+    if background.gradient is None:
+        specs.append(Spec(("color",), "Colour", COLOUR, g))
+    else:
+        specs += [Spec(("gradient", "top"), "Top", COLOUR, g),
+                  Spec(("gradient", "bottom"), "Bottom", COLOUR, g)]
+    return specs
+
+
+PRESET_NAMES = tuple(PRESETS)

@@ -1,0 +1,605 @@
+"""The editor's window: scene tree (left), picture (centre), properties (right), menus and a
+toolbar with Render / Stop, a progress bar with the time left. It wires the document, the
+render controller and autosave together and owns every dialog (each behind one method, so the
+tests can answer them)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from PySide6.QtCore import QSettings, Qt, QTimer
+from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
+from PySide6.QtWidgets import (
+    QDockWidget,
+    QFileDialog,
+    QLabel,
+    QMainWindow,
+    QMessageBox,
+    QProgressBar,
+    QToolButton,
+)
+
+from .. import scene as S
+from ..errors import WhittedError
+from ..scene import Scene, load_scene, save_scene
+from ..scene.default import default_scene
+from . import camera_ops, catalog
+from .autosave import Autosave, recovery_for
+from .document import (
+    CAMERA,
+    RENDER,
+    EditRefused,
+    SceneDocument,
+    get_path,
+    label_of,
+    rebuild_scene,
+    set_path,
+)
+from .properties import PropertyPanel
+from .recent import RecentFiles
+from .render_controller import RenderController
+from .tree import SceneTree
+from .viewport import Viewport
+
+SCENE_FILTER = "Scene files (*.toml *.json);;TOML scene (*.toml);;JSON scene (*.json)"
+IMAGE_FILTER = "PNG image (*.png);;OpenEXR HDR image (*.exr);;All images (*.png *.exr *.jpg *.pfm)"
+#: fits a 1366×768 screen with its panel and the title bar
+WINDOW_SIZE = (1280, 680)
+
+
+def starter_scene() -> Scene:
+    """What File > New gives: a floor, a sphere, an ambient and a point light."""
+    return Scene(
+        render=S.RenderSettings(width=640, height=480),
+        camera=S.Camera(position=(0.0, 1.5, 6.0), look_at=(0.0, 0.6, 0.0), fov=40.0),
+        background=S.Background(gradient=S.Gradient(top=(0.3, 0.45, 0.75),
+                                                     bottom=(0.85, 0.88, 0.95))),
+        lights=[S.AmbientLight(name="ambient", intensity=0.2),
+                S.PointLight(name="lamp", position=(-4.0, 6.0, 5.0), intensity=0.9)],
+        objects=[S.Plane(name="floor", material="matte"),
+                 S.Sphere(name="ball", center=(0.0, 0.8, 0.0), radius=0.8, material="plastic")],
+    )
+
+
+def rebase_files(scene: Scene, folder: Path) -> Scene:
+    """``scene`` with relative model/texture file names re-pointed from its base folder to
+    ``folder`` (Save As elsewhere), and ``folder`` as its base."""
+    old = scene.base_dir
+    folder = folder.resolve()
+
+    def moved(name: str) -> str:
+        p = Path(name)
+        return name if p.is_absolute() else os.path.relpath(old / p, folder)
+
+    data = scene.model_dump()
+    for obj in data["objects"]:
+        if obj.get("file"):
+            obj["file"] = moved(obj["file"])
+        mat = obj.get("material")
+        if isinstance(mat, dict) and isinstance(mat.get("texture"), dict) and \
+                mat["texture"].get("file"):
+            mat["texture"]["file"] = moved(mat["texture"]["file"])
+    for mat in data["materials"].values():
+        if isinstance(mat.get("texture"), dict) and mat["texture"].get("file"):
+            mat["texture"]["file"] = moved(mat["texture"]["file"])
+    return Scene.model_validate(data).with_base_dir(folder)
+
+
+class MainWindow(QMainWindow):
+    def __init__(self, scene: Scene | None = None, path: Path | None = None, *,
+                 settings: QSettings | None = None, autosave_folder: Path | None = None,
+                 autosave_interval_ms: int = 60_000, preview: bool = True,
+                 warm_up: bool = True) -> None:
+        super().__init__()
+        self.settings = settings if settings is not None else QSettings("whitted", "editor")
+        self.recent = RecentFiles(self.settings)
+        if scene is None:
+            scene = default_scene()
+        if path is not None:
+            scene = scene.with_base_dir(Path(path).parent)
+        self.doc = SceneDocument(scene, Path(path) if path is not None else None, self)
+        self.controller = RenderController(self)
+        self.controller.preview_enabled = preview
+        self.autosave = Autosave(self.doc, interval_ms=autosave_interval_ms,
+                                 folder=autosave_folder, parent=self)
+
+        self.viewport = Viewport(self)
+        self.setCentralWidget(self.viewport)
+        self.tree = SceneTree(self.doc)
+        self.properties = PropertyPanel(self.doc)
+        self.properties.choose_file = self.choose_file
+        self._dock(self.tree, "Scene", Qt.DockWidgetArea.LeftDockWidgetArea, 240)
+        self._dock(self.properties, "Properties", Qt.DockWidgetArea.RightDockWidgetArea, 390)
+
+        self.progress = QProgressBar(self)
+        self.progress.setRange(0, 1000)
+        self.progress.setMaximumWidth(220)
+        self.progress.setTextVisible(True)
+        self.progress.setFormat("%p%")
+        self.eta = QLabel("", self)
+        self.statusBar().addPermanentWidget(self.eta)
+        self.statusBar().addPermanentWidget(self.progress)
+
+        self._make_actions()
+        self._make_menus()
+        self._make_toolbar()
+
+        self.doc.changed.connect(self._scene_changed)
+        self.doc.path_changed.connect(self._update_title)
+        self.doc.undo_stack.cleanChanged.connect(lambda clean: self._update_title())
+        self.controller.frame.connect(self.viewport.show_image)
+        self.controller.frame.connect(self._frame_shown)
+        self.controller.progress.connect(self._progress)
+        self.controller.finished.connect(self._render_finished)
+        self.controller.failed.connect(self._render_failed)
+        self.controller.kernels_ready.connect(self._kernels_ready)
+        self.autosave.saved.connect(lambda text: self.statusBar().showMessage(text, 3000))
+        self.viewport.orbit.connect(self._orbit)
+        self.viewport.pan.connect(self._pan)
+        self.viewport.zoom.connect(self._zoom)
+
+        self._fit_window()
+        self._update_title()
+        self._update_render_actions()
+        self.viewport.set_aspect(scene.render.width, scene.render.height)
+        if warm_up:
+            self.viewport.caption = "Loading the render kernels (the first run compiles them)…"
+            self.controller.warm_up()
+        self.controller.request_preview(self.doc.scene)
+
+    # ------------------------------------------------------------------ layout
+
+    def _dock(self, widget, title: str, area, width: int) -> QDockWidget:
+        dock = QDockWidget(title, self)
+        dock.setObjectName(title)
+        dock.setWidget(widget)
+        dock.setFeatures(QDockWidget.DockWidgetFeature.DockWidgetMovable
+                         | QDockWidget.DockWidgetFeature.DockWidgetFloatable)
+        self.addDockWidget(area, dock)
+        self.resizeDocks([dock], [width], Qt.Orientation.Horizontal)
+        return dock
+
+    def _fit_window(self) -> None:
+        w, h = WINDOW_SIZE
+        screen = self.screen()
+        if screen is not None:
+            avail = screen.availableGeometry()
+            w, h = min(w, avail.width() - 20), min(h, avail.height() - 40)
+        self.resize(max(w, 800), max(h, 500))
+
+    def _action(self, text: str, slot, shortcut=None, tip: str = "") -> QAction:
+        action = QAction(text, self)
+        if shortcut is not None:
+            if isinstance(shortcut, list):
+                action.setShortcuts(shortcut)
+            else:
+                action.setShortcut(shortcut)
+        if tip:
+            action.setStatusTip(tip)
+            action.setToolTip(tip)
+        action.triggered.connect(lambda checked=False: slot())
+        return action
+
+    def _make_actions(self) -> None:
+        K = QKeySequence
+        self.act_new = self._action("&New", self.new_scene, K.StandardKey.New)
+        self.act_open = self._action("&Open…", self.open_dialog, K.StandardKey.Open)
+        self.act_save = self._action("&Save", self.save, K.StandardKey.Save)
+        self.act_save_as = self._action("Save &As…", self.save_as, K("Ctrl+Shift+S"))
+        self.act_save_image = self._action("Save &Image…", self.save_image, K("Ctrl+E"),
+                                           "save the picture as PNG or EXR")
+        self.act_quit = self._action("&Quit", self.close, K.StandardKey.Quit)
+        stack = self.doc.undo_stack
+        self.act_undo = stack.createUndoAction(self, "&Undo")
+        self.act_undo.setShortcuts([K("Ctrl+Z")])
+        self.act_redo = stack.createRedoAction(self, "&Redo")
+        self.act_redo.setShortcuts([K("Ctrl+Shift+Z"), K("Ctrl+Y")])
+        self.act_duplicate = self._action("D&uplicate", self.duplicate_selected, K("Ctrl+D"))
+        self.act_rename = self._action("Re&name", self.rename_selected, K("F2"))
+        self.act_delete = self._action("&Delete", self.delete_selected, K.StandardKey.Delete)
+        self.act_delete.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+        self.act_rename.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+        for a in (self.act_duplicate, self.act_rename, self.act_delete):
+            self.tree.addAction(a)
+        self.act_render = self._action("&Render", self.start_render, K("Ctrl+R"),
+                                       "render the full picture, tile by tile")
+        self.act_stop = self._action("&Stop", self.stop_render, K("Esc"),
+                                     "stop the render and keep the picture so far")
+        self.act_preview = QAction("Interactive &preview", self, checkable=True, checked=True)
+        self.act_preview.toggled.connect(self._toggle_preview)
+        self.act_settings = self._action("Render &settings…",
+                                         lambda: self.select(RENDER))
+        self.object_actions: dict[str, QAction] = {}
+        for kind, text in catalog.OBJECT_KINDS.items():
+            self.object_actions[kind] = self._action(text, lambda k=kind: self.add_object(k))
+        self.act_model = self._action("Model from file…", self.add_model,
+                                      tip="OBJ, PLY, STL, OFF, glTF")
+        self.act_model.setEnabled(catalog.HAS_MESH)
+        self.light_actions: dict[str, QAction] = {}
+        for kind, text in catalog.LIGHT_KINDS.items():
+            self.light_actions[kind] = self._action(text, lambda k=kind: self.add_light(k))
+
+    def _make_menus(self) -> None:
+        bar = self.menuBar()
+        file = bar.addMenu("&File")
+        file.addActions([self.act_new, self.act_open])
+        self.recent_menu = file.addMenu("Open &Recent")
+        self.recent_menu.aboutToShow.connect(self._fill_recent)
+        file.addActions([self.act_save, self.act_save_as])
+        file.addSeparator()
+        file.addAction(self.act_save_image)
+        file.addSeparator()
+        file.addAction(self.act_quit)
+        edit = bar.addMenu("&Edit")
+        edit.addActions([self.act_undo, self.act_redo])
+        edit.addSeparator()
+        edit.addActions([self.act_duplicate, self.act_rename, self.act_delete])
+        add = bar.addMenu("&Add")
+        self.add_object_menu = add.addMenu("&Object")
+        self.add_object_menu.addActions(list(self.object_actions.values()))
+        self.add_object_menu.addSeparator()
+        self.add_object_menu.addAction(self.act_model)
+        self.add_light_menu = add.addMenu("&Light")
+        self.add_light_menu.addActions(list(self.light_actions.values()))
+        render = bar.addMenu("&Render")
+        render.addActions([self.act_render, self.act_stop])
+        render.addSeparator()
+        render.addActions([self.act_preview, self.act_settings])
+        help_ = bar.addMenu("&Help")
+        help_.addAction(self._action("&Controls", self._show_controls))
+
+    def _make_toolbar(self) -> None:
+        tools = self.addToolBar("Main")
+        tools.setObjectName("main toolbar")
+        tools.setMovable(False)
+        for menu, text in ((self.add_object_menu, "Add object"),
+                           (self.add_light_menu, "Add light")):
+            button = QToolButton(self)
+            button.setText(text)
+            button.setMenu(menu)
+            button.setPopupMode(QToolButton.ToolButtonPopupMode.InstantPopup)
+            tools.addWidget(button)
+        tools.addSeparator()
+        tools.addActions([self.act_undo, self.act_redo])
+        tools.addSeparator()
+        tools.addActions([self.act_render, self.act_stop])
+
+    # ------------------------------------------------------------------ dialogs (tests answer)
+
+    def ask_unsaved(self) -> str:
+        """'save', 'discard' or 'cancel' for unsaved changes."""
+        buttons = (QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
+                   | QMessageBox.StandardButton.Cancel)
+        answer = QMessageBox.question(
+            self, "Unsaved changes", f"Save the changes to {self.scene_name()}?", buttons,
+            QMessageBox.StandardButton.Save)
+        return {QMessageBox.StandardButton.Save: "save",
+                QMessageBox.StandardButton.Discard: "discard"}.get(answer, "cancel")
+
+    def ask_recover(self, autosave: Path) -> bool:
+        answer = QMessageBox.question(
+            self, "Recover unsaved changes?",
+            f"{autosave.name} holds changes to {self.scene_name()} that were never saved "
+            "(the editor closed unexpectedly). Recover them?")
+        return answer == QMessageBox.StandardButton.Yes
+
+    def ask_open_path(self) -> Path | None:
+        name, _ = QFileDialog.getOpenFileName(self, "Open scene", self._start_dir(), SCENE_FILTER)
+        return Path(name) if name else None
+
+    def ask_save_path(self) -> Path | None:
+        start = str(self.doc.path) if self.doc.path else str(Path(self._start_dir(),
+                                                                  "scene.toml"))
+        name, chosen = QFileDialog.getSaveFileName(self, "Save scene as", start, SCENE_FILTER)
+        if not name:
+            return None
+        path = Path(name)
+        if path.suffix.lower() not in (".toml", ".json"):
+            path = path.with_suffix(".json" if "json" in chosen.lower() else ".toml")
+        return path
+
+    def ask_image_path(self) -> Path | None:
+        stem = self.doc.path.stem if self.doc.path else "render"
+        name, chosen = QFileDialog.getSaveFileName(
+            self, "Save image", str(Path(self._start_dir(), f"{stem}.png")), IMAGE_FILTER)
+        if not name:
+            return None
+        path = Path(name)
+        if not path.suffix:
+            path = path.with_suffix(".exr" if "exr" in chosen.lower() else ".png")
+        return path
+
+    def choose_file(self, title: str, filters: str) -> str | None:
+        name, _ = QFileDialog.getOpenFileName(self, title, self._start_dir(), filters)
+        return name or None
+
+    def show_error(self, title: str, message: str) -> None:
+        QMessageBox.warning(self, title, message)
+
+    def _start_dir(self) -> str:
+        return str(self.doc.path.parent if self.doc.path else Path.cwd())
+
+    def _show_controls(self) -> None:
+        QMessageBox.information(self, "Controls", (
+            "Picture: drag to orbit the camera, right-drag or Shift-drag to pan, wheel to zoom.\n"
+            "Scene tree: Delete removes, Ctrl+D duplicates, F2 or double-click renames.\n"
+            "Ctrl+Z / Ctrl+Shift+Z undo and redo every edit. Ctrl+R renders, Esc stops."))
+
+    # ------------------------------------------------------------------ files
+
+    def scene_name(self) -> str:
+        return self.doc.path.name if self.doc.path else "the untitled scene"
+
+    def _update_title(self) -> None:
+        name = self.doc.path.name if self.doc.path else "untitled"
+        self.setWindowTitle(f"{name}[*] — whitted")
+        self.setWindowModified(self.doc.dirty)
+
+    def maybe_save(self) -> bool:
+        """Before the scene goes away: True when it may go (saved or discarded)."""
+        if not self.doc.dirty:
+            return True
+        answer = self.ask_unsaved()
+        if answer == "save":
+            return self.save()
+        if answer == "discard":
+            self.autosave.discard()
+            return True
+        return False
+
+    def new_scene(self) -> bool:
+        if not self.maybe_save():
+            return False
+        self.controller.stop()
+        self.doc.set_scene(starter_scene(), None)
+        return True
+
+    def open_dialog(self) -> bool:
+        if not self.maybe_save():
+            return False
+        path = self.ask_open_path()
+        return self.open_path(path, ask=False) if path else False
+
+    def open_path(self, path: Path, *, ask: bool = True) -> bool:
+        """Open a scene file; offers a newer autosave of it for recovery."""
+        if ask and not self.maybe_save():
+            return False
+        path = Path(path)
+        try:
+            scene = load_scene(path)
+        except WhittedError as exc:
+            self.show_error("Cannot open the scene", str(exc))
+            if not path.exists():
+                self.recent.remove(path)
+            return False
+        self.controller.stop()
+        self.doc.set_scene(scene, path)
+        self.recent.add(path)
+        self.offer_recovery()
+        return True
+
+    def offer_recovery(self) -> bool:
+        """If an autosave of the current scene is newer than the file, offer it back."""
+        auto = recovery_for(self.doc.path, self.autosave.folder)
+        if auto is None:
+            return False
+        if not self.ask_recover(auto):
+            self.autosave.discard()
+            return False
+        try:
+            scene = self.autosave.recover(auto, self.doc.path)
+        except WhittedError as exc:
+            self.show_error("Cannot recover", str(exc))
+            return False
+        self.doc.set_scene(scene, self.doc.path, dirty=True)
+        self.statusBar().showMessage(f"Recovered the unsaved changes from {auto.name}", 5000)
+        return True
+
+    def save(self) -> bool:
+        if self.doc.path is None:
+            return self.save_as()
+        return self.save_to(self.doc.path)
+
+    def save_as(self, path: Path | None = None) -> bool:
+        path = path if path is not None else self.ask_save_path()
+        return self.save_to(Path(path)) if path is not None else False
+
+    def save_to(self, path: Path) -> bool:
+        old_path = self.doc.path
+        scene = self.doc.scene
+        try:
+            if path.parent.resolve() != scene.base_dir.resolve():
+                scene = rebase_files(scene, path.parent)
+            save_scene(scene, path)
+        except (WhittedError, OSError, ValueError) as exc:
+            self.show_error("Cannot save the scene", str(exc))
+            return False
+        if old_path is not None and old_path != path:
+            self.autosave.discard(old_path)
+        self.doc.mark_saved(path, scene.with_base_dir(path.parent))
+        self.autosave.discard()
+        self.recent.add(path)
+        self.statusBar().showMessage(f"Saved {path}", 4000)
+        return True
+
+    def save_image(self, path: Path | None = None) -> bool:
+        image = self.controller.last_image
+        note = ""
+        if image is None:
+            image = self.controller.last_preview
+            note = " (the preview: render for the full picture)"
+        if image is None:
+            self.show_error("No picture yet", "Render the scene first (Ctrl+R).")
+            return False
+        path = path if path is not None else self.ask_image_path()
+        if path is None:
+            return False
+        try:
+            image.save(path)
+        except (ValueError, OSError) as exc:
+            self.show_error("Cannot save the image", str(exc))
+            return False
+        self.statusBar().showMessage(f"Saved {path}{note}", 5000)
+        return True
+
+    def _fill_recent(self) -> None:
+        self.recent_menu.clear()
+        paths = self.recent.paths()
+        for p in paths:
+            action = self.recent_menu.addAction(str(p))
+            action.triggered.connect(lambda checked=False, p=p: self.open_path(p))
+        if not paths:
+            self.recent_menu.addAction("(none)").setEnabled(False)
+
+    def closeEvent(self, event: QCloseEvent) -> None:  # noqa: N802
+        if not self.maybe_save():
+            event.ignore()
+            return
+        if not self.doc.dirty:
+            self.autosave.discard()
+        self.autosave.timer.stop()
+        self.controller.shutdown()
+        event.accept()
+
+    # ------------------------------------------------------------------ edits
+
+    def select(self, key) -> None:
+        self.doc.select(key)
+        self.tree.select_key(key)
+        self.properties.refresh()
+
+    def add_object(self, kind: str) -> tuple:
+        obj = catalog.new_object(self.doc.scene, kind)
+        return self.doc.add("objects", obj, f"Add {kind}")
+
+    def add_light(self, kind: str) -> tuple:
+        light = catalog.new_light(self.doc.scene, kind)
+        return self.doc.add("lights", light, f"Add {kind} light")
+
+    def add_model(self, path: Path | None = None) -> tuple | None:
+        if path is None:
+            name = self.choose_file("Add a model", catalog_model_filter())
+            if not name:
+                return None
+            path = Path(name)
+        try:
+            obj = catalog.new_model(self.doc.scene, Path(path))
+        except (ValueError, EditRefused) as exc:
+            self.show_error("Cannot add the model", str(exc))
+            return None
+        return self.doc.add("objects", obj, f"Add model {Path(path).name}")
+
+    def delete_selected(self) -> bool:
+        return self.doc.delete(self.doc.selection)
+
+    def duplicate_selected(self):
+        return self.doc.duplicate(self.doc.selection)
+
+    def rename_selected(self) -> None:
+        item = self.tree.item_for(self.doc.selection)
+        if item is not None and len(self.doc.selection) == 2:
+            self.tree.editItem(item, 0)
+
+    def _camera_edit(self, camera, text: str, merge) -> None:
+        try:
+            self.doc.edit_item(CAMERA, camera.model_dump(), text, merge_key=merge)
+        except EditRefused as exc:
+            self.statusBar().showMessage(str(exc), 3000)
+
+    def _orbit(self, yaw: float, pitch: float, drag: int) -> None:
+        try:
+            camera = camera_ops.orbit(self.doc.scene.camera, yaw, pitch)
+        except ValueError:
+            return
+        self._camera_edit(camera, "Orbit camera", ("orbit", drag))
+
+    def _pan(self, dx: float, dy: float, drag: int) -> None:
+        try:
+            camera = camera_ops.pan(self.doc.scene.camera, dx, dy)
+        except ValueError:
+            return
+        self._camera_edit(camera, "Pan camera", ("pan", drag))
+
+    def _zoom(self, factor: float) -> None:
+        try:
+            camera = camera_ops.zoom(self.doc.scene.camera, factor)
+        except ValueError:
+            return
+        # wheel notches in a row zoom as one step
+        self._zoom_serial = getattr(self, "_zoom_serial", 0)
+        if not getattr(self, "_zoom_timer", None):
+            self._zoom_timer = QTimer(self)
+            self._zoom_timer.setSingleShot(True)
+            self._zoom_timer.setInterval(600)
+            self._zoom_timer.timeout.connect(self._end_zoom)
+        self._zoom_timer.start()
+        self._camera_edit(camera, "Zoom camera", ("zoom", self._zoom_serial))
+
+    def _end_zoom(self) -> None:
+        self._zoom_serial += 1
+
+    # ------------------------------------------------------------------ rendering
+
+    def _scene_changed(self, key=None) -> None:
+        scene = self.doc.scene
+        self.viewport.set_aspect(scene.render.width, scene.render.height)
+        self._update_title()
+        if self.controller.rendering:
+            self.controller.stop()
+            self.statusBar().showMessage("Render stopped: the scene changed", 3000)
+        self.controller.request_preview(scene)
+
+    def start_render(self) -> None:
+        self.controller.render(self.doc.scene)
+        self.progress.setValue(0)
+        self.eta.setText("starting…")
+        self._update_render_actions()
+
+    def stop_render(self) -> None:
+        if self.controller.rendering:
+            self.controller.stop()
+            self.eta.setText("stopping…")
+
+    def _update_render_actions(self) -> None:
+        running = self.controller.rendering
+        self.act_render.setEnabled(not running)
+        self.act_stop.setEnabled(running)
+
+    def _progress(self, fraction: float, eta, text: str) -> None:
+        self.progress.setValue(round(fraction * 1000))
+        self.eta.setText(text)
+
+    def _frame_shown(self, image, kind: str) -> None:
+        self.viewport.caption = "preview" if kind == "preview" else ""
+
+    def _render_finished(self, kind: str, text: str) -> None:
+        self.statusBar().showMessage(text, 8000)
+        self._update_render_actions()
+
+    def _render_failed(self, kind: str, message: str) -> None:
+        self.viewport.caption = f"cannot render: {message}"
+        self.viewport.update()
+        self.statusBar().showMessage(f"Cannot {kind}: {message}", 8000)
+        self._update_render_actions()
+
+    def _kernels_ready(self, seconds: float) -> None:
+        if self.viewport.caption.startswith("Loading"):
+            self.viewport.caption = ""
+            self.viewport.update()
+        if seconds > 1:
+            self.statusBar().showMessage(f"Render kernels ready ({seconds:.0f} s)", 4000)
+
+    def _toggle_preview(self, on: bool) -> None:
+        self.controller.preview_enabled = on
+        if on:
+            self.controller.request_preview(self.doc.scene)
+
+
+def catalog_model_filter() -> str:
+    from .fields import MODEL_FILTER
+
+    return MODEL_FILTER
+
+
+__all__ = ["MainWindow", "get_path", "label_of", "rebuild_scene", "set_path", "starter_scene"]

@@ -1,0 +1,392 @@
+"""The properties panel: every property of the selected item with a fitting editor. An edit
+builds the item anew through the scene model; a value the model refuses stays in its field,
+marked red, with the model's message under it, and never reaches the scene."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from pydantic import BaseModel
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import (
+    QComboBox,
+    QFormLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QScrollArea,
+    QVBoxLayout,
+    QWidget,
+)
+
+from ..scene import PRESETS, Material, Transform
+from ..scene.types import Gradient
+from . import camera_ops
+from . import fields as F
+from .document import (
+    BACKGROUND,
+    CAMERA,
+    RENDER,
+    EditRefused,
+    SceneDocument,
+    get_path,
+    label_of,
+    set_path,
+)
+from .widgets import (
+    BoolEditor,
+    ChoiceEditor,
+    CoefficientEditor,
+    ColourEditor,
+    FieldEditor,
+    FieldRow,
+    FileEditor,
+    NumberEditor,
+    TextEditor,
+    VectorEditor,
+)
+
+SMOOTH = {None: "auto", True: "on", False: "off"}
+
+
+def make_editor(spec: F.Spec) -> FieldEditor:
+    k = spec.kind
+    if k == F.TEXT:
+        return TextEditor()
+    if k in (F.NUMBER, F.INT, F.OPT_INT):
+        return NumberEditor(integer=k != F.NUMBER, optional=k == F.OPT_INT)
+    if k in (F.VEC3, F.ANGLES):
+        return VectorEditor()
+    if k == F.SCALE:
+        return VectorEditor(scalar_ok=True)
+    if k in (F.COEF, F.ATTEN):
+        return CoefficientEditor(spec.lo, spec.hi, triple_ok=k == F.ATTEN)
+    if k == F.COLOUR:
+        return ColourEditor()
+    if k == F.CHOICE:
+        return ChoiceEditor(spec.choices)
+    if k == F.BOOL:
+        return BoolEditor()
+    if k == F.FILE:
+        return FileEditor()
+    raise ValueError(k)
+
+
+class PropertyPanel(QWidget):
+    """Shows the document's selected item. ``choose_file(title, filters)`` (set by the window)
+    asks for a file and returns its path or None."""
+
+    def __init__(self, doc: SceneDocument, parent=None) -> None:
+        super().__init__(parent)
+        self.doc = doc
+        self.choose_file: Callable[[str, str], str | None] = lambda title, filters: None
+        self.rows: dict[tuple, FieldRow] = {}
+        self.specs: dict[tuple, F.Spec] = {}
+        self.material_combo: QComboBox | None = None
+        self.material_row: FieldRow | None = None
+        self._signature: object = None
+        self.title = QLabel(self)
+        self.title.setStyleSheet("font-weight: bold; font-size: 11pt;")
+        self.scroll = QScrollArea(self)
+        self.scroll.setWidgetResizable(True)
+        self.scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        box = QVBoxLayout(self)
+        box.setContentsMargins(4, 4, 4, 4)
+        box.addWidget(self.title)
+        box.addWidget(self.scroll, 1)
+        self.form: QWidget | None = None
+        doc.changed.connect(self.refresh)
+        self.refresh()
+
+    # ------------------------------------------------------------------ building
+
+    def specs_for(self, key: tuple, item: BaseModel) -> list[F.Spec]:
+        if key == CAMERA:
+            return F.camera_specs(item)
+        if key == RENDER:
+            return F.render_specs(item)
+        if key == BACKGROUND:
+            return F.background_specs(item)
+        if key[0] == "lights":
+            return F.light_specs(item)
+        specs = F.object_specs(item)
+        geometry = [s for s in specs if s.group != F.TRANSFORM]
+        placement = [s for s in specs if s.group == F.TRANSFORM]
+        return geometry + F.material_specs(self.doc.scene.material_of(key[1])) + placement
+
+    def refresh(self, *_: object) -> None:
+        key = self.doc.selection
+        item = self.doc.item(key)
+        if item is None:
+            self.title.setText("Nothing selected")
+            self._rebuild(key, [])
+            return
+        specs = self.specs_for(key, item)
+        self.title.setText(self.describe(key, item))
+        signature = (key[0], key[1] if len(key) > 1 else None, getattr(item, "type", None),
+                     tuple(specs))
+        if signature != self._signature:
+            self._signature = signature
+            self._rebuild(key, specs)
+        self._update_values(key, item)
+
+    def describe(self, key: tuple, item: BaseModel) -> str:
+        if key == CAMERA:
+            return "Camera"
+        if key == RENDER:
+            return "Render settings"
+        if key == BACKGROUND:
+            return "Background"
+        kind = "Light" if key[0] == "lights" else "Object"
+        return f"{kind}: {label_of(item)} ({item.type})"
+
+    def _rebuild(self, key: tuple, specs: list[F.Spec]) -> None:
+        if self.form is not None:
+            self.form.hide()
+            self.form.deleteLater()
+        self.rows, self.specs = {}, {}
+        self.material_combo = None
+        self.form = QWidget()
+        outer = QVBoxLayout(self.form)
+        outer.setContentsMargins(0, 0, 0, 0)
+        groups: dict[str, QFormLayout] = {}
+        for spec in specs:
+            group = spec.group or "General"
+            if group not in groups:
+                box = QGroupBox(group, self.form)
+                form = QFormLayout(box)
+                form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
+                groups[group] = form
+                outer.addWidget(box)
+                if group == F.MATERIAL:
+                    self._add_material_source(form)
+            editor = make_editor(spec)
+            row = FieldRow(editor)
+            label = QLabel(spec.label)
+            if spec.tip:
+                label.setToolTip(spec.tip)
+                editor.setToolTip(spec.tip)
+            groups[group].addRow(label, row)
+            self.rows[spec.path] = row
+            self.specs[spec.path] = spec
+            editor.committed.connect(
+                lambda value, continuous, s=spec: self.commit(s, value, continuous))
+            if isinstance(editor, FileEditor):
+                editor.browse.connect(lambda s=spec, e=editor: self._browse(s, e))
+        if key == CAMERA:
+            outer.addWidget(self._camera_tools())
+        outer.addStretch(1)
+        self.scroll.setWidget(self.form)
+
+    def _add_material_source(self, form: QFormLayout) -> None:
+        combo = QComboBox()
+        combo.setToolTip("a preset copies its values into this object's material; "
+                         "a scene material is shared with the objects that use it")
+        row = FieldRow(FieldEditor())
+        row.layout().insertWidget(0, combo)
+        form.addRow(QLabel("Preset"), row)
+        self.material_combo = combo
+        self.material_row = row
+        combo.activated.connect(lambda i: self.choose_material(combo.itemData(i)))
+
+    def _camera_tools(self) -> QGroupBox:
+        box = QGroupBox("Rotate the camera")
+        form = QFormLayout(box)
+        self.rotate_axis = QComboBox()
+        self.rotate_axis.addItems(["X", "Y", "Z"])
+        self.rotate_axis.setCurrentIndex(1)
+        self.rotate_angle = NumberEditor()
+        self.rotate_angle.set_value(15.0)
+        self.rotate_pivot = QComboBox()
+        self.rotate_pivot.addItem("about the camera (turn the view)", "camera")
+        self.rotate_pivot.addItem("about the target (circle it)", "target")
+        self.rotate_row = FieldRow(self.rotate_angle)
+        button = QPushButton("Rotate")
+        button.clicked.connect(self.rotate_camera)
+        self.rotate_button = button
+        line = QWidget()
+        h = QHBoxLayout(line)
+        h.setContentsMargins(0, 0, 0, 0)
+        h.addWidget(self.rotate_axis)
+        h.addWidget(self.rotate_row, 1)
+        h.addWidget(button)
+        form.addRow("Axis, angle (°)", line)
+        form.addRow("Pivot", self.rotate_pivot)
+        hint = QLabel("In the picture: drag to orbit, right- or Shift-drag to pan, wheel to zoom.")
+        hint.setWordWrap(True)
+        hint.setStyleSheet("color: #555;")
+        form.addRow(hint)
+        return box
+
+    # ------------------------------------------------------------------ values
+
+    def value_of(self, key: tuple, item: BaseModel, spec: F.Spec) -> Any:
+        path = spec.path
+        if path[0] == "material" and key[0] == "objects":
+            material = self.doc.scene.material_of(key[1])
+            if path[1:] == ("texture", "type"):
+                return getattr(material.texture, "type", "none")
+            if path[1] == "specular_color" and material.specular_color is None:
+                return (1.0, 1.0, 1.0)
+            return get_path(material, path[1:])
+        if path[0] == "transform" and item.transform is None:
+            return get_path(Transform(), path[1:])
+        if key == BACKGROUND and path == ("mode",):
+            return "colour" if item.gradient is None else "gradient"
+        if path == ("smooth",):
+            return SMOOTH[item.smooth]
+        value = get_path(item, path)
+        if path == ("transform", "rotate") and value is None:
+            return (0.0, 0.0, 0.0)
+        return value
+
+    def _update_values(self, key: tuple, item: BaseModel) -> None:
+        for path, row in self.rows.items():
+            row.clear_error()
+            row.editor.set_value(self.value_of(key, item, self.specs[path]))
+        if self.material_combo is not None:
+            self._fill_material_combo(key, item)
+
+    def _fill_material_combo(self, key: tuple, item: BaseModel) -> None:
+        combo = self.material_combo
+        assert combo is not None
+        combo.clear()
+        combo.addItem("Default (grey)", "default:")
+        for name in self.doc.scene.materials:
+            combo.addItem(f"{name} (scene material)", f"named:{name}")
+        for name in PRESETS:
+            combo.addItem(f"{name} (preset)", f"preset:{name}")
+        combo.addItem("Custom", "custom:")
+        ref = item.material
+        if ref is None:
+            current = "default:"
+        elif isinstance(ref, str):
+            current = f"named:{ref}" if ref in self.doc.scene.materials else f"preset:{ref}"
+        elif ref.preset is not None and ref == Material(preset=ref.preset):
+            current = f"preset:{ref.preset}"
+        else:
+            current = "custom:"
+        index = combo.findData(current)
+        combo.setCurrentIndex(index if index >= 0 else combo.count() - 1)
+
+    # ------------------------------------------------------------------ edits
+
+    def commit(self, spec: F.Spec, value: Any, continuous: bool = False) -> bool:
+        """Apply one field's new value; False (and a message at the field) if refused."""
+        key = self.doc.selection
+        item = self.doc.item(key)
+        row = self.rows.get(spec.path)
+        if item is None:
+            return False
+        editor = row.editor if row else None
+        merge = (key, spec.path, getattr(editor, "session", None)) if continuous else None
+        try:
+            data = self._data_with(key, item, spec, value)
+            self.doc.edit_item(key, data, f"Change {spec.label.lower()}", merge_key=merge)
+        except EditRefused as exc:
+            if row is not None:
+                row.show_error(str(exc))
+            return False
+        if row is not None:
+            row.clear_error()
+        return True
+
+    def _data_with(self, key: tuple, item: BaseModel, spec: F.Spec, value: Any) -> dict:
+        path = spec.path
+        data = item.model_dump()
+        if path[0] == "material" and key[0] == "objects":
+            material = self.doc.scene.material_of(key[1]).model_dump()
+            if path[1:] == ("texture", "type"):
+                material["texture"] = self._new_texture(value, material.get("texture"))
+            else:
+                material = set_path(material, path[1:], value)
+            data["material"] = material
+            return data
+        if path[0] == "transform" and data.get("transform") is None:
+            data["transform"] = Transform().model_dump()
+        if key == BACKGROUND and path == ("mode",):
+            if value == "colour":
+                data["gradient"] = None
+            elif data.get("gradient") is None:
+                c = data["color"]
+                data["gradient"] = Gradient(top=c, bottom=c).model_dump()
+            return data
+        if path == ("smooth",):
+            value = {v: k for k, v in SMOOTH.items()}[value]
+        return set_path(data, path, value)
+
+    def _new_texture(self, kind: str, old: dict | None) -> dict | None:
+        if kind == "none":
+            return None
+        if old is not None and old.get("type") == kind:
+            return old
+        if kind == "image":
+            name = self.choose_file("Texture image", F.IMAGE_FILTER)
+            if not name:
+                raise EditRefused("choose an image file for the texture")
+            return {"type": "image", "file": self._relative(name)}
+        return {"type": kind}
+
+    def choose_material(self, choice: str) -> None:
+        """``default:``, ``named:NAME``, ``preset:NAME`` or ``custom:`` (the drop-down)."""
+        kind, _, name = choice.partition(":")
+        key = self.doc.selection
+        item = self.doc.item(key)
+        if item is None or key[0] != "objects":
+            return
+        data = item.model_dump()
+        if kind == "default":
+            data["material"] = None
+        elif kind == "named":
+            data["material"] = name
+        elif kind == "preset":
+            data["material"] = {"preset": name}
+        else:  # custom: this object's own copy of what it shows now
+            data["material"] = self.doc.scene.material_of(key[1]).model_dump()
+        try:
+            self.doc.edit_item(key, data, "Change material")
+        except EditRefused as exc:
+            if self.material_row is not None:
+                self.material_row.show_error(str(exc))
+
+    def _browse(self, spec: F.Spec, editor: FileEditor) -> None:
+        name = self.choose_file(spec.label, spec.filters)
+        if name:
+            editor.choose(self._relative(name))
+
+    def _relative(self, name: str) -> str:
+        from pathlib import Path
+
+        p = Path(name)
+        try:
+            return str(p.resolve().relative_to(self.doc.scene.base_dir.resolve()))
+        except ValueError:
+            return str(p)
+
+    def rotate_camera(self) -> bool:
+        """The Rotate button: turn the camera by the angle about the chosen axis."""
+        try:
+            from .widgets import parse_number
+
+            angle = float(parse_number(self.rotate_angle.line.text()))
+        except ValueError as exc:
+            self.rotate_row.show_error(str(exc))
+            return False
+        axis = self.rotate_axis.currentText()
+        pivot = self.rotate_pivot.currentData()
+        try:
+            camera = camera_ops.rotate_about_axis(self.doc.scene.camera, axis, angle, pivot=pivot)
+            self.doc.edit_item(CAMERA, camera.model_dump(),
+                               f"Rotate camera {angle:g}° about {axis}")
+        except (ValueError, EditRefused) as exc:
+            self.rotate_row.show_error(str(exc).splitlines()[0])
+            return False
+        self.rotate_row.clear_error()
+        return True
+
+    # ------------------------------------------------------------------ for tests and the window
+
+    def row(self, *path: object) -> FieldRow:
+        return self.rows[tuple(path)]

@@ -1,0 +1,255 @@
+"""Full renders and the interactive preview, both through :class:`whitted.RenderJob` on its
+own background threads (the kernels release the GIL, so the event loop keeps running). The
+controller polls the job's framebuffer from a QTimer on the UI thread: no Qt object is touched
+from a render thread."""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from PySide6.QtCore import QObject, QTimer, Signal
+from PySide6.QtGui import QImage
+
+from ..output.image import Image
+from ..render.api import Progress, RenderJob, available_threads, warm_up_kernels
+from ..scene import Scene
+
+POLL_MS = 50
+#: preview pixel budget: starts here, adapts so that a preview takes about PREVIEW_TARGET_S
+PREVIEW_PIXELS = 160 * 120
+PREVIEW_MIN_PIXELS, PREVIEW_MAX_PIXELS = 64 * 48, 480 * 360
+PREVIEW_TARGET_S = 0.25
+PREVIEW_DEPTH = 2
+PREVIEW_SHADOW_SAMPLES = 4
+
+
+def to_qimage(pixels: np.ndarray, transfer: str, tonemap: str) -> QImage:
+    """Display values of a linear float framebuffer, as a QImage that owns its memory."""
+    rgb = np.ascontiguousarray(Image(pixels, transfer=transfer, tonemap=tonemap).to_srgb8())
+    h, w, _ = rgb.shape
+    return QImage(rgb.data, w, h, 3 * w, QImage.Format.Format_RGB888).copy()
+
+
+def preview_scene(scene: Scene, pixels: int) -> Scene:
+    """The scene at low resolution (same aspect ratio), shallow depth, one sample."""
+    s = scene.render
+    scale = min(1.0, math.sqrt(pixels / (s.width * s.height)))
+    width = max(1, round(s.width * scale))
+    height = max(1, round(s.height * scale))
+    return scene.with_settings(width=width, height=height, samples=1,
+                               max_depth=min(s.max_depth, PREVIEW_DEPTH),
+                               shadow_samples=min(s.shadow_samples, PREVIEW_SHADOW_SAMPLES))
+
+
+@dataclass
+class _Active:
+    job: RenderJob
+    kind: str  # "preview" or "render"
+    started: float
+    scene: Scene
+    latest: Progress | None = None
+    shown_tiles: int = -1
+    first_pixels: float | None = None
+
+
+class RenderController(QObject):
+    """``frame(QImage, kind)``: a new picture to show; ``progress(fraction, eta, text)``;
+    ``started(kind)``; ``finished(kind, text)``; ``failed(kind, message)``."""
+
+    frame = Signal(QImage, str)
+    progress = Signal(float, object, str)
+    started = Signal(str)
+    finished = Signal(str, str)
+    failed = Signal(str, str)
+    kernels_ready = Signal(float)
+
+    def __init__(self, parent=None, *, preview_delay_ms: int = 30) -> None:
+        super().__init__(parent)
+        self.full: _Active | None = None
+        self.preview: _Active | None = None
+        self.preview_pixels = PREVIEW_PIXELS
+        self.preview_enabled = True
+        self.last_image: Image | None = None  # the last full render, partial if stopped
+        self.last_preview: Image | None = None
+        self.previews_done = 0
+        self.last_preview_seconds: float | None = None
+        self.first_pixels_seconds: float | None = None
+        self._pending: Scene | None = None
+        self._poll = QTimer(self)
+        self._poll.setInterval(POLL_MS)
+        self._poll.timeout.connect(self._tick)
+        self._throttle = QTimer(self)
+        self._throttle.setSingleShot(True)
+        self._throttle.setInterval(preview_delay_ms)
+        self._throttle.timeout.connect(self._start_preview)
+        self._warm = threading.Event()
+        self._warm_seconds = 0.0
+
+    # ------------------------------------------------------------------ kernels
+
+    def warm_up(self) -> None:
+        """Compile or load the kernels on a background thread (the first render waits)."""
+        def work() -> None:
+            self._warm_seconds = warm_up_kernels()
+            self._warm.set()
+
+        threading.Thread(target=work, name="whitted-warm-up", daemon=True).start()
+        self._poll.start()
+
+    @property
+    def kernels_loaded(self) -> bool:
+        return self._warm.is_set()
+
+    # ------------------------------------------------------------------ full renders
+
+    @property
+    def rendering(self) -> bool:
+        return self.full is not None
+
+    def render(self, scene: Scene) -> RenderJob:
+        """Start a full render of ``scene``; the running preview (if any) is dropped."""
+        self.stop()
+        self._cancel_preview()
+        self._pending = None
+        active = _Active(RenderJob(scene, progress=None), "render", time.perf_counter(), scene)
+        active.job.progress = lambda p, a=active: setattr(a, "latest", p)
+        self.full = active
+        self.first_pixels_seconds = None
+        active.job.start()
+        self._poll.start()
+        self.started.emit("render")
+        return active.job
+
+    def stop(self) -> None:
+        """Stop the full render after the tiles in flight; the picture so far is kept."""
+        if self.full is not None:
+            self.full.job.cancel()
+
+    # ------------------------------------------------------------------ preview
+
+    def request_preview(self, scene: Scene) -> None:
+        """Preview ``scene`` soon (edits in quick succession coalesce into one preview)."""
+        if not self.preview_enabled:
+            return
+        self._pending = scene
+        if not self._throttle.isActive():
+            self._throttle.start()
+
+    def _start_preview(self) -> None:
+        scene, self._pending = self._pending, None
+        if scene is None:
+            return
+        if self.full is not None:
+            if self.full.job.cancel_token.cancelled:  # stopping: preview once it has
+                self._pending = scene
+                self._throttle.start()
+            return
+        self._cancel_preview()
+        small = preview_scene(scene, self.preview_pixels)
+        active = _Active(RenderJob(small), "preview", time.perf_counter(), scene)
+        self.preview = active
+        active.job.start()
+        self._poll.start()
+
+    def _cancel_preview(self) -> None:
+        if self.preview is not None:
+            self.preview.job.cancel()
+            self.preview = None
+
+    # ------------------------------------------------------------------ polling
+
+    def _tick(self) -> None:
+        if self._warm.is_set() and self._warm_seconds >= 0:
+            self.kernels_ready.emit(self._warm_seconds)
+            self._warm_seconds = -1.0
+        if self.preview is not None and not self.preview.job.running:
+            self._preview_done(self.preview)
+        if self.full is not None:
+            self._full_tick(self.full)
+        if self.full is None and self.preview is None and self._warm_seconds < 0:
+            self._poll.stop()
+
+    def _preview_done(self, active: _Active) -> None:
+        self.preview = None
+        job = active.job
+        if job.error is not None:
+            self.failed.emit("preview", _one_line(job.error))
+            return
+        if job.cancel_token.cancelled or job.image is None:
+            return
+        seconds = time.perf_counter() - active.started
+        render_seconds = job.stats.render_seconds + job.stats.build_seconds
+        if job.stats.compile_seconds == 0:  # adapt the resolution to the time it took
+            ratio = PREVIEW_TARGET_S / max(render_seconds, 1e-3)
+            self.preview_pixels = int(np.clip(self.preview_pixels * min(max(ratio, 0.5), 2.0),
+                                              PREVIEW_MIN_PIXELS, PREVIEW_MAX_PIXELS))
+        self.last_preview = job.image
+        self.last_preview_seconds = seconds
+        self.previews_done += 1
+        s = job.settings
+        self.frame.emit(to_qimage(job.framebuffer, s.transfer, s.tonemap), "preview")
+
+    def _full_tick(self, active: _Active) -> None:
+        job = active.job
+        p = active.latest
+        s = job.settings
+        if p is not None and p.tiles_done != active.shown_tiles:
+            active.shown_tiles = p.tiles_done
+            if active.first_pixels is None:
+                active.first_pixels = time.perf_counter() - active.started
+                self.first_pixels_seconds = active.first_pixels
+            self.frame.emit(to_qimage(job.framebuffer, s.transfer, s.tonemap), "render")
+            self.progress.emit(p.fraction, p.eta, _progress_text(p))
+        if job.running:
+            return
+        self.full = None
+        if job.error is not None:
+            self.failed.emit("render", _one_line(job.error))
+            return
+        image = job.image
+        self.last_image = image
+        stats = job.stats
+        if image is not None:
+            self.frame.emit(to_qimage(job.framebuffer, s.transfer, s.tonemap), "render")
+        if stats.cancelled:
+            text = f"Stopped: kept {stats.tiles_done}/{stats.tiles_total} tiles"
+        else:
+            text = (f"Rendered {stats.width}×{stats.height} in {stats.render_seconds:.2f} s "
+                    f"({stats.total_rays:,} rays, {stats.threads} threads)")
+        self.progress.emit(stats.tiles_done / max(stats.tiles_total, 1), None, text)
+        self.finished.emit("render", text)
+
+    def shutdown(self, timeout: float = 5.0) -> None:
+        """Cancel everything and wait for the render threads (closing the window)."""
+        self._throttle.stop()
+        self._poll.stop()
+        jobs = [a.job for a in (self.full, self.preview) if a is not None]
+        for job in jobs:
+            job.cancel()
+        for job in jobs:
+            if job._thread is not None:
+                job._thread.join(timeout)
+        self.full = self.preview = None
+
+
+def _progress_text(p: Progress) -> str:
+    eta = "" if p.eta is None else f", {_duration(p.eta)} left"
+    return f"{p.fraction:.0%} ({p.tiles_done}/{p.tiles_total} tiles){eta}"
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 60:
+        return f"{seconds:.0f} s"
+    return f"{int(seconds // 60)} min {int(seconds % 60):02d} s"
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()
+    return text[0] if text else type(exc).__name__
+
+
+__all__ = ["RenderController", "available_threads", "preview_scene", "to_qimage"]

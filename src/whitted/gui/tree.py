@@ -1,0 +1,134 @@
+"""The scene tree: Camera, Render settings, Background, then the lights and the objects.
+Selecting an item selects it in the document (the properties panel follows); double-click or
+F2 renames a light or an object in place."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtWidgets import QAbstractItemView, QTreeWidget, QTreeWidgetItem
+
+from .document import BACKGROUND, CAMERA, RENDER, SceneDocument, label_of
+
+KEY_ROLE = Qt.ItemDataRole.UserRole
+
+
+class SceneTree(QTreeWidget):
+    selected = Signal(object)  # selection key
+
+    def __init__(self, doc: SceneDocument, parent=None) -> None:
+        super().__init__(parent)
+        self.doc = doc
+        self.setHeaderHidden(True)
+        self.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
+        self.setEditTriggers(QAbstractItemView.EditTrigger.DoubleClicked
+                             | QAbstractItemView.EditTrigger.EditKeyPressed)
+        self.setContextMenuPolicy(Qt.ContextMenuPolicy.ActionsContextMenu)
+        self._filling = False
+        self.itemSelectionChanged.connect(self._selection_changed)
+        self.itemChanged.connect(self._renamed)
+        doc.changed.connect(self.fill)
+        self.fill()
+
+    def fill(self, *_: object) -> None:
+        """Rebuild the tree from the document's scene and select the document's selection
+        (only the texts change when the lists keep their lengths)."""
+        scene = self.doc.scene
+        shape = (len(scene.lights), len(scene.objects))
+        if shape == getattr(self, "_shape", None):
+            self._update_texts()
+            return
+        self._shape = shape
+        self._filling = True
+        try:
+            expanded = {self.topLevelItem(i).text(0).split(" ")[0]: self.topLevelItem(i)
+                        .isExpanded() for i in range(self.topLevelItemCount())}
+            self.clear()
+            for key, text in ((CAMERA, "Camera"), (RENDER, "Render settings"),
+                              (BACKGROUND, "Background")):
+                item = QTreeWidgetItem([text])
+                item.setData(0, KEY_ROLE, key)
+                self.addTopLevelItem(item)
+            for kind, title in (("lights", "Lights"), ("objects", "Objects")):
+                items = getattr(scene, kind)
+                group = QTreeWidgetItem([f"{title} ({len(items)})"])
+                group.setData(0, KEY_ROLE, None)
+                group.setFlags(group.flags() & ~Qt.ItemFlag.ItemIsSelectable)
+                self.addTopLevelItem(group)
+                for i, obj in enumerate(items):
+                    child = QTreeWidgetItem([self.text_of(obj)])
+                    child.setData(0, KEY_ROLE, (kind, i))
+                    child.setToolTip(0, f"{obj.type} {'light' if kind == 'lights' else ''}")
+                    child.setFlags(child.flags() | Qt.ItemFlag.ItemIsEditable)
+                    group.addChild(child)
+                group.setExpanded(expanded.get(title, True))
+            found = self.item_for(self.doc.selection)
+            if found is not None:
+                self.setCurrentItem(found)
+                found.setSelected(True)
+        finally:
+            self._filling = False
+
+    def _update_texts(self) -> None:
+        self._filling = True
+        try:
+            for i in range(self.topLevelItemCount()):
+                top = self.topLevelItem(i)
+                for j in range(top.childCount()):
+                    child = top.child(j)
+                    obj = self.doc.item(child.data(0, KEY_ROLE))
+                    if obj is not None and child.text(0) != self.text_of(obj):
+                        child.setText(0, self.text_of(obj))
+            found = self.item_for(self.doc.selection)
+            if found is not None and not found.isSelected():
+                self.setCurrentItem(found)
+        finally:
+            self._filling = False
+
+    @staticmethod
+    def text_of(obj) -> str:
+        name = label_of(obj)
+        return name if name == obj.type else f"{name}  ({obj.type})"
+
+    def item_for(self, key) -> QTreeWidgetItem | None:
+        for i in range(self.topLevelItemCount()):
+            top = self.topLevelItem(i)
+            if top.data(0, KEY_ROLE) == key:
+                return top
+            for j in range(top.childCount()):
+                if top.child(j).data(0, KEY_ROLE) == key:
+                    return top.child(j)
+        return None
+
+    def select_key(self, key) -> None:
+        item = self.item_for(key)
+        if item is not None:
+            self.setCurrentItem(item)
+
+    def _selection_changed(self) -> None:
+        if self._filling:
+            return
+        items = self.selectedItems()
+        key = items[0].data(0, KEY_ROLE) if items else None
+        if key is not None and key != self.doc.selection:
+            self.doc.select(key)
+            self.selected.emit(key)
+
+    def _renamed(self, item: QTreeWidgetItem, column: int) -> None:
+        if self._filling:
+            return
+        key = item.data(0, KEY_ROLE)
+        if key is None or len(key) != 2:
+            return
+        text = item.text(0).strip()
+        # after the editor has closed: renaming rebuilds the tree
+        QTimer.singleShot(0, lambda: self._rename(key, text))
+
+    def _rename(self, key, text: str) -> None:
+        obj = self.doc.item(key)
+        if obj is None:
+            return
+        suffix = f"  ({obj.type})"  # "name  (type)" as shown: keep only the name part
+        name = text[: -len(suffix)] if text.endswith(suffix) else text
+        if text != self.text_of(obj):
+            self.doc.rename(key, name)
+        self._update_texts()  # an unchanged name: show the model's text again
