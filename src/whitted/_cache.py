@@ -16,7 +16,7 @@ import os
 import sys
 from pathlib import Path
 
-KERNEL_DIRS = ("kernels", "compile")
+KERNEL_DIRS = ("kernels", "compile", "assets")
 
 
 def kernel_source_hash() -> str:

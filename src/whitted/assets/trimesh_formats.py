@@ -1,0 +1,181 @@
+"""PLY, STL, OFF and glTF/GLB files through trimesh, with nothing merged or repaired.
+
+Every geometry of the file's scene is placed by its node transform and the results are
+concatenated in scene-graph order; each geometry gets one material from its PBR base colour (or
+its simple diffuse colour). A base-colour texture becomes an :class:`ImageTexture` when it is an
+image file next to a ``.gltf`` (matched through the material's name); images embedded in the
+file are not supported (a warning; the base colour is used).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SceneError
+from ..scene.materials import Material
+from ..scene.textures import ImageTexture
+from .mesh import MeshData
+
+
+def _external_base_colour_images(path: Path) -> dict[str, Path]:
+    """Material name -> base colour image file, for a .gltf whose images are files."""
+    if path.suffix.lower() != ".gltf":
+        return {}
+    try:
+        document = json.loads(path.read_text(encoding="utf-8"))
+        images = document.get("images", [])
+        textures = document.get("textures", [])
+        found: dict[str, Path] = {}
+        for material in document.get("materials", []):
+            info = material.get("pbrMetallicRoughness", {}).get("baseColorTexture")
+            if not info:
+                continue
+            source = textures[info["index"]].get("source")
+            uri = images[source].get("uri", "") if source is not None else ""
+            if uri and not uri.startswith("data:"):
+                from urllib.parse import unquote
+
+                image_path = path.parent / unquote(uri)
+                if image_path.is_file() and material.get("name"):
+                    found[material["name"]] = image_path.resolve()
+        return found
+    except (OSError, ValueError, KeyError, IndexError, TypeError, AttributeError):
+        return {}
+
+
+def _linear_colour(values: object) -> tuple[float, float, float] | None:
+    if values is None:
+        return None
+    array = np.asarray(values, dtype=np.float64).reshape(-1)
+    if array.size < 3 or not np.all(np.isfinite(array[:3])):
+        return None
+    if np.asarray(values).dtype == np.uint8 or array[:3].max() > 1.0:
+        array = array / 255.0
+    r, g, b = (float(min(max(v, 0.0), 1.0)) for v in array[:3])
+    return (r, g, b)
+
+
+def _material_of(geometry: object, images: dict[str, Path], name: str, warnings: list[str],
+                 texture_files: list[str], has_uvs: bool) -> Material:
+    visual = getattr(geometry, "visual", None)
+    material = getattr(visual, "material", None)
+    if material is None:
+        return Material()
+    fields: dict[str, object] = {}
+    colour = _linear_colour(getattr(material, "baseColorFactor", None))
+    if colour is None:
+        colour = _linear_colour(getattr(material, "diffuse", None))
+    if colour is not None:
+        fields["color"] = colour
+    has_image = (getattr(material, "baseColorTexture", None) is not None
+                 or getattr(material, "image", None) is not None)
+    if has_image:
+        image_path = images.get(getattr(material, "name", None) or "")
+        if image_path is not None and has_uvs:
+            fields["texture"] = ImageTexture(file=str(image_path))
+            if str(image_path) not in texture_files:
+                texture_files.append(str(image_path))
+        else:
+            warnings.append(f"{name}: material '{getattr(material, 'name', '')}': embedded "
+                            "texture images are not supported (base colour used)")
+    return Material.model_validate(fields)
+
+
+def load_with_trimesh(path: Path, name: str) -> MeshData:
+    """A MeshData for a PLY, STL, OFF or glTF/GLB file."""
+    import trimesh
+
+    logging.getLogger("trimesh").setLevel(logging.ERROR)
+    try:
+        scene = trimesh.load_scene(os.fspath(path), process=False)
+    except Exception as error:  # trimesh raises many kinds for a bad file
+        detail = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+        raise SceneError(f"cannot read the {path.suffix.lower()[1:].upper()} file: {detail}",
+                         file=name) from None
+    images = _external_base_colour_images(path)
+    warnings: list[str] = []
+    texture_files: list[str] = []
+    vertex_blocks: list[np.ndarray] = []
+    face_blocks: list[np.ndarray] = []
+    normal_blocks: list[np.ndarray | None] = []
+    uv_blocks: list[np.ndarray | None] = []
+    material_blocks: list[np.ndarray] = []
+    materials: list[Material] = []
+    offset = 0
+    for node in scene.graph.nodes_geometry:
+        transform, geometry_name = scene.graph[node]
+        geometry = scene.geometry.get(geometry_name)
+        if not isinstance(geometry, trimesh.Trimesh):
+            continue  # point clouds and paths have no triangles
+        vertices = np.asarray(geometry.vertices, dtype=np.float64)
+        faces = np.asarray(geometry.faces, dtype=np.int64).reshape(-1, 3)
+        transform = np.asarray(transform, dtype=np.float64)
+        identity = np.array_equal(transform, np.eye(4))
+        if not identity:
+            vertices = vertices @ transform[:3, :3].T + transform[:3, 3]
+        normals = None
+        if "vertex_normals" in geometry._cache:
+            normals = np.asarray(geometry.vertex_normals, dtype=np.float64)
+            if not identity:
+                normals = normals @ np.linalg.inv(transform[:3, :3])
+            lengths = np.linalg.norm(normals, axis=1)
+            lengths[lengths == 0.0] = 1.0
+            normals = normals / lengths[:, None]
+        uv = getattr(geometry.visual, "uv", None)
+        uvs = None
+        if uv is not None and len(uv) == len(vertices):
+            uvs = np.asarray(uv, dtype=np.float64)[:, :2]
+        materials.append(_material_of(geometry, images, name, warnings, texture_files,
+                                      uvs is not None))
+        vertex_blocks.append(vertices)
+        face_blocks.append(faces + offset)
+        normal_blocks.append(normals)
+        uv_blocks.append(uvs)
+        material_blocks.append(np.full(len(faces), len(materials) - 1, np.int32))
+        offset += len(vertices)
+    if not vertex_blocks:
+        vertices = np.zeros((0, 3), np.float64)
+        faces = np.zeros((0, 3), np.int64)
+        materials = [Material()]
+        face_material = np.zeros(0, np.int32)
+    else:
+        vertices = np.concatenate(vertex_blocks)
+        faces = np.concatenate(face_blocks)
+        face_material = np.concatenate(material_blocks)
+    normals_out = None
+    if normal_blocks and all(block is not None for block in normal_blocks):
+        normals_out = np.concatenate(normal_blocks)
+    elif any(block is not None for block in normal_blocks):
+        warnings.append(f"{name}: only some geometries have normals: normals not used")
+    uvs_out = None
+    if uv_blocks and any(block is not None for block in uv_blocks):
+        uvs_out = np.concatenate([
+            block if block is not None else np.zeros((len(v), 2)) for block, v in
+            zip(uv_blocks, vertex_blocks, strict=True)
+        ])
+    if not np.all(np.isfinite(vertices)):
+        raise SceneError("vertex position is not finite (nan or inf)", file=name)
+    if len(faces) and (faces.min() < 0 or faces.max() >= len(vertices)):
+        raise SceneError(f"face index out of range ({len(vertices)} vertices)", file=name)
+    if len(vertices) > 2**31 - 1:
+        raise SceneError("too many vertices", file=name)
+    if not materials:
+        materials = [Material()]
+    return MeshData(
+        vertices=np.ascontiguousarray(vertices),
+        faces=np.ascontiguousarray(faces, dtype=np.int32),
+        normals=normals_out,
+        uvs=uvs_out,
+        face_material=face_material,
+        materials=materials,
+        warnings=warnings,
+        vertex_records=len(vertices),
+        triangle_records=len(faces),
+        source=name,
+        texture_files=texture_files,
+    )
