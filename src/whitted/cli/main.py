@@ -265,6 +265,40 @@ def gui(
     raise typer.Exit(run_editor(scene, scene_path))
 
 
+@app.command()
+def export(
+    scene_path: Annotated[
+        Path | None, typer.Argument(metavar="[SCENE]", help="Scene file; default: built-in scene")
+    ] = None,
+    output: Annotated[
+        Path | None, typer.Option("-o", "--output", help="File to write; default: SCENE.pov")
+    ] = None,
+    export_format: Annotated[str, typer.Option("--format", "-f", help="Only 'pov'")] = "pov",
+    width: Annotated[int | None, typer.Option("--width", "-W", help="Image width")] = None,
+    height: Annotated[int | None, typer.Option("--height", "-H", help="Image height")] = None,
+) -> None:
+    """Write SCENE for another renderer: POV-Ray 3.7 scene language (--format pov)."""
+    from ..export.pov import export_pov
+
+    if export_format != "pov":
+        raise fail(f"--format: unknown format {export_format!r} (known: pov)")
+    try:
+        scene, name = _load(scene_path)
+        scene = scene.with_settings(width=width, height=height)
+        if output is None:
+            output = Path(scene_path.stem if scene_path else "default").with_suffix(".pov")
+        if not output.parent.exists():
+            raise fail(f"{output}: the folder {output.parent} does not exist")
+        export_pov(scene, output, source=name)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    except ValidationError as exc:
+        raise fail(_override_error(exc)) from None
+    r = scene.render
+    out.print(f"{name} -> {output} (POV-Ray 3.7; render with: povray +I{output} "
+              f"+W{r.width} +H{r.height} -A)")
+
+
 def main() -> None:
     """Console entry point: usage mistakes end as one ``error:`` line and status 2."""
     try:
