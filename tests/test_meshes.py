@@ -1,0 +1,258 @@
+"""Triangle meshes through the real pipeline: watertightness, instancing, smooth normals,
+barycentric texture coordinates, per-triangle materials, degenerate triangles."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from numba import njit
+
+import whitted
+from meshgen import cube, uv_sphere
+from whitted.compile.flatten import compile_scene
+from whitted.kernels.accel import closest_hit, surface_normals
+from whitted.kernels.uv import surface_uv
+
+
+@njit(cache=False)
+def _first_hits(geo, origins, directions, tmin, stack):
+    """t of the nearest hit beyond tmin[k] for every ray (inf on a miss)."""
+    out = np.empty(origins.shape[0])
+    for k in range(origins.shape[0]):
+        o = (origins[k, 0], origins[k, 1], origins[k, 2])
+        d = (directions[k, 0], directions[k, 1], directions[k, 2])
+        t, prim, tri, b1, b2 = closest_hit(geo, o, d, tmin[k], np.inf, stack)
+        out[k] = t if prim >= 0 else np.inf
+    return out
+
+
+def _hits(compiled, origins, directions, tmin=None):
+    origins = np.ascontiguousarray(origins, np.float64)
+    directions = np.ascontiguousarray(directions, np.float64)
+    if tmin is None:
+        tmin = np.zeros(len(origins))
+    return _first_hits(compiled.geometry, origins, directions,
+                       np.ascontiguousarray(tmin, np.float64), np.empty(128, np.int32))
+
+
+def _targets(verts, faces):
+    """The exact places rays slip through leaky meshes: every vertex and edge midpoint."""
+    v = verts.astype(np.float32).astype(np.float64)
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    mid = 0.5 * (v[edges[:, 0]] + v[edges[:, 1]])
+    return np.concatenate([v, mid])
+
+
+TRANSFORMS = [
+    None,
+    whitted.Transform(scale=(1.7, 0.6, 1.1), rotate=(23.0, -41.0, 7.0), translate=(0.3, -2, 5)),
+]
+
+
+@pytest.fixture(scope="module")
+def sphere_mesh():
+    v, f = uv_sphere(24, 48)
+    n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    assert (np.einsum("ij,ij->i", n, v[f].mean(axis=1)) > 0).all()  # wound outward
+    return v, f
+
+
+@pytest.mark.parametrize("transform", TRANSFORMS, ids=["identity", "affine"])
+def test_closed_mesh_is_watertight(sphere_mesh, transform):
+    """A ray from inside a closed mesh always hits it, and a ray that enters from outside
+    always leaves: aimed exactly at every vertex and edge midpoint, and a million random."""
+    v, f = sphere_mesh
+    mesh = whitted.Mesh(v, f, transform=transform)
+    compiled = compile_scene(whitted.Scene(objects=[mesh]))
+    m = transform.matrix() if transform is not None else np.eye(4)
+
+    def world(p):
+        return p @ m[:3, :3].T + m[:3, 3]
+
+    rng = np.random.default_rng(7)
+    targets = _targets(v, f)
+    inner = rng.uniform(-0.3, 0.3, (len(targets), 3))
+    # inside -> out through each vertex / edge midpoint
+    o, tgt = world(inner), world(targets)
+    assert np.isfinite(_hits(compiled, o, tgt - o)).all()
+    # outside -> in through each vertex / edge midpoint, then out again
+    far = world(inner + 3.0 * (targets - inner))
+    d = world(inner) - far
+    t_in = _hits(compiled, far, d)
+    assert np.isfinite(t_in).all()
+    t_out = _hits(compiled, far, d, t_in * (1 + 1e-9))
+    assert np.isfinite(t_out).all()
+    # a million random rays from random interior points in random directions
+    n = 1_000_000
+    o = world(rng.uniform(-0.5, 0.5, (n, 3)))
+    d = rng.normal(size=(n, 3))
+    assert np.isfinite(_hits(compiled, o, d)).all()
+
+
+def test_mesh_hits_match_analytic_box():
+    """A box as 12 triangles gives the same distances and normals as the analytic box."""
+    v, f = cube((-1, -0.5, -2), (1.5, 1, 0.5))
+    rng = np.random.default_rng(3)
+    o = rng.uniform(-6, 6, (2000, 3))
+    d = rng.uniform((-1.5, -1, -2.5), (2, 1.5, 1), (2000, 3)) - o  # at the box and around it
+    as_mesh = _hits(compile_scene(whitted.Scene(objects=[whitted.Mesh(v, f)])), o, d)
+    as_box = _hits(compile_scene(whitted.Scene(objects=[
+        whitted.Box(min=(-1, -0.5, -2), max=(1.5, 1, 0.5))])), o, d)
+    assert 1000 < np.isfinite(as_box).sum() < 2000
+    np.testing.assert_array_equal(np.isfinite(as_mesh), np.isfinite(as_box))
+    hit = np.isfinite(as_box)
+    np.testing.assert_allclose(as_mesh[hit], as_box[hit], rtol=1e-12, atol=1e-12)
+
+
+def test_instances_share_one_copy():
+    v, f = uv_sphere(8, 16)
+    base = whitted.Mesh(v, f)
+    moved = base.model_copy(update={"transform": whitted.Transform(translate=(3, 0, 0))})
+    scaled = base.model_copy(update={"transform": whitted.Transform(scale=2, translate=(-4, 0, 0))})
+    compiled = compile_scene(whitted.Scene(objects=[base, moved, scaled]))
+    geo = compiled.geometry
+    assert len(geo.mesh_faces) == len(f)  # the triangles are stored once
+    assert len(geo.mesh_info) == 1
+    assert compiled.triangles == len(f)
+    assert compiled.instanced_triangles == 3 * len(f)
+    # each instance is where its transform puts it: rays down -z through their centres
+    o = np.array([[0, 0, 10], [3, 0, 10], [-4, 0, 10]], float)
+    d = np.tile([0.0, 0.0, -1.0], (3, 1))
+    np.testing.assert_allclose(_hits(compiled, o, d), [9.0, 9.0, 8.0], atol=1e-6)
+
+
+def test_same_model_file_is_instanced(tmp_path):
+    v, f = cube()
+    lines = [f"v {x} {y} {z}" for x, y, z in v] + [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in f]
+    (tmp_path / "box.obj").write_text("\n".join(lines) + "\n")
+    scene_file = tmp_path / "scene.toml"
+    scene_file.write_text(
+        '[[objects]]\ntype = "mesh"\nfile = "box.obj"\n\n'
+        '[[objects]]\ntype = "mesh"\nfile = "box.obj"\ntransform = { translate = [4, 0, 0] }\n'
+    )
+    compiled = compile_scene(whitted.load_scene(scene_file))
+    assert len(compiled.geometry.mesh_faces) == 12
+    assert compiled.instanced_triangles == 24
+
+
+def _one_triangle_hit(mesh, ray_o, ray_d):
+    compiled = compile_scene(whitted.Scene(objects=[mesh]))
+    geo = compiled.geometry
+    t, prim, tri, b1, b2 = closest_hit(geo, ray_o, ray_d, 0.0, math.inf, np.empty(128, np.int32))
+    assert prim == 0 and tri == 0
+    p = tuple(o + t * d for o, d in zip(ray_o, ray_d, strict=True))
+    return geo, prim, tri, b1, b2, p
+
+
+def test_smooth_normals_interpolate_the_corners():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+    normals = np.array([[0, 0, 1], [1, 0, 1], [0, 1, 1]], float) / [[1], [math.sqrt(2)],
+                                                                      [math.sqrt(2)]]
+    mesh = whitted.Mesh(v, [[0, 1, 2]], normals=normals)
+    geo, prim, tri, b1, b2, p = _one_triangle_hit(mesh, (0.25, 0.5, 1.0), (0.0, 0.0, -1.0))
+    assert (b1, b2) == pytest.approx((0.25, 0.5))
+    ng, ns = surface_normals(geo, prim, tri, b1, b2, p)
+    assert ng == pytest.approx((0, 0, 1))
+    expect = 0.25 * normals[0] + 0.25 * normals[1] + 0.5 * normals[2]
+    assert ns == pytest.approx(tuple(expect / np.linalg.norm(expect)))
+    # smooth = false ignores the normals
+    flat = whitted.Mesh(v, [[0, 1, 2]], normals=normals, smooth=False)
+    geo, prim, tri, b1, b2, p = _one_triangle_hit(flat, (0.25, 0.5, 1.0), (0.0, 0.0, -1.0))
+    assert surface_normals(geo, prim, tri, b1, b2, p)[1] == pytest.approx((0, 0, 1))
+
+
+def test_computed_smooth_normals_respect_the_crease_angle():
+    v, f = cube()
+    sharp = compile_scene(whitted.Scene(objects=[whitted.Mesh(v, f, smooth=True)]))
+    # 90-degree edges are above the default 60-degree crease: every corner keeps its face normal
+    n = sharp.geometry.tri_normals
+    face = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    face /= np.linalg.norm(face, axis=1, keepdims=True)
+    np.testing.assert_allclose(n, np.repeat(face[:, None, :], 3, axis=1), atol=1e-6)
+    soft = compile_scene(whitted.Scene(objects=[whitted.Mesh(v, f, smooth=True,
+                                                             crease_angle=100)]))
+    # above 90 degrees everything joins: a corner normal points along the corner's diagonal
+    corner = soft.geometry.tri_normals.reshape(-1, 3)
+    np.testing.assert_allclose(np.abs(corner), 1 / math.sqrt(3), atol=1e-6)
+    # a sphere mesh smooths towards the true sphere normal
+    sv, sf = uv_sphere(16, 32)
+    smooth = compile_scene(whitted.Scene(objects=[whitted.Mesh(sv, sf, smooth=True)]))
+    at = sv[sf].astype(np.float32).astype(np.float64)
+    true = at / np.linalg.norm(at, axis=2, keepdims=True)
+    assert np.max(np.abs(smooth.geometry.tri_normals - true)) < 0.02
+
+
+def test_mesh_uvs_and_barycentric_default():
+    v = np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0]], float)
+    uvs = np.array([[0.1, 0.2], [0.9, 0.2], [0.1, 0.8]])
+    geo, prim, tri, b1, b2, p = _one_triangle_hit(whitted.Mesh(v, [[0, 1, 2]], uvs=uvs),
+                                                  (0.5, 1.0, 1.0), (0.0, 0.0, -1.0))
+    u, w = surface_uv(geo, prim, tri, b1, b2, p)
+    assert (u, w) == pytest.approx((0.1 + 0.8 * 0.25, 0.2 + 0.6 * 0.5))
+    geo, prim, tri, b1, b2, p = _one_triangle_hit(whitted.Mesh(v, [[0, 1, 2]]),
+                                                  (0.5, 1.0, 1.0), (0.0, 0.0, -1.0))
+    assert surface_uv(geo, prim, tri, b1, b2, p) == pytest.approx((0.25, 0.5))
+
+
+def test_degenerate_triangles_are_dropped_with_a_count():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [2, 0, 0]], float)
+    faces = [[0, 1, 2], [0, 1, 3], [1, 1, 2], [0, 2, 1]]  # collinear, repeated corner
+    compiled = compile_scene(whitted.Scene(objects=[whitted.Mesh(v, faces)]))
+    assert compiled.triangles == 2
+    assert any("dropped 2 degenerate triangles" in w for w in compiled.warnings)
+
+
+def test_per_triangle_materials_and_override():
+    """Two triangles of one mesh with different materials shade differently; an object's
+    material overrides them all."""
+    v = np.array([[-2, -1, 0], [0, -1, 0], [0, 1, 0], [-2, 1, 0], [2, -1, 0], [2, 1, 0]], float)
+    faces = [[0, 1, 2], [0, 2, 3], [1, 4, 5], [1, 5, 2]]
+    from whitted.compile.meshes import MeshSource
+    mesh = whitted.Mesh(v, faces)
+    scene = whitted.Scene(objects=[mesh], lights=[whitted.AmbientLight(intensity=1.0)])
+    scene.camera.position = (0.0, 0.0, 5.0)
+    # through the public path: default material everywhere
+    img = whitted.render(scene, width=40, height=20).pixels
+    assert img[10, 12] == pytest.approx(img[10, 28])
+    # two file materials through the compiler's mesh source
+    red = whitted.Material(color=(1, 0, 0), ka=1, kd=0)
+    blue = whitted.Material(color=(0, 0, 1), ka=1, kd=0)
+    src = MeshSource("two.obj", v, np.array(faces), None, None, np.array([0, 0, 1, 1]),
+                     [red, blue])
+    from whitted.compile import flatten
+
+    original = flatten._mesh_source
+    flatten._mesh_source = lambda *a: src
+    try:
+        compiled = compile_scene(scene)
+        mats = compiled.materials[compiled.geometry.tri_material]
+        assert (mats[:2, 0] == 1).all() and (mats[2:, 2] == 1).all()
+        over = scene.model_copy(update={"objects": [mesh.model_copy(update={
+            "material": whitted.Material(color=(0, 1, 0), ka=1, kd=0)})]})
+        compiled = compile_scene(over)
+        assert compiled.geometry.prim_material[0] >= 0
+    finally:
+        flatten._mesh_source = original
+
+
+def test_closed_mesh_rendered_from_inside_and_outside():
+    """From inside a closed mesh every pixel sees the mesh (nothing leaks to the background);
+    from outside its silhouette is the sphere's."""
+    v, f = uv_sphere(32, 64, r=2.0)
+    mesh = whitted.Mesh(v, f, smooth=True, material=whitted.Material(color=(1, 1, 1), ka=1))
+    scene = whitted.Scene(objects=[mesh], lights=[whitted.PointLight(position=(0, 0.5, 0))],
+                          background=whitted.Background(color=(0, 0, 0)))
+    scene.camera.position = (0.0, 0.0, 0.3)
+    depth = whitted.render_aovs(scene, width=160, height=120)["depth"]
+    assert np.isfinite(depth).all()
+    img = whitted.render(scene, width=64, height=48).pixels
+    assert img.min() > 0.05  # lit or ambient everywhere, never background black
+    scene.camera.position = (0.0, 0.0, 8.0)
+    scene.camera.fov = 40.0
+    depth = whitted.render_aovs(scene, width=101, height=101)["depth"]
+    analytic = whitted.render_aovs(scene.model_copy(update={"objects": [whitted.Sphere(
+        radius=2.0)]}), width=101, height=101)["depth"]
+    differ = np.isfinite(depth) != np.isfinite(analytic)
+    assert differ.sum() <= 0.03 * np.isfinite(analytic).sum()  # facets cut a thin rim only
