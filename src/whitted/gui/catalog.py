@@ -87,7 +87,9 @@ def check_model_file(path: Path) -> None:
         load_mesh = None
     try:
         if load_mesh is not None:
-            load_mesh(path)
+            data = load_mesh(path)
+            if len(getattr(data, "faces", (0,))) == 0:
+                raise ValueError("no triangles in the file")
         else:  # the loader is not there yet: at least check that trimesh reads it
             import trimesh
 

@@ -127,14 +127,14 @@ class MainWindow(QMainWindow):
 
         self.doc.changed.connect(self._scene_changed)
         self.doc.path_changed.connect(self._update_title)
-        self.doc.undo_stack.cleanChanged.connect(lambda clean: self._update_title())
+        self.doc.undo_stack.cleanChanged.connect(self._update_title)
         self.controller.frame.connect(self.viewport.show_image)
         self.controller.frame.connect(self._frame_shown)
         self.controller.progress.connect(self._progress)
         self.controller.finished.connect(self._render_finished)
         self.controller.failed.connect(self._render_failed)
         self.controller.kernels_ready.connect(self._kernels_ready)
-        self.autosave.saved.connect(lambda text: self.statusBar().showMessage(text, 3000))
+        self.autosave.saved.connect(self._status)
         self.viewport.orbit.connect(self._orbit)
         self.viewport.pan.connect(self._pan)
         self.viewport.zoom.connect(self._zoom)
@@ -331,7 +331,7 @@ class MainWindow(QMainWindow):
     def scene_name(self) -> str:
         return self.doc.path.name if self.doc.path else "the untitled scene"
 
-    def _update_title(self) -> None:
+    def _update_title(self, *_: object) -> None:
         name = self.doc.path.name if self.doc.path else "untitled"
         self.setWindowTitle(f"{name}[*] — whitted")
         self.setWindowModified(self.doc.dirty)
@@ -589,6 +589,9 @@ class MainWindow(QMainWindow):
             self.viewport.update()
         if seconds > 1:
             self.statusBar().showMessage(f"Render kernels ready ({seconds:.0f} s)", 4000)
+
+    def _status(self, text: str) -> None:
+        self.statusBar().showMessage(text, 3000)
 
     def _toggle_preview(self, on: bool) -> None:
         self.controller.preview_enabled = on
