@@ -134,11 +134,15 @@ def render(
     signal.signal(signal.SIGINT, on_interrupt)
     try:
         _run_with_progress(job, quiet)
+    except WhittedError as exc:  # a model or texture file the scene names is unusable
+        raise fail(str(exc)) from None
     finally:
         signal.signal(signal.SIGINT, previous)
     image = job.image
     assert image is not None
     stats = job.stats
+    for warning in stats.warnings:
+        err.print(f"warning: {warning}", markup=False, highlight=False)
     image.save(output, bit_depth=bit_depth)
     written = [str(output)]
     if aovs and not interrupted.is_set():
@@ -200,18 +204,62 @@ def _run_with_progress(job, quiet: bool) -> None:
         job.wait()
 
 
-@app.command()
-def info(
-    scene_path: Annotated[Path | None, typer.Argument(metavar="[SCENE]")] = None,
-) -> None:
-    """Print a scene's objects, lights, bounds and an estimate of the work."""
-    from ..compile.flatten import compile_scene
+def _model_info(path: Path) -> None:
+    """``whitted info MODEL``: what the loader reads from a model file."""
+    from ..assets import load_mesh
 
     try:
-        scene, name = _load(scene_path)
+        mesh = load_mesh(path)
     except WhittedError as exc:
         raise fail(str(exc)) from None
-    compiled = compile_scene(scene)
+    out.print(f"[bold]{path}[/]", highlight=False)
+    out.print(f"vertices: {mesh.vertex_records}")
+    out.print(f"triangles: {mesh.triangle_records}")
+    if len(mesh.vertices) != mesh.vertex_records:
+        out.print(f"vertices after splitting by normal/uv: {len(mesh.vertices)}")
+    if len(mesh.faces) and len(mesh.vertices):
+        used = mesh.vertices[np.unique(mesh.faces)]
+        lo = ", ".join(f"{v:.4g}" for v in used.min(axis=0))
+        hi = ", ".join(f"{v:.4g}" for v in used.max(axis=0))
+        out.print(f"bounds: ({lo}) .. ({hi})")
+    else:
+        out.print("bounds: no triangles")
+    out.print(f"normals: {'yes' if mesh.normals is not None else 'no'}, "
+              f"texture coordinates: {'yes' if mesh.uvs is not None else 'no'}")
+    counts = np.bincount(mesh.face_material, minlength=len(mesh.materials))
+    out.print(f"materials: {len(mesh.materials)}")
+    for k, mat in enumerate(mesh.materials):
+        colour = ", ".join(f"{c:.3g}" for c in mat.color)
+        tex = f" texture={mat.texture.file}" if getattr(mat.texture, "file", None) else ""
+        out.print(f"  [{k}] color=({colour}) kt={mat.kt:.3g} triangles={counts[k]}{tex}",
+                  highlight=False)
+    out.print(f"textures: {len(mesh.texture_files)}")
+    for file in mesh.texture_files:
+        out.print(f"  {file}", highlight=False)
+    out.print(f"warnings: {len(mesh.warnings)}")
+    for warning in mesh.warnings:
+        out.print(f"  {warning}", markup=False, highlight=False)
+
+
+@app.command()
+def info(
+    scene_path: Annotated[
+        Path | None, typer.Argument(metavar="[SCENE|MODEL]", help="A scene or a model file")
+    ] = None,
+) -> None:
+    """Print a scene's objects, lights, bounds and an estimate of the work; or what a model
+    file (OBJ, PLY, STL, OFF, glTF) holds: vertices, triangles, bounds, materials, textures."""
+    from ..assets.mesh import SUPPORTED_SUFFIXES
+    from ..compile.flatten import compile_scene
+
+    if scene_path is not None and scene_path.suffix.lower() in SUPPORTED_SUFFIXES:
+        _model_info(scene_path)
+        return
+    try:
+        scene, name = _load(scene_path)
+        compiled = compile_scene(scene)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
     r = scene.render
     out.print(f"[bold]{name}[/]")
     out.print(f"image: {r.width}x{r.height}, {r.samples} sample(s)/pixel, max depth "
@@ -234,6 +282,12 @@ def info(
         out.print("bounds: no bounded objects")
     out.print(f"bvh: {len(compiled.geometry.node_min)} nodes over "
               f"{len(compiled.geometry.node_prims)} primitives")
+    if compiled.triangles:
+        out.print(f"meshes: {len(compiled.geometry.mesh_info)} stored, "
+                  f"{compiled.triangles:,} triangles ({compiled.instanced_triangles:,} with "
+                  f"instances), {len(compiled.geometry.mesh_node_count):,} mesh BVH nodes")
+    for warning in compiled.warnings:
+        out.print(f"warning: {warning}", markup=False, highlight=False)
     shadow = sum(
         (light.samples or r.shadow_samples) if light.type == "disk" else 1
         for light in scene.lights if light.type != "ambient"

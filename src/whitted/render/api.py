@@ -82,6 +82,8 @@ class RenderStats:
     tiles_done: int = 0
     tiles_total: int = 0
     cancelled: bool = False
+    warnings: list[str] = field(default_factory=list)  # from the scene's compilation
+    triangles: int = 0  # mesh triangles stored (each distinct mesh once)
 
     @property
     def total_rays(self) -> int:
@@ -232,6 +234,8 @@ class RenderJob:
         stats.compile_seconds = warm_up_kernels()
         compiled: CompiledScene = compile_scene(self.scene)
         stats.build_seconds = compiled.build_seconds
+        stats.warnings = list(compiled.warnings)
+        stats.triangles = compiled.triangles
         params = render_params(self.scene, compiled, self.settings)
         tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size)
         counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
