@@ -15,6 +15,7 @@ $(BIN)/whitted: pyproject.toml
 
 $(VENV)/.test-deps: $(BIN)/whitted
 	$(BIN)/python -m pip install --quiet -e '.[test]'
+	scripts/install-qt-deps.sh  # the system libraries Qt needs (the editor's tests), if missing
 	@touch $@
 
 install: $(BIN)/whitted
