@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from importlib import resources
+from pathlib import Path
 
 from .io import parse_scene_text, scene_from_dict
 from .scene import Scene
@@ -15,5 +16,7 @@ def default_scene_text() -> str:
 
 
 def default_scene() -> Scene:
-    """A fresh copy of the default scene (what ``whitted render`` shows with no scene file)."""
-    return scene_from_dict(parse_scene_text(default_scene_text(), ".toml", "<default scene>"))
+    """A fresh copy of the default scene (what ``whitted render`` shows with no scene file);
+    its model files are packaged beside it."""
+    scene = scene_from_dict(parse_scene_text(default_scene_text(), ".toml", "<default scene>"))
+    return scene.with_base_dir(Path(str(resources.files("whitted.scene").joinpath("data"))))
