@@ -445,6 +445,13 @@ def scan_obj(data, fill, info, positions, texcoords, normals, corner_v, corner_v
                     break
                 token_start = i
                 i = _token_end(data, i, n)
+                slashes = 0
+                for k in range(token_start, i):
+                    if data[k] == 47:
+                        slashes += 1
+                if slashes > 2:
+                    _fail(info, ERR_INVALID_CORNER, line, token_start, i, 0, 0, 0)
+                    return
                 # split the corner at '/' into up to three fields
                 field_start = token_start
                 field = 0
@@ -453,9 +460,6 @@ def scan_obj(data, fill, info, positions, texcoords, normals, corner_v, corner_v
                     field_end = field_start
                     while field_end < i and data[field_end] != 47:
                         field_end += 1
-                    if field > 2:
-                        _fail(info, ERR_INVALID_CORNER, line, token_start, i, 0, 0, 0)
-                        return
                     status, index = _parse_index_field(data, field_start, field_end)
                     if status == 2:
                         _fail(info, ERR_INVALID_CORNER, line, token_start, i, 0, 0, 0)
