@@ -102,31 +102,36 @@ def load_mesh(path: str | Path) -> MeshData:
             _cache.move_to_end(key)
             return cached
         load_lock = _load_locks.setdefault(key, threading.Lock())
-    with load_lock:  # two threads asking for one file: the second waits and takes the result
+    try:
+        with load_lock:  # two threads asking for one file: the second waits for the first
+            with _cache_lock:
+                cached = _cache.get(key)
+            if cached is not None:
+                return cached
+            mesh = _read_model(file_path, name, suffix)
+            _freeze(mesh)
+            with _cache_lock:
+                _cache[key] = mesh
+                _cache.move_to_end(key)
+                while len(_cache) > _CACHE_ENTRIES:
+                    _cache.popitem(last=False)
+    finally:
         with _cache_lock:
-            cached = _cache.get(key)
-        if cached is not None:
-            return cached
-        if suffix in OBJ_SUFFIXES:
-            try:
-                data = file_path.read_bytes()
-            except OSError as error:
-                raise SceneError(
-                    f"cannot read the file ({error.strerror or error})", file=name
-                ) from None
-            mesh = load_obj_bytes(data, name, file_path.parent)
-        else:
-            from .trimesh_formats import load_with_trimesh
-
-            mesh = load_with_trimesh(file_path, name)
-        _freeze(mesh)
-        with _cache_lock:
-            _cache[key] = mesh
-            _cache.move_to_end(key)
-            while len(_cache) > _CACHE_ENTRIES:
-                _cache.popitem(last=False)
             _load_locks.pop(key, None)
     return mesh
+
+
+def _read_model(file_path: Path, name: str, suffix: str) -> MeshData:
+    if suffix in OBJ_SUFFIXES:
+        try:
+            data = file_path.read_bytes()
+        except OSError as error:
+            raise SceneError(f"cannot read the file ({error.strerror or error})",
+                             file=name) from None
+        return load_obj_bytes(data, name, file_path.parent)
+    from .trimesh_formats import load_with_trimesh
+
+    return load_with_trimesh(file_path, name)
 
 
 def _freeze(mesh: MeshData) -> None:
@@ -318,17 +323,26 @@ def _minus_one(like: np.ndarray) -> np.ndarray:
 def _convert_hard_numbers(
     text: np.ndarray, hard_numbers: np.ndarray, targets: tuple[np.ndarray, ...], name: str
 ) -> None:
-    """Numbers the fast path left out (many digits, large exponents): Python's float()."""
-    for start, end, line, kind, flat in hard_numbers.tolist():
-        value = float(text[start:end].tobytes())
-        if not np.isfinite(value):
-            what = _RECORD_NAMES[kind][0]
-            raise SceneError(
-                f"{what} value {_token_text(text, start, end)} is not finite", file=name,
-                line=line,
-            )
-        target = targets[kind]
-        target.reshape(-1)[flat] = value
+    """Numbers the fast path left out (many digits, large exponents): converted by NumPy's
+    string-to-double cast (correctly rounded, like float()), all at once."""
+    if len(hard_numbers) == 0:
+        return
+    starts, ends, lines, kinds, flat = (hard_numbers[:, k] for k in range(5))
+    buffer = np.empty(int((ends - starts).sum()) + len(hard_numbers), np.uint8)
+    obj_scan.gather_tokens(text, hard_numbers, buffer)
+    values = np.array(buffer.tobytes().split(), dtype=np.float64)
+    bad = ~np.isfinite(values)
+    if bad.any():
+        k = int(np.argmax(bad))
+        what = _RECORD_NAMES[int(kinds[k])][0]
+        raise SceneError(
+            f"{what} value {_token_text(text, int(starts[k]), int(ends[k]))} is not finite",
+            file=name, line=int(lines[k]),
+        )
+    for kind, target in enumerate(targets):
+        chosen = kinds == kind
+        if chosen.any():
+            target.reshape(-1)[flat[chosen]] = values[chosen]
 
 
 def _library_names(argument: str, folder: Path) -> list[str]:
@@ -384,7 +398,14 @@ def _obj_materials(
                 material = Material()
             else:
                 record, mtl_folder, mtl_name = records[key]
-                material = to_material(record, mtl_folder, mtl_name, warnings, texture_files)
+                try:
+                    material = to_material(record, mtl_folder, mtl_name, warnings,
+                                           texture_files)
+                except ValueError as error:  # pydantic's ValidationError is a ValueError
+                    problem = str(error).splitlines()[0]
+                    warnings.append(f"{mtl_name}:{record.line}: material '{record.name}' "
+                                    f"cannot be used ({problem}); default material used")
+                    material = Material()
             slot_of[key] = len(materials)
             materials.append(material)
         return slot_of[key]

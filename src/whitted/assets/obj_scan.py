@@ -617,3 +617,15 @@ def split_corners(vertex_count, corner_v, corner_vt, corner_vn):
                 slot = next_copy[slot]
             faces[t, c] = slot
     return faces, source_position[:used], texcoord_index[:used], normal_index[:used]
+
+
+@_scanner
+def gather_tokens(data, spans, out):
+    """Copy the tokens data[spans[k, 0]:spans[k, 1]] into out, one blank after each."""
+    position = 0
+    for k in range(spans.shape[0]):
+        for j in range(spans[k, 0], spans[k, 1]):
+            out[position] = data[j]
+            position += 1
+        out[position] = 32
+        position += 1
