@@ -535,6 +535,27 @@ def test_glb_scene_applies_transforms(tmp_path):
     assert len(mesh.materials) == 2
 
 
+def test_glb_embedded_texture_becomes_an_image_file(tmp_path, monkeypatch):
+    import trimesh
+    from PIL import Image
+
+    monkeypatch.setenv("WHITTED_CACHE_DIR", str(tmp_path / "cache"))
+    box = trimesh.creation.box()
+    uv = np.random.default_rng(0).random((len(box.vertices), 2))
+    material = trimesh.visual.material.PBRMaterial(
+        name="red", baseColorTexture=Image.new("RGB", (8, 8), (255, 0, 0)),
+        baseColorFactor=[255, 255, 255, 255])
+    box.visual = trimesh.visual.TextureVisuals(uv=uv, material=material)
+    path = tmp_path / "textured.glb"
+    path.write_bytes(trimesh.Scene(box).export(file_type="glb"))
+    mesh = load_mesh(path)
+    assert mesh.uvs is not None and mesh.warnings == []
+    (texture_file,) = mesh.texture_files
+    assert Path(texture_file).parent == tmp_path / "cache" / "textures"
+    assert Image.open(texture_file).getpixel((3, 3)) == (255, 0, 0)
+    assert mesh.materials[0].texture.file == texture_file
+
+
 def test_broken_ply_is_a_scene_error(tmp_path):
     path = tmp_path / "broken.ply"
     path.write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 10\n" + bytes(7))

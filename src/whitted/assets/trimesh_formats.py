@@ -3,19 +3,25 @@
 Every geometry of the file's scene is placed by its node transform and the results are
 concatenated in scene-graph order; each geometry gets one material from its PBR base colour (or
 its simple diffuse colour). A base-colour texture becomes an :class:`ImageTexture` when it is an
-image file next to a ``.gltf`` (matched through the material's name); images embedded in the
-file are not supported (a warning; the base colour is used).
+image file next to a ``.gltf`` (matched through the material's name); an image embedded in the
+file is written once, as PNG named by its content hash, to ``textures/`` in whitted's cache folder
+(``$WHITTED_CACHE_DIR``, default ``~/.cache/whitted``) so that it has a file to name. A texture
+without texture coordinates is a warning (the base colour is used).
 """
 
 from __future__ import annotations
 
+import hashlib
+import io
 import json
 import logging
 import os
+import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from .._cache import cache_dir
 from ..errors import SceneError
 from ..scene.materials import Material
 from ..scene.textures import ImageTexture
@@ -48,6 +54,25 @@ def _external_base_colour_images(path: Path) -> dict[str, Path]:
         return {}
 
 
+def _embedded_image_file(image: object) -> Path | None:
+    """A PNG file holding an image trimesh decoded from the model (None if it cannot be made)."""
+    try:
+        buffer = io.BytesIO()
+        image.save(buffer, format="PNG")  # type: ignore[attr-defined]
+        data = buffer.getvalue()
+        folder = cache_dir().parent / "textures"
+        path = folder / f"{hashlib.sha256(data).hexdigest()[:32]}.png"
+        if not path.is_file():
+            folder.mkdir(parents=True, exist_ok=True)
+            handle, temporary = tempfile.mkstemp(dir=folder, suffix=".part")
+            with os.fdopen(handle, "wb") as stream:
+                stream.write(data)
+            os.replace(temporary, path)
+        return path
+    except (OSError, ValueError, AttributeError):
+        return None
+
+
 def _linear_colour(values: object) -> tuple[float, float, float] | None:
     if values is None:
         return None
@@ -72,17 +97,22 @@ def _material_of(geometry: object, images: dict[str, Path], name: str, warnings:
         colour = _linear_colour(getattr(material, "diffuse", None))
     if colour is not None:
         fields["color"] = colour
-    has_image = (getattr(material, "baseColorTexture", None) is not None
-                 or getattr(material, "image", None) is not None)
-    if has_image:
-        image_path = images.get(getattr(material, "name", None) or "")
-        if image_path is not None and has_uvs:
+    image = getattr(material, "baseColorTexture", None)
+    if image is None:
+        image = getattr(material, "image", None)
+    if image is not None:
+        label = getattr(material, "name", None) or ""
+        image_path = images.get(label) or _embedded_image_file(image)
+        if image_path is None:
+            warnings.append(f"{name}: material '{label}': its texture image cannot be stored "
+                            "(base colour used)")
+        elif not has_uvs:
+            warnings.append(f"{name}: material '{label}' has a texture but the mesh has no "
+                            "texture coordinates (base colour used)")
+        else:
             fields["texture"] = ImageTexture(file=str(image_path))
             if str(image_path) not in texture_files:
                 texture_files.append(str(image_path))
-        else:
-            warnings.append(f"{name}: material '{getattr(material, 'name', '')}': embedded "
-                            "texture images are not supported (base colour used)")
     return Material.model_validate(fields)
 
 
