@@ -310,6 +310,9 @@ def test_vertex_colours_and_w_are_not_positions(tmp_path):
         ("v 1 2 3\nv 1 2 0x10\n", 2, "invalid number '0x10'"),
         ("v 1 2 3\n\x00\x01binary\n", 2, "binary data (byte 0x00)"),
         ("# ok\nusemtl a\x07b\n", 2, "binary data (byte 0x07)"),
+        ("v 0 0 \\\n0\nv 1 0 0\nv 1 x 0\n", 4, "invalid number 'x'"),
+        ("v 0 0 0\rv 1 0 0\r\rv 1 x 0\r", 4, "invalid number 'x'"),
+        ("v 0 0 0\r\nv 1 0 0\r\nf 1 2 3 # two\r\n", 3, "vertex index 3 out of range"),
     ],
 )
 def test_obj_errors(tmp_path, text, line, message):
@@ -317,6 +320,13 @@ def test_obj_errors(tmp_path, text, line, message):
     assert error.line == line
     assert message in error.message, error.message
     assert str(error).startswith(f"{tmp_path / 'bad.obj'}:{line}: ")
+
+
+def test_huge_normals_are_normalised(tmp_path):
+    mesh = _load_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 1e300 1e300 0\nvn 0 0 0\n"
+                      "f 1//1 2//1 3//2\n", tmp_path)
+    assert np.allclose(mesh.normals[:2], [[0.5**0.5, 0.5**0.5, 0]] * 2)
+    assert mesh.normals[2].tolist() == [0, 0, 0]  # the file's zero normal stays zero
 
 
 def test_binary_garbage_is_an_error(tmp_path):

@@ -298,9 +298,7 @@ def load_obj_bytes(data: bytes, name: str, folder: Path) -> MeshData:
             vertex_normals[:, 2] = 1.0  # vertices no face uses
             given = normal_index >= 0
             vertex_normals[given] = normals[normal_index[given]]
-            lengths = np.linalg.norm(vertex_normals, axis=1)
-            nonzero = lengths > 0.0
-            vertex_normals[nonzero] /= lengths[nonzero, None]
+            _normalise_rows(vertex_normals)
     return MeshData(
         vertices=vertices,
         faces=np.ascontiguousarray(faces, dtype=np.int32),
@@ -314,6 +312,15 @@ def load_obj_bytes(data: bytes, name: str, folder: Path) -> MeshData:
         source=name,
         texture_files=texture_files,
     )
+
+
+def _normalise_rows(vectors: np.ndarray) -> None:
+    """Scale each non-zero row to unit length in place (huge values do not overflow)."""
+    largest = np.abs(vectors).max(axis=1)
+    nonzero = largest > 0.0
+    vectors[nonzero] /= largest[nonzero, None]
+    lengths = np.linalg.norm(vectors, axis=1)
+    vectors[nonzero] /= lengths[nonzero, None]
 
 
 def _minus_one(like: np.ndarray) -> np.ndarray:
