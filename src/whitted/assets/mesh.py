@@ -243,6 +243,8 @@ def load_obj_bytes(data: bytes, name: str, folder: Path) -> MeshData:
     texcoord_count = int(info[obj_scan.INFO_TEXCOORDS])
     normal_count = int(info[obj_scan.INFO_NORMALS])
     triangle_count = int(info[obj_scan.INFO_TRIANGLES])
+    if max(position_count, texcoord_count, normal_count) >= 2**31 - 1:
+        raise SceneError("more than 2^31 records of one kind: too large", file=name)
     positions = np.zeros((position_count, 3), np.float64)
     texcoords = np.zeros((texcoord_count, 2), np.float64)
     normals = np.zeros((normal_count, 3), np.float64)
