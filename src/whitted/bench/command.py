@@ -1,0 +1,111 @@
+"""What ``whitted bench`` does once its options are parsed (the CLI is a thin wrapper)."""
+
+from __future__ import annotations
+
+import platform
+from pathlib import Path
+
+from rich.console import Console
+
+from ..errors import WhittedError
+from ..render.api import available_threads
+from .runner import BenchError, BenchOptions, rich_table, run_bench, write_json
+from .studies import plot_study, run_study, study_markdown
+
+
+class BenchUsageError(WhittedError):
+    """A bad ``whitted bench`` option (one line, exit status 2)."""
+
+
+def parse_threads(text: str | None) -> list[int] | None:
+    """``"1,2"`` -> [1, 2]; ``"all"`` or 0 -> every core."""
+    if not text:
+        return None
+    counts = []
+    for part in text.split(","):
+        part = part.strip().lower()
+        if part in ("all", "0"):
+            counts.append(available_threads())
+            continue
+        if not part.isdigit() or int(part) < 1:
+            raise BenchUsageError(f"--threads: expected counts like 1,2 (got {part!r})")
+        counts.append(int(part))
+    return list(dict.fromkeys(counts))
+
+
+def parse_size(text: str | None) -> tuple[int, int] | None:
+    if not text:
+        return None
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise BenchUsageError(
+            f"--size: expected WIDTHxHEIGHT such as 320x240 (got {text!r})") from None
+    if w < 1 or h < 1:
+        raise BenchUsageError(f"--size: width and height must be positive (got {text!r})")
+    return w, h
+
+
+def bench_main(
+    *, scenes: list[str] | None, runs: int, threads: str | None, quick: bool,
+    compare: str | None, study: str | None, json_path: Path | None, plot_path: Path | None,
+    markdown_path: Path | None, size: str | None, in_process: bool,
+    out: Console, err: Console,
+) -> None:
+    if compare not in (None, "povray"):
+        raise BenchUsageError(f"--compare: unknown renderer {compare!r} (known: povray)")
+    if study not in (None, "threads", "size"):
+        raise BenchUsageError(f"--study: unknown study {study!r} (threads or size)")
+    if runs < 1:
+        raise BenchUsageError("--runs: must be at least 1")
+    if compare == "povray":
+        from .povray import povray_executable
+
+        if povray_executable() is None:
+            raise BenchUsageError("--compare povray: povray is not installed "
+                                  "(Debian: apt-get install povray)")
+    options = BenchOptions(scenes=scenes or None, runs=runs, threads=parse_threads(threads),
+                           quick=quick, compare=compare, in_process=in_process,
+                           size=parse_size(size))
+
+    def log(line: str) -> None:
+        err.print(f"[dim]{line}[/]", highlight=False)
+
+    err.print(f"[dim]whitted bench on {platform.processor() or platform.machine()}, "
+              f"{available_threads()} usable core(s); "
+              f"{'quick' if quick else f'median of {options.effective().runs} run(s)'}"
+              " after a warm-up[/]")
+    try:
+        if study:
+            result = run_study(study, options, log)
+        else:
+            result = run_bench(options, log)
+    except BenchError as exc:
+        raise BenchUsageError(str(exc)) from None
+    for name, why in result.skipped:
+        err.print(f"skipped {name}: {why}")
+    if not result.rows:
+        raise BenchUsageError("no scene could be rendered")
+    title = f"whitted bench{' --study ' + study if study else ''}"
+    table = rich_table(result.rows, title=title)
+    # wide enough for every column, also when the output is a file or a pipe
+    needed = Console(width=1000).measure(table).maximum
+    if needed > out.width and not out.is_terminal:
+        Console(file=out.file, width=needed, highlight=False).print(table)
+    else:
+        out.print(table)
+    if json_path is not None:
+        write_json(result.rows, json_path)
+        out.print(f"wrote {json_path}")
+    if study:
+        plot = plot_path or Path(f"bench-study-{study}.png")
+        plot_study(study, result.rows, plot, with_seed=not quick)
+        out.print(f"wrote {plot}")
+        if markdown_path is not None:
+            markdown_path.write_text(study_markdown(study, result.rows) + "\n", encoding="utf-8")
+            out.print(f"wrote {markdown_path}")
+    elif markdown_path is not None:
+        from .runner import markdown_table
+
+        markdown_path.write_text(markdown_table(result.rows) + "\n", encoding="utf-8")
+        out.print(f"wrote {markdown_path}")

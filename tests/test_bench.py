@@ -1,0 +1,131 @@
+"""``whitted bench``: the quick run's table and JSON, the fresh-process path, the POV-Ray
+comparison (when POV-Ray is installed), the studies' plots and the generated models. No timing
+assertions: only that every stage was measured and every ray kind counted."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from whitted.bench.models import CONE_SEGMENTS, height_field_mesh, rounded_box_mesh
+from whitted.bench.povray import parse_povray_statistics, povray_rays
+from whitted.bench.runner import TABLE_COLUMNS, BenchOptions, run_bench
+from whitted.bench.scenes import SCENES, benchmarks_dir, has_meshes, load_bench_scene
+from whitted.bench.studies import plot_study, study_markdown, study_thread_counts
+from whitted.cli.main import app
+
+JSON_KEYS = {"scene", "width", "height", "threads", "rays", "render_s", "wall_s", "mrays_per_s",
+             "startup_s", "compile_s", "build_s", "peak_mib"}
+
+
+def test_quick_bench_table_and_json(tmp_path):
+    out = tmp_path / "bench.json"
+    result = CliRunner().invoke(app, ["bench", "--quick", "--json", str(out)])
+    assert result.exit_code == 0, result.output
+    for column in TABLE_COLUMNS:
+        assert column in result.output, column
+    rows = json.loads(out.read_text())
+    quick_scenes = [name for name, spec in SCENES.items() if spec.quick]
+    assert [r["scene"] for r in rows] == quick_scenes  # meshes render: none skipped
+    for row in rows:
+        assert row.keys() >= JSON_KEYS
+        assert row["width"] <= 64 and row["runs"] == 1
+        assert row["rays"]["primary"] == row["width"] * row["height"]
+        assert row["rays"]["shadow"] > 0
+        assert row["render_s"] > 0 and row["wall_s"] >= row["render_s"]
+    by_scene = {r["scene"]: r for r in rows}
+    for name in ("seed000", "ice"):  # glass: every kind of ray
+        assert all(count > 0 for count in by_scene[name]["rays"].values()), name
+    assert by_scene["softshadow"]["rays"]["shadow"] > 10 * by_scene["seed000"]["rays"]["shadow"]
+
+
+def test_fresh_process_run_measures_every_stage():
+    result = run_bench(BenchOptions(scenes=["lecture"], runs=1, threads=[1], size=(16, 16),
+                                    warmup=False), log=lambda line: None)
+    (row,) = result.rows
+    assert row["mode"] == "process" and row["width"] == 16
+    assert row["rays"]["primary"] == 256 and row["rays"]["shadow"] > 0
+    parts = row["startup_s"] + row["compile_s"] + row["build_s"] + row["render_s"]
+    assert row["wall_s"] == pytest.approx(parts, rel=1e-6)
+    assert row["startup_s"] > 0 and row["peak_mib"] > 10
+
+
+def test_compare_povray(tmp_path):
+    if shutil.which("povray") is None:
+        message = "povray is not on PATH: whitted bench --compare povray was not run"
+        print(message)
+        pytest.skip(message)
+    out = tmp_path / "compare.json"
+    result = CliRunner().invoke(app, ["bench", "--quick", "--scene", "seed000", "--compare",
+                                      "povray", "--json", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "POV trace s" in result.output
+    (row,) = json.loads(out.read_text())
+    for key in ("povray_trace_s", "povray_wall_s", "ratio_render", "ratio_wall"):
+        assert row[key] > 0, key
+    assert row["ratio_render"] == pytest.approx(row["render_s"] / row["povray_trace_s"])
+    assert row["povray_rays"]["primary"] == row["width"] * row["height"]
+    assert row["povray_rays"]["shadow"] > 0
+
+
+def test_povray_statistics_are_parsed():
+    text = """
+Pixels:           164832   Samples:               0   Smpls/Pxl: 0.00
+Rays:             775935   Saved:            119739   Max Level: 6/6
+Shadow Ray Tests:            924552   Succeeded:                297866
+Reflected Rays:              421376
+Refracted Rays:              189727
+  Parse Time:       0 hours  0 minutes  0 seconds (0.012 seconds)
+  Trace Time:       0 hours  0 minutes  1 seconds (1.265 seconds)
+"""
+    stats = parse_povray_statistics(text)
+    assert stats["trace_s"] == 1.265 and stats["parse_s"] == 0.012
+    assert povray_rays(stats) == {"primary": 164832, "shadow": 924552, "reflection": 421376,
+                                  "refraction": 189727}
+
+
+def test_bad_options_are_one_line_errors():
+    for args in (["--compare", "mitsuba"], ["--study", "colour"], ["--threads", "x"],
+                 ["--scene", "nonesuch", "--quick"], ["--runs", "0"], ["--size", "9"]):
+        result = CliRunner().invoke(app, ["bench", *args])
+        assert result.exit_code == 2, (args, result.output)
+
+
+def test_study_tables_and_plots(tmp_path):
+    assert study_thread_counts(6) == [1, 2, 4, 6] and study_thread_counts(1) == [1]
+    rows = [
+        {"scene": "ice", "width": s, "height": s, "threads": t, "render_s": s * s / 1e5 / t,
+         "wall_s": 1 + s * s / 1e5 / t, "mrays_per_s": 2.0, "povray_trace_s": s * s / 2e5 / t,
+         "povray_wall_s": 0.5 + s * s / 2e5 / t, "ratio_render": 2.0}
+        for s in (128, 256) for t in (1, 2)
+    ]
+    for kind in ("size", "threads"):
+        png = plot_study(kind, rows, tmp_path / f"{kind}.png")
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    table = study_markdown("size", rows)
+    assert "| ice | 256x256 | 2 |" in table and "2.00" in table  # speed-up of 2 threads
+
+
+def test_benchmark_scenes_and_models():
+    folder = benchmarks_dir()
+    assert (folder / "seed000.toml").is_file()
+    seed = load_bench_scene("seed000")
+    assert (seed.render.width, seed.render.height, seed.render.max_depth) == (809, 817, 5)
+    cones = [obj for obj in seed.objects if obj.type == "mesh"]
+    assert len(cones) == 4 and has_meshes(seed)
+    from whitted.assets import load_mesh
+
+    assert sum(len(load_mesh(c.file).faces) for c in cones) == 642 == 2 * sum(CONE_SEGMENTS)
+    soft = load_bench_scene("softshadow")
+    assert [light.type for light in soft.lights] == ["ambient", "disk"]
+    assert soft.lights[1].samples == 64
+    vertices, faces = rounded_box_mesh((1.0, 0.5, 0.8), 0.2, 6)
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]).tolist()
+    directed = set(map(tuple, edges))
+    assert len(directed) == len(edges) and all((b, a) in directed for a, b in directed)  # closed
+    _, field = height_field_mesh(quads=(10, 5))
+    assert len(field) == 100
