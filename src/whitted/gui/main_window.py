@@ -261,7 +261,15 @@ class MainWindow(QMainWindow):
             button.setPopupMode(QToolButton.ToolButtonPopupMode.InstantPopup)
             tools.addWidget(button)
         tools.addSeparator()
-        tools.addActions([self.act_undo, self.act_redo])
+        stack = self.doc.undo_stack
+        for text, slot, signal, tip in (
+                ("Undo", stack.undo, stack.canUndoChanged, "undo the last edit (Ctrl+Z)"),
+                ("Redo", stack.redo, stack.canRedoChanged, "redo (Ctrl+Shift+Z)")):
+            action = tools.addAction(text)  # short texts here; the Edit menu names the edit
+            action.setToolTip(tip)
+            action.triggered.connect(slot)
+            action.setEnabled(False)
+            signal.connect(action.setEnabled)
         tools.addSeparator()
         tools.addActions([self.act_render, self.act_stop])
 

@@ -8,30 +8,39 @@ from __future__ import annotations
 import math
 import threading
 import time
-from dataclasses import dataclass
+from collections import deque
+from dataclasses import dataclass, field
 
 import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
 from PySide6.QtGui import QImage
 
+from ..output.encode import encode_ldr
 from ..output.image import Image
 from ..render.api import Progress, RenderJob, available_threads, warm_up_kernels
 from ..scene import Scene
 
-POLL_MS = 50
+POLL_MS = 25
 #: preview pixel budget: starts here, adapts so that a preview takes about PREVIEW_TARGET_S
 PREVIEW_PIXELS = 160 * 120
 PREVIEW_MIN_PIXELS, PREVIEW_MAX_PIXELS = 64 * 48, 480 * 360
-PREVIEW_TARGET_S = 0.25
+PREVIEW_TARGET_S = 0.15
 PREVIEW_DEPTH = 2
 PREVIEW_SHADOW_SAMPLES = 4
 
 
-def to_qimage(pixels: np.ndarray, transfer: str, tonemap: str) -> QImage:
-    """Display values of a linear float framebuffer, as a QImage that owns its memory."""
-    rgb = np.ascontiguousarray(Image(pixels, transfer=transfer, tonemap=tonemap).to_srgb8())
+def qimage_of(rgb: np.ndarray) -> QImage:
+    """A QImage (owning its memory) with the pixels of an (H, W, 3) uint8 array."""
     h, w, _ = rgb.shape
-    return QImage(rgb.data, w, h, 3 * w, QImage.Format.Format_RGB888).copy()
+    image = QImage(w, h, QImage.Format.Format_RGB888)
+    rows = np.frombuffer(image.bits(), np.uint8).reshape(h, image.bytesPerLine())
+    rows[:, : 3 * w] = rgb.reshape(h, 3 * w)
+    return image
+
+
+def to_qimage(pixels: np.ndarray, transfer: str, tonemap: str) -> QImage:
+    """Display values of a linear float framebuffer."""
+    return qimage_of(Image(pixels, transfer=transfer, tonemap=tonemap).to_srgb8())
 
 
 def preview_scene(scene: Scene, pixels: int) -> Scene:
@@ -54,6 +63,33 @@ class _Active:
     latest: Progress | None = None
     shown_tiles: int = -1
     first_pixels: float | None = None
+    #: tiles finished since the last poll (appended by the render threads)
+    new_tiles: deque = field(default_factory=deque)
+    display: np.ndarray | None = None  # uint8 display values, updated band by band
+
+    def on_progress(self, p: Progress) -> None:
+        """Called on a render thread: only plain stores and a deque append."""
+        self.new_tiles.append(p.new_tiles)
+        self.latest = p
+
+    def display_image(self) -> QImage:
+        """The display picture, re-encoding only the rows of the tiles finished since the
+        last call (the whole frame once at the start)."""
+        job = self.job
+        s = job.settings
+        fb = job.framebuffer
+        if self.display is None:
+            self.display = np.zeros(fb.shape, np.uint8)
+        rows: list[np.ndarray] = []
+        while self.new_tiles:
+            rows.append(self.new_tiles.popleft())
+        if rows:
+            tiles = np.concatenate(rows)
+            if len(tiles):
+                y0, y1 = int(tiles[:, 1].min()), int(tiles[:, 3].max())
+                self.display[y0:y1] = encode_ldr(fb[y0:y1], transfer=s.transfer,
+                                                 tonemap=s.tonemap)
+        return qimage_of(self.display)
 
 
 class RenderController(QObject):
@@ -116,7 +152,7 @@ class RenderController(QObject):
         self._cancel_preview()
         self._pending = None
         active = _Active(RenderJob(scene, progress=None), "render", time.perf_counter(), scene)
-        active.job.progress = lambda p, a=active: setattr(a, "latest", p)
+        active.job.progress = active.on_progress
         self.full = active
         self.first_pixels_seconds = None
         active.job.start()
@@ -196,13 +232,12 @@ class RenderController(QObject):
     def _full_tick(self, active: _Active) -> None:
         job = active.job
         p = active.latest
-        s = job.settings
         if p is not None and p.tiles_done != active.shown_tiles:
             active.shown_tiles = p.tiles_done
             if active.first_pixels is None:
                 active.first_pixels = time.perf_counter() - active.started
                 self.first_pixels_seconds = active.first_pixels
-            self.frame.emit(to_qimage(job.framebuffer, s.transfer, s.tonemap), "render")
+            self.frame.emit(active.display_image(), "render")
             self.progress.emit(p.fraction, p.eta, _progress_text(p))
         if job.running:
             return
@@ -214,7 +249,7 @@ class RenderController(QObject):
         self.last_image = image
         stats = job.stats
         if image is not None:
-            self.frame.emit(to_qimage(job.framebuffer, s.transfer, s.tonemap), "render")
+            self.frame.emit(active.display_image(), "render")
         if stats.cancelled:
             text = f"Stopped: kept {stats.tiles_done}/{stats.tiles_total} tiles"
         else:
