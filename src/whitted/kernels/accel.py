@@ -162,14 +162,66 @@ def box_entry(bmin, bmax, node, o, inv, tmin, tmax):
 @kernel
 def closest_hit(geo, o, d, tmin, tmax, stack):
     """Nearest hit in (tmin, tmax): (t, primitive, triangle, b1, b2), or (tmax, -1, -1, 0, 0).
-    ``stack`` is caller-owned int32 scratch space (128 entries: two levels of 64)."""
+    ``stack`` is caller-owned int32 scratch space (128 entries: two levels of 64).
+
+    The unbounded primitives and then the BVH's leaves feed one loop with a single call of
+    :func:`hit_primitive` (one inlined copy of every intersection routine keeps the compile
+    short)."""
     best_t = tmax
     best = -1
     best_tri = -1
     best_b1 = 0.0
     best_b2 = 0.0
-    for j in range(geo.unbounded.shape[0]):
-        i = geo.unbounded[j]
+    n_unbounded = geo.unbounded.shape[0]
+    bmin = geo.node_min
+    bmax = geo.node_max
+    inv = inverse_direction(d)
+    top = -1
+    if bmin.shape[0] > 0:
+        top = 0
+        stack[0] = 0
+    j = 0  # next unbounded primitive
+    leaf = 0  # next entry of the current leaf
+    leaf_end = 0
+    while True:
+        if j < n_unbounded:
+            i = geo.unbounded[j]
+            j += 1
+        elif leaf < leaf_end:
+            i = geo.node_prims[leaf]
+            leaf += 1
+        elif top >= 0:
+            node = stack[top]
+            top -= 1
+            if box_entry(bmin, bmax, node, o, inv, tmin, best_t) == INF:
+                continue
+            count = geo.node_count[node]
+            if count > 0:
+                leaf = geo.node_offset[node]
+                leaf_end = leaf + count
+                continue
+            left = node + 1
+            right = geo.node_offset[node]
+            t_left = box_entry(bmin, bmax, left, o, inv, tmin, best_t)
+            t_right = box_entry(bmin, bmax, right, o, inv, tmin, best_t)
+            # push the farther child first so the nearer one is visited next
+            if t_left <= t_right:
+                if t_right != INF:
+                    top += 1
+                    stack[top] = right
+                if t_left != INF:
+                    top += 1
+                    stack[top] = left
+            else:
+                if t_left != INF:
+                    top += 1
+                    stack[top] = left
+                if t_right != INF:
+                    top += 1
+                    stack[top] = right
+            continue
+        else:
+            break
         t, tri, b1, b2 = hit_primitive(geo, i, o, d, tmin, best_t, stack)
         if t < best_t:
             best_t = t
@@ -177,48 +229,4 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
             best_tri = tri
             best_b1 = b1
             best_b2 = b2
-    if geo.node_min.shape[0] == 0:
-        return best_t, best, best_tri, best_b1, best_b2
-    bmin = geo.node_min
-    bmax = geo.node_max
-    inv = inverse_direction(d)
-    if box_entry(bmin, bmax, 0, o, inv, tmin, best_t) == INF:
-        return best_t, best, best_tri, best_b1, best_b2
-    top = 0
-    stack[0] = 0
-    while top >= 0:
-        node = stack[top]
-        top -= 1
-        count = geo.node_count[node]
-        if count > 0:
-            first = geo.node_offset[node]
-            for j in range(first, first + count):
-                i = geo.node_prims[j]
-                t, tri, b1, b2 = hit_primitive(geo, i, o, d, tmin, best_t, stack)
-                if t < best_t:
-                    best_t = t
-                    best = i
-                    best_tri = tri
-                    best_b1 = b1
-                    best_b2 = b2
-            continue
-        left = node + 1
-        right = geo.node_offset[node]
-        t_left = box_entry(bmin, bmax, left, o, inv, tmin, best_t)
-        t_right = box_entry(bmin, bmax, right, o, inv, tmin, best_t)
-        # push the farther child first so the nearer one is visited next
-        if t_left <= t_right:
-            if t_right != INF:
-                top += 1
-                stack[top] = right
-            if t_left != INF:
-                top += 1
-                stack[top] = left
-        else:
-            if t_left != INF:
-                top += 1
-                stack[top] = left
-            if t_right != INF:
-                top += 1
-                stack[top] = right
     return best_t, best, best_tri, best_b1, best_b2

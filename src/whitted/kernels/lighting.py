@@ -47,39 +47,49 @@ from .vec import dot, madd, normalize, sub, vload
 
 @kernel
 def any_occluder(geo, mats, o, d, tmin, tmax, stack):
-    """0: nothing on the segment (tmin, tmax) of the ray; 1: an opaque occluder; 2: only
-    transparent ones."""
+    """0: nothing on the segment (tmin, tmax) of the ray; 1: an opaque occluder (the search
+    stops at the first one); 2: only transparent ones. One call site of :func:`occludes`
+    serves the unbounded primitives and the BVH leaves alike."""
     seen_transparent = 0
-    for j in range(geo.unbounded.shape[0]):
-        state = occludes(geo, mats, geo.unbounded[j], o, d, tmin, tmax, stack)
-        if state == 1:
-            return 1
-        seen_transparent = max(seen_transparent, state)
-    if geo.node_min.shape[0] == 0:
-        return seen_transparent
+    n_unbounded = geo.unbounded.shape[0]
     bmin = geo.node_min
     bmax = geo.node_max
     inv = inverse_direction(d)
-    top = 0
-    stack[0] = 0
-    while top >= 0:
-        node = stack[top]
-        top -= 1
-        if box_entry(bmin, bmax, node, o, inv, tmin, tmax) == INF:
+    top = -1
+    if bmin.shape[0] > 0:
+        top = 0
+        stack[0] = 0
+    j = 0
+    leaf = 0
+    leaf_end = 0
+    while True:
+        if j < n_unbounded:
+            i = geo.unbounded[j]
+            j += 1
+        elif leaf < leaf_end:
+            i = geo.node_prims[leaf]
+            leaf += 1
+        elif top >= 0:
+            node = stack[top]
+            top -= 1
+            if box_entry(bmin, bmax, node, o, inv, tmin, tmax) == INF:
+                continue
+            count = geo.node_count[node]
+            if count > 0:
+                leaf = geo.node_offset[node]
+                leaf_end = leaf + count
+                continue
+            top += 1
+            stack[top] = node + 1
+            top += 1
+            stack[top] = geo.node_offset[node]
             continue
-        count = geo.node_count[node]
-        if count > 0:
-            first = geo.node_offset[node]
-            for j in range(first, first + count):
-                state = occludes(geo, mats, geo.node_prims[j], o, d, tmin, tmax, stack)
-                if state == 1:
-                    return 1
-                seen_transparent = max(seen_transparent, state)
-            continue
-        top += 1
-        stack[top] = node + 1
-        top += 1
-        stack[top] = geo.node_offset[node]
+        else:
+            break
+        state = occludes(geo, mats, i, o, d, tmin, tmax, stack)
+        if state == 1:
+            return 1
+        seen_transparent = max(seen_transparent, state)
     return seen_transparent
 
 
