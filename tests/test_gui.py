@@ -16,6 +16,7 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
+from PIL import Image as PILImage  # noqa: E402
 
 pytest.importorskip("PySide6.QtWidgets")
 
@@ -111,6 +112,11 @@ def test_add_a_model_from_a_file(window, tmp_path):
     key = window.add_model(obj)
     assert key is not None and window.doc.item(key).type == "mesh"
     assert window.doc.scene.resolve_path(window.doc.item(key).file).resolve() == obj.resolve()
+    # saved elsewhere, the scene still finds its model
+    (tmp_path / "elsewhere").mkdir()
+    assert window.save_as(tmp_path / "elsewhere" / "with_model.toml")
+    loaded = whitted.load_scene(tmp_path / "elsewhere" / "with_model.toml")
+    assert loaded.resolve_path(loaded.objects[key[1]].file).resolve() == obj.resolve()
     bad = tmp_path / "broken.obj"
     bad.write_text("this is not a model\n")
     n = len(window.doc.scene.objects)
@@ -157,6 +163,30 @@ def test_edit_properties_with_every_kind_of_field(window):
     window.select(CAMERA)
     assert set_text(window, ("fov",), "50") == ""
     assert window.doc.scene.camera.fov == 50.0
+
+
+def test_textures_from_the_drop_down_and_the_file_chooser(window, tmp_path):
+    if "texture" not in whitted.Material.model_fields:
+        pytest.skip("no textures in the scene model")
+    window.object_actions["sphere"].trigger()
+    index = window.doc.selection[1]
+    window.properties.row("material", "texture", "type").editor.committed.emit("checker", False)
+    assert window.doc.scene.material_of(index).texture.type == "checker"
+    assert set_text(window, ("material", "texture", "checks"), "4") == ""
+    assert window.doc.scene.material_of(index).texture.checks == 4.0
+    picture = tmp_path / "wood.png"
+    PILImage.new("RGB", (4, 4), (200, 120, 40)).save(picture)
+    window.properties.choose_file = lambda title, filters: None  # the dialog is cancelled
+    window.properties.row("material", "texture", "type").editor.committed.emit("image", False)
+    assert window.doc.scene.material_of(index).texture.type == "checker"
+    assert "choose an image" in window.properties.row("material", "texture", "type").error
+    window.properties.choose_file = lambda title, filters: str(picture)
+    window.properties.row("material", "texture", "type").editor.committed.emit("image", False)
+    texture = window.doc.scene.material_of(index).texture
+    assert texture.type == "image"
+    assert window.doc.scene.resolve_path(texture.file).resolve() == picture.resolve()
+    window.properties.row("material", "texture", "type").editor.committed.emit("none", False)
+    assert window.doc.scene.material_of(index).texture is None
 
 
 def test_invalid_values_are_refused_at_the_field(window):

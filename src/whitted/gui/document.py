@@ -12,7 +12,7 @@ from PySide6.QtCore import QObject, Signal
 from PySide6.QtGui import QUndoStack
 
 from ..scene import Scene
-from ..scene.io import _clean_loc, _clean_message, _format_path, _priority
+from ..scene.io import _clean_loc, _clean_message, _priority
 from .commands import SceneEdit
 
 #: what is selected: ("camera",), ("render",), ("background",), ("lights", i), ("objects", i)
@@ -31,10 +31,7 @@ def validation_message(exc: ValidationError) -> str:
     """One line for the first problem of a pydantic error, in the scene files' words."""
     # unions report one error per member: the deepest one is the informative one
     e = max(exc.errors(), key=lambda e: (len(_clean_loc(e["loc"])), _priority(e)))
-    msg = _clean_message(e)
-    keys = _clean_loc(e["loc"])
-    where = _format_path(keys) if keys else ""
-    return f"{where}: {msg}" if where and not msg.startswith(where) else msg
+    return _clean_message(e)  # shown at the field itself: no key path needed
 
 
 def scene_fields(scene: Scene) -> dict[str, Any]:

@@ -143,9 +143,11 @@ class PropertyPanel(QWidget):
         return f"{kind}: {label_of(item)} ({item.type})"
 
     def _rebuild(self, key: tuple, specs: list[F.Spec]) -> None:
-        if self.form is not None:
-            self.form.hide()
-            self.form.deleteLater()
+        if self.form is not None:  # deleted later: its editor may be emitting right now
+            old = self.scroll.takeWidget()
+            if old is not None:
+                old.hide()
+                old.deleteLater()
         self.rows, self.specs = {}, {}
         self.material_combo = None
         self.form = QWidget()
@@ -289,6 +291,7 @@ class PropertyPanel(QWidget):
             if row is not None:
                 row.show_error(str(exc))
             return False
+        row = self.rows.get(spec.path)  # the form may have been rebuilt by the edit
         if row is not None:
             row.clear_error()
         return True
