@@ -489,3 +489,21 @@ def test_the_cli_starts_without_qt():
     assert subprocess.run([sys.executable, "-c", code], timeout=120).returncode == 0
     result = CliRunner().invoke(cli_app, ["gui", "--help"])
     assert result.exit_code == 0 and "editor" in result.output
+
+
+def test_an_edit_during_a_render_stops_it_and_previews(make_window, qtbot):
+    scene = whitted.default_scene().with_settings(width=320, height=320, samples=16)
+    window = make_window(scene=scene)
+    wait_preview(qtbot, window, 0)
+    done = window.controller.previews_done
+    window.act_render.trigger()
+    qtbot.waitUntil(lambda: window.controller.full is None
+                    or window.controller.full.latest is not None, timeout=SLOW)
+    window.select(("objects", 1))
+    window.properties.row("material", "color").editor.choose("#0000ff")
+    qtbot.waitUntil(lambda: not window.controller.rendering, timeout=SLOW)
+    wait_preview(qtbot, window, done)
+    assert window.viewport.kind == "preview"
+    # the recent-files menu lists what was opened
+    window._fill_recent()
+    assert [a.text() for a in window.recent_menu.actions()] == ["(none)"]
