@@ -31,6 +31,10 @@ test: install-test
 	$(BIN)/ruff check src tests
 	$(BIN)/python -m pytest -q
 
+## Render the benchmark scenes (benchmarks/) and print the timing table
+bench: install
+	$(BIN)/whitted bench
+
 lint: install-test
 	$(BIN)/ruff check src tests
 
