@@ -399,9 +399,13 @@ def compile_scene(scene: Scene) -> CompiledScene:
     params = np.array(b.params, dtype=np.float64).reshape(n, N_PRIM_PARAMS)
     lo = np.array(b.lo, dtype=np.float64).reshape(n, 3)
     hi = np.array(b.hi, dtype=np.float64).reshape(n, 3)
-    bounded = np.flatnonzero(np.all(np.isfinite(lo) & np.isfinite(hi), axis=1)).astype(np.int32)
-    unbounded = np.flatnonzero(~np.all(np.isfinite(lo) & np.isfinite(hi), axis=1))
+    finite = np.all(np.isfinite(lo) & np.isfinite(hi), axis=1)
+    is_instance = prim_type == SHAPE_MESH
+    bounded = np.flatnonzero(finite & ~is_instance).astype(np.int32)
+    instances = np.flatnonzero(is_instance).astype(np.int32)
+    unbounded = np.flatnonzero(~finite)
     bvh = build_bvh(lo[bounded], hi[bounded])
+    inst_bvh = build_bvh(lo[instances], hi[instances])
     geometry = GeometryArrays(
         prim_type=prim_type,
         prim_params=params,
@@ -417,14 +421,19 @@ def compile_scene(scene: Scene) -> CompiledScene:
         node_axis=np.ascontiguousarray(bvh.node_axis, dtype=np.int8),
         node_prims=np.ascontiguousarray(bounded[bvh.prim_order], dtype=np.int32),
         unbounded=unbounded.astype(np.int32),
+        inst_node_min=np.ascontiguousarray(inst_bvh.node_min, dtype=np.float64),
+        inst_node_max=np.ascontiguousarray(inst_bvh.node_max, dtype=np.float64),
+        inst_node_offset=np.ascontiguousarray(inst_bvh.node_offset, dtype=np.int32),
+        inst_node_count=np.ascontiguousarray(inst_bvh.node_count, dtype=np.int32),
+        inst_prims=np.ascontiguousarray(instances[inst_bvh.prim_order], dtype=np.int32),
         **meshes.arrays(),
         **compile_textures(materials.textures, scene.resolve_path)._asdict(),
     )
     mat_table = np.array(materials.rows, dtype=np.float64).reshape(len(materials.rows),
                                                                     N_MAT_PARAMS)
     lights, ambient = _light_rows(scene)
-    if len(bounded):
-        bmin, bmax = lo[bounded].min(axis=0), hi[bounded].max(axis=0)
+    if finite.any():
+        bmin, bmax = lo[finite].min(axis=0), hi[finite].max(axis=0)
     else:
         bmin, bmax = np.full(3, np.inf), np.full(3, -np.inf)
     return CompiledScene(

@@ -13,7 +13,7 @@ import math
 
 from .intersect import INF, intersect_local, normal_local
 from .jit import kernel
-from .layout import MAT_KT, SHAPE_MESH
+from .layout import MAT_KT
 from .mesh import OPAQUE_KT, mesh_closest_hit, mesh_normals, mesh_occlusion
 from .vec import normalize
 
@@ -47,31 +47,40 @@ def to_object(xforms, xf, o, d):
 
 
 @kernel
-def hit_primitive(geo, i, o, d, tmin, tmax, stack):
-    """(t, triangle, b1, b2) of the ray with primitive ``i``; t = INF on a miss."""
+def hit_analytic(geo, i, o, d, tmin, tmax):
+    """t of the ray with analytic primitive ``i`` (INF on a miss). Kept small so the compiler
+    inlines it into the traversal loops."""
     xf = geo.prim_xform[i]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
-    typ = geo.prim_type[i]
-    if typ == SHAPE_MESH:
-        mesh = int(geo.prim_params[i, 0])
-        return mesh_closest_hit(geo, mesh, o, d, inverse_direction(d), tmin, tmax, stack,
-                                MESH_STACK_BASE)
-    return intersect_local(typ, geo.prim_params, i, o, d, tmin, tmax), -1, 0.0, 0.0
+    return intersect_local(geo.prim_type[i], geo.prim_params, i, o, d, tmin, tmax)
 
 
 @kernel
-def occludes(geo, mats, i, o, d, tmin, tmax, stack):
-    """Does primitive ``i`` block the segment (tmin, tmax)? 0: no; 1: opaquely; 2: only
-    through transparent surfaces."""
+def hit_instance(geo, i, o, d, tmin, tmax, stack):
+    """(t, triangle, b1, b2) of the ray with mesh instance ``i``; t = INF on a miss."""
     xf = geo.prim_xform[i]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
-    typ = geo.prim_type[i]
-    if typ == SHAPE_MESH:
-        return mesh_occlusion(geo, mats, int(geo.prim_params[i, 0]), geo.prim_material[i], o, d,
-                              inverse_direction(d), tmin, tmax, stack, MESH_STACK_BASE)
-    if intersect_local(typ, geo.prim_params, i, o, d, tmin, tmax) == INF:
+    return mesh_closest_hit(geo, int(geo.prim_params[i, 0]), o, d, inverse_direction(d), tmin,
+                            tmax, stack, MESH_STACK_BASE)
+
+
+@kernel
+def instance_occludes(geo, mats, i, o, d, tmin, tmax, stack):
+    """:func:`occludes` for a mesh instance."""
+    xf = geo.prim_xform[i]
+    if xf >= 0:
+        o, d = to_object(geo.xforms, xf, o, d)
+    return mesh_occlusion(geo, mats, int(geo.prim_params[i, 0]), geo.prim_material[i], o, d,
+                          inverse_direction(d), tmin, tmax, stack, MESH_STACK_BASE)
+
+
+@kernel
+def occludes(geo, mats, i, o, d, tmin, tmax):
+    """Does analytic primitive ``i`` block the segment (tmin, tmax)? 0: no; 1: opaquely;
+    2: only through a transparent surface."""
+    if hit_analytic(geo, i, o, d, tmin, tmax) == INF:
         return 0
     return 1 if mats[geo.prim_material[i], MAT_KT] < OPAQUE_KT else 2
 
@@ -160,18 +169,76 @@ def box_entry(bmin, bmax, node, o, inv, tmin, tmax):
 
 
 @kernel
-def closest_hit(geo, o, d, tmin, tmax, stack):
-    """Nearest hit in (tmin, tmax): (t, primitive, triangle, b1, b2), or (tmax, -1, -1, 0, 0).
-    ``stack`` is caller-owned int32 scratch space (128 entries: two levels of 64).
+def _push_children(bmin, bmax, node_offset, node, o, inv, tmin, tmax, stack, top):
+    """Push the children of interior ``node`` that the ray meets, the farther one first so
+    the nearer one is visited next; returns the new stack top."""
+    left = node + 1
+    right = node_offset[node]
+    t_left = box_entry(bmin, bmax, left, o, inv, tmin, tmax)
+    t_right = box_entry(bmin, bmax, right, o, inv, tmin, tmax)
+    if t_left <= t_right:
+        if t_right != INF:
+            top += 1
+            stack[top] = right
+        if t_left != INF:
+            top += 1
+            stack[top] = left
+    else:
+        if t_left != INF:
+            top += 1
+            stack[top] = left
+        if t_right != INF:
+            top += 1
+            stack[top] = right
+    return top
 
-    The unbounded primitives and then the BVH's leaves feed one loop with a single call of
-    :func:`hit_primitive` (one inlined copy of every intersection routine keeps the compile
-    short)."""
+
+@kernel
+def closest_instance_hit(geo, o, d, tmin, tmax, stack):
+    """Nearest mesh-instance hit in (tmin, tmax), as :func:`closest_hit` returns it."""
     best_t = tmax
     best = -1
     best_tri = -1
     best_b1 = 0.0
     best_b2 = 0.0
+    bmin = geo.inst_node_min
+    bmax = geo.inst_node_max
+    inv = inverse_direction(d)
+    top = 0
+    stack[0] = 0
+    while top >= 0:
+        node = stack[top]
+        top -= 1
+        if box_entry(bmin, bmax, node, o, inv, tmin, best_t) == INF:
+            continue
+        count = geo.inst_node_count[node]
+        if count == 0:
+            top = _push_children(bmin, bmax, geo.inst_node_offset, node, o, inv, tmin, best_t,
+                                 stack, top)
+            continue
+        first = geo.inst_node_offset[node]
+        for j in range(first, first + count):
+            i = geo.inst_prims[j]
+            t, tri, b1, b2 = hit_instance(geo, i, o, d, tmin, best_t, stack)
+            if t < best_t:
+                best_t = t
+                best = i
+                best_tri = tri
+                best_b1 = b1
+                best_b2 = b2
+    return best_t, best, best_tri, best_b1, best_b2
+
+
+@kernel
+def closest_hit(geo, o, d, tmin, tmax, stack):
+    """Nearest hit in (tmin, tmax): (t, primitive, triangle, b1, b2), or (tmax, -1, -1, 0, 0).
+    ``stack`` is caller-owned int32 scratch space (128 entries: two levels of 64).
+
+    First the analytic shapes (the unbounded ones, then the BVH's leaves, through one call
+    site of the intersection routines), then, only when the scene has meshes, the mesh
+    instances' own BVH up to the nearest hit so far."""
+    best_t = tmax
+    best = -1
     n_unbounded = geo.unbounded.shape[0]
     bmin = geo.node_min
     bmax = geo.node_max
@@ -199,34 +266,18 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
             if count > 0:
                 leaf = geo.node_offset[node]
                 leaf_end = leaf + count
-                continue
-            left = node + 1
-            right = geo.node_offset[node]
-            t_left = box_entry(bmin, bmax, left, o, inv, tmin, best_t)
-            t_right = box_entry(bmin, bmax, right, o, inv, tmin, best_t)
-            # push the farther child first so the nearer one is visited next
-            if t_left <= t_right:
-                if t_right != INF:
-                    top += 1
-                    stack[top] = right
-                if t_left != INF:
-                    top += 1
-                    stack[top] = left
             else:
-                if t_left != INF:
-                    top += 1
-                    stack[top] = left
-                if t_right != INF:
-                    top += 1
-                    stack[top] = right
+                top = _push_children(bmin, bmax, geo.node_offset, node, o, inv, tmin, best_t,
+                                     stack, top)
             continue
         else:
             break
-        t, tri, b1, b2 = hit_primitive(geo, i, o, d, tmin, best_t, stack)
+        t = hit_analytic(geo, i, o, d, tmin, best_t)
         if t < best_t:
             best_t = t
             best = i
-            best_tri = tri
-            best_b1 = b1
-            best_b2 = b2
-    return best_t, best, best_tri, best_b1, best_b2
+    if geo.inst_node_min.shape[0] > 0:
+        t, prim, tri, b1, b2 = closest_instance_hit(geo, o, d, tmin, best_t, stack)
+        if prim >= 0:
+            return t, prim, tri, b1, b2
+    return best_t, best, -1, 0.0, 0.0

@@ -104,7 +104,14 @@ class GeometryArrays(NamedTuple):
     node_prims: np.ndarray  # (N,) int32 primitive indices in leaf order
     unbounded: np.ndarray  # (U,) int32 primitives outside the BVH (infinite planes)
     # triangle meshes, each stored once in its own space with its own BVH (the bottom level);
-    # SHAPE_MESH primitives instance them (their prim_xform maps world to mesh space)
+    # SHAPE_MESH primitives instance them (their prim_xform maps world to mesh space). The
+    # instances have a top-level BVH of their own (same layout as node_*), walked after the
+    # analytic shapes', so scenes without meshes never pay for the instance code path.
+    inst_node_min: np.ndarray  # (I, 3) float64
+    inst_node_max: np.ndarray  # (I, 3) float64
+    inst_node_offset: np.ndarray  # (I,) int32
+    inst_node_count: np.ndarray  # (I,) int32
+    inst_prims: np.ndarray  # (J,) int32 SHAPE_MESH primitive indices in leaf order
     mesh_info: np.ndarray  # (K, N_MESH_INFO) int32
     mesh_vertices: np.ndarray  # (V, 3) float32 positions
     mesh_faces: np.ndarray  # (T, 3) int32 rows of mesh_vertices, counter-clockwise = front

@@ -10,6 +10,7 @@ from .accel import (
     box_entry,
     closest_hit,
     hit_material,
+    instance_occludes,
     inverse_direction,
     occludes,
     surface_normals,
@@ -46,10 +47,40 @@ from .vec import dot, madd, normalize, sub, vload
 
 
 @kernel
+def _instances_occlusion(geo, mats, o, d, tmin, tmax, stack):
+    """:func:`any_occluder` over the mesh instances' BVH."""
+    seen_transparent = 0
+    bmin = geo.inst_node_min
+    bmax = geo.inst_node_max
+    inv = inverse_direction(d)
+    top = 0
+    stack[0] = 0
+    while top >= 0:
+        node = stack[top]
+        top -= 1
+        if box_entry(bmin, bmax, node, o, inv, tmin, tmax) == INF:
+            continue
+        count = geo.inst_node_count[node]
+        if count == 0:
+            top += 1
+            stack[top] = node + 1
+            top += 1
+            stack[top] = geo.inst_node_offset[node]
+            continue
+        first = geo.inst_node_offset[node]
+        for j in range(first, first + count):
+            state = instance_occludes(geo, mats, geo.inst_prims[j], o, d, tmin, tmax, stack)
+            if state == 1:
+                return 1
+            seen_transparent = max(seen_transparent, state)
+    return seen_transparent
+
+
+@kernel
 def any_occluder(geo, mats, o, d, tmin, tmax, stack):
     """0: nothing on the segment (tmin, tmax) of the ray; 1: an opaque occluder (the search
-    stops at the first one); 2: only transparent ones. One call site of :func:`occludes`
-    serves the unbounded primitives and the BVH leaves alike."""
+    stops at the first one); 2: only transparent ones. Analytic shapes first (one call site
+    of the intersection routines), then the mesh instances when there are any."""
     seen_transparent = 0
     n_unbounded = geo.unbounded.shape[0]
     bmin = geo.node_min
@@ -78,15 +109,20 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
             if count > 0:
                 leaf = geo.node_offset[node]
                 leaf_end = leaf + count
-                continue
-            top += 1
-            stack[top] = node + 1
-            top += 1
-            stack[top] = geo.node_offset[node]
+            else:
+                top += 1
+                stack[top] = node + 1
+                top += 1
+                stack[top] = geo.node_offset[node]
             continue
         else:
             break
-        state = occludes(geo, mats, i, o, d, tmin, tmax, stack)
+        state = occludes(geo, mats, i, o, d, tmin, tmax)
+        if state == 1:
+            return 1
+        seen_transparent = max(seen_transparent, state)
+    if geo.inst_node_min.shape[0] > 0:
+        state = _instances_occlusion(geo, mats, o, d, tmin, tmax, stack)
         if state == 1:
             return 1
         seen_transparent = max(seen_transparent, state)
