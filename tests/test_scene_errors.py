@@ -14,6 +14,7 @@ from pydantic import ValidationError
 
 import whitted
 from whitted import SceneError, load_scene
+from whitted.scene.io import rebase_files
 
 # A small valid scene. Each bad case below changes one thing in it. The comments after the
 # [[objects]] headers make those lines easy to find (and check that comments are allowed there).
@@ -286,11 +287,16 @@ def test_save_then_load_round_trips(source: Path | None, suffix: str, tmp_path: 
     path = tmp_path / f"saved{suffix}"
     assert scene.save(path) == path
     again = load_scene(path)
-    assert again == scene
+    # saved elsewhere, relative model/texture names are re-pointed at the same files
+    assert again == rebase_files(scene, tmp_path)
+    for before, after in zip(scene.objects, again.objects, strict=True):
+        if getattr(before, "file", None):
+            assert again.resolve_path(after.file).resolve() == \
+                scene.resolve_path(before.file).resolve()
     # and once more through the other format
     other = tmp_path / ("saved.json" if suffix == ".toml" else "saved.toml")
     again.save(other)
-    assert load_scene(other) == scene
+    assert load_scene(other) == again
 
 
 def test_good_scene_round_trips(tmp_path: Path):

@@ -5,7 +5,6 @@ tests can answer them)."""
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 from PySide6.QtCore import QSettings, Qt, QTimer
@@ -24,6 +23,7 @@ from .. import scene as S
 from ..errors import WhittedError
 from ..scene import Scene, load_scene, save_scene
 from ..scene.default import default_scene
+from ..scene.io import rebase_files
 from . import camera_ops, catalog
 from .autosave import Autosave, recovery_for
 from .document import (
@@ -60,30 +60,6 @@ def starter_scene() -> Scene:
         objects=[S.Plane(name="floor", material="matte"),
                  S.Sphere(name="ball", center=(0.0, 0.8, 0.0), radius=0.8, material="plastic")],
     )
-
-
-def rebase_files(scene: Scene, folder: Path) -> Scene:
-    """``scene`` with relative model/texture file names re-pointed from its base folder to
-    ``folder`` (Save As elsewhere), and ``folder`` as its base."""
-    old = scene.base_dir
-    folder = folder.resolve()
-
-    def moved(name: str) -> str:
-        p = Path(name)
-        return name if p.is_absolute() else os.path.relpath(old / p, folder)
-
-    data = scene.model_dump()
-    for obj in data["objects"]:
-        if obj.get("file"):
-            obj["file"] = moved(obj["file"])
-        mat = obj.get("material")
-        if isinstance(mat, dict) and isinstance(mat.get("texture"), dict) and \
-                mat["texture"].get("file"):
-            mat["texture"]["file"] = moved(mat["texture"]["file"])
-    for mat in data["materials"].values():
-        if isinstance(mat.get("texture"), dict) and mat["texture"].get("file"):
-            mat["texture"]["file"] = moved(mat["texture"]["file"])
-    return Scene.model_validate(data).with_base_dir(folder)
 
 
 class MainWindow(QMainWindow):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import difflib
 import json
+import os
 import re
 import tomllib
 import typing
@@ -368,10 +369,61 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     return scene.model_dump(mode="json", exclude_none=True)
 
 
+def _moved_name(name: str, old: Path, new: Path) -> str:
+    """File name ``name`` (relative to folder ``old``) as seen from folder ``new``: relative
+    while that stays close (at most two levels up), else absolute."""
+    p = Path(name).expanduser()
+    if p.is_absolute():
+        return name
+    target = (old / p).resolve()
+    try:
+        rel = Path(os.path.relpath(target, new))
+    except ValueError:  # another drive
+        return str(target)
+    if rel.parts[:3] == ("..", "..", ".."):
+        return str(target)
+    return rel.as_posix()
+
+
+def rebase_files(scene: Scene, folder: str | Path) -> Scene:
+    """A copy of ``scene`` whose relative model and texture file names point at the same
+    files from ``folder`` (and whose base folder is ``folder``): what saving elsewhere needs."""
+    old = scene.base_dir
+    folder = Path(folder).resolve()
+    if old.resolve() == folder:
+        return scene.model_copy().with_base_dir(folder)
+
+    def moved(name: str) -> str:
+        return _moved_name(name, old, folder)
+
+    objects = []
+    for obj in scene.objects:
+        update: dict[str, Any] = {}
+        if getattr(obj, "file", None):
+            update["file"] = moved(obj.file)
+        mat = obj.material
+        if isinstance(mat, Material) and getattr(mat.texture, "file", None):
+            tex = mat.texture.model_copy(update={"file": moved(mat.texture.file)})
+            update["material"] = mat.model_copy(update={"texture": tex})
+        objects.append(obj.model_copy(update=update) if update else obj)
+    materials = {}
+    for key, mat in scene.materials.items():
+        if getattr(mat.texture, "file", None):
+            tex = mat.texture.model_copy(update={"file": moved(mat.texture.file)})
+            mat = mat.model_copy(update={"texture": tex})
+        materials[key] = mat
+    return scene.model_copy(update={"objects": objects, "materials": materials}).with_base_dir(
+        folder)
+
+
 def save_scene(scene: Scene, path: str | Path) -> Path:
+    """Write ``scene`` as TOML or JSON (by extension), atomically. Relative model and texture
+    file names are rewritten to stay valid from the new file's folder."""
     from ..output.encode import atomic_write
 
     path = Path(path)
+    if path.parent.resolve() != scene.base_dir.resolve():
+        scene = rebase_files(scene, path.parent)
     suffix = path.suffix.lower()
     data = scene_to_dict(scene)
     if suffix == ".toml":
