@@ -32,7 +32,7 @@ app = typer.Typer(
     help="whitted: a fast Whitted ray tracer. Render scene files (TOML/JSON) to images.",
     pretty_exceptions_enable=False,
 )
-err = Console(stderr=True, highlight=False)
+err = Console(stderr=True, highlight=False, soft_wrap=True)
 out = Console(highlight=False, soft_wrap=True)
 
 AOV_NAMES = ("depth", "normal", "id")
@@ -267,7 +267,9 @@ def info(
     out.print(f"objects: {len(scene.objects)}")
     for i, obj in enumerate(scene.objects):
         mat = obj.material if isinstance(obj.material, str) else (
-            "inline" if obj.material is not None else "default")
+            "inline" if obj.material is not None
+            else "from the file" if obj.type == "mesh" and getattr(obj, "file", None)
+            else "default")
         label = f" '{obj.name}'" if obj.name else ""
         out.print(f"  [{i}] {obj.type}{label} material={mat}")
     out.print(f"lights: {len(scene.lights)}")

@@ -319,7 +319,7 @@ def _mesh_source(scene: Scene, obj_index: int, shape: Mesh, warnings: list[str])
 
 def _mesh_key(scene: Scene, shape: Mesh) -> tuple:
     """Objects with equal keys share one stored mesh (instancing)."""
-    shading = (shape.smooth, shape.crease_angle)
+    shading = (shape.smooth, shape.crease_angle if shape.smooth else None)
     if shape.file is not None:
         return ("file", str(scene.resolve_path(shape.file).resolve()), *shading)
     return ("arrays", id(shape.vertices), id(shape.faces), id(shape.normals), id(shape.uvs),

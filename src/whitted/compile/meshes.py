@@ -4,7 +4,8 @@ Every distinct mesh (one model file with one normal setting, or one set of inlin
 stored once, in its own space: float32 positions, int32 triangles, per-triangle material rows,
 corner normals when it is smooth-shaded, corner uvs when it has texture coordinates, and a
 binned-SAH BVH with float32 boxes rounded outward. Scene objects that use it become instances
-(:data:`SHAPE_MESH` primitives of the scene BVH) with their own transform and material.
+(:data:`SHAPE_MESH` primitives, in a top-level BVH of the instances) with their own transform
+and material.
 Degenerate triangles (zero area, non-finite corners) are dropped here, with a warning that
 counts them.
 """

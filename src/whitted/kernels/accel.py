@@ -1,7 +1,8 @@
 """Scene-level ray queries: nearest hit through the BVH (plus the unbounded planes), and the
 surface normals of a hit in world space.
 
-Two levels: the scene BVH holds the analytic shapes and the mesh *instances*; an instance
+Two levels: the scene BVH holds the analytic shapes; the mesh *instances* have a top-level
+BVH of their own, walked after it (so scenes without meshes never run that code); an instance
 maps the ray into its mesh's space and walks the mesh's own BVH (:mod:`.mesh`). A hit is
 (t, primitive, triangle, b1, b2): ``triangle`` is -1 for analytic shapes, and (b1, b2) are
 the barycentric coordinates on the triangle.

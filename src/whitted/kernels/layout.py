@@ -2,8 +2,9 @@
 
 Primitives: ``prim_type[i]`` is one of the ``SHAPE_*`` codes and ``prim_params[i]`` holds the
 shape's numbers in the order listed next to each code. All positions are in the primitive's own
-space; ``prim_xform[i] >= 0`` names a 3x4 world-to-object matrix in ``xforms`` (used only for
-quadrics under a non-similarity transform, every other transform is baked into the numbers).
+space; ``prim_xform[i] >= 0`` names a 3x4 world-to-object matrix in ``xforms`` (used for mesh
+instances under any transform but the identity, and for quadrics under a non-similarity
+transform; every other transform is baked into the numbers).
 """
 
 from __future__ import annotations

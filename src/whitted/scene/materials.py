@@ -14,7 +14,7 @@ class Material(Strict):
     """How a surface shades.
 
     The Whitted model (lecture eq. 9): ``I = ka·Ia·Ca + Σ_j Ij·(kd·Cd·(n·l) + ks·Cs·spec) +
-    kr·Ir + kt·It`` where ``spec`` is ``(r·v)^shininess`` (phong) or ``(n·h)^shininess`` (blinn).
+    kr·Ir + kt·Cd·It`` where ``spec`` is ``(r·v)^shininess`` (phong) or ``(n·h)^shininess`` (blinn).
     ``attenuation`` is the Beer–Lambert absorption coefficient per unit length inside the body
     (``exp(-attenuation·distance)``), a number or a colour-wise triple.
 

@@ -1,4 +1,5 @@
-"""Shapes. Every one is intersected exactly (no tessellation) and takes a ``transform``."""
+"""Shapes. Every one takes a ``transform``. The analytic ones are intersected exactly (no
+tessellation); a ``Mesh`` is made of triangles (from a model file or from arrays)."""
 
 from __future__ import annotations
 

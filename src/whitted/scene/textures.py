@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from .types import Colour, Finite, Strict
 
@@ -25,6 +25,13 @@ class _Texture(Strict):
     offset: Vec2 = (0.0, 0.0)
     scale: Vec2 = (1.0, 1.0)
     rotation: Finite = 0.0
+
+    @field_validator("scale")
+    @classmethod
+    def _scale_nonzero(cls, v: tuple[float, float]) -> tuple[float, float]:
+        if any(abs(s) < 1e-12 for s in v):
+            raise ValueError("scale must not be zero (the texture would be one colour)")
+        return v
 
 
 class ImageTexture(_Texture):
