@@ -45,6 +45,15 @@ def _targets(verts, faces):
     return np.concatenate([v, mid])
 
 
+# every mesh test runs both ways a mesh can be stored: flattened into the scene BVH as triangle
+# primitives (a small mesh used once) and instanced (stored once, its own BVH)
+LAYOUTS = [pytest.param(None, id="flattened"), pytest.param(0, id="instanced")]
+
+
+def compile_as(scene, layout):
+    return compile_scene(scene) if layout is None else compile_scene(scene, flatten_limit=layout)
+
+
 TRANSFORMS = [
     None,
     whitted.Transform(scale=(1.7, 0.6, 1.1), rotate=(23.0, -41.0, 7.0), translate=(0.3, -2, 5)),
@@ -59,13 +68,14 @@ def sphere_mesh():
     return v, f
 
 
+@pytest.mark.parametrize("layout", LAYOUTS)
 @pytest.mark.parametrize("transform", TRANSFORMS, ids=["identity", "affine"])
-def test_closed_mesh_is_watertight(sphere_mesh, transform):
+def test_closed_mesh_is_watertight(sphere_mesh, transform, layout):
     """A ray from inside a closed mesh always hits it, and a ray that enters from outside
     always leaves: aimed exactly at every vertex and edge midpoint, and a million random."""
     v, f = sphere_mesh
     mesh = whitted.Mesh(v, f, transform=transform)
-    compiled = compile_scene(whitted.Scene(objects=[mesh]))
+    compiled = compile_as(whitted.Scene(objects=[mesh]), layout)
     m = transform.matrix() if transform is not None else np.eye(4)
 
     def world(p):
@@ -91,13 +101,14 @@ def test_closed_mesh_is_watertight(sphere_mesh, transform):
     assert np.isfinite(_hits(compiled, o, d)).all()
 
 
-def test_mesh_hits_match_analytic_box():
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_mesh_hits_match_analytic_box(layout):
     """A box as 12 triangles gives the same distances and normals as the analytic box."""
     v, f = cube((-1, -0.5, -2), (1.5, 1, 0.5))
     rng = np.random.default_rng(3)
     o = rng.uniform(-6, 6, (2000, 3))
     d = rng.uniform((-1.5, -1, -2.5), (2, 1.5, 1), (2000, 3)) - o  # at the box and around it
-    as_mesh = _hits(compile_scene(whitted.Scene(objects=[whitted.Mesh(v, f)])), o, d)
+    as_mesh = _hits(compile_as(whitted.Scene(objects=[whitted.Mesh(v, f)]), layout), o, d)
     as_box = _hits(compile_scene(whitted.Scene(objects=[
         whitted.Box(min=(-1, -0.5, -2), max=(1.5, 1, 0.5))])), o, d)
     assert 1000 < np.isfinite(as_box).sum() < 2000
@@ -137,69 +148,76 @@ def test_same_model_file_is_instanced(tmp_path):
     assert compiled.instanced_triangles == 24
 
 
-def _one_triangle_hit(mesh, ray_o, ray_d):
-    compiled = compile_scene(whitted.Scene(objects=[mesh]))
+def _one_triangle_hit(mesh, ray_o, ray_d, layout):
+    compiled = compile_as(whitted.Scene(objects=[mesh]), layout)
     geo = compiled.geometry
     t, prim, tri, b1, b2 = closest_hit(geo, ray_o, ray_d, 0.0, math.inf, np.empty(128, np.int32))
-    assert prim == 0 and tri == 0
+    assert prim == 0 and tri == (-1 if layout is None else 0)
     p = tuple(o + t * d for o, d in zip(ray_o, ray_d, strict=True))
     return geo, prim, tri, b1, b2, p
 
 
-def test_smooth_normals_interpolate_the_corners():
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_smooth_normals_interpolate_the_corners(layout):
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
     normals = np.array([[0, 0, 1], [1, 0, 1], [0, 1, 1]], float) / [[1], [math.sqrt(2)],
                                                                       [math.sqrt(2)]]
     mesh = whitted.Mesh(v, [[0, 1, 2]], normals=normals)
-    geo, prim, tri, b1, b2, p = _one_triangle_hit(mesh, (0.25, 0.5, 1.0), (0.0, 0.0, -1.0))
-    assert (b1, b2) == pytest.approx((0.25, 0.5))
+    geo, prim, tri, b1, b2, p = _one_triangle_hit(mesh, (0.25, 0.5, 1.0), (0.0, 0.0, -1.0),
+                                                  layout)
+    if tri >= 0:
+        assert (b1, b2) == pytest.approx((0.25, 0.5))
     ng, ns = surface_normals(geo, prim, tri, b1, b2, p)
     assert ng == pytest.approx((0, 0, 1))
     expect = 0.25 * normals[0] + 0.25 * normals[1] + 0.5 * normals[2]
     assert ns == pytest.approx(tuple(expect / np.linalg.norm(expect)))
     # smooth = false ignores the normals
     flat = whitted.Mesh(v, [[0, 1, 2]], normals=normals, smooth=False)
-    geo, prim, tri, b1, b2, p = _one_triangle_hit(flat, (0.25, 0.5, 1.0), (0.0, 0.0, -1.0))
+    geo, prim, tri, b1, b2, p = _one_triangle_hit(flat, (0.25, 0.5, 1.0), (0.0, 0.0, -1.0),
+                                                  layout)
     assert surface_normals(geo, prim, tri, b1, b2, p)[1] == pytest.approx((0, 0, 1))
 
 
-def test_computed_smooth_normals_respect_the_crease_angle():
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_computed_smooth_normals_respect_the_crease_angle(layout):
     v, f = cube()
-    sharp = compile_scene(whitted.Scene(objects=[whitted.Mesh(v, f, smooth=True)]))
+    sharp = compile_as(whitted.Scene(objects=[whitted.Mesh(v, f, smooth=True)]), layout)
     # 90-degree edges are above the default 60-degree crease: every corner keeps its face normal
     n = sharp.geometry.tri_normals
     face = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     face /= np.linalg.norm(face, axis=1, keepdims=True)
     np.testing.assert_allclose(n, np.repeat(face[:, None, :], 3, axis=1), atol=1e-6)
-    soft = compile_scene(whitted.Scene(objects=[whitted.Mesh(v, f, smooth=True,
-                                                             crease_angle=100)]))
+    soft = compile_as(whitted.Scene(objects=[whitted.Mesh(v, f, smooth=True, crease_angle=100)]),
+                      layout)
     # above 90 degrees everything joins: a corner normal points along the corner's diagonal
     corner = soft.geometry.tri_normals.reshape(-1, 3)
     np.testing.assert_allclose(np.abs(corner), 1 / math.sqrt(3), atol=1e-6)
     # a sphere mesh smooths towards the true sphere normal
     sv, sf = uv_sphere(16, 32)
-    smooth = compile_scene(whitted.Scene(objects=[whitted.Mesh(sv, sf, smooth=True)]))
+    smooth = compile_as(whitted.Scene(objects=[whitted.Mesh(sv, sf, smooth=True)]), layout)
     at = sv[sf].astype(np.float32).astype(np.float64)
     true = at / np.linalg.norm(at, axis=2, keepdims=True)
     assert np.max(np.abs(smooth.geometry.tri_normals - true)) < 0.02
 
 
-def test_mesh_uvs_and_barycentric_default():
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_mesh_uvs_and_barycentric_default(layout):
     v = np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0]], float)
     uvs = np.array([[0.1, 0.2], [0.9, 0.2], [0.1, 0.8]])
     geo, prim, tri, b1, b2, p = _one_triangle_hit(whitted.Mesh(v, [[0, 1, 2]], uvs=uvs),
-                                                  (0.5, 1.0, 1.0), (0.0, 0.0, -1.0))
+                                                  (0.5, 1.0, 1.0), (0.0, 0.0, -1.0), layout)
     u, w = surface_uv(geo, prim, tri, b1, b2, p)
     assert (u, w) == pytest.approx((0.1 + 0.8 * 0.25, 0.2 + 0.6 * 0.5))
     geo, prim, tri, b1, b2, p = _one_triangle_hit(whitted.Mesh(v, [[0, 1, 2]]),
-                                                  (0.5, 1.0, 1.0), (0.0, 0.0, -1.0))
+                                                  (0.5, 1.0, 1.0), (0.0, 0.0, -1.0), layout)
     assert surface_uv(geo, prim, tri, b1, b2, p) == pytest.approx((0.25, 0.5))
 
 
-def test_degenerate_triangles_are_dropped_with_a_count():
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_degenerate_triangles_are_dropped_with_a_count(layout):
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [2, 0, 0]], float)
     faces = [[0, 1, 2], [0, 1, 3], [1, 1, 2], [0, 2, 1]]  # collinear, repeated corner
-    compiled = compile_scene(whitted.Scene(objects=[whitted.Mesh(v, faces)]))
+    compiled = compile_as(whitted.Scene(objects=[whitted.Mesh(v, faces)]), layout)
     assert compiled.triangles == 2
     assert any("dropped 2 degenerate triangles" in w for w in compiled.warnings)
 
@@ -226,13 +244,19 @@ def test_per_triangle_materials_and_override():
     original = flatten._mesh_source
     flatten._mesh_source = lambda *a: src
     try:
-        compiled = compile_scene(scene)
+        compiled = compile_scene(scene, flatten_limit=0)  # instanced: the triangles' materials
         mats = compiled.materials[compiled.geometry.tri_material]
+        assert (mats[:2, 0] == 1).all() and (mats[2:, 2] == 1).all()
+        compiled = compile_scene(scene)  # flattened: each triangle primitive has its own
+        mats = compiled.materials[compiled.geometry.prim_material]
         assert (mats[:2, 0] == 1).all() and (mats[2:, 2] == 1).all()
         over = scene.model_copy(update={"objects": [mesh.model_copy(update={
             "material": whitted.Material(color=(0, 1, 0), ka=1, kd=0)})]})
-        compiled = compile_scene(over)
+        compiled = compile_scene(over, flatten_limit=0)
         assert compiled.geometry.prim_material[0] >= 0
+        flat = compile_scene(over)
+        green = flat.materials[flat.geometry.prim_material]
+        assert (green[:, 1] == 1).all() and (green[:, 0] == 0).all()
     finally:
         flatten._mesh_source = original
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..kernels.features import NO_INSTANCES_DTYPE
 from ..kernels.layout import (
     FALLOFF_CODES,
     LIGHT_DIRECTION,
@@ -81,32 +82,37 @@ class CompiledScene:
 
 
 class _Builder:
+    """Primitive rows, gathered in blocks (one row per analytic shape, one block per
+    flattened mesh) and joined at the end."""
+
     def __init__(self) -> None:
-        self.types: list[int] = []
-        self.params: list[np.ndarray] = []
-        self.xform_index: list[int] = []
+        self.blocks: list[tuple] = []
         self.xforms: list[np.ndarray] = []
-        self.material: list[int] = []
-        self.object: list[int] = []
-        self.solid: list[int] = []
-        self.lo: list[np.ndarray] = []
-        self.hi: list[np.ndarray] = []
 
     def add(self, typ, values, lo, hi, *, material, obj, solid, world_to_object=None):
-        row = np.zeros(N_PRIM_PARAMS)
-        row[: len(values)] = values
-        self.types.append(typ)
-        self.params.append(row)
-        if world_to_object is None:
-            self.xform_index.append(-1)
-        else:
-            self.xform_index.append(len(self.xforms))
+        row = np.zeros((1, N_PRIM_PARAMS))
+        row[0, : len(values)] = values
+        xf = -1
+        if world_to_object is not None:
+            xf = len(self.xforms)
             self.xforms.append(world_to_object[:3, :4])
-        self.material.append(material)
-        self.object.append(obj)
-        self.solid.append(int(solid))
-        self.lo.append(np.asarray(lo, dtype=np.float64))
-        self.hi.append(np.asarray(hi, dtype=np.float64))
+        self.add_block(typ, row, np.asarray(lo, np.float64).reshape(1, 3),
+                       np.asarray(hi, np.float64).reshape(1, 3), material, obj, solid, xf)
+
+    def add_block(self, typ, params, lo, hi, material, obj, solid, xf=-1):
+        k = len(params)
+        self.blocks.append((np.full(k, typ, np.int32), params, np.full(k, xf, np.int32),
+                            np.broadcast_to(np.asarray(material, np.int32), (k,)),
+                            np.full(k, obj, np.int32), np.full(k, int(solid), np.int32),
+                            lo, hi))
+
+    def columns(self):
+        """types, params, xform index, material, object, solid, lo, hi: joined arrays."""
+        if not self.blocks:
+            return (np.zeros(0, np.int32), np.zeros((0, N_PRIM_PARAMS)), np.zeros(0, np.int32),
+                    np.zeros(0, np.int32), np.zeros(0, np.int32), np.zeros(0, np.int32),
+                    np.zeros((0, 3)), np.zeros((0, 3)))
+        return tuple(np.concatenate([blk[k] for blk in self.blocks]) for k in range(8))
 
 
 def _similarity_scale(linear: np.ndarray) -> float | None:
@@ -201,8 +207,8 @@ def _add_shape(b: _Builder, shape, m: np.ndarray, material: int, obj: int) -> No
         n = _unit(np.cross(e1, e2))
         lo, hi = _corners_bounds([v0, v1, v2])
         uvs = np.array(shape.uvs, dtype=np.float64).reshape(-1)
-        b.add(SHAPE_TRIANGLE, [*v0, *e1, *e2, *n, *uvs], lo, hi, material=material, obj=obj,
-              solid=False)
+        b.add(SHAPE_TRIANGLE, [*v0, *e1, *e2, *n, *uvs, -1.0], lo, hi, material=material,
+              obj=obj, solid=False)
     elif isinstance(shape, Disk):
         c, n, r = np.array(shape.center), _unit(shape.normal), shape.radius
         if s is not None:
@@ -317,6 +323,48 @@ def _mesh_source(scene: Scene, obj_index: int, shape: Mesh, warnings: list[str])
     )
 
 
+FLATTEN_LIMIT = 65_536  # a mesh used once with at most this many triangles joins the scene BVH
+DEFAULT_UVS = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 1.0])  # barycentric: (u, v) = (b1, b2)
+
+
+def _add_flat_mesh(b: _Builder, meshes: MeshTable, src: MeshSource, rows: np.ndarray,
+                   shape: Mesh, m: np.ndarray, override: int, obj: int) -> int:
+    """A mesh used by one object, its transform baked in, as triangle primitives of the scene
+    BVH (one BVH over analytic shapes and triangles). Returns the triangles added."""
+    lin = m[:3, :3]
+    v = np.asarray(src.vertices, np.float64) @ lin.T + m[:3, 3]
+    kept = meshes.drawable(src, v)
+    if kept is None:
+        return 0
+    faces, face_material, corners = kept
+    t = len(faces)
+    e1 = corners[:, 1] - corners[:, 0]
+    e2 = corners[:, 2] - corners[:, 0]
+    n = np.cross(e1, e2)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    params = np.empty((t, N_PRIM_PARAMS))
+    params[:, 0:3] = corners[:, 0]
+    params[:, 3:6] = e1
+    params[:, 6:9] = e2
+    params[:, 9:12] = n
+    params[:, 12:18] = DEFAULT_UVS if src.uvs is None else np.asarray(src.uvs)[faces].reshape(
+        t, 6)
+    params[:, 18] = -1.0
+    normals = None
+    if shape.smooth is not False and src.normals is not None:  # the file's, carried along
+        normals = np.asarray(src.normals, np.float64)[faces] @ np.linalg.inv(lin)
+        length = np.linalg.norm(normals, axis=2, keepdims=True)
+        normals = normals / np.where(length > 0, length, 1.0)
+    elif shape.smooth:
+        normals = meshes.corner_normals(src, v, faces, True, shape.crease_angle)
+    if normals is not None:
+        params[:, 18] = meshes.add_normal_rows(normals) + np.arange(t)
+    material = np.asarray(rows, np.int32)[face_material] if override < 0 else override
+    b.add_block(SHAPE_TRIANGLE, params, corners.min(axis=1), corners.max(axis=1), material, obj,
+                shape.solid)
+    return t
+
+
 def _mesh_key(scene: Scene, shape: Mesh) -> tuple:
     """Objects with equal keys share one stored mesh (instancing)."""
     shading = (shape.smooth, shape.crease_angle if shape.smooth else None)
@@ -361,9 +409,14 @@ def _light_rows(scene: Scene) -> tuple[np.ndarray, tuple[float, float, float]]:
     return table, (float(ambient[0]), float(ambient[1]), float(ambient[2]))
 
 
-def compile_scene(scene: Scene) -> CompiledScene:
-    """Flatten ``scene`` into the kernel layout and build the BVH over its bounded shapes."""
+def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT) -> CompiledScene:
+    """Flatten ``scene`` into the kernel layout and build the BVHs over its bounded shapes.
+
+    A mesh used by one object with at most ``flatten_limit`` triangles becomes triangle
+    primitives of the scene BVH; bigger ones, and any used by several objects, are stored
+    once and instanced."""
     import time
+    from collections import Counter
 
     start = time.perf_counter()
     b = _Builder()
@@ -372,19 +425,26 @@ def compile_scene(scene: Scene) -> CompiledScene:
     mesh_of: dict[tuple, object] = {}
     warnings: list[str] = []
     instanced = 0
+    flat = 0
+    uses = Counter(_mesh_key(scene, s) for s in scene.objects if isinstance(s, Mesh))
     for obj_index, shape in enumerate(scene.objects):
         m = shape.transform.matrix() if shape.transform is not None else np.eye(4)
         if isinstance(shape, Mesh):
             key = _mesh_key(scene, shape)
+            override = -1 if shape.material is None else materials.add(
+                scene.material_of(obj_index))
             if key not in mesh_of:
                 src = _mesh_source(scene, obj_index, shape, warnings)
                 rows = np.array([materials.add(mat) for mat in src.materials], np.int32)
+                if uses[key] == 1 and len(src.faces) <= flatten_limit:
+                    added = _add_flat_mesh(b, meshes, src, rows, shape, m, override, obj_index)
+                    flat += added
+                    instanced += added
+                    continue
                 mesh_of[key] = meshes.add(src, rows, shape.smooth, shape.crease_angle)
             stored = mesh_of[key]
             if stored is None:
                 continue
-            override = -1 if shape.material is None else materials.add(
-                scene.material_of(obj_index))
             identity = np.array_equal(m, np.eye(4))
             lo, hi = _corners_bounds(_box_corners(stored.lo, stored.hi), None if identity else m)
             b.add(SHAPE_MESH, [stored.index], lo, hi, material=override, obj=obj_index,
@@ -394,11 +454,7 @@ def compile_scene(scene: Scene) -> CompiledScene:
         _add_shape(b, shape, m, materials.add(scene.material_of(obj_index)), obj_index)
     warnings.extend(meshes.warnings)
 
-    n = len(b.types)
-    prim_type = np.array(b.types, dtype=np.int32)
-    params = np.array(b.params, dtype=np.float64).reshape(n, N_PRIM_PARAMS)
-    lo = np.array(b.lo, dtype=np.float64).reshape(n, 3)
-    hi = np.array(b.hi, dtype=np.float64).reshape(n, 3)
+    prim_type, params, prim_xform, prim_material, prim_object, prim_solid, lo, hi = b.columns()
     finite = np.all(np.isfinite(lo) & np.isfinite(hi), axis=1)
     is_instance = prim_type == SHAPE_MESH
     bounded = np.flatnonzero(finite & ~is_instance).astype(np.int32)
@@ -409,11 +465,11 @@ def compile_scene(scene: Scene) -> CompiledScene:
     geometry = GeometryArrays(
         prim_type=prim_type,
         prim_params=params,
-        prim_xform=np.array(b.xform_index, dtype=np.int32),
+        prim_xform=prim_xform,
         xforms=np.array(b.xforms, dtype=np.float64).reshape(len(b.xforms), 3, 4),
-        prim_material=np.array(b.material, dtype=np.int32),
-        prim_object=np.array(b.object, dtype=np.int32),
-        prim_solid=np.array(b.solid, dtype=np.int32),
+        prim_material=np.ascontiguousarray(prim_material),
+        prim_object=prim_object,
+        prim_solid=prim_solid,
         node_min=np.ascontiguousarray(bvh.node_min, dtype=np.float64),
         node_max=np.ascontiguousarray(bvh.node_max, dtype=np.float64),
         node_offset=np.ascontiguousarray(bvh.node_offset, dtype=np.int32),
@@ -421,7 +477,9 @@ def compile_scene(scene: Scene) -> CompiledScene:
         node_axis=np.ascontiguousarray(bvh.node_axis, dtype=np.int8),
         node_prims=np.ascontiguousarray(bounded[bvh.prim_order], dtype=np.int32),
         unbounded=unbounded.astype(np.int32),
-        inst_node_min=np.ascontiguousarray(inst_bvh.node_min, dtype=np.float64),
+        # float32 marks a scene without instances: kernels specialised for it (features.py)
+        inst_node_min=np.ascontiguousarray(
+            inst_bvh.node_min, dtype=np.float64 if len(instances) else NO_INSTANCES_DTYPE),
         inst_node_max=np.ascontiguousarray(inst_bvh.node_max, dtype=np.float64),
         inst_node_offset=np.ascontiguousarray(inst_bvh.node_offset, dtype=np.int32),
         inst_node_count=np.ascontiguousarray(inst_bvh.node_count, dtype=np.int32),
@@ -445,7 +503,7 @@ def compile_scene(scene: Scene) -> CompiledScene:
         bounds_max=bmax,
         build_seconds=time.perf_counter() - start,
         warnings=warnings,
-        triangles=meshes.n_tris,
+        triangles=meshes.n_tris + flat,
         instanced_triangles=instanced,
     )
 

@@ -86,13 +86,11 @@ class MeshTable:
         self.n_uv_rows = 0
         self.warnings: list[str] = []
 
-    def add(self, src: MeshSource, material_rows: np.ndarray, smooth: bool | None,
-            crease_angle: float) -> CompiledMesh | None:
-        """Store ``src`` (``material_rows[k]`` = material-table row of ``src.materials[k]``).
-        Returns None when no triangle is left to draw."""
-        verts32 = np.ascontiguousarray(src.vertices, dtype=np.float32)
+    def drawable(self, src: MeshSource, v: np.ndarray):
+        """(faces, face_material, corners) of the triangles of ``src`` worth drawing, with
+        positions ``v``: degenerate ones (zero area, not finite) dropped with a warning that
+        counts them. None when nothing is left."""
         faces = np.ascontiguousarray(src.faces, dtype=np.int64).reshape(-1, 3)
-        v = verts32.astype(np.float64)  # exactly the positions the kernels will see
         corners = v[faces]  # (T, 3, 3)
         area2 = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
                                         corners[:, 2] - corners[:, 0]), axis=1)
@@ -101,15 +99,44 @@ class MeshTable:
         if dropped:
             self.warnings.append(f"{src.label}: dropped {dropped} degenerate triangle"
                                  f"{'s' if dropped != 1 else ''} (zero area or not finite)")
+        face_material = np.asarray(src.face_material)
         if not keep.all():
             faces = faces[keep]
             corners = corners[keep]
-            face_material = np.asarray(src.face_material)[keep]
-        else:
-            face_material = np.asarray(src.face_material)
+            face_material = face_material[keep]
         if len(faces) == 0:
             self.warnings.append(f"{src.label}: no triangles to draw")
             return None
+        return faces, face_material, corners
+
+    def corner_normals(self, src: MeshSource, v: np.ndarray, faces: np.ndarray,
+                       smooth: bool | None, crease_angle: float) -> np.ndarray | None:
+        """(T, 3, 3) corner normals in the mesh's space, or None for flat shading."""
+        if smooth is False:
+            return None
+        if src.normals is not None:
+            return np.asarray(src.normals, dtype=np.float32)[faces]
+        if smooth:
+            return smooth_corner_normals(v, faces, crease_angle)
+        return None
+
+    def add_normal_rows(self, normals: np.ndarray) -> int:
+        """Append (T, 3, 3) corner normals to tri_normals; returns the first row."""
+        row = self.n_normal_rows
+        self.tri_normals.append(np.ascontiguousarray(normals, dtype=np.float32))
+        self.n_normal_rows += len(normals)
+        return row
+
+    def add(self, src: MeshSource, material_rows: np.ndarray, smooth: bool | None,
+            crease_angle: float) -> CompiledMesh | None:
+        """Store ``src`` (``material_rows[k]`` = material-table row of ``src.materials[k]``).
+        Returns None when no triangle is left to draw."""
+        verts32 = np.ascontiguousarray(src.vertices, dtype=np.float32)
+        v = verts32.astype(np.float64)  # exactly the positions the kernels will see
+        kept = self.drawable(src, v)
+        if kept is None:
+            return None
+        faces, face_material, corners = kept
         t = len(faces)
         lo_tri = corners.min(axis=1)
         hi_tri = corners.max(axis=1)
@@ -118,17 +145,9 @@ class MeshTable:
         del lo_tri, hi_tri
 
         normal_row = -1
-        corner_normals = None
-        if smooth is not False:
-            if src.normals is not None:
-                n = np.asarray(src.normals, dtype=np.float32)[faces]
-                corner_normals = n
-            elif smooth:
-                corner_normals = smooth_corner_normals(v, faces, crease_angle)
+        corner_normals = self.corner_normals(src, v, faces, smooth, crease_angle)
         if corner_normals is not None:
-            normal_row = self.n_normal_rows
-            self.tri_normals.append(np.ascontiguousarray(corner_normals, dtype=np.float32))
-            self.n_normal_rows += t
+            normal_row = self.add_normal_rows(corner_normals)
         uv_row = -1
         if src.uvs is not None:
             uv_row = self.n_uv_rows

@@ -12,11 +12,12 @@ from __future__ import annotations
 
 import math
 
+from .features import has_instances
 from .intersect import INF, intersect_local, normal_local
 from .jit import kernel
-from .layout import MAT_KT
+from .layout import MAT_KT, SHAPE_TRIANGLE, TRIANGLE_NORMALS
 from .mesh import OPAQUE_KT, mesh_closest_hit, mesh_normals, mesh_occlusion
-from .vec import normalize
+from .vec import dot, normalize, sub, vload
 
 TINY_DIRECTION = 1e-30  # stands in for a zero direction component in the slab test
 MESH_STACK_BASE = 64  # traversal stack entries [0, 64) for the scene BVH, the rest for meshes
@@ -121,11 +122,41 @@ def world_normal(geo, i, p):
 
 
 @kernel
+def _triangle_shading_normal(geo, i, p, fallback):
+    """The corner normals of a smooth-shaded triangle primitive blended at ``p``."""
+    P = geo.prim_params
+    q = sub(p, vload(P, i, 0))
+    e1 = vload(P, i, 3)
+    e2 = vload(P, i, 6)
+    d00 = dot(e1, e1)
+    d01 = dot(e1, e2)
+    d11 = dot(e2, e2)
+    d20 = dot(q, e1)
+    d21 = dot(q, e2)
+    denom = d00 * d11 - d01 * d01
+    b1 = (d11 * d20 - d01 * d21) / denom
+    b2 = (d00 * d21 - d01 * d20) / denom
+    b0 = 1.0 - b1 - b2
+    r = int(P[i, TRIANGLE_NORMALS])
+    n = geo.tri_normals
+    ns = (
+        b0 * n[r, 0, 0] + b1 * n[r, 1, 0] + b2 * n[r, 2, 0],
+        b0 * n[r, 0, 1] + b1 * n[r, 1, 1] + b2 * n[r, 2, 1],
+        b0 * n[r, 0, 2] + b1 * n[r, 1, 2] + b2 * n[r, 2, 2],
+    )
+    if ns[0] == 0.0 and ns[1] == 0.0 and ns[2] == 0.0:
+        return fallback
+    return normalize(ns)
+
+
+@kernel
 def surface_normals(geo, prim, tri, b1, b2, p):
     """(geometric, shading) unit normals in world space of a hit at ``p``. They differ only on
     smooth-shaded meshes; the geometric one decides which side a ray is on."""
     if tri < 0:
         n = world_normal(geo, prim, p)
+        if geo.prim_type[prim] == SHAPE_TRIANGLE and geo.prim_params[prim, TRIANGLE_NORMALS] >= 0:
+            return n, _triangle_shading_normal(geo, prim, p, n)
         return n, n
     ng, ns = mesh_normals(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
     xf = geo.prim_xform[prim]
@@ -277,7 +308,7 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
         if t < best_t:
             best_t = t
             best = i
-    if geo.inst_node_min.shape[0] > 0:
+    if has_instances(geo):
         t, prim, tri, b1, b2 = closest_instance_hit(geo, o, d, tmin, best_t, stack)
         if prim >= 0:
             return t, prim, tri, b1, b2

@@ -19,7 +19,8 @@ SHAPE_PLANE = 1  # point 0:3, unit normal 3:6
 # corner 0:3, edge1 3:6, edge2 6:9, unit normal 9:12, dual u 12:15, dual v 15:18
 SHAPE_RECTANGLE = 2
 SHAPE_DISK = 3  # center 0:3, unit normal 3:6, radius 6
-SHAPE_TRIANGLE = 4  # v0 0:3, edge1 3:6, edge2 6:9, unit normal 9:12
+SHAPE_TRIANGLE = 4  # v0 0:3, edge1 3:6, edge2 6:9, unit normal 9:12, corner uvs 12:18,
+# row of tri_normals with its corner normals 18 (-1: flat)
 SHAPE_BOX = 5  # corner 0:3, inverse edge matrix rows 3:12 (local = M^-1 (p - corner) in [0,1]^3)
 SHAPE_FRUSTUM = 6  # base 0:3, unit axis 3:6, height 6, base radius 7, top radius 8, capped 9
 SHAPE_MESH = 7  # an instance of a triangle mesh: mesh index 0 (a row of mesh_info)
@@ -29,9 +30,10 @@ SPHERE_FRAME = 4  # 4:13 the object's x, y, z axes in world space (unit), for sp
 PLANE_TANGENT = 6  # 6:9 unit tangent (u direction); v = normal x tangent
 DISK_TANGENT = 7  # 7:10
 TRIANGLE_UV = 12  # 12:18 texture coordinates of the three corners
+TRIANGLE_NORMALS = 18  # row of tri_normals (smooth-shaded triangles of a flattened mesh), or -1
 FRUSTUM_TANGENT = 10  # 10:13 unit vector perpendicular to the axis where u = 0
 
-N_PRIM_PARAMS = 18
+N_PRIM_PARAMS = 19
 
 # material columns
 MAT_COLOR = 0

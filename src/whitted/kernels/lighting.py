@@ -15,6 +15,7 @@ from .accel import (
     occludes,
     surface_normals,
 )
+from .features import has_instances
 from .intersect import INF
 from .jit import kernel
 from .layout import (
@@ -121,7 +122,7 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
         if state == 1:
             return 1
         seen_transparent = max(seen_transparent, state)
-    if geo.inst_node_min.shape[0] > 0:
+    if has_instances(geo):
         state = _instances_occlusion(geo, mats, o, d, tmin, tmax, stack)
         if state == 1:
             return 1

@@ -131,32 +131,41 @@ def tile_grid(width: int, height: int, tile: int = DEFAULT_TILE) -> np.ndarray:
 
 
 _kernel_lock = threading.Lock()
-_kernels_ready = False
+_kernels_ready: set[bool] = set()  # kernel variants loaded: with / without mesh instances
 
 
-def warm_up_kernels() -> float:
-    """Compile (first run) or load from the on-disk cache (later runs) the render kernels.
-    Returns the seconds it took; 0 when they were already loaded in this process."""
-    global _kernels_ready
+def _kernel_variant(compiled: CompiledScene) -> bool:
+    return compiled.geometry.inst_node_min.dtype == np.float64
+
+
+def warm_up_kernels(compiled: CompiledScene | None = None) -> float:
+    """Compile (first run) or load from the on-disk cache (later runs) the render kernels:
+    the variant for scenes like ``compiled`` (kernels are specialised for scenes with and
+    without mesh instances), or without meshes when None; the BVH builder too. Returns the
+    seconds it took; 0 when that variant was already loaded in this process."""
     with _kernel_lock:
-        if _kernels_ready:
+        if compiled is not None and _kernel_variant(compiled) in _kernels_ready:
+            return 0.0
+        if compiled is None and False in _kernels_ready:
             return 0.0
         start = time.perf_counter()
         from ..kernels.tiles import lane_workspace, render_aovs, render_tiles
         from ..scene.shapes import Sphere
 
         scene = Scene(objects=[Sphere(radius=1.0)])  # one bounded shape: the BVH builder too
-        compiled = compile_scene(scene)
+        if compiled is None:
+            compiled = compile_scene(scene)
         params = render_params(scene, compiled, scene.render.model_copy(update={"width": 1,
                                                                                  "height": 1}))
         fb = np.zeros((1, 1, 3), np.float32)
         counters = np.zeros((1, N_RAY_KINDS), np.int64)
-        render_tiles(np.zeros((1, 4), np.int32), fb, compiled.geometry, compiled.materials,
-                     compiled.lights, params, counters, lane_workspace(params.max_depth), 0, 1)
-        render_aovs(compiled.geometry, params, np.zeros((1, 1), np.float32),
+        no_tiles = np.zeros((0, 4), np.int32)  # compiles (or loads) without rendering
+        render_tiles(no_tiles, fb, compiled.geometry, compiled.materials, compiled.lights,
+                     params, counters, lane_workspace(params.max_depth), 0, 1)
+        render_aovs(compiled.geometry, params._replace(height=0), np.zeros((1, 1), np.float32),
                     np.zeros((1, 1, 3), np.float32), np.zeros((1, 1), np.int32),
                     lane_workspace(0), 0, 1)
-        _kernels_ready = True
+        _kernels_ready.add(_kernel_variant(compiled))
         return time.perf_counter() - start
 
 
@@ -233,6 +242,7 @@ class RenderJob:
         stats = self.stats
         stats.compile_seconds = warm_up_kernels()
         compiled: CompiledScene = compile_scene(self.scene)
+        stats.compile_seconds += warm_up_kernels(compiled)
         stats.build_seconds = compiled.build_seconds
         stats.warnings = list(compiled.warnings)
         stats.triangles = compiled.triangles
@@ -307,6 +317,7 @@ def render_aovs(scene: Scene, **overrides: object) -> dict[str, np.ndarray]:
         scene = scene.with_settings(**overrides)
     warm_up_kernels()
     compiled = compile_scene(scene)
+    warm_up_kernels(compiled)
     s = scene.render
     params = render_params(scene, compiled, s)
     depth = np.empty((s.height, s.width), np.float32)
