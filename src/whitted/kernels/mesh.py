@@ -19,7 +19,7 @@ from .vec import cross, normalize
 OPAQUE_KT = 0.01  # the lecture's rule: an occluder with kt below this blocks the light
 
 
-@kernel
+@kernel(fastmath=False)
 def shear_setup(d):
     """Per-ray constants of the watertight test: the axis permutation (kx, ky, kz) that makes
     |d[kz]| largest (and keeps the winding), and the shear (sx, sy, sz)."""
@@ -39,7 +39,7 @@ def shear_setup(d):
     return kx, ky, kz, d[kx] / dz, d[ky] / dz, 1.0 / dz
 
 
-@kernel
+@kernel(fastmath=False)  # exact rounding: see the module docstring
 def intersect_mesh_triangle(verts, faces, tri, o, kx, ky, kz, sx, sy, sz, tmin, tmax):
     """(t, b1, b2) of the ray with triangle ``tri``: hit point = (1-b1-b2)·v0 + b1·v1 + b2·v2;
     t = INF on a miss. ``kx..sz`` come from :func:`shear_setup` of the ray direction."""
