@@ -122,7 +122,7 @@ def test_instances_share_one_copy():
     base = whitted.Mesh(v, f)
     moved = base.model_copy(update={"transform": whitted.Transform(translate=(3, 0, 0))})
     scaled = base.model_copy(update={"transform": whitted.Transform(scale=2, translate=(-4, 0, 0))})
-    compiled = compile_scene(whitted.Scene(objects=[base, moved, scaled]))
+    compiled = compile_scene(whitted.Scene(objects=[base, moved, scaled]), flatten_limit=0)
     geo = compiled.geometry
     assert len(geo.mesh_faces) == len(f)  # the triangles are stored once
     assert len(geo.mesh_info) == 1
@@ -143,7 +143,7 @@ def test_same_model_file_is_instanced(tmp_path):
         '[[objects]]\ntype = "mesh"\nfile = "box.obj"\n\n'
         '[[objects]]\ntype = "mesh"\nfile = "box.obj"\ntransform = { translate = [4, 0, 0] }\n'
     )
-    compiled = compile_scene(whitted.load_scene(scene_file))
+    compiled = compile_scene(whitted.load_scene(scene_file), flatten_limit=0)
     assert len(compiled.geometry.mesh_faces) == 12
     assert compiled.instanced_triangles == 24
 
@@ -280,3 +280,29 @@ def test_closed_mesh_rendered_from_inside_and_outside():
         radius=2.0)]}), width=101, height=101)["depth"]
     differ = np.isfinite(depth) != np.isfinite(analytic)
     assert differ.sum() <= 0.03 * np.isfinite(analytic).sum()  # facets cut a thin rim only
+
+
+def test_small_meshes_are_flattened_big_ones_instanced():
+    """A mesh joins the scene BVH as triangles while all its copies stay within the limit; past
+    it the mesh is stored once and instanced."""
+    v, f = uv_sphere(4, 8)  # 48 triangles
+    assert len(f) == 48
+    base = whitted.Mesh(v, f)
+    copies = [base.model_copy(update={"transform": whitted.Transform(translate=(3 * k, 0, 0))})
+              for k in range(3)]
+    two = compile_scene(whitted.Scene(objects=copies[:2]), flatten_limit=100)
+    assert len(two.geometry.mesh_faces) == 0 and len(two.geometry.prim_type) == 96
+    assert two.geometry.inst_node_min.dtype == np.float32  # the kernels without instances
+    three = compile_scene(whitted.Scene(objects=copies), flatten_limit=100)
+    assert len(three.geometry.mesh_faces) == 48 and len(three.geometry.prim_type) == 3
+    assert three.instanced_triangles == two.instanced_triangles + 48 == 144
+    # both layouts see the same surfaces
+    rng = np.random.default_rng(5)
+    o = np.tile([3.0, 0.5, 9.0], (4000, 1))
+    d = rng.uniform((-6, -1.5, -9), (6, 1.5, -9), (4000, 3)) - [0.0, 0.5, 0.0]
+    t_flat, t_inst = _hits(two, o, d), _hits(compile_scene(
+        whitted.Scene(objects=copies[:2]), flatten_limit=0), o, d)
+    assert np.isfinite(t_flat).sum() > 500
+    np.testing.assert_array_equal(np.isfinite(t_flat), np.isfinite(t_inst))
+    hit = np.isfinite(t_flat)
+    np.testing.assert_allclose(t_flat[hit], t_inst[hit], rtol=1e-6)

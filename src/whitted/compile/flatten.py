@@ -323,14 +323,18 @@ def _mesh_source(scene: Scene, obj_index: int, shape: Mesh, warnings: list[str])
     )
 
 
-FLATTEN_LIMIT = 65_536  # a mesh used once with at most this many triangles joins the scene BVH
+# A mesh whose copies (triangles x objects using it) come to at most this many triangles joins
+# the scene BVH as triangle primitives, one copy per object; a bigger one is stored once and
+# instanced. Small meshes are faster flattened (a scene without instances runs kernels
+# specialised without the instance walks); big ones are cheaper instanced.
+FLATTEN_LIMIT = 65_536
 DEFAULT_UVS = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 1.0])  # barycentric: (u, v) = (b1, b2)
 
 
 def _add_flat_mesh(b: _Builder, meshes: MeshTable, src: MeshSource, rows: np.ndarray,
                    shape: Mesh, m: np.ndarray, override: int, obj: int) -> int:
-    """A mesh used by one object, its transform baked in, as triangle primitives of the scene
-    BVH (one BVH over analytic shapes and triangles). Returns the triangles added."""
+    """One object's copy of a small mesh, its transform baked in, as triangle primitives of the
+    scene BVH (one BVH over analytic shapes and triangles). Returns the triangles added."""
     lin = m[:3, :3]
     v = np.asarray(src.vertices, np.float64) @ lin.T + m[:3, 3]
     kept = meshes.drawable(src, v)
@@ -412,9 +416,9 @@ def _light_rows(scene: Scene) -> tuple[np.ndarray, tuple[float, float, float]]:
 def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT) -> CompiledScene:
     """Flatten ``scene`` into the kernel layout and build the BVHs over its bounded shapes.
 
-    A mesh used by one object with at most ``flatten_limit`` triangles becomes triangle
-    primitives of the scene BVH; bigger ones, and any used by several objects, are stored
-    once and instanced."""
+    A mesh whose copies (triangles x objects using it) come to at most ``flatten_limit``
+    triangles becomes triangle primitives of the scene BVH, one copy per object; a bigger one
+    is stored once and instanced."""
     import time
     from collections import Counter
 
@@ -423,6 +427,7 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT) -> CompiledS
     materials = _MaterialTable()
     meshes = MeshTable()
     mesh_of: dict[tuple, object] = {}
+    sources: dict[tuple, tuple[MeshSource, np.ndarray]] = {}
     warnings: list[str] = []
     instanced = 0
     flat = 0
@@ -433,14 +438,17 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT) -> CompiledS
             key = _mesh_key(scene, shape)
             override = -1 if shape.material is None else materials.add(
                 scene.material_of(obj_index))
-            if key not in mesh_of:
+            if key not in sources:
                 src = _mesh_source(scene, obj_index, shape, warnings)
                 rows = np.array([materials.add(mat) for mat in src.materials], np.int32)
-                if uses[key] == 1 and len(src.faces) <= flatten_limit:
-                    added = _add_flat_mesh(b, meshes, src, rows, shape, m, override, obj_index)
-                    flat += added
-                    instanced += added
-                    continue
+                sources[key] = (src, rows)
+            src, rows = sources[key]
+            if uses[key] * len(src.faces) <= flatten_limit:
+                added = _add_flat_mesh(b, meshes, src, rows, shape, m, override, obj_index)
+                flat += added
+                instanced += added
+                continue
+            if key not in mesh_of:
                 mesh_of[key] = meshes.add(src, rows, shape.smooth, shape.crease_angle)
             stored = mesh_of[key]
             if stored is None:
