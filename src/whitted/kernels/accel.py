@@ -10,16 +10,14 @@ the barycentric coordinates on the triangle.
 
 from __future__ import annotations
 
-import math
-
 from .features import has_instances
-from .intersect import INF, intersect_local, normal_local
+from .intersect import INF, intersect_local, normal_local, triangle_barycentric
 from .jit import kernel
 from .layout import MAT_KT, SHAPE_TRIANGLE, TRIANGLE_NORMALS
 from .mesh import OPAQUE_KT, mesh_closest_hit, mesh_normals, mesh_occlusion
-from .vec import dot, normalize, sub, vload
+from .traverse import box_entry, inverse_direction, push_children
+from .vec import normalize
 
-TINY_DIRECTION = 1e-30  # stands in for a zero direction component in the slab test
 MESH_STACK_BASE = 64  # traversal stack entries [0, 64) for the scene BVH, the rest for meshes
 
 
@@ -125,17 +123,7 @@ def world_normal(geo, i, p):
 def _triangle_shading_normal(geo, i, p, fallback):
     """The corner normals of a smooth-shaded triangle primitive blended at ``p``."""
     P = geo.prim_params
-    q = sub(p, vload(P, i, 0))
-    e1 = vload(P, i, 3)
-    e2 = vload(P, i, 6)
-    d00 = dot(e1, e1)
-    d01 = dot(e1, e2)
-    d11 = dot(e2, e2)
-    d20 = dot(q, e1)
-    d21 = dot(q, e2)
-    denom = d00 * d11 - d01 * d01
-    b1 = (d11 * d20 - d01 * d21) / denom
-    b2 = (d00 * d21 - d01 * d20) / denom
+    b1, b2 = triangle_barycentric(P, i, p)
     b0 = 1.0 - b1 - b2
     r = int(P[i, TRIANGLE_NORMALS])
     n = geo.tri_normals
@@ -166,66 +154,6 @@ def surface_normals(geo, prim, tri, b1, b2, p):
 
 
 @kernel
-def _safe_inverse(x):
-    if abs(x) < TINY_DIRECTION:
-        return 1.0 / math.copysign(TINY_DIRECTION, x)
-    return 1.0 / x
-
-
-@kernel
-def inverse_direction(d):
-    """1/d per component, with zero components replaced by a huge finite value so the slab
-    test never computes 0·inf."""
-    return (_safe_inverse(d[0]), _safe_inverse(d[1]), _safe_inverse(d[2]))
-
-
-@kernel
-def box_entry(bmin, bmax, node, o, inv, tmin, tmax):
-    """Entry distance of the ray into box ``node`` when it overlaps (tmin, tmax), else INF."""
-    t0 = (bmin[node, 0] - o[0]) * inv[0]
-    t1 = (bmax[node, 0] - o[0]) * inv[0]
-    tn = min(t0, t1)
-    tf = max(t0, t1)
-    t0 = (bmin[node, 1] - o[1]) * inv[1]
-    t1 = (bmax[node, 1] - o[1]) * inv[1]
-    tn = max(tn, min(t0, t1))
-    tf = min(tf, max(t0, t1))
-    t0 = (bmin[node, 2] - o[2]) * inv[2]
-    t1 = (bmax[node, 2] - o[2]) * inv[2]
-    tn = max(tn, min(t0, t1))
-    tf = min(tf, max(t0, t1))
-    # the relative slack keeps flat boxes (a rectangle in a plane) from being missed
-    if tf * (1.0 + 1e-9) + 1e-12 < max(tn, tmin) or tn > tmax:
-        return INF
-    return tn
-
-
-@kernel
-def _push_children(bmin, bmax, node_offset, node, o, inv, tmin, tmax, stack, top):
-    """Push the children of interior ``node`` that the ray meets, the farther one first so
-    the nearer one is visited next; returns the new stack top."""
-    left = node + 1
-    right = node_offset[node]
-    t_left = box_entry(bmin, bmax, left, o, inv, tmin, tmax)
-    t_right = box_entry(bmin, bmax, right, o, inv, tmin, tmax)
-    if t_left <= t_right:
-        if t_right != INF:
-            top += 1
-            stack[top] = right
-        if t_left != INF:
-            top += 1
-            stack[top] = left
-    else:
-        if t_left != INF:
-            top += 1
-            stack[top] = left
-        if t_right != INF:
-            top += 1
-            stack[top] = right
-    return top
-
-
-@kernel
 def closest_instance_hit(geo, o, d, tmin, tmax, stack):
     """Nearest mesh-instance hit in (tmin, tmax), as :func:`closest_hit` returns it."""
     best_t = tmax
@@ -245,7 +173,7 @@ def closest_instance_hit(geo, o, d, tmin, tmax, stack):
             continue
         count = geo.inst_node_count[node]
         if count == 0:
-            top = _push_children(bmin, bmax, geo.inst_node_offset, node, o, inv, tmin, best_t,
+            top = push_children(bmin, bmax, geo.inst_node_offset, node, o, inv, tmin, best_t,
                                  stack, top)
             continue
         first = geo.inst_node_offset[node]
@@ -299,7 +227,7 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
                 leaf = geo.node_offset[node]
                 leaf_end = leaf + count
             else:
-                top = _push_children(bmin, bmax, geo.node_offset, node, o, inv, tmin, best_t,
+                top = push_children(bmin, bmax, geo.node_offset, node, o, inv, tmin, best_t,
                                      stack, top)
             continue
         else:

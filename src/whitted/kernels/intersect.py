@@ -127,6 +127,21 @@ def intersect_triangle(P, i, o, d, tmin, tmax):
 
 
 @kernel
+def triangle_barycentric(P, i, p):
+    """(b1, b2) of point ``p`` on triangle primitive ``i``: p = v0 + b1·edge1 + b2·edge2."""
+    q = sub(p, vload(P, i, 0))
+    e1 = vload(P, i, 3)
+    e2 = vload(P, i, 6)
+    d00 = dot(e1, e1)
+    d01 = dot(e1, e2)
+    d11 = dot(e2, e2)
+    d20 = dot(q, e1)
+    d21 = dot(q, e2)
+    denom = d00 * d11 - d01 * d01
+    return (d11 * d20 - d01 * d21) / denom, (d00 * d21 - d01 * d20) / denom
+
+
+@kernel
 def _box_local(P, i, x):
     """Row-vector product M^-1 x with the inverse edge matrix stored row-major at 3:12."""
     return (

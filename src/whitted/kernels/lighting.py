@@ -7,11 +7,9 @@ from __future__ import annotations
 import math
 
 from .accel import (
-    box_entry,
     closest_hit,
     hit_material,
     instance_occludes,
-    inverse_direction,
     occludes,
     surface_normals,
 )
@@ -44,6 +42,7 @@ from .layout import (
 from .media import media_enter, media_leave
 from .mesh import OPAQUE_KT
 from .sampling import concentric_disk, random01, stratum
+from .traverse import box_entry, inverse_direction
 from .vec import dot, madd, normalize, sub, vload
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 from .intersect import INF
 from .jit import kernel
 from .layout import MAT_KT, MESH_NORMALS, MESH_ROOT, MESH_TRI_OFFSET, MESH_UVS
+from .traverse import box_entry, push_children
 from .vec import cross, normalize
 
 OPAQUE_KT = 0.01  # the lecture's rule: an occluder with kt below this blocks the light
@@ -71,27 +72,6 @@ def intersect_mesh_triangle(verts, faces, tri, o, kx, ky, kz, sx, sy, sz, tmin, 
 
 
 @kernel
-def _node_entry(bmin, bmax, node, o, inv, tmin, tmax):
-    """Entry distance of the ray into node box ``node`` when it overlaps (tmin, tmax), else
-    INF. Boxes are stored rounded outward, so the plain slab test never misses a triangle."""
-    t0 = (bmin[node, 0] - o[0]) * inv[0]
-    t1 = (bmax[node, 0] - o[0]) * inv[0]
-    tn = min(t0, t1)
-    tf = max(t0, t1)
-    t0 = (bmin[node, 1] - o[1]) * inv[1]
-    t1 = (bmax[node, 1] - o[1]) * inv[1]
-    tn = max(tn, min(t0, t1))
-    tf = min(tf, max(t0, t1))
-    t0 = (bmin[node, 2] - o[2]) * inv[2]
-    t1 = (bmax[node, 2] - o[2]) * inv[2]
-    tn = max(tn, min(t0, t1))
-    tf = min(tf, max(t0, t1))
-    if tf * (1.0 + 1e-9) + 1e-12 < max(tn, tmin) or tn > tmax:
-        return INF
-    return tn
-
-
-@kernel
 def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
     """Nearest triangle of mesh ``mesh`` hit by the ray (mesh space) in (tmin, tmax):
     (t, triangle, b1, b2), t = INF on a miss. ``stack[base:]`` is scratch."""
@@ -105,7 +85,7 @@ def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
     best_b1 = 0.0
     best_b2 = 0.0
     root = geo.mesh_info[mesh, MESH_ROOT]
-    if _node_entry(bmin, bmax, root, o, inv, tmin, best_t) == INF:
+    if box_entry(bmin, bmax, root, o, inv, tmin, best_t) == INF:
         return INF, -1, 0.0, 0.0
     top = base
     stack[top] = root
@@ -125,24 +105,8 @@ def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
                     best_b1 = b1
                     best_b2 = b2
             continue
-        left = node + 1
-        right = geo.mesh_node_offset[node]
-        t_left = _node_entry(bmin, bmax, left, o, inv, tmin, best_t)
-        t_right = _node_entry(bmin, bmax, right, o, inv, tmin, best_t)
-        if t_left <= t_right:
-            if t_right != INF:
-                top += 1
-                stack[top] = right
-            if t_left != INF:
-                top += 1
-                stack[top] = left
-        else:
-            if t_left != INF:
-                top += 1
-                stack[top] = left
-            if t_right != INF:
-                top += 1
-                stack[top] = right
+        top = push_children(bmin, bmax, geo.mesh_node_offset, node, o, inv, tmin, best_t, stack,
+                            top)
     if best < 0:
         return INF, -1, 0.0, 0.0
     return best_t, best, best_b1, best_b2
@@ -167,7 +131,7 @@ def mesh_occlusion(geo, mats, mesh, material, o, d, inv, tmin, tmax, stack, base
     while top >= base:
         node = stack[top]
         top -= 1
-        if _node_entry(bmin, bmax, node, o, inv, tmin, tmax) == INF:
+        if box_entry(bmin, bmax, node, o, inv, tmin, tmax) == INF:
             continue
         count = geo.mesh_node_count[node]
         if count > 0:

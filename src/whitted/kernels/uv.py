@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 
 from .accel import to_object
-from .intersect import _box_local
+from .intersect import _box_local, triangle_barycentric
 from .jit import kernel
 from .layout import (
     DISK_TANGENT,
@@ -53,17 +53,7 @@ def _sphere_uv(P, i, p):
 
 @kernel
 def _triangle_uv(P, i, p):
-    q = sub(p, vload(P, i, 0))
-    e1 = vload(P, i, 3)
-    e2 = vload(P, i, 6)
-    d00 = dot(e1, e1)
-    d01 = dot(e1, e2)
-    d11 = dot(e2, e2)
-    d20 = dot(q, e1)
-    d21 = dot(q, e2)
-    denom = d00 * d11 - d01 * d01
-    b1 = (d11 * d20 - d01 * d21) / denom
-    b2 = (d00 * d21 - d01 * d20) / denom
+    b1, b2 = triangle_barycentric(P, i, p)
     b0 = 1.0 - b1 - b2
     c = TRIANGLE_UV
     return (

@@ -1,0 +1,72 @@
+"""Helpers every BVH walk shares (the scene's, the instances' and each mesh's own): the slab
+test of a node box, a ray's safe inverse direction, and pushing a node's children nearest
+last. The boxes may be float64 (scene level) or float32 rounded outward (meshes)."""
+
+from __future__ import annotations
+
+import math
+
+from .intersect import INF
+from .jit import kernel
+
+TINY_DIRECTION = 1e-30  # stands in for a zero direction component in the slab test
+
+
+@kernel
+def _safe_inverse(x):
+    if abs(x) < TINY_DIRECTION:
+        return 1.0 / math.copysign(TINY_DIRECTION, x)
+    return 1.0 / x
+
+
+@kernel
+def inverse_direction(d):
+    """1/d per component, with zero components replaced by a huge finite value so the slab
+    test never computes 0·inf."""
+    return (_safe_inverse(d[0]), _safe_inverse(d[1]), _safe_inverse(d[2]))
+
+
+@kernel
+def box_entry(bmin, bmax, node, o, inv, tmin, tmax):
+    """Entry distance of the ray into box ``node`` when it overlaps (tmin, tmax), else INF."""
+    t0 = (bmin[node, 0] - o[0]) * inv[0]
+    t1 = (bmax[node, 0] - o[0]) * inv[0]
+    tn = min(t0, t1)
+    tf = max(t0, t1)
+    t0 = (bmin[node, 1] - o[1]) * inv[1]
+    t1 = (bmax[node, 1] - o[1]) * inv[1]
+    tn = max(tn, min(t0, t1))
+    tf = min(tf, max(t0, t1))
+    t0 = (bmin[node, 2] - o[2]) * inv[2]
+    t1 = (bmax[node, 2] - o[2]) * inv[2]
+    tn = max(tn, min(t0, t1))
+    tf = min(tf, max(t0, t1))
+    # the relative slack keeps flat boxes (a rectangle in a plane) from being missed
+    if tf * (1.0 + 1e-9) + 1e-12 < max(tn, tmin) or tn > tmax:
+        return INF
+    return tn
+
+
+@kernel
+def push_children(bmin, bmax, node_offset, node, o, inv, tmin, tmax, stack, top):
+    """Push the children of interior ``node`` that the ray meets, the farther one first so
+    the nearer one is visited next; returns the new stack top."""
+    left = node + 1
+    right = node_offset[node]
+    t_left = box_entry(bmin, bmax, left, o, inv, tmin, tmax)
+    t_right = box_entry(bmin, bmax, right, o, inv, tmin, tmax)
+    if t_left <= t_right:
+        if t_right != INF:
+            top += 1
+            stack[top] = right
+        if t_left != INF:
+            top += 1
+            stack[top] = left
+    else:
+        if t_left != INF:
+            top += 1
+            stack[top] = left
+        if t_right != INF:
+            top += 1
+            stack[top] = right
+    return top
