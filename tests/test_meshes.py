@@ -13,6 +13,7 @@ import whitted
 from meshgen import cube, uv_sphere
 from whitted.compile.flatten import compile_scene
 from whitted.kernels.accel import closest_hit, surface_normals
+from whitted.kernels.layout import PRIM_MATERIAL
 from whitted.kernels.uv import surface_uv
 
 
@@ -248,14 +249,14 @@ def test_per_triangle_materials_and_override():
         mats = compiled.materials[compiled.geometry.tri_material]
         assert (mats[:2, 0] == 1).all() and (mats[2:, 2] == 1).all()
         compiled = compile_scene(scene)  # flattened: each triangle primitive has its own
-        mats = compiled.materials[compiled.geometry.prim_material]
+        mats = compiled.materials[compiled.geometry.prim_info[:, PRIM_MATERIAL]]
         assert (mats[:2, 0] == 1).all() and (mats[2:, 2] == 1).all()
         over = scene.model_copy(update={"objects": [mesh.model_copy(update={
             "material": whitted.Material(color=(0, 1, 0), ka=1, kd=0)})]})
         compiled = compile_scene(over, flatten_limit=0)
-        assert compiled.geometry.prim_material[0] >= 0
+        assert compiled.geometry.prim_info[0, PRIM_MATERIAL] >= 0
         flat = compile_scene(over)
-        green = flat.materials[flat.geometry.prim_material]
+        green = flat.materials[flat.geometry.prim_info[:, PRIM_MATERIAL]]
         assert (green[:, 1] == 1).all() and (green[:, 0] == 0).all()
     finally:
         flatten._mesh_source = original
@@ -291,10 +292,10 @@ def test_small_meshes_are_flattened_big_ones_instanced():
     copies = [base.model_copy(update={"transform": whitted.Transform(translate=(3 * k, 0, 0))})
               for k in range(3)]
     two = compile_scene(whitted.Scene(objects=copies[:2]), flatten_limit=100)
-    assert len(two.geometry.mesh_faces) == 0 and len(two.geometry.prim_type) == 96
-    assert two.geometry.inst_node_min.dtype == np.float32  # the kernels without instances
+    assert len(two.geometry.mesh_faces) == 0 and len(two.geometry.prim_info) == 96
+    assert two.geometry.inst_box.dtype == np.float32  # the kernels without instances
     three = compile_scene(whitted.Scene(objects=copies), flatten_limit=100)
-    assert len(three.geometry.mesh_faces) == 48 and len(three.geometry.prim_type) == 3
+    assert len(three.geometry.mesh_faces) == 48 and len(three.geometry.prim_info) == 3
     assert three.instanced_triangles == two.instanced_triangles + 48 == 144
     # both layouts see the same surfaces
     rng = np.random.default_rng(5)

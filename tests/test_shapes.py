@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 
 from whitted.compile.flatten import compile_scene
 from whitted.kernels.accel import closest_hit, surface_normals
+from whitted.kernels.layout import PRIM_OBJECT
 from whitted.scene import (
     AxisAngle,
     Box,
@@ -64,7 +65,7 @@ class Compiled:
             return None
         p = tuple(oi + t * di for oi, di in zip(o, d, strict=True))
         n, _ = surface_normals(geo, prim, tri, b1, b2, p)
-        return Hit(float(t), np.array(p), np.array(n), int(geo.prim_object[prim]))
+        return Hit(float(t), np.array(p), np.array(n), int(geo.prim_info[prim, PRIM_OBJECT]))
 
 
 def first_hit(shapes, origin, direction, tmin=0.0, tmax=math.inf) -> Hit | None:

@@ -282,12 +282,12 @@ def info(
         out.print(f"bounds: ({lo}) .. ({hi}) (infinite planes: {len(compiled.geometry.unbounded)})")
     else:
         out.print("bounds: no bounded objects")
-    out.print(f"bvh: {len(compiled.geometry.node_min)} nodes over "
+    out.print(f"bvh: {len(compiled.geometry.node_link)} nodes over "
               f"{len(compiled.geometry.node_prims)} primitives")
     if compiled.triangles:
         out.print(f"meshes: {len(compiled.geometry.mesh_info)} stored, "
                   f"{compiled.triangles:,} triangles ({compiled.instanced_triangles:,} with "
-                  f"instances), {len(compiled.geometry.mesh_node_count):,} mesh BVH nodes")
+                  f"instances), {len(compiled.geometry.mesh_link):,} mesh BVH nodes")
     for warning in compiled.warnings:
         out.print(f"warning: {warning}", markup=False, highlight=False)
     shadow = sum(

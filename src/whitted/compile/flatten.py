@@ -44,7 +44,13 @@ from ..kernels.layout import (
     MAT_TEXTURE,
     N_LIGHT_PARAMS,
     N_MAT_PARAMS,
+    N_PRIM_INFO,
     N_PRIM_PARAMS,
+    PRIM_MATERIAL,
+    PRIM_OBJECT,
+    PRIM_SOLID,
+    PRIM_TYPE,
+    PRIM_XFORM,
     SHAPE_BOX,
     SHAPE_DISK,
     SHAPE_FRUSTUM,
@@ -413,6 +419,15 @@ def _light_rows(scene: Scene) -> tuple[np.ndarray, tuple[float, float, float]]:
     return table, (float(ambient[0]), float(ambient[1]), float(ambient[2]))
 
 
+def _packed_nodes(bvh, dtype) -> tuple[np.ndarray, np.ndarray]:
+    """A BVH's nodes in the kernel layout: boxes (M, 2, 3) and links (M, 2) (layout.py)."""
+    box = np.empty((len(bvh.node_count), 2, 3), dtype)
+    box[:, 0] = bvh.node_min
+    box[:, 1] = bvh.node_max
+    link = np.stack([bvh.node_offset, bvh.node_count], axis=1).astype(np.int32)
+    return box, link
+
+
 def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT) -> CompiledScene:
     """Flatten ``scene`` into the kernel layout and build the BVHs over its bounded shapes.
 
@@ -470,27 +485,26 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT) -> CompiledS
     unbounded = np.flatnonzero(~finite)
     bvh = build_bvh(lo[bounded], hi[bounded])
     inst_bvh = build_bvh(lo[instances], hi[instances])
+    prim_info = np.empty((len(prim_type), N_PRIM_INFO), np.int32)
+    prim_info[:, PRIM_TYPE] = prim_type
+    prim_info[:, PRIM_XFORM] = prim_xform
+    prim_info[:, PRIM_MATERIAL] = prim_material
+    prim_info[:, PRIM_SOLID] = prim_solid
+    prim_info[:, PRIM_OBJECT] = prim_object
+    node_box, node_link = _packed_nodes(bvh, np.float64)
+    # float32 marks a scene without instances: kernels specialised for it (features.py)
+    inst_box, inst_link = _packed_nodes(
+        inst_bvh, np.float64 if len(instances) else NO_INSTANCES_DTYPE)
     geometry = GeometryArrays(
-        prim_type=prim_type,
+        prim_info=prim_info,
         prim_params=params,
-        prim_xform=prim_xform,
         xforms=np.array(b.xforms, dtype=np.float64).reshape(len(b.xforms), 3, 4),
-        prim_material=np.ascontiguousarray(prim_material),
-        prim_object=prim_object,
-        prim_solid=prim_solid,
-        node_min=np.ascontiguousarray(bvh.node_min, dtype=np.float64),
-        node_max=np.ascontiguousarray(bvh.node_max, dtype=np.float64),
-        node_offset=np.ascontiguousarray(bvh.node_offset, dtype=np.int32),
-        node_count=np.ascontiguousarray(bvh.node_count, dtype=np.int32),
-        node_axis=np.ascontiguousarray(bvh.node_axis, dtype=np.int8),
+        node_box=node_box,
+        node_link=node_link,
         node_prims=np.ascontiguousarray(bounded[bvh.prim_order], dtype=np.int32),
         unbounded=unbounded.astype(np.int32),
-        # float32 marks a scene without instances: kernels specialised for it (features.py)
-        inst_node_min=np.ascontiguousarray(
-            inst_bvh.node_min, dtype=np.float64 if len(instances) else NO_INSTANCES_DTYPE),
-        inst_node_max=np.ascontiguousarray(inst_bvh.node_max, dtype=np.float64),
-        inst_node_offset=np.ascontiguousarray(inst_bvh.node_offset, dtype=np.int32),
-        inst_node_count=np.ascontiguousarray(inst_bvh.node_count, dtype=np.int32),
+        inst_box=inst_box,
+        inst_link=inst_link,
         inst_prims=np.ascontiguousarray(instances[inst_bvh.prim_order], dtype=np.int32),
         **meshes.arrays(),
         **compile_textures(materials.textures, scene.resolve_path)._asdict(),

@@ -74,10 +74,8 @@ class MeshTable:
         self.tri_material: list[np.ndarray] = []
         self.tri_normals: list[np.ndarray] = []
         self.tri_uvs: list[np.ndarray] = []
-        self.node_min: list[np.ndarray] = []
-        self.node_max: list[np.ndarray] = []
-        self.node_offset: list[np.ndarray] = []
-        self.node_count: list[np.ndarray] = []
+        self.node_box: list[np.ndarray] = []
+        self.node_link: list[np.ndarray] = []
         self.node_tris: list[np.ndarray] = []
         self.n_vertices = 0
         self.n_tris = 0
@@ -165,14 +163,15 @@ class MeshTable:
         self.vertices.append(verts32)
         self.faces.append((faces + self.n_vertices).astype(np.int32))
         self.tri_material.append(np.asarray(material_rows, np.int32)[face_material])
-        self.node_min.append(_round_down32(bvh.node_min))
-        self.node_max.append(_round_up32(bvh.node_max))
+        box = np.empty((len(bvh.node_count), 2, 3), np.float32)
+        box[:, 0] = _round_down32(bvh.node_min)
+        box[:, 1] = _round_up32(bvh.node_max)
+        self.node_box.append(box)
         leaf = bvh.node_count > 0
         # global indices: interior nodes name their right child among all meshes' nodes,
         # leaves their first entry among all meshes' node_tris
         offset = np.where(leaf, bvh.node_offset + self.n_tris, bvh.node_offset + self.n_nodes)
-        self.node_offset.append(offset.astype(np.int32))
-        self.node_count.append(bvh.node_count.astype(np.int32))
+        self.node_link.append(np.stack([offset, bvh.node_count], axis=1).astype(np.int32))
         self.node_tris.append((bvh.prim_order + self.n_tris).astype(np.int32))
         lo = np.array(bvh.node_min[0], np.float64)  # the root box: all triangles
         hi = np.array(bvh.node_max[0], np.float64)
@@ -196,10 +195,8 @@ class MeshTable:
             "tri_material": cat(self.tri_material, (0,), np.int32),
             "tri_normals": cat(self.tri_normals, (0, 3, 3), np.float32),
             "tri_uvs": cat(self.tri_uvs, (0, 3, 2), np.float32),
-            "mesh_node_min": cat(self.node_min, (0, 3), np.float32),
-            "mesh_node_max": cat(self.node_max, (0, 3), np.float32),
-            "mesh_node_offset": cat(self.node_offset, (0,), np.int32),
-            "mesh_node_count": cat(self.node_count, (0,), np.int32),
+            "mesh_box": cat(self.node_box, (0, 2, 3), np.float32),
+            "mesh_link": cat(self.node_link, (0, 2), np.int32),
             "mesh_node_tris": cat(self.node_tris, (0,), np.int32),
         }
 

@@ -13,7 +13,14 @@ from __future__ import annotations
 from .features import has_instances
 from .intersect import INF, intersect_local, normal_local, triangle_barycentric
 from .jit import kernel
-from .layout import MAT_KT, SHAPE_TRIANGLE, TRIANGLE_NORMALS
+from .layout import (
+    MAT_KT,
+    PRIM_MATERIAL,
+    PRIM_TYPE,
+    PRIM_XFORM,
+    SHAPE_TRIANGLE,
+    TRIANGLE_NORMALS,
+)
 from .mesh import OPAQUE_KT, mesh_closest_hit, mesh_normals, mesh_occlusion
 from .traverse import box_entry, inverse_direction, push_children
 from .vec import normalize
@@ -50,16 +57,16 @@ def to_object(xforms, xf, o, d):
 def hit_analytic(geo, i, o, d, tmin, tmax):
     """t of the ray with analytic primitive ``i`` (INF on a miss). Kept small so the compiler
     inlines it into the traversal loops."""
-    xf = geo.prim_xform[i]
+    xf = geo.prim_info[i, PRIM_XFORM]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
-    return intersect_local(geo.prim_type[i], geo.prim_params, i, o, d, tmin, tmax)
+    return intersect_local(geo.prim_info[i, PRIM_TYPE], geo.prim_params, i, o, d, tmin, tmax)
 
 
 @kernel
 def hit_instance(geo, i, o, d, tmin, tmax, stack):
     """(t, triangle, b1, b2) of the ray with mesh instance ``i``; t = INF on a miss."""
-    xf = geo.prim_xform[i]
+    xf = geo.prim_info[i, PRIM_XFORM]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
     return mesh_closest_hit(geo, int(geo.prim_params[i, 0]), o, d, inverse_direction(d), tmin,
@@ -69,11 +76,11 @@ def hit_instance(geo, i, o, d, tmin, tmax, stack):
 @kernel
 def instance_occludes(geo, mats, i, o, d, tmin, tmax, stack):
     """:func:`occludes` for a mesh instance."""
-    xf = geo.prim_xform[i]
+    xf = geo.prim_info[i, PRIM_XFORM]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
-    return mesh_occlusion(geo, mats, int(geo.prim_params[i, 0]), geo.prim_material[i], o, d,
-                          inverse_direction(d), tmin, tmax, stack, MESH_STACK_BASE)
+    return mesh_occlusion(geo, mats, int(geo.prim_params[i, 0]), geo.prim_info[i, PRIM_MATERIAL],
+                          o, d, inverse_direction(d), tmin, tmax, stack, MESH_STACK_BASE)
 
 
 @kernel
@@ -82,14 +89,14 @@ def occludes(geo, mats, i, o, d, tmin, tmax):
     2: only through a transparent surface."""
     if hit_analytic(geo, i, o, d, tmin, tmax) == INF:
         return 0
-    return 1 if mats[geo.prim_material[i], MAT_KT] < OPAQUE_KT else 2
+    return 1 if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT else 2
 
 
 @kernel
 def hit_material(geo, prim, tri):
     """Material row of a hit: the primitive's, or for meshes without an override the
     triangle's own."""
-    m = geo.prim_material[prim]
+    m = geo.prim_info[prim, PRIM_MATERIAL]
     if m < 0 and tri >= 0:
         return geo.tri_material[tri]
     return m
@@ -111,12 +118,12 @@ def _normal_to_world(m, xf, n):
 @kernel
 def world_normal(geo, i, p):
     """Outward unit geometric normal of analytic primitive ``i`` at world point ``p``."""
-    xf = geo.prim_xform[i]
+    xf = geo.prim_info[i, PRIM_XFORM]
     if xf < 0:
-        return normal_local(geo.prim_type[i], geo.prim_params, i, p)
+        return normal_local(geo.prim_info[i, PRIM_TYPE], geo.prim_params, i, p)
     lp, _ = to_object(geo.xforms, xf, p, p)
     return _normal_to_world(geo.xforms, xf,
-                            normal_local(geo.prim_type[i], geo.prim_params, i, lp))
+                            normal_local(geo.prim_info[i, PRIM_TYPE], geo.prim_params, i, lp))
 
 
 @kernel
@@ -143,11 +150,12 @@ def surface_normals(geo, prim, tri, b1, b2, p):
     smooth-shaded meshes; the geometric one decides which side a ray is on."""
     if tri < 0:
         n = world_normal(geo, prim, p)
-        if geo.prim_type[prim] == SHAPE_TRIANGLE and geo.prim_params[prim, TRIANGLE_NORMALS] >= 0:
+        smooth = geo.prim_params[prim, TRIANGLE_NORMALS] >= 0
+        if geo.prim_info[prim, PRIM_TYPE] == SHAPE_TRIANGLE and smooth:
             return n, _triangle_shading_normal(geo, prim, p, n)
         return n, n
     ng, ns = mesh_normals(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
-    xf = geo.prim_xform[prim]
+    xf = geo.prim_info[prim, PRIM_XFORM]
     if xf < 0:
         return ng, ns
     return _normal_to_world(geo.xforms, xf, ng), _normal_to_world(geo.xforms, xf, ns)
@@ -161,22 +169,21 @@ def closest_instance_hit(geo, o, d, tmin, tmax, stack):
     best_tri = -1
     best_b1 = 0.0
     best_b2 = 0.0
-    bmin = geo.inst_node_min
-    bmax = geo.inst_node_max
+    box = geo.inst_box
     inv = inverse_direction(d)
     top = 0
     stack[0] = 0
     while top >= 0:
         node = stack[top]
         top -= 1
-        if box_entry(bmin, bmax, node, o, inv, tmin, best_t) == INF:
+        if box_entry(box, node, o, inv, tmin, best_t) == INF:
             continue
-        count = geo.inst_node_count[node]
+        count = geo.inst_link[node, 1]
         if count == 0:
-            top = push_children(bmin, bmax, geo.inst_node_offset, node, o, inv, tmin, best_t,
+            top = push_children(box, geo.inst_link, node, o, inv, tmin, best_t,
                                  stack, top)
             continue
-        first = geo.inst_node_offset[node]
+        first = geo.inst_link[node, 0]
         for j in range(first, first + count):
             i = geo.inst_prims[j]
             t, tri, b1, b2 = hit_instance(geo, i, o, d, tmin, best_t, stack)
@@ -200,11 +207,10 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
     best_t = tmax
     best = -1
     n_unbounded = geo.unbounded.shape[0]
-    bmin = geo.node_min
-    bmax = geo.node_max
+    box = geo.node_box
     inv = inverse_direction(d)
     top = -1
-    if bmin.shape[0] > 0:
+    if box.shape[0] > 0:
         top = 0
         stack[0] = 0
     j = 0  # next unbounded primitive
@@ -220,14 +226,14 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
         elif top >= 0:
             node = stack[top]
             top -= 1
-            if box_entry(bmin, bmax, node, o, inv, tmin, best_t) == INF:
+            if box_entry(box, node, o, inv, tmin, best_t) == INF:
                 continue
-            count = geo.node_count[node]
+            count = geo.node_link[node, 1]
             if count > 0:
-                leaf = geo.node_offset[node]
+                leaf = geo.node_link[node, 0]
                 leaf_end = leaf + count
             else:
-                top = push_children(bmin, bmax, geo.node_offset, node, o, inv, tmin, best_t,
+                top = push_children(box, geo.node_link, node, o, inv, tmin, best_t,
                                      stack, top)
             continue
         else:

@@ -18,6 +18,7 @@ from .layout import (
     MAT_KT,
     MAT_TEXTURE,
     MAX_MEDIA,
+    PRIM_SOLID,
     RAY_REFLECTION,
     RAY_REFRACTION,
 )
@@ -175,7 +176,7 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
             n_out = n_media
             for k in range(n_media):
                 scratch[k] = media[k]
-            if geo.prim_solid[prim]:  # media are keyed by material row
+            if geo.prim_info[prim, PRIM_SOLID]:  # media are keyed by material row
                 n1 = mats[media[n_media - 1], MAT_IOR] if n_media > 0 else 1.0
                 if entering:
                     n_out = media_enter(scratch, n_out, m)

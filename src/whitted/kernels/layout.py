@@ -1,10 +1,10 @@
 """The flat array layout shared by the compiler (which writes it) and the kernels (which read it).
 
-Primitives: ``prim_type[i]`` is one of the ``SHAPE_*`` codes and ``prim_params[i]`` holds the
-shape's numbers in the order listed next to each code. All positions are in the primitive's own
-space; ``prim_xform[i] >= 0`` names a 3x4 world-to-object matrix in ``xforms`` (used for mesh
-instances under any transform but the identity, and for quadrics under a non-similarity
-transform; every other transform is baked into the numbers).
+Primitives: ``prim_info[i, PRIM_TYPE]`` is one of the ``SHAPE_*`` codes and ``prim_params[i]``
+holds the shape's numbers in the order listed next to each code. All positions are in the
+primitive's own space; ``prim_info[i, PRIM_XFORM] >= 0`` names a 3x4 world-to-object matrix
+in ``xforms`` (used for mesh instances under any transform but the identity, and for quadrics
+under a non-similarity transform; every other transform is baked into the numbers).
 """
 
 from __future__ import annotations
@@ -89,42 +89,50 @@ N_RAY_KINDS = 4
 MAX_MEDIA = 8  # nesting depth of media a ray can be inside
 
 
-class GeometryArrays(NamedTuple):
-    """Everything a ray needs to find what it hits (all NumPy arrays, read-only in kernels)."""
+# prim_info columns
+PRIM_TYPE = 0  # SHAPE_* code
+PRIM_XFORM = 1  # row of xforms (world to object), -1 when the numbers are in world space
+PRIM_MATERIAL = 2  # row of the material table (-1: a mesh instance using its triangles')
+PRIM_SOLID = 3  # 1 when it bounds a volume (rays enter and leave media)
+PRIM_OBJECT = 4  # index of the scene object it came from
+N_PRIM_INFO = 5
 
-    prim_type: np.ndarray  # (P,) int32 shape code
+# BVH layout (every level): node_box[n] = (lower corner, upper corner); node_link[n] = (offset,
+# count): a leaf (count > 0) holds entries offset .. offset + count - 1 of its index list; an
+# interior node (count 0) has its left child at n + 1 and its right child at offset.
+LINK_OFFSET = 0
+LINK_COUNT = 1
+
+
+class GeometryArrays(NamedTuple):
+    """Everything a ray needs to find what it hits (all NumPy arrays, read-only in kernels).
+
+    Kept to few arrays on purpose: kernels pass this tuple to each other, and every array in
+    it costs at every call that is not inlined (14 unused arrays measured at -14 %)."""
+
+    prim_info: np.ndarray  # (P, N_PRIM_INFO) int32
     prim_params: np.ndarray  # (P, N_PRIM_PARAMS) float64
-    prim_xform: np.ndarray  # (P,) int32 index into xforms, -1 when the numbers are in world space
     xforms: np.ndarray  # (X, 3, 4) float64 world-to-object affine matrices
-    prim_material: np.ndarray  # (P,) int32 row of the material table
-    prim_object: np.ndarray  # (P,) int32 index of the scene object it came from
-    prim_solid: np.ndarray  # (P,) int32 1 when it bounds a volume (rays enter and leave media)
-    node_min: np.ndarray  # (M, 3) float64 BVH node boxes
-    node_max: np.ndarray  # (M, 3) float64
-    node_offset: np.ndarray  # (M,) int32 leaf: first entry in node_prims; interior: right child
-    node_count: np.ndarray  # (M,) int32 leaf: primitive count; interior: 0
-    node_axis: np.ndarray  # (M,) int8 split axis of interior nodes
+    node_box: np.ndarray  # (M, 2, 3) float64 scene BVH over the bounded analytic primitives
+    node_link: np.ndarray  # (M, 2) int32
     node_prims: np.ndarray  # (N,) int32 primitive indices in leaf order
     unbounded: np.ndarray  # (U,) int32 primitives outside the BVH (infinite planes)
     # triangle meshes, each stored once in its own space with its own BVH (the bottom level);
-    # SHAPE_MESH primitives instance them (their prim_xform maps world to mesh space). The
-    # instances have a top-level BVH of their own (same layout as node_*), walked after the
-    # analytic shapes', so scenes without meshes never pay for the instance code path.
-    inst_node_min: np.ndarray  # (I, 3) float64
-    inst_node_max: np.ndarray  # (I, 3) float64
-    inst_node_offset: np.ndarray  # (I,) int32
-    inst_node_count: np.ndarray  # (I,) int32
+    # SHAPE_MESH primitives instance them (their xform maps world to mesh space). The
+    # instances have a top-level BVH of their own, walked after the analytic shapes'; its
+    # boxes are float32 (and empty) in scenes without instances, which selects kernels
+    # compiled without the instance walks (features.py).
+    inst_box: np.ndarray  # (I, 2, 3) float64
+    inst_link: np.ndarray  # (I, 2) int32
     inst_prims: np.ndarray  # (J,) int32 SHAPE_MESH primitive indices in leaf order
     mesh_info: np.ndarray  # (K, N_MESH_INFO) int32
     mesh_vertices: np.ndarray  # (V, 3) float32 positions
     mesh_faces: np.ndarray  # (T, 3) int32 rows of mesh_vertices, counter-clockwise = front
     tri_material: np.ndarray  # (T,) int32 material row of each triangle
-    tri_normals: np.ndarray  # (Tn, 3, 3) float32 corner normals of smooth-shaded meshes
+    tri_normals: np.ndarray  # (Tn, 3, 3) float32 corner normals of smooth-shaded triangles
     tri_uvs: np.ndarray  # (Tu, 3, 2) float32 corner texture coordinates
-    mesh_node_min: np.ndarray  # (N, 3) float32 bottom-level node boxes (rounded outward)
-    mesh_node_max: np.ndarray  # (N, 3) float32
-    mesh_node_offset: np.ndarray  # (N,) int32 leaf: first entry in mesh_node_tris; else right
-    mesh_node_count: np.ndarray  # (N,) int32 leaf: triangle count; interior: 0
+    mesh_box: np.ndarray  # (N, 2, 3) float32 bottom-level node boxes (rounded outward)
+    mesh_link: np.ndarray  # (N, 2) int32 (leaf offsets index mesh_node_tris)
     mesh_node_tris: np.ndarray  # (T,) int32 triangle indices in leaf order
     # textures (see texture_layout.py): one row per texture, all image texels in one array
     tex_info: np.ndarray  # (X, N_TEX_PARAMS) float64

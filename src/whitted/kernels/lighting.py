@@ -37,6 +37,7 @@ from .layout import (
     MAT_KT,
     MAT_SHININESS,
     MAT_SPECULAR,
+    PRIM_SOLID,
     RAY_SHADOW,
 )
 from .media import media_enter, media_leave
@@ -50,24 +51,23 @@ from .vec import dot, madd, normalize, sub, vload
 def _instances_occlusion(geo, mats, o, d, tmin, tmax, stack):
     """:func:`any_occluder` over the mesh instances' BVH."""
     seen_transparent = 0
-    bmin = geo.inst_node_min
-    bmax = geo.inst_node_max
+    box = geo.inst_box
     inv = inverse_direction(d)
     top = 0
     stack[0] = 0
     while top >= 0:
         node = stack[top]
         top -= 1
-        if box_entry(bmin, bmax, node, o, inv, tmin, tmax) == INF:
+        if box_entry(box, node, o, inv, tmin, tmax) == INF:
             continue
-        count = geo.inst_node_count[node]
+        count = geo.inst_link[node, 1]
         if count == 0:
             top += 1
             stack[top] = node + 1
             top += 1
-            stack[top] = geo.inst_node_offset[node]
+            stack[top] = geo.inst_link[node, 0]
             continue
-        first = geo.inst_node_offset[node]
+        first = geo.inst_link[node, 0]
         for j in range(first, first + count):
             state = instance_occludes(geo, mats, geo.inst_prims[j], o, d, tmin, tmax, stack)
             if state == 1:
@@ -83,11 +83,10 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
     of the intersection routines), then the mesh instances when there are any."""
     seen_transparent = 0
     n_unbounded = geo.unbounded.shape[0]
-    bmin = geo.node_min
-    bmax = geo.node_max
+    box = geo.node_box
     inv = inverse_direction(d)
     top = -1
-    if bmin.shape[0] > 0:
+    if box.shape[0] > 0:
         top = 0
         stack[0] = 0
     j = 0
@@ -103,17 +102,17 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
         elif top >= 0:
             node = stack[top]
             top -= 1
-            if box_entry(bmin, bmax, node, o, inv, tmin, tmax) == INF:
+            if box_entry(box, node, o, inv, tmin, tmax) == INF:
                 continue
-            count = geo.node_count[node]
+            count = geo.node_link[node, 1]
             if count > 0:
-                leaf = geo.node_offset[node]
+                leaf = geo.node_link[node, 0]
                 leaf_end = leaf + count
             else:
                 top += 1
                 stack[top] = node + 1
                 top += 1
-                stack[top] = geo.node_offset[node]
+                stack[top] = geo.node_link[node, 0]
             continue
         else:
             break
@@ -168,7 +167,7 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
         if kt < OPAQUE_KT:
             return (0.0, 0.0, 0.0)
         entering = True
-        if geo.prim_solid[prim]:
+        if geo.prim_info[prim, PRIM_SOLID]:
             n, _ = surface_normals(geo, prim, tri, b1, b2, madd(o, d, t))
             entering = dot(d, n) < 0.0
             if entering:

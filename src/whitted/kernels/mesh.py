@@ -78,23 +78,22 @@ def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
     kx, ky, kz, sx, sy, sz = shear_setup(d)
     verts = geo.mesh_vertices
     faces = geo.mesh_faces
-    bmin = geo.mesh_node_min
-    bmax = geo.mesh_node_max
+    box = geo.mesh_box
     best_t = tmax
     best = -1
     best_b1 = 0.0
     best_b2 = 0.0
     root = geo.mesh_info[mesh, MESH_ROOT]
-    if box_entry(bmin, bmax, root, o, inv, tmin, best_t) == INF:
+    if box_entry(box, root, o, inv, tmin, best_t) == INF:
         return INF, -1, 0.0, 0.0
     top = base
     stack[top] = root
     while top >= base:
         node = stack[top]
         top -= 1
-        count = geo.mesh_node_count[node]
+        count = geo.mesh_link[node, 1]
         if count > 0:
-            first = geo.mesh_node_offset[node]
+            first = geo.mesh_link[node, 0]
             for j in range(first, first + count):
                 tri = geo.mesh_node_tris[j]
                 t, b1, b2 = intersect_mesh_triangle(verts, faces, tri, o, kx, ky, kz, sx, sy,
@@ -105,7 +104,7 @@ def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
                     best_b1 = b1
                     best_b2 = b2
             continue
-        top = push_children(bmin, bmax, geo.mesh_node_offset, node, o, inv, tmin, best_t, stack,
+        top = push_children(box, geo.mesh_link, node, o, inv, tmin, best_t, stack,
                             top)
     if best < 0:
         return INF, -1, 0.0, 0.0
@@ -123,19 +122,18 @@ def mesh_occlusion(geo, mats, mesh, material, o, d, inv, tmin, tmax, stack, base
     kx, ky, kz, sx, sy, sz = shear_setup(d)
     verts = geo.mesh_vertices
     faces = geo.mesh_faces
-    bmin = geo.mesh_node_min
-    bmax = geo.mesh_node_max
+    box = geo.mesh_box
     seen = 0
     top = base
     stack[top] = geo.mesh_info[mesh, MESH_ROOT]
     while top >= base:
         node = stack[top]
         top -= 1
-        if box_entry(bmin, bmax, node, o, inv, tmin, tmax) == INF:
+        if box_entry(box, node, o, inv, tmin, tmax) == INF:
             continue
-        count = geo.mesh_node_count[node]
+        count = geo.mesh_link[node, 1]
         if count > 0:
-            first = geo.mesh_node_offset[node]
+            first = geo.mesh_link[node, 0]
             for j in range(first, first + count):
                 tri = geo.mesh_node_tris[j]
                 t, _, _ = intersect_mesh_triangle(verts, faces, tri, o, kx, ky, kz, sx, sy, sz,
@@ -149,7 +147,7 @@ def mesh_occlusion(geo, mats, mesh, material, o, d, inv, tmin, tmax, stack, base
         top += 1
         stack[top] = node + 1
         top += 1
-        stack[top] = geo.mesh_node_offset[node]
+        stack[top] = geo.mesh_link[node, 0]
     return seen
 
 

@@ -15,7 +15,11 @@ import numpy as np
 from .accel import closest_hit, surface_normals
 from .integrator import N_STACK_F, N_STACK_I, trace_path
 from .jit import kernel
-from .layout import MAX_MEDIA, RAY_PRIMARY
+from .layout import (
+    MAX_MEDIA,
+    PRIM_OBJECT,
+    RAY_PRIMARY,
+)
 from .sampling import random01, stratum
 from .vec import madd, normalize
 
@@ -105,7 +109,7 @@ def render_aovs(geo, params, depth, normal, object_id, work, lane, lanes):
                     normal[py, px, k] = 0.0
                 continue
             depth[py, px] = t
-            object_id[py, px] = geo.prim_object[prim]
+            object_id[py, px] = geo.prim_info[prim, PRIM_OBJECT]
             n, _ = surface_normals(geo, prim, tri, b1, b2, madd(o, d, t))
             for k in range(3):
                 normal[py, px, k] = n[k]

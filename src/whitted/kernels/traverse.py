@@ -27,18 +27,18 @@ def inverse_direction(d):
 
 
 @kernel
-def box_entry(bmin, bmax, node, o, inv, tmin, tmax):
+def box_entry(box, node, o, inv, tmin, tmax):
     """Entry distance of the ray into box ``node`` when it overlaps (tmin, tmax), else INF."""
-    t0 = (bmin[node, 0] - o[0]) * inv[0]
-    t1 = (bmax[node, 0] - o[0]) * inv[0]
+    t0 = (box[node, 0, 0] - o[0]) * inv[0]
+    t1 = (box[node, 1, 0] - o[0]) * inv[0]
     tn = min(t0, t1)
     tf = max(t0, t1)
-    t0 = (bmin[node, 1] - o[1]) * inv[1]
-    t1 = (bmax[node, 1] - o[1]) * inv[1]
+    t0 = (box[node, 0, 1] - o[1]) * inv[1]
+    t1 = (box[node, 1, 1] - o[1]) * inv[1]
     tn = max(tn, min(t0, t1))
     tf = min(tf, max(t0, t1))
-    t0 = (bmin[node, 2] - o[2]) * inv[2]
-    t1 = (bmax[node, 2] - o[2]) * inv[2]
+    t0 = (box[node, 0, 2] - o[2]) * inv[2]
+    t1 = (box[node, 1, 2] - o[2]) * inv[2]
     tn = max(tn, min(t0, t1))
     tf = min(tf, max(t0, t1))
     # the relative slack keeps flat boxes (a rectangle in a plane) from being missed
@@ -48,13 +48,13 @@ def box_entry(bmin, bmax, node, o, inv, tmin, tmax):
 
 
 @kernel
-def push_children(bmin, bmax, node_offset, node, o, inv, tmin, tmax, stack, top):
+def push_children(box, link, node, o, inv, tmin, tmax, stack, top):
     """Push the children of interior ``node`` that the ray meets, the farther one first so
     the nearer one is visited next; returns the new stack top."""
     left = node + 1
-    right = node_offset[node]
-    t_left = box_entry(bmin, bmax, left, o, inv, tmin, tmax)
-    t_right = box_entry(bmin, bmax, right, o, inv, tmin, tmax)
+    right = link[node, 0]
+    t_left = box_entry(box, left, o, inv, tmin, tmax)
+    t_right = box_entry(box, right, o, inv, tmin, tmax)
     if t_left <= t_right:
         if t_right != INF:
             top += 1

@@ -23,6 +23,8 @@ from .layout import (
     DISK_TANGENT,
     FRUSTUM_TANGENT,
     PLANE_TANGENT,
+    PRIM_TYPE,
+    PRIM_XFORM,
     SHAPE_BOX,
     SHAPE_DISK,
     SHAPE_FRUSTUM,
@@ -94,10 +96,10 @@ def _frustum_uv(P, i, p):
 @kernel
 def surface_uv(geo, prim, tri, b1, b2, p):
     """Texture coordinates of the hit at world point ``p`` (see the module docstring)."""
-    typ = geo.prim_type[prim]
+    typ = geo.prim_info[prim, PRIM_TYPE]
     if typ == SHAPE_MESH:
         return mesh_uv(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
-    xf = geo.prim_xform[prim]
+    xf = geo.prim_info[prim, PRIM_XFORM]
     if xf >= 0:
         p, _ = to_object(geo.xforms, xf, p, p)
     P = geo.prim_params

@@ -135,7 +135,7 @@ _kernels_ready: set[bool] = set()  # kernel variants loaded: with / without mesh
 
 
 def _kernel_variant(compiled: CompiledScene) -> bool:
-    return compiled.geometry.inst_node_min.dtype == np.float64
+    return compiled.geometry.inst_box.dtype == np.float64
 
 
 def warm_up_kernels(compiled: CompiledScene | None = None) -> float:
