@@ -285,9 +285,17 @@ def info(
     out.print(f"bvh: {len(compiled.geometry.node_link)} nodes over "
               f"{len(compiled.geometry.node_prims)} primitives")
     if compiled.triangles:
-        out.print(f"meshes: {len(compiled.geometry.mesh_info)} stored, "
-                  f"{compiled.triangles:,} triangles ({compiled.instanced_triangles:,} with "
-                  f"instances), {len(compiled.geometry.mesh_link):,} mesh BVH nodes")
+        geo = compiled.geometry
+        stored = len(geo.mesh_faces)
+        flat = compiled.triangles - stored
+        parts = []
+        if flat:
+            parts.append(f"{flat:,} triangles in the scene BVH")
+        if stored:
+            parts.append(f"{len(geo.mesh_info)} stored for instancing ({stored:,} triangles, "
+                         f"{compiled.instanced_triangles - flat:,} with instances, "
+                         f"{len(geo.mesh_link):,} mesh BVH nodes)")
+        out.print("meshes: " + "; ".join(parts))
     for warning in compiled.warnings:
         out.print(f"warning: {warning}", markup=False, highlight=False)
     shadow = sum(
