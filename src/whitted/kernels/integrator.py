@@ -109,7 +109,7 @@ def _push(st_f, st_i, top, o, d, w, depth, media_src, n_media):
 
 @kernel
 def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media, scratch,
-               stack, counters):
+               stack, hits, counters):
     """Radiance arriving along the camera ray (o, d) with unit d: I = ka·Ia + direct light +
     kr·Ir + kt·It, the secondary terms traced while their weight stays above min_weight."""
     r = 0.0
@@ -156,7 +156,7 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
         ka = mats[m, MAT_KA]
         amb = params.ambient
         local = direct_light(geo, mats, lights, params, p, n_shade, v, m, albedo, media,
-                             n_media, scratch, stack, counters,
+                             n_media, scratch, stack, hits, counters,
                              (pixel, sample, 2 + vertex * RNG_DIMS_PER_HIT))
         vertex += 1
         r += w[0] * (ka * amb[0] * tex[0] * mats[m, MAT_AMBIENT] + local[0])

@@ -8,6 +8,7 @@ import math
 
 from .accel import (
     closest_hit,
+    hit_analytic,
     hit_material,
     instance_occludes,
     occludes,
@@ -37,6 +38,7 @@ from .layout import (
     MAT_KT,
     MAT_SHININESS,
     MAT_SPECULAR,
+    PRIM_MATERIAL,
     PRIM_SOLID,
     RAY_SHADOW,
 )
@@ -128,8 +130,114 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
     return seen_transparent
 
 
+MAX_SHADOW_HITS = 32  # transparent surfaces one shadow ray gathers in one walk (hits buffer)
+
+
 @kernel
-def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch, stack):
+def _insert_hit(hits, n, t, prim):
+    """Insert (t, prim) into the first n pairs of ``hits``, kept sorted by t; returns n + 1."""
+    k = n
+    while k > 0 and hits[2 * (k - 1)] > t:
+        hits[2 * k] = hits[2 * (k - 1)]
+        hits[2 * k + 1] = hits[2 * (k - 1) + 1]
+        k -= 1
+    hits[2 * k] = t
+    hits[2 * k + 1] = prim
+    return n + 1
+
+
+@kernel
+def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits):
+    """Every analytic surface crossing on the segment (tmin, tmax), in one walk of the scene
+    BVH, into ``hits`` as (t, primitive) pairs sorted by t: both crossings of a closed body
+    (they are convex: at most two, the second searched from ``step`` past the first). Returns
+    how many; -1 when an opaque surface blocks the segment (the walk stops there); -2 when
+    there are more than the buffer holds."""
+    n = 0
+    n_unbounded = geo.unbounded.shape[0]
+    box = geo.node_box
+    inv = inverse_direction(d)
+    top = -1
+    if box.shape[0] > 0:
+        top = 0
+        stack[0] = 0
+    j = 0
+    leaf = 0
+    leaf_end = 0
+    while True:
+        if j < n_unbounded:
+            i = geo.unbounded[j]
+            j += 1
+        elif leaf < leaf_end:
+            i = geo.node_prims[leaf]
+            leaf += 1
+        elif top >= 0:
+            node = stack[top]
+            top -= 1
+            if box_entry(box, node, o, inv, tmin, tmax) == INF:
+                continue
+            count = geo.node_link[node, 1]
+            if count > 0:
+                leaf = geo.node_link[node, 0]
+                leaf_end = leaf + count
+            else:
+                top += 1
+                stack[top] = node + 1
+                top += 1
+                stack[top] = geo.node_link[node, 0]
+            continue
+        else:
+            break
+        t = hit_analytic(geo, i, o, d, tmin, tmax)
+        if t == INF:
+            continue
+        if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT:
+            return -1
+        if n == MAX_SHADOW_HITS:
+            return -2
+        n = _insert_hit(hits, n, t, i)
+        if geo.prim_info[i, PRIM_SOLID]:
+            t = hit_analytic(geo, i, o, d, t * (1.0 + 1e-12) + step, tmax)
+            if t < INF:
+                if n == MAX_SHADOW_HITS:
+                    return -2
+                n = _insert_hit(hits, n, t, i)
+    return n
+
+
+@kernel
+def _pass_surface(geo, mats, prim, tri, b1, b2, o, d, t, scratch, count, trans):
+    """Light crossing the transparent surface hit at t: media pushed or popped, kt·colour
+    applied where it enters. Returns (media count, transmittance)."""
+    m = hit_material(geo, prim, tri)
+    kt = mats[m, MAT_KT]
+    entering = True
+    if geo.prim_info[prim, PRIM_SOLID]:
+        n, _ = surface_normals(geo, prim, tri, b1, b2, madd(o, d, t))
+        entering = dot(d, n) < 0.0
+        if entering:
+            count = media_enter(scratch, count, m)
+        else:
+            count = media_leave(scratch, count, m)
+    if entering:
+        trans = (trans[0] * kt * mats[m, MAT_COLOR], trans[1] * kt * mats[m, MAT_COLOR + 1],
+                 trans[2] * kt * mats[m, MAT_COLOR + 2])
+    return count, trans
+
+
+@kernel
+def _absorb(mats, scratch, count, length, trans):
+    """Beer-Lambert absorption over ``length`` in the innermost medium, if any."""
+    if count == 0:
+        return trans
+    m = scratch[count - 1]
+    return (trans[0] * math.exp(-mats[m, MAT_ATTEN] * length),
+            trans[1] * math.exp(-mats[m, MAT_ATTEN + 1] * length),
+            trans[2] * math.exp(-mats[m, MAT_ATTEN + 2] * length))
+
+
+@kernel
+def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch, stack, hits):
     """Fraction of light (per channel) that reaches ``o`` from ``dist`` along unit ``d``.
 
     The segment starts at ``epsilon`` along the ray (not offset along the normal), so a
@@ -139,49 +247,53 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
     Each transparent occluder multiplies by its ``kt·color`` where the ray enters it, and the
     medium the shadow ray is in absorbs ``exp(-attenuation·length)`` segment by segment (the
     ray starts in the media ``media[:n_media]`` of the point being shaded)."""
-    state = any_occluder(geo, mats, o, d, params.epsilon, dist, stack)
-    if state == 0:
-        return (1.0, 1.0, 1.0)
-    if state == 1:
-        return (0.0, 0.0, 0.0)
     for k in range(n_media):
         scratch[k] = media[k]
     count = n_media
-    tr = 1.0
-    tg = 1.0
-    tb = 1.0
+    trans = (1.0, 1.0, 1.0)
     t_from = params.epsilon
+    if not has_instances(geo):
+        # one walk gathers every surface on the segment, sorted; surfaces closer than the
+        # stepping below to the previous one are the same crossing (a shared edge) and skipped
+        n = gather_transparent_hits(geo, mats, o, d, params.epsilon, dist, params.epsilon,
+                                    stack, hits)
+        if n == 0:
+            return (1.0, 1.0, 1.0)
+        if n == -1:
+            return (0.0, 0.0, 0.0)
+        if n > 0:
+            for k in range(n):
+                t = hits[2 * k]
+                if t <= t_from:
+                    continue
+                trans = _absorb(mats, scratch, count, t - t_from, trans)
+                count, trans = _pass_surface(geo, mats, int(hits[2 * k + 1]), -1, 0.0, 0.0, o,
+                                             d, t, scratch, count, trans)
+                if max(trans[0], max(trans[1], trans[2])) < 1e-4:
+                    return (0.0, 0.0, 0.0)
+                t_from = t * (1.0 + 1e-12) + params.epsilon
+            return _absorb(mats, scratch, count, dist - t_from, trans)
+        # more surfaces than the buffer holds: step from one to the next below
+    else:
+        state = any_occluder(geo, mats, o, d, params.epsilon, dist, stack)
+        if state == 0:
+            return (1.0, 1.0, 1.0)
+        if state == 1:
+            return (0.0, 0.0, 0.0)
     for _ in range(64):
         t, prim, tri, b1, b2 = closest_hit(geo, o, d, t_from, dist, stack)
         seg_end = t if prim >= 0 else dist
-        if count > 0:
-            m = scratch[count - 1]
-            length = seg_end - t_from
-            tr *= math.exp(-mats[m, MAT_ATTEN] * length)
-            tg *= math.exp(-mats[m, MAT_ATTEN + 1] * length)
-            tb *= math.exp(-mats[m, MAT_ATTEN + 2] * length)
+        trans = _absorb(mats, scratch, count, seg_end - t_from, trans)
         if prim < 0:
             break
-        m = hit_material(geo, prim, tri)
-        kt = mats[m, MAT_KT]
-        if kt < OPAQUE_KT:
+        if mats[hit_material(geo, prim, tri), MAT_KT] < OPAQUE_KT:
             return (0.0, 0.0, 0.0)
-        entering = True
-        if geo.prim_info[prim, PRIM_SOLID]:
-            n, _ = surface_normals(geo, prim, tri, b1, b2, madd(o, d, t))
-            entering = dot(d, n) < 0.0
-            if entering:
-                count = media_enter(scratch, count, m)
-            else:
-                count = media_leave(scratch, count, m)
-        if entering:
-            tr *= kt * mats[m, MAT_COLOR]
-            tg *= kt * mats[m, MAT_COLOR + 1]
-            tb *= kt * mats[m, MAT_COLOR + 2]
-        if max(tr, max(tg, tb)) < 1e-4:
+        count, trans = _pass_surface(geo, mats, prim, tri, b1, b2, o, d, t, scratch, count,
+                                     trans)
+        if max(trans[0], max(trans[1], trans[2])) < 1e-4:
             return (0.0, 0.0, 0.0)
         t_from = t * (1.0 + 1e-12) + params.epsilon
-    return (tr, tg, tb)
+    return trans
 
 
 @kernel
@@ -221,7 +333,8 @@ def _brdf(mats, m, albedo, n, v, ldir):
 
 @kernel
 def direct_light(
-    geo, mats, lights, params, p, n, v, m, albedo, media, n_media, scratch, stack, counters, rng
+    geo, mats, lights, params, p, n, v, m, albedo, media, n_media, scratch, stack, hits,
+    counters, rng
 ):
     """Light reflected toward ``v`` at point ``p`` with shading normal ``n`` (facing ``v``) by
     every non-ambient light; ``albedo`` is the diffuse colour there. ``rng`` = (pixel, sample,
@@ -262,7 +375,7 @@ def direct_light(
                 counters[RAY_SHADOW] += 1
                 vis = shadow_transmittance(
                     geo, mats, params, p, ldir, dist - params.epsilon, media, n_media,
-                    scratch, stack,
+                    scratch, stack, hits,
                 )
                 if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
                     continue
@@ -278,7 +391,7 @@ def direct_light(
                 continue
             counters[RAY_SHADOW] += 1
             vis = shadow_transmittance(
-                geo, mats, params, p, ldir, INF, media, n_media, scratch, stack
+                geo, mats, params, p, ldir, INF, media, n_media, scratch, stack, hits
             )
             if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
                 continue

@@ -20,6 +20,7 @@ from .layout import (
     PRIM_OBJECT,
     RAY_PRIMARY,
 )
+from .lighting import MAX_SHADOW_HITS
 from .sampling import random01, stratum
 from .vec import madd, normalize
 
@@ -28,14 +29,16 @@ BVH_STACK = 128
 
 def lane_workspace(max_depth: int):
     """Scratch arrays one lane reuses for every ray: the ray stack (float and int parts), two
-    media lists and the BVH traversal stack. Allocated in Python: the kernels run without the
-    Numba runtime's reference counting, which would otherwise cost a third of the time."""
+    media lists, the BVH traversal stack and a shadow ray's sorted surface hits. Allocated in
+    Python: the kernels run without the Numba runtime's reference counting, which would
+    otherwise cost a third of the time."""
     return (
         np.empty((max_depth + 2, N_STACK_F)),
         np.empty((max_depth + 2, N_STACK_I), np.int32),
         np.empty(MAX_MEDIA, np.int32),
         np.empty(MAX_MEDIA, np.int32),
         np.empty(BVH_STACK, np.int32),
+        np.empty(2 * MAX_SHADOW_HITS),
     )
 
 
@@ -62,7 +65,7 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
     the lane's scratch memory from :func:`lane_workspace`."""
     n_tiles = tiles.shape[0]
     spp = params.samples
-    st_f, st_i, media, scratch, stack = work
+    st_f, st_i, media, scratch, stack, hits = work
     for t in range(lane, n_tiles, lanes):
         cnt = counters[t]
         for py in range(tiles[t, 1], tiles[t, 3]):
@@ -82,7 +85,7 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
                     o, d = camera_ray(params, px + jx, py + jy)
                     cnt[RAY_PRIMARY] += 1
                     c = trace_path(geo, mats, lights, params, o, d, pixel, s, st_f, st_i,
-                                   media, scratch, stack, cnt)
+                                   media, scratch, stack, hits, cnt)
                     r += c[0]
                     g += c[1]
                     b += c[2]
