@@ -151,8 +151,8 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits):
     """Every analytic surface crossing on the segment (tmin, tmax), in one walk of the scene
     BVH, into ``hits`` as (t, primitive) pairs sorted by t: both crossings of a closed body
     (they are convex: at most two, the second searched from ``step`` past the first). Returns
-    how many; -1 when an opaque surface blocks the segment (the walk stops there); -2 when
-    there are more than the buffer holds."""
+    how many; -1 when an opaque surface blocks the segment (the walk stops there and
+    ``hits[1]`` names it); -2 when there are more than the buffer holds."""
     n = 0
     n_unbounded = geo.unbounded.shape[0]
     box = geo.node_box
@@ -192,6 +192,7 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits):
         if t == INF:
             continue
         if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT:
+            hits[1] = i
             return -1
         if n == MAX_SHADOW_HITS:
             return -2
@@ -237,7 +238,8 @@ def _absorb(mats, scratch, count, length, trans):
 
 
 @kernel
-def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch, stack, hits):
+def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch, stack, hits,
+                         blocker):
     """Fraction of light (per channel) that reaches ``o`` from ``dist`` along unit ``d``.
 
     The segment starts at ``epsilon`` along the ray (not offset along the normal), so a
@@ -246,7 +248,14 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
 
     Each transparent occluder multiplies by its ``kt·color`` where the ray enters it, and the
     medium the shadow ray is in absorbs ``exp(-attenuation·length)`` segment by segment (the
-    ray starts in the media ``media[:n_media]`` of the point being shaded)."""
+    ray starts in the media ``media[:n_media]`` of the point being shaded).
+
+    ``blocker`` (or -1) is an opaque analytic primitive that blocked a previous shadow ray
+    from the same point (the next sample of the same area light, say): it is tried first, and
+    when it blocks this ray too no walk is needed. Returns (transmittance, the opaque
+    primitive that blocked the ray or -1)."""
+    if blocker >= 0 and hit_analytic(geo, blocker, o, d, params.epsilon, dist) < INF:
+        return (0.0, 0.0, 0.0), blocker
     for k in range(n_media):
         scratch[k] = media[k]
     count = n_media
@@ -258,9 +267,9 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
         n = gather_transparent_hits(geo, mats, o, d, params.epsilon, dist, params.epsilon,
                                     stack, hits)
         if n == 0:
-            return (1.0, 1.0, 1.0)
+            return (1.0, 1.0, 1.0), -1
         if n == -1:
-            return (0.0, 0.0, 0.0)
+            return (0.0, 0.0, 0.0), int(hits[1])
         if n > 0:
             for k in range(n):
                 t = hits[2 * k]
@@ -270,16 +279,16 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
                 count, trans = _pass_surface(geo, mats, int(hits[2 * k + 1]), -1, 0.0, 0.0, o,
                                              d, t, scratch, count, trans)
                 if max(trans[0], max(trans[1], trans[2])) < 1e-4:
-                    return (0.0, 0.0, 0.0)
+                    return (0.0, 0.0, 0.0), -1
                 t_from = t * (1.0 + 1e-12) + params.epsilon
-            return _absorb(mats, scratch, count, dist - t_from, trans)
+            return _absorb(mats, scratch, count, dist - t_from, trans), -1
         # more surfaces than the buffer holds: step from one to the next below
     else:
         state = any_occluder(geo, mats, o, d, params.epsilon, dist, stack)
         if state == 0:
-            return (1.0, 1.0, 1.0)
+            return (1.0, 1.0, 1.0), -1
         if state == 1:
-            return (0.0, 0.0, 0.0)
+            return (0.0, 0.0, 0.0), -1
     for _ in range(64):
         t, prim, tri, b1, b2 = closest_hit(geo, o, d, t_from, dist, stack)
         seg_end = t if prim >= 0 else dist
@@ -287,13 +296,13 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
         if prim < 0:
             break
         if mats[hit_material(geo, prim, tri), MAT_KT] < OPAQUE_KT:
-            return (0.0, 0.0, 0.0)
+            return (0.0, 0.0, 0.0), -1
         count, trans = _pass_surface(geo, mats, prim, tri, b1, b2, o, d, t, scratch, count,
                                      trans)
         if max(trans[0], max(trans[1], trans[2])) < 1e-4:
-            return (0.0, 0.0, 0.0)
+            return (0.0, 0.0, 0.0), -1
         t_from = t * (1.0 + 1e-12) + params.epsilon
-    return trans
+    return trans, -1
 
 
 @kernel
@@ -354,6 +363,7 @@ def direct_light(
                 n_samples = int(lights[j, LIGHT_SAMPLES])
             share = 1.0 / n_samples
             centre = vload(lights, j, LIGHT_POSITION)
+            blocker = -1  # what shadowed this light's previous sample from p
             for s in range(n_samples):
                 target = centre
                 if kind == LIGHT_DISK:
@@ -373,10 +383,12 @@ def direct_light(
                 if dot(n, ldir) <= 0.0:
                     continue
                 counters[RAY_SHADOW] += 1
-                vis = shadow_transmittance(
+                vis, found = shadow_transmittance(
                     geo, mats, params, p, ldir, dist - params.epsilon, media, n_media,
-                    scratch, stack, hits,
+                    scratch, stack, hits, blocker,
                 )
+                if found >= 0:
+                    blocker = found
                 if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
                     continue
                 f = _brdf(mats, m, albedo, n, v, ldir)
@@ -390,8 +402,8 @@ def direct_light(
             if dot(n, ldir) <= 0.0:
                 continue
             counters[RAY_SHADOW] += 1
-            vis = shadow_transmittance(
-                geo, mats, params, p, ldir, INF, media, n_media, scratch, stack, hits
+            vis, _ = shadow_transmittance(
+                geo, mats, params, p, ldir, INF, media, n_media, scratch, stack, hits, -1
             )
             if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
                 continue
