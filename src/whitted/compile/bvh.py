@@ -12,6 +12,8 @@ extent only (one axis keeps the build inside its time budget), and the SAH cost
 ``1 + (A_L * N_L + A_R * N_R) / A`` of the best bin boundary is compared with the leaf cost
 ``n``. The node becomes a leaf when ``n <= 1``, or when no split is cheaper than the leaf and
 ``n`` is at most the leaf cap (16). When every centroid coincides the index range is halved.
+``traversal_cost`` (default 1, relative to one primitive test) scales the ``1``: meshes use 2,
+which makes leaves of a few triangles and a third fewer nodes at the same speed.
 
 The tree depth never exceeds :data:`MAX_DEPTH`: a node that could otherwise end up deeper
 switches to exact median splits on its widest centroid axis, so a traversal stack of
@@ -224,7 +226,8 @@ def _sah_axis(rows, start, end, axis, cmin, scale, nb, bin_cnt, bin_box, r_area,
 
 
 @njit(cache=True, nogil=True)
-def _build(rows, idx, n_bins, leaf_cap, node_min, node_max, node_offset, node_count, node_axis):
+def _build(rows, idx, n_bins, leaf_cap, node_min, node_max, node_offset, node_count, node_axis,
+           traversal_cost):
     """Build the tree in place; returns the number of nodes written."""
     n = rows.shape[0]
     if n == 0:
@@ -332,7 +335,7 @@ def _build(rows, idx, n_bins, leaf_cap, node_min, node_max, node_offset, node_co
                     cmin = cur[6 + axis]
                     scale = nb * _BIN_SCALE_SHRINK / (cur[9 + axis] - cur[6 + axis])
                     area = _half_area(cur[0], cur[1], cur[2], cur[3], cur[4], cur[5])
-                    split_cost = area * TRAVERSAL_COST + best_cost
+                    split_cost = area * traversal_cost + best_cost
                     leaf_cost = area * INTERSECTION_COST * count
                     if split_cost >= leaf_cost and count <= leaf_cap:
                         make_leaf = True
@@ -432,6 +435,7 @@ def build_bvh(
     bounds_max: np.ndarray,
     max_leaf_size: int = 4,
     n_bins: int = 16,
+    traversal_cost: float = TRAVERSAL_COST,
 ) -> BVH:
     """BVH over N primitives with bounds ``bounds_min[i] .. bounds_max[i]`` ((N, 3) arrays).
 
@@ -483,6 +487,7 @@ def build_bvh(
         node_offset,
         node_count,
         node_axis,
+        float(traversal_cost),
     )
     del rows
     return BVH(

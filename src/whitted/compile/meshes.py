@@ -27,6 +27,9 @@ from ..kernels.layout import (
 from .bvh import build_bvh
 from .normals import smooth_corner_normals
 
+# SAH cost of visiting a node, relative to one watertight triangle test (see compile/bvh.py)
+MESH_TRAVERSAL_COST = 2.0  # measured: 28-55 % fewer nodes than 1.0, same speed
+
 
 @dataclass
 class MeshSource:
@@ -139,7 +142,7 @@ class MeshTable:
         lo_tri = corners.min(axis=1)
         hi_tri = corners.max(axis=1)
         del corners
-        bvh = build_bvh(lo_tri, hi_tri)
+        bvh = build_bvh(lo_tri, hi_tri, traversal_cost=MESH_TRAVERSAL_COST)
         del lo_tri, hi_tri
 
         normal_row = -1
