@@ -391,7 +391,7 @@ def rebase_files(scene: Scene, folder: str | Path) -> Scene:
     old = scene.base_dir
     folder = Path(folder).resolve()
     if old.resolve() == folder:
-        return scene.model_copy().with_base_dir(folder)
+        return scene.with_base_dir(folder)
 
     def moved(name: str) -> str:
         return _moved_name(name, old, folder)

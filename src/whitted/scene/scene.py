@@ -69,9 +69,11 @@ class Scene(Strict):
         return self._base_dir if self._base_dir is not None else Path.cwd()
 
     def with_base_dir(self, folder: str | Path | None) -> Scene:
-        """This scene with relative file names taken relative to ``folder``."""
-        self._base_dir = None if folder is None else Path(folder).resolve()
-        return self
+        """A copy of this scene (shallow: the parts are shared, as they are immutable in use)
+        whose relative file names are taken relative to ``folder``."""
+        scene = self.model_copy()
+        scene._base_dir = None if folder is None else Path(folder).resolve()
+        return scene
 
     def resolve_path(self, name: str | Path) -> Path:
         """The file a scene names: absolute as given, else relative to :attr:`base_dir`."""
