@@ -12,7 +12,7 @@ from PySide6.QtCore import QObject, Signal
 from PySide6.QtGui import QUndoStack
 
 from ..scene import Scene
-from ..scene.io import _clean_loc, _clean_message, _priority
+from ..scene.io import validation_message
 from .commands import SceneEdit
 
 #: what is selected: ("camera",), ("render",), ("background",), ("lights", i), ("objects", i)
@@ -25,13 +25,6 @@ SINGLETONS = (CAMERA, RENDER, BACKGROUND)
 
 class EditRefused(ValueError):
     """An edit the scene model rejects; the message is one short line for the field."""
-
-
-def validation_message(exc: ValidationError) -> str:
-    """One line for the first problem of a pydantic error, in the scene files' words."""
-    # unions report one error per member: the deepest one is the informative one
-    e = max(exc.errors(), key=lambda e: (len(_clean_loc(e["loc"])), _priority(e)))
-    return _clean_message(e)  # shown at the field itself: no key path needed
 
 
 def scene_fields(scene: Scene) -> dict[str, Any]:

@@ -266,8 +266,7 @@ class RenderController(QObject):
         for job in jobs:
             job.cancel()
         for job in jobs:
-            if job._thread is not None:
-                job._thread.join(timeout)
+            job.join(timeout)
         self.full = self.preview = None
 
 

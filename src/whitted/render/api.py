@@ -215,6 +215,14 @@ class RenderJob:
         self._thread.start()
         return self._thread
 
+    def join(self, timeout: float | None = None) -> bool:
+        """Wait for the background thread (if any) without raising its error; True when it
+        has finished."""
+        if self._thread is not None:
+            self._thread.join(timeout)
+            return not self._thread.is_alive()
+        return True
+
     def wait(self, timeout: float | None = None) -> Image | None:
         if self._thread is not None:
             self._thread.join(timeout)

@@ -139,6 +139,14 @@ def _priority(error: Any) -> int:
     return 2
 
 
+def validation_message(exc: ValidationError) -> str:
+    """The most informative problem of a pydantic error, in the scene files' words and without
+    its key path (what an editor shows at the field itself)."""
+    # unions report one error per member: the deepest one is the informative one
+    best = max(exc.errors(), key=lambda e: (len(_clean_loc(e["loc"])), _priority(e)))
+    return _clean_message(best)
+
+
 def _scene_error(
     exc: ValidationError, file: str | None, text: str | None, data: Any = None
 ) -> SceneError:
