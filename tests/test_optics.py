@@ -152,3 +152,22 @@ def test_coloured_absorption_tints_shadows():
     expected = np.exp(-np.array(atten) * 1.0)  # 1 unit of cube on the vertical light path
     n_dot_l = (np.array([0, 10, 0]) - hit)[1] / 10.0
     assert value == pytest.approx(expected * n_dot_l, rel=2e-3)
+
+
+def test_shadow_through_more_sheets_than_one_gather_holds():
+    """40 stacked transparent sheets (more than a shadow walk gathers at once) between a floor
+    and a light each pass kt of the light: the floor receives kt**40 of it."""
+    kt = 0.9
+    sheet = whitted.Material(color=(1, 1, 1), ka=0, kd=0, ks=0, kt=kt)
+    sheets = [whitted.Rectangle(corner=(-5, 1 + 0.1 * k, 5), edge1=(10, 0, 0), edge2=(0, 0, -10),
+                                material=sheet) for k in range(40)]
+    floor = whitted.Plane(point=(0, 0, 0), normal=(0, 1, 0),
+                          material=whitted.Material(color=(1, 1, 1), ka=0, kd=1, ks=0))
+    scene = whitted.Scene(
+        render=whitted.RenderSettings(width=1, height=1, max_depth=0),
+        camera=whitted.Camera(position=(0.0, 0.5, 0.001), look_at=(0.0, 0.0, 0.0), fov=0.1),
+        lights=[whitted.PointLight(position=(0, 10, 0))],
+        objects=[floor, *sheets],
+    )
+    value = whitted.render(scene).pixels[0, 0]
+    assert value == pytest.approx([kt**40] * 3, rel=1e-3)

@@ -17,6 +17,7 @@ from ..kernels.features import NO_INSTANCES_DTYPE
 from ..kernels.layout import (
     FALLOFF_CODES,
     LIGHT_DIRECTION,
+    LIGHT_DIRECTIONAL,
     LIGHT_DISK,
     LIGHT_DISK_U,
     LIGHT_DISK_V,
@@ -398,7 +399,7 @@ def _light_rows(scene: Scene) -> tuple[np.ndarray, tuple[float, float, float]]:
             row[LIGHT_TYPE] = LIGHT_POINT
             row[LIGHT_POSITION : LIGHT_POSITION + 3] = light.position
         elif isinstance(light, DirectionalLight):
-            row[LIGHT_TYPE] = 2
+            row[LIGHT_TYPE] = LIGHT_DIRECTIONAL
             row[LIGHT_DIRECTION : LIGHT_DIRECTION + 3] = _unit(light.direction)
         elif isinstance(light, DiskLight):
             row[LIGHT_TYPE] = LIGHT_DISK

@@ -19,12 +19,12 @@ from .intersect import INF
 from .jit import kernel
 from .layout import (
     LIGHT_DIRECTION,
+    LIGHT_DIRECTIONAL,
     LIGHT_DISK,
     LIGHT_DISK_U,
     LIGHT_DISK_V,
     LIGHT_DIST_SCALE,
     LIGHT_FALLOFF,
-    LIGHT_POINT,
     LIGHT_POSITION,
     LIGHT_RADIANCE,
     LIGHT_RADIUS,
@@ -134,8 +134,15 @@ MAX_SHADOW_HITS = 32  # transparent surfaces one shadow ray gathers in one walk 
 
 
 @kernel
-def _insert_hit(hits, n, t, prim):
-    """Insert (t, prim) into the first n pairs of ``hits``, kept sorted by t; returns n + 1."""
+def _keep_nearest(hits, n, t, prim, full):
+    """Insert (t, prim) into the first n pairs of ``hits``, kept sorted by t and at most
+    MAX_SHADOW_HITS long (the farthest pair drops out). Returns (n, full): full once a pair
+    was dropped or refused."""
+    if n == MAX_SHADOW_HITS:
+        if t >= hits[2 * (n - 1)]:
+            return n, True
+        n -= 1
+        full = True
     k = n
     while k > 0 and hits[2 * (k - 1)] > t:
         hits[2 * k] = hits[2 * (k - 1)]
@@ -143,17 +150,19 @@ def _insert_hit(hits, n, t, prim):
         k -= 1
     hits[2 * k] = t
     hits[2 * k + 1] = prim
-    return n + 1
+    return n + 1, full
 
 
 @kernel
 def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits):
-    """Every analytic surface crossing on the segment (tmin, tmax), in one walk of the scene
+    """The analytic surface crossings on the segment (tmin, tmax), in one walk of the scene
     BVH, into ``hits`` as (t, primitive) pairs sorted by t: both crossings of a closed body
-    (they are convex: at most two, the second searched from ``step`` past the first). Returns
-    how many; -1 when an opaque surface blocks the segment (the walk stops there and
-    ``hits[1]`` names it); -2 when there are more than the buffer holds."""
+    (they are convex: at most two, the second searched from ``step`` past the first), the
+    nearest MAX_SHADOW_HITS of them. Returns (n, full): full when there were more (walk again
+    from past the last one); n = -1 when an opaque surface blocks the segment (the walk stops
+    there and ``hits[1]`` names it)."""
     n = 0
+    full = False
     n_unbounded = geo.unbounded.shape[0]
     box = geo.node_box
     inv = inverse_direction(d)
@@ -193,17 +202,13 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits):
             continue
         if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT:
             hits[1] = i
-            return -1
-        if n == MAX_SHADOW_HITS:
-            return -2
-        n = _insert_hit(hits, n, t, i)
+            return -1, False
+        n, full = _keep_nearest(hits, n, t, i, full)
         if geo.prim_info[i, PRIM_SOLID]:
             t = hit_analytic(geo, i, o, d, t * (1.0 + 1e-12) + step, tmax)
             if t < INF:
-                if n == MAX_SHADOW_HITS:
-                    return -2
-                n = _insert_hit(hits, n, t, i)
-    return n
+                n, full = _keep_nearest(hits, n, t, i, full)
+    return n, full
 
 
 @kernel
@@ -262,15 +267,16 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
     trans = (1.0, 1.0, 1.0)
     t_from = params.epsilon
     if not has_instances(geo):
-        # one walk gathers every surface on the segment, sorted; surfaces closer than the
-        # stepping below to the previous one are the same crossing (a shared edge) and skipped
-        n = gather_transparent_hits(geo, mats, o, d, params.epsilon, dist, params.epsilon,
-                                    stack, hits)
-        if n == 0:
-            return (1.0, 1.0, 1.0), -1
-        if n == -1:
-            return (0.0, 0.0, 0.0), int(hits[1])
-        if n > 0:
+        # walks gather the surfaces on the segment, sorted, a buffer-full at a time; one
+        # closer than ``epsilon`` to the previous crossing is the same crossing (a shared
+        # edge, a touching pair) and is skipped, as the stepping walk below would
+        for window in range(64):
+            n, full = gather_transparent_hits(geo, mats, o, d, t_from, dist, params.epsilon,
+                                              stack, hits)
+            if n == -1:
+                return (0.0, 0.0, 0.0), int(hits[1])
+            if n == 0 and window == 0:
+                return (1.0, 1.0, 1.0), -1
             for k in range(n):
                 t = hits[2 * k]
                 if t <= t_from:
@@ -281,14 +287,14 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
                 if max(trans[0], max(trans[1], trans[2])) < 1e-4:
                     return (0.0, 0.0, 0.0), -1
                 t_from = t * (1.0 + 1e-12) + params.epsilon
-            return _absorb(mats, scratch, count, dist - t_from, trans), -1
-        # more surfaces than the buffer holds: step from one to the next below
-    else:
-        state = any_occluder(geo, mats, o, d, params.epsilon, dist, stack)
-        if state == 0:
-            return (1.0, 1.0, 1.0), -1
-        if state == 1:
-            return (0.0, 0.0, 0.0), -1
+            if not full:
+                break
+        return _absorb(mats, scratch, count, dist - t_from, trans), -1
+    state = any_occluder(geo, mats, o, d, params.epsilon, dist, stack)
+    if state == 0:
+        return (1.0, 1.0, 1.0), -1
+    if state == 1:
+        return (0.0, 0.0, 0.0), -1
     for _ in range(64):
         t, prim, tri, b1, b2 = closest_hit(geo, o, d, t_from, dist, stack)
         seg_end = t if prim >= 0 else dist
@@ -357,14 +363,19 @@ def direct_light(
     for j in range(lights.shape[0]):
         kind = lights[j, LIGHT_TYPE]
         radiance = vload(lights, j, LIGHT_RADIANCE)
-        if kind == LIGHT_POINT or kind == LIGHT_DISK:
-            n_samples = 1
-            if kind == LIGHT_DISK:
-                n_samples = int(lights[j, LIGHT_SAMPLES])
-            share = 1.0 / n_samples
-            centre = vload(lights, j, LIGHT_POSITION)
-            blocker = -1  # what shadowed this light's previous sample from p
-            for s in range(n_samples):
+        n_samples = int(lights[j, LIGHT_SAMPLES]) if kind == LIGHT_DISK else 1
+        share = 1.0 / n_samples
+        centre = vload(lights, j, LIGHT_POSITION)
+        blocker = -1  # what shadowed this light's previous sample from p
+        for s in range(n_samples):
+            # one shadow ray per sample (one call site: the shadow code is inlined once)
+            if kind == LIGHT_DIRECTIONAL:
+                travel = vload(lights, j, LIGHT_DIRECTION)
+                ldir = (-travel[0], -travel[1], -travel[2])
+                dist = INF
+                tmax = INF
+                weight = 1.0
+            else:
                 target = centre
                 if kind == LIGHT_DISK:
                     cx, cy, m_cols, m_rows = stratum(s, n_samples)
@@ -380,35 +391,20 @@ def direct_light(
                 if dist == 0.0:
                     continue
                 ldir = (to_light[0] / dist, to_light[1] / dist, to_light[2] / dist)
-                if dot(n, ldir) <= 0.0:
-                    continue
-                counters[RAY_SHADOW] += 1
-                vis, found = shadow_transmittance(
-                    geo, mats, params, p, ldir, dist - params.epsilon, media, n_media,
-                    scratch, stack, hits, blocker,
-                )
-                if found >= 0:
-                    blocker = found
-                if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
-                    continue
-                f = _brdf(mats, m, albedo, n, v, ldir)
-                k = share * _falloff(lights, j, dist)
-                r += k * radiance[0] * vis[0] * f[0]
-                g += k * radiance[1] * vis[1] * f[1]
-                b += k * radiance[2] * vis[2] * f[2]
-        else:  # directional
-            ldir = vload(lights, j, LIGHT_DIRECTION)
-            ldir = (-ldir[0], -ldir[1], -ldir[2])
+                tmax = dist - params.epsilon
+                weight = share * _falloff(lights, j, dist)
             if dot(n, ldir) <= 0.0:
                 continue
             counters[RAY_SHADOW] += 1
-            vis, _ = shadow_transmittance(
-                geo, mats, params, p, ldir, INF, media, n_media, scratch, stack, hits, -1
+            vis, found = shadow_transmittance(
+                geo, mats, params, p, ldir, tmax, media, n_media, scratch, stack, hits, blocker,
             )
+            if found >= 0:
+                blocker = found
             if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
                 continue
             f = _brdf(mats, m, albedo, n, v, ldir)
-            r += radiance[0] * vis[0] * f[0]
-            g += radiance[1] * vis[1] * f[1]
-            b += radiance[2] * vis[2] * f[2]
+            r += weight * radiance[0] * vis[0] * f[0]
+            g += weight * radiance[1] * vis[1] * f[1]
+            b += weight * radiance[2] * vis[2] * f[2]
     return (r, g, b)
