@@ -22,7 +22,13 @@ from .layout import (
     TRIANGLE_NORMALS,
 )
 from .mesh import OPAQUE_KT, mesh_closest_hit, mesh_normals, mesh_occlusion
-from .traverse import box_entry, inverse_direction, push_children
+from .traverse import (
+    box_entry,
+    inverse_direction,
+    next_scene_candidate,
+    push_children,
+    start_scene_walk,
+)
 from .vec import normalize
 
 MESH_STACK_BASE = 64  # traversal stack entries [0, 64) for the scene BVH, the rest for meshes
@@ -206,37 +212,15 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
     instances' own BVH up to the nearest hit so far."""
     best_t = tmax
     best = -1
-    n_unbounded = geo.unbounded.shape[0]
-    box = geo.node_box
     inv = inverse_direction(d)
-    top = -1
-    if box.shape[0] > 0:
-        top = 0
-        stack[0] = 0
-    j = 0  # next unbounded primitive
-    leaf = 0  # next entry of the current leaf
+    top = start_scene_walk(geo, stack)
+    j = 0  # the walk's cursor: next unbounded primitive, current leaf, stack top
+    leaf = 0
     leaf_end = 0
     while True:
-        if j < n_unbounded:
-            i = geo.unbounded[j]
-            j += 1
-        elif leaf < leaf_end:
-            i = geo.node_prims[leaf]
-            leaf += 1
-        elif top >= 0:
-            node = stack[top]
-            top -= 1
-            if box_entry(box, node, o, inv, tmin, best_t) == INF:
-                continue
-            count = geo.node_link[node, 1]
-            if count > 0:
-                leaf = geo.node_link[node, 0]
-                leaf_end = leaf + count
-            else:
-                top = push_children(box, geo.node_link, node, o, inv, tmin, best_t,
-                                     stack, top)
-            continue
-        else:
+        i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, best_t, stack, j,
+                                                         leaf, leaf_end, top, True)
+        if i < 0:
             break
         t = hit_analytic(geo, i, o, d, tmin, best_t)
         if t < best_t:

@@ -45,7 +45,7 @@ from .layout import (
 from .media import media_enter, media_leave
 from .mesh import OPAQUE_KT
 from .sampling import concentric_disk, random01, stratum
-from .traverse import box_entry, inverse_direction
+from .traverse import box_entry, inverse_direction, next_scene_candidate, start_scene_walk
 from .vec import dot, madd, normalize, sub, vload
 
 
@@ -84,39 +84,15 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
     stops at the first one); 2: only transparent ones. Analytic shapes first (one call site
     of the intersection routines), then the mesh instances when there are any."""
     seen_transparent = 0
-    n_unbounded = geo.unbounded.shape[0]
-    box = geo.node_box
     inv = inverse_direction(d)
-    top = -1
-    if box.shape[0] > 0:
-        top = 0
-        stack[0] = 0
-    j = 0
+    top = start_scene_walk(geo, stack)
+    j = 0  # the walk's cursor: next unbounded primitive, current leaf, stack top
     leaf = 0
     leaf_end = 0
     while True:
-        if j < n_unbounded:
-            i = geo.unbounded[j]
-            j += 1
-        elif leaf < leaf_end:
-            i = geo.node_prims[leaf]
-            leaf += 1
-        elif top >= 0:
-            node = stack[top]
-            top -= 1
-            if box_entry(box, node, o, inv, tmin, tmax) == INF:
-                continue
-            count = geo.node_link[node, 1]
-            if count > 0:
-                leaf = geo.node_link[node, 0]
-                leaf_end = leaf + count
-            else:
-                top += 1
-                stack[top] = node + 1
-                top += 1
-                stack[top] = geo.node_link[node, 0]
-            continue
-        else:
+        i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, tmax, stack, j,
+                                                         leaf, leaf_end, top, False)
+        if i < 0:
             break
         state = occludes(geo, mats, i, o, d, tmin, tmax)
         if state == 1:
@@ -163,39 +139,15 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits):
     there and ``hits[1]`` names it)."""
     n = 0
     full = False
-    n_unbounded = geo.unbounded.shape[0]
-    box = geo.node_box
     inv = inverse_direction(d)
-    top = -1
-    if box.shape[0] > 0:
-        top = 0
-        stack[0] = 0
-    j = 0
+    top = start_scene_walk(geo, stack)
+    j = 0  # the walk's cursor: next unbounded primitive, current leaf, stack top
     leaf = 0
     leaf_end = 0
     while True:
-        if j < n_unbounded:
-            i = geo.unbounded[j]
-            j += 1
-        elif leaf < leaf_end:
-            i = geo.node_prims[leaf]
-            leaf += 1
-        elif top >= 0:
-            node = stack[top]
-            top -= 1
-            if box_entry(box, node, o, inv, tmin, tmax) == INF:
-                continue
-            count = geo.node_link[node, 1]
-            if count > 0:
-                leaf = geo.node_link[node, 0]
-                leaf_end = leaf + count
-            else:
-                top += 1
-                stack[top] = node + 1
-                top += 1
-                stack[top] = geo.node_link[node, 0]
-            continue
-        else:
+        i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, tmax, stack, j,
+                                                         leaf, leaf_end, top, False)
+        if i < 0:
             break
         t = hit_analytic(geo, i, o, d, tmin, tmax)
         if t == INF:

@@ -70,3 +70,44 @@ def push_children(box, link, node, o, inv, tmin, tmax, stack, top):
             top += 1
             stack[top] = right
     return top
+
+
+@kernel
+def start_scene_walk(geo, stack):
+    """Begin a walk of the scene BVH: its root on the stack; returns the stack top."""
+    if geo.node_box.shape[0] == 0:
+        return -1
+    stack[0] = 0
+    return 0
+
+
+@kernel
+def next_scene_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top, ordered):
+    """The next analytic primitive a ray on (tmin, tmax) may hit: first the unbounded ones,
+    then those of the scene BVH's leaves whose boxes it meets. The walk's state is the cursor
+    (j, leaf, leaf_end, top), passed in and returned with the primitive (-1 when the walk is
+    over). ``ordered`` pushes the nearer child last (closest-hit walks, which pass the nearest
+    hit so far as ``tmax``); any-hit walks skip the ordering."""
+    box = geo.node_box
+    while True:
+        if j < geo.unbounded.shape[0]:
+            return geo.unbounded[j], j + 1, leaf, leaf_end, top
+        if leaf < leaf_end:
+            return geo.node_prims[leaf], j, leaf + 1, leaf_end, top
+        if top < 0:
+            return -1, j, leaf, leaf_end, top
+        node = stack[top]
+        top -= 1
+        if box_entry(box, node, o, inv, tmin, tmax) == INF:
+            continue
+        count = geo.node_link[node, 1]
+        if count > 0:
+            leaf = geo.node_link[node, 0]
+            leaf_end = leaf + count
+        elif ordered:
+            top = push_children(box, geo.node_link, node, o, inv, tmin, tmax, stack, top)
+        else:
+            top += 1
+            stack[top] = node + 1
+            top += 1
+            stack[top] = geo.node_link[node, 0]
