@@ -461,6 +461,26 @@ def test_render_then_stop_keeps_the_partial_picture(make_window, qtbot):
     assert window.save_image(out) and out.exists()
 
 
+def test_a_render_starts_over_the_dimmed_preview(make_window, qtbot):
+    scene = whitted.default_scene().with_settings(width=320, height=320, samples=16)
+    window = make_window(scene=scene)
+    wait_preview(qtbot, window, 0)
+    window.act_render.trigger()
+    active = window.controller.full
+    assert active.backdrop is not None and active.backdrop.shape == (320, 320, 3)
+    assert active.backdrop.max() > 0
+    qtbot.waitUntil(lambda: active.display is not None, timeout=SLOW)
+    window.act_stop.trigger()
+    qtbot.waitUntil(lambda: not window.controller.rendering, timeout=SLOW)
+    stats = window.controller.last_image.meta["stats"]
+    assert 0 < stats.tiles_done < stats.tiles_total
+    # where no tile arrived the picture shows the preview, elsewhere the render
+    missing = window.controller.last_image.pixels.max(axis=2) == 0
+    assert missing.any() and (~missing).any()
+    assert (active.display[missing] == active.backdrop[missing]).all()
+    assert not (active.display[~missing] == active.backdrop[~missing]).all()
+
+
 def test_the_editor_renders_what_whitted_render_renders(make_window, qtbot, tmp_path):
     window = make_window(preview=False)
     window.object_actions["box"].trigger()

@@ -21,6 +21,7 @@ from ..render.api import Progress, RenderJob, available_threads, warm_up_kernels
 from ..scene import Scene
 
 POLL_MS = 25
+BACKDROP_DIM = 0.6  # the preview under unrendered tiles, dimmed so the finished ones stand out
 #: preview pixel budget: starts here, adapts so that a preview takes about PREVIEW_TARGET_S
 PREVIEW_PIXELS = 160 * 120
 PREVIEW_MIN_PIXELS, PREVIEW_MAX_PIXELS = 64 * 48, 480 * 360
@@ -65,7 +66,8 @@ class _Active:
     first_pixels: float | None = None
     #: tiles finished since the last poll (appended by the render threads)
     new_tiles: deque = field(default_factory=deque)
-    display: np.ndarray | None = None  # uint8 display values, updated band by band
+    display: np.ndarray | None = None  # uint8 display values, updated tile by tile
+    backdrop: np.ndarray | None = None  # shown where no tile has arrived yet (the preview)
 
     def on_progress(self, p: Progress) -> None:
         """Called on a render thread: only plain stores and a deque append."""
@@ -73,22 +75,18 @@ class _Active:
         self.latest = p
 
     def display_image(self) -> QImage:
-        """The display picture, re-encoding only the rows of the tiles finished since the
-        last call (the whole frame once at the start)."""
+        """The display picture: the dimmed preview (or black) where no tile has arrived yet,
+        re-encoding only the tiles finished since the last call."""
         job = self.job
         s = job.settings
         fb = job.framebuffer
         if self.display is None:
-            self.display = np.zeros(fb.shape, np.uint8)
-        rows: list[np.ndarray] = []
+            fits = self.backdrop is not None and self.backdrop.shape == fb.shape
+            self.display = self.backdrop.copy() if fits else np.zeros(fb.shape, np.uint8)
         while self.new_tiles:
-            rows.append(self.new_tiles.popleft())
-        if rows:
-            tiles = np.concatenate(rows)
-            if len(tiles):
-                y0, y1 = int(tiles[:, 1].min()), int(tiles[:, 3].max())
-                self.display[y0:y1] = encode_ldr(fb[y0:y1], transfer=s.transfer,
-                                                 tonemap=s.tonemap)
+            for x0, y0, x1, y1 in self.new_tiles.popleft():
+                self.display[y0:y1, x0:x1] = encode_ldr(fb[y0:y1, x0:x1], transfer=s.transfer,
+                                                        tonemap=s.tonemap)
         return qimage_of(self.display)
 
 
@@ -152,6 +150,7 @@ class RenderController(QObject):
         self._cancel_preview()
         self._pending = None
         active = _Active(RenderJob(scene, progress=None), "render", time.perf_counter(), scene)
+        active.backdrop = self._backdrop(scene)
         active.job.progress = active.on_progress
         self.full = active
         self.first_pixels_seconds = None
@@ -159,6 +158,18 @@ class RenderController(QObject):
         self._poll.start()
         self.started.emit("render")
         return active.job
+
+    def _backdrop(self, scene: Scene) -> np.ndarray | None:
+        """The last preview scaled to the render's size and dimmed, to show under the tiles
+        a render has not reached yet (None before any preview)."""
+        preview = self.last_preview
+        if preview is None:
+            return None
+        s = scene.render
+        small = encode_ldr(preview.pixels, transfer=s.transfer, tonemap=s.tonemap)
+        ys = np.arange(s.height) * small.shape[0] // s.height
+        xs = np.arange(s.width) * small.shape[1] // s.width
+        return (small[ys][:, xs] * BACKDROP_DIM).astype(np.uint8)
 
     def stop(self) -> None:
         """Stop the full render after the tiles in flight; the picture so far is kept."""
