@@ -40,7 +40,9 @@ from .layout import (
     MAT_SPECULAR,
     PRIM_MATERIAL,
     PRIM_SOLID,
+    PRIM_TYPE,
     RAY_SHADOW,
+    SHAPE_TRIANGLE,
 )
 from .media import media_enter, media_leave
 from .mesh import OPAQUE_KT
@@ -156,7 +158,9 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits):
             hits[1] = i
             return -1, False
         n, full = _keep_nearest(hits, n, t, i, full)
-        if geo.prim_info[i, PRIM_SOLID]:
+        # a closed analytic body is crossed twice (the triangles of a flattened solid mesh
+        # are each crossed once: their body's other side is other triangles)
+        if geo.prim_info[i, PRIM_SOLID] and geo.prim_info[i, PRIM_TYPE] != SHAPE_TRIANGLE:
             t = hit_analytic(geo, i, o, d, t * (1.0 + 1e-12) + step, tmax)
             if t < INF:
                 n, full = _keep_nearest(hits, n, t, i, full)
