@@ -213,10 +213,7 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
     best_t = tmax
     best = -1
     inv = inverse_direction(d)
-    top = start_scene_walk(geo, stack)
-    j = 0  # the walk's cursor: next unbounded primitive, current leaf, stack top
-    leaf = 0
-    leaf_end = 0
+    j, leaf, leaf_end, top = start_scene_walk(geo, stack)
     while True:
         i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, best_t, stack, j,
                                                          leaf, leaf_end, top, True)

@@ -87,10 +87,7 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
     of the intersection routines), then the mesh instances when there are any."""
     seen_transparent = 0
     inv = inverse_direction(d)
-    top = start_scene_walk(geo, stack)
-    j = 0  # the walk's cursor: next unbounded primitive, current leaf, stack top
-    leaf = 0
-    leaf_end = 0
+    j, leaf, leaf_end, top = start_scene_walk(geo, stack)
     while True:
         i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, tmax, stack, j,
                                                          leaf, leaf_end, top, False)
@@ -142,10 +139,7 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits):
     n = 0
     full = False
     inv = inverse_direction(d)
-    top = start_scene_walk(geo, stack)
-    j = 0  # the walk's cursor: next unbounded primitive, current leaf, stack top
-    leaf = 0
-    leaf_end = 0
+    j, leaf, leaf_end, top = start_scene_walk(geo, stack)
     while True:
         i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, tmax, stack, j,
                                                          leaf, leaf_end, top, False)

@@ -74,11 +74,12 @@ def push_children(box, link, node, o, inv, tmin, tmax, stack, top):
 
 @kernel
 def start_scene_walk(geo, stack):
-    """Begin a walk of the scene BVH: its root on the stack; returns the stack top."""
+    """Begin a walk of the scene BVH: its root on the stack. Returns the cursor
+    (j, leaf, leaf_end, top) that :func:`next_scene_candidate` takes."""
     if geo.node_box.shape[0] == 0:
-        return -1
+        return 0, 0, 0, -1
     stack[0] = 0
-    return 0
+    return 0, 0, 0, 0
 
 
 @kernel
