@@ -77,7 +77,7 @@ def schlick(cos_i, n1, n2, cos_t):
     return r0 + (1.0 - r0) * x * x * x * x * x
 
 
-@kernel
+@kernel(inline="always")
 def surface_colour(geo, mats, m, prim, tri, b1, b2, p):
     """(texture factor, diffuse colour) at a hit: the material's colour times its texture's
     value at the point's (u, v); the factor is white when the material has no texture."""
@@ -107,9 +107,9 @@ def _push(st_f, st_i, top, o, d, w, depth, media_src, n_media):
     return top
 
 
-@kernel
+@kernel(inline="always")
 def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media, scratch,
-               stack, hits, counters):
+               stack, hits, listed, counters):
     """Radiance arriving along the camera ray (o, d) with unit d: I = ka·Ia + direct light +
     kr·Ir + kt·It, the secondary terms traced while their weight stays above min_weight."""
     r = 0.0
@@ -156,7 +156,7 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
         ka = mats[m, MAT_KA]
         amb = params.ambient
         local = direct_light(geo, mats, lights, params, p, n_shade, v, m, albedo, media,
-                             n_media, scratch, stack, hits, counters,
+                             n_media, scratch, stack, hits, listed, counters,
                              (pixel, sample, 2 + vertex * RNG_DIMS_PER_HIT))
         vertex += 1
         r += w[0] * (ka * amb[0] * tex[0] * mats[m, MAT_AMBIENT] + local[0])

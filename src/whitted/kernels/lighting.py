@@ -106,6 +106,77 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
 
 
 MAX_SHADOW_HITS = 32  # transparent surfaces one shadow ray gathers in one walk (hits buffer)
+SHADOW_LIST_CAP = 48  # primitives a soft-shadow bundle may list; past that its rays walk the BVH
+MIN_BUNDLE_SAMPLES = 4  # area lights with fewer samples per point skip the bundle listing
+
+
+@kernel(inline="always")
+def _cone_meets_box(box, node, p, axis, radius):
+    """Could the cone from apex ``p`` to the ball of ``radius`` around ``p + axis`` (which
+    holds an area light's disk) meet box ``node``? Conservative: the cone's cross-section at
+    parameter t along the axis, a disk of radius t·radius, is widened to the square of that
+    half-width, and the box test becomes six linear bounds on t in [0, 1]."""
+    t_lo = 0.0
+    t_hi = 1.0
+    for k in range(3):
+        lo = box[node, 0, k] - p[k]
+        hi = box[node, 1, k] - p[k]
+        a = axis[k] + radius  # the square's far edge reaches the box's low face: t·a >= lo
+        if a > 0.0:
+            t_lo = max(t_lo, lo / a)
+        elif a < 0.0:
+            t_hi = min(t_hi, lo / a)
+        elif lo > 0.0:
+            return False
+        b = axis[k] - radius  # its near edge stays below the box's high face: t·b <= hi
+        if b > 0.0:
+            t_hi = min(t_hi, hi / b)
+        elif b < 0.0:
+            t_lo = max(t_lo, hi / b)
+        elif hi < 0.0:
+            return False
+    # the relative slack keeps flat boxes (a rectangle in a plane) in
+    return t_lo <= t_hi * (1.0 + 1e-9) + 1e-12
+
+
+@kernel(inline="always")
+def list_bundle_occluders(geo, p, axis, radius, stack, listed):
+    """Every analytic primitive that could block a ray from ``p`` to the ball of ``radius``
+    around ``p + axis`` (an area light seen from a shaded point): the unbounded ones, and
+    those in the scene BVH's leaves whose boxes meet the cone of such rays. They go into
+    ``listed``; returns their count, or -1 when there are more than SHADOW_LIST_CAP (the
+    bundle's rays then walk the BVH one by one). The shadow rays of the bundle test only the
+    listed primitives: the same hits as a walk, found without one."""
+    n = 0
+    for j in range(geo.unbounded.shape[0]):
+        if n == SHADOW_LIST_CAP:
+            return -1
+        listed[n] = geo.unbounded[j]
+        n += 1
+    if geo.node_box.shape[0] == 0:
+        return n
+    radius = radius * (1.0 + 1e-7) + 1e-12
+    top = 0
+    stack[0] = 0
+    while top >= 0:
+        node = stack[top]
+        top -= 1
+        if not _cone_meets_box(geo.node_box, node, p, axis, radius):
+            continue
+        count = geo.node_link[node, 1]
+        if count == 0:
+            top += 1
+            stack[top] = node + 1
+            top += 1
+            stack[top] = geo.node_link[node, 0]
+            continue
+        if n + count > SHADOW_LIST_CAP:
+            return -1
+        first = geo.node_link[node, 0]
+        for leaf in range(first, first + count):
+            listed[n] = geo.node_prims[leaf]
+            n += 1
+    return n
 
 
 @kernel
@@ -128,23 +199,31 @@ def _keep_nearest(hits, n, t, prim, full):
     return n + 1, full
 
 
-@kernel
-def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits):
+@kernel(inline="always")
+def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, listed, n_listed):
     """The analytic surface crossings on the segment (tmin, tmax), in one walk of the scene
-    BVH, into ``hits`` as (t, primitive) pairs sorted by t: both crossings of a closed body
-    (they are convex: at most two, the second searched from ``step`` past the first), the
-    nearest MAX_SHADOW_HITS of them. Returns (n, full): full when there were more (walk again
-    from past the last one); n = -1 when an opaque surface blocks the segment (the walk stops
-    there and ``hits[1]`` names it)."""
+    BVH (or, when ``n_listed`` >= 0, of the primitives ``listed[:n_listed]``), into ``hits``
+    as (t, primitive) pairs sorted by t: both crossings of a closed body (they are convex: at
+    most two, the second searched from ``step`` past the first), the nearest MAX_SHADOW_HITS
+    of them. Returns (n, full): full when there were more (walk again from past the last one);
+    n = -1 when an opaque surface blocks the segment (the walk stops there and ``hits[1]``
+    names it)."""
     n = 0
     full = False
     inv = inverse_direction(d)
     j, leaf, leaf_end, top = start_scene_walk(geo, stack)
+    k = 0
     while True:
-        i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, tmax, stack, j,
-                                                         leaf, leaf_end, top, False)
-        if i < 0:
-            break
+        if n_listed >= 0:
+            if k == n_listed:
+                break
+            i = listed[k]
+            k += 1
+        else:
+            i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, tmax, stack,
+                                                             j, leaf, leaf_end, top, False)
+            if i < 0:
+                break
         t = hit_analytic(geo, i, o, d, tmin, tmax)
         if t == INF:
             continue
@@ -192,9 +271,9 @@ def _absorb(mats, scratch, count, length, trans):
             trans[2] * math.exp(-mats[m, MAT_ATTEN + 2] * length))
 
 
-@kernel
+@kernel(inline="always")
 def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch, stack, hits,
-                         blocker):
+                         blocker, listed, n_listed):
     """Fraction of light (per channel) that reaches ``o`` from ``dist`` along unit ``d``.
 
     The segment starts at ``epsilon`` along the ray (not offset along the normal), so a
@@ -207,8 +286,9 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
 
     ``blocker`` (or -1) is an opaque analytic primitive that blocked a previous shadow ray
     from the same point (the next sample of the same area light, say): it is tried first, and
-    when it blocks this ray too no walk is needed. Returns (transmittance, the opaque
-    primitive that blocked the ray or -1)."""
+    when it blocks this ray too no walk is needed. When ``n_listed`` >= 0, the ray's possible
+    occluders are ``listed[:n_listed]`` (see :func:`list_bundle_occluders`) and no BVH walk is
+    made. Returns (transmittance, the opaque primitive that blocked the ray or -1)."""
     if blocker >= 0 and hit_analytic(geo, blocker, o, d, params.epsilon, dist) < INF:
         return (0.0, 0.0, 0.0), blocker
     for k in range(n_media):
@@ -222,7 +302,7 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
         # edge, a touching pair) and is skipped, as the stepping walk below would
         for window in range(64):
             n, full = gather_transparent_hits(geo, mats, o, d, t_from, dist, params.epsilon,
-                                              stack, hits)
+                                              stack, hits, listed, n_listed)
             if n == -1:
                 return (0.0, 0.0, 0.0), int(hits[1])
             if n == 0 and window == 0:
@@ -296,10 +376,10 @@ def _brdf(mats, m, albedo, n, v, ldir):
     )
 
 
-@kernel
+@kernel(inline="always")
 def direct_light(
     geo, mats, lights, params, p, n, v, m, albedo, media, n_media, scratch, stack, hits,
-    counters, rng
+    listed, counters, rng
 ):
     """Light reflected toward ``v`` at point ``p`` with shading normal ``n`` (facing ``v``) by
     every non-ambient light; ``albedo`` is the diffuse colour there. ``rng`` = (pixel, sample,
@@ -317,6 +397,10 @@ def direct_light(
         share = 1.0 / n_samples
         centre = vload(lights, j, LIGHT_POSITION)
         blocker = -1  # what shadowed this light's previous sample from p
+        n_listed = -1  # the samples' shared list of possible occluders (-1: none, walk)
+        if kind == LIGHT_DISK and n_samples >= MIN_BUNDLE_SAMPLES and not has_instances(geo):
+            n_listed = list_bundle_occluders(geo, p, sub(centre, p), lights[j, LIGHT_RADIUS],
+                                             stack, listed)
         for s in range(n_samples):
             # one shadow ray per sample (one call site: the shadow code is inlined once)
             if kind == LIGHT_DIRECTIONAL:
@@ -348,6 +432,7 @@ def direct_light(
             counters[RAY_SHADOW] += 1
             vis, found = shadow_transmittance(
                 geo, mats, params, p, ldir, tmax, media, n_media, scratch, stack, hits, blocker,
+                listed, n_listed,
             )
             if found >= 0:
                 blocker = found

@@ -20,7 +20,7 @@ from .layout import (
     PRIM_OBJECT,
     RAY_PRIMARY,
 )
-from .lighting import MAX_SHADOW_HITS
+from .lighting import MAX_SHADOW_HITS, SHADOW_LIST_CAP
 from .sampling import random01, stratum
 from .vec import madd, normalize
 
@@ -29,7 +29,8 @@ BVH_STACK = 128
 
 def lane_workspace(max_depth: int):
     """Scratch arrays one lane reuses for every ray: the ray stack (float and int parts), two
-    media lists, the BVH traversal stack and a shadow ray's sorted surface hits. Allocated in
+    media lists, the BVH traversal stack, a shadow ray's sorted surface hits and the list of
+    what may block an area light's bundle of shadow rays. Allocated in
     Python: the kernels run without the Numba runtime's reference counting, which would
     otherwise cost a third of the time."""
     return (
@@ -39,6 +40,7 @@ def lane_workspace(max_depth: int):
         np.empty(MAX_MEDIA, np.int32),
         np.empty(BVH_STACK, np.int32),
         np.empty(2 * MAX_SHADOW_HITS),
+        np.empty(SHADOW_LIST_CAP, np.int32),
     )
 
 
@@ -65,7 +67,7 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
     the lane's scratch memory from :func:`lane_workspace`."""
     n_tiles = tiles.shape[0]
     spp = params.samples
-    st_f, st_i, media, scratch, stack, hits = work
+    st_f, st_i, media, scratch, stack, hits, listed = work
     for t in range(lane, n_tiles, lanes):
         cnt = counters[t]
         for py in range(tiles[t, 1], tiles[t, 3]):
@@ -85,7 +87,7 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
                     o, d = camera_ray(params, px + jx, py + jy)
                     cnt[RAY_PRIMARY] += 1
                     c = trace_path(geo, mats, lights, params, o, d, pixel, s, st_f, st_i,
-                                   media, scratch, stack, hits, cnt)
+                                   media, scratch, stack, hits, listed, cnt)
                     r += c[0]
                     g += c[1]
                     b += c[2]

@@ -47,7 +47,7 @@ def box_entry(box, node, o, inv, tmin, tmax):
     return tn
 
 
-@kernel
+@kernel(inline="always")
 def push_children(box, link, node, o, inv, tmin, tmax, stack, top):
     """Push the children of interior ``node`` that the ray meets, the farther one first so
     the nearer one is visited next; returns the new stack top."""

@@ -1,0 +1,135 @@
+"""Soft shadows test each area-light sample only against the primitives listed for the
+shaded point's bundle of shadow rays: the list must hold every primitive any of those rays
+can hit (else a shadow would be lost), and should leave out the rest (the speed-up)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numba import njit
+
+import whitted
+from meshgen import uv_sphere
+from whitted.compile.flatten import compile_scene
+from whitted.kernels.accel import hit_analytic
+from whitted.kernels.intersect import INF
+from whitted.kernels.lighting import SHADOW_LIST_CAP, _cone_meets_box, list_bundle_occluders
+
+
+@njit(cache=False)
+def _audit_bundles(geo, points, centre, u_axis, v_axis, radius, n_rays, seed):
+    """For each point: the length of its list (-1: too many), and how many primitives one
+    of its shadow rays to a random point of the disk hits without their being listed."""
+    np.random.seed(seed)
+    stack = np.empty(128, np.int32)
+    listed = np.empty(SHADOW_LIST_CAP, np.int32)
+    n_prims = geo.prim_info.shape[0]
+    counts = np.empty(points.shape[0], np.int64)
+    unlisted = 0
+    for k in range(points.shape[0]):
+        p = (points[k, 0], points[k, 1], points[k, 2])
+        axis = (centre[0] - p[0], centre[1] - p[1], centre[2] - p[2])
+        n = list_bundle_occluders(geo, p, axis, radius, stack, listed)
+        counts[k] = n
+        if n < 0:
+            continue
+        for _ in range(n_rays):
+            rr = radius * math.sqrt(np.random.random())
+            phi = 2.0 * math.pi * np.random.random()
+            a = rr * math.cos(phi)
+            b = rr * math.sin(phi)
+            d = (centre[0] + a * u_axis[0] + b * v_axis[0] - p[0],
+                 centre[1] + a * u_axis[1] + b * v_axis[1] - p[1],
+                 centre[2] + a * u_axis[2] + b * v_axis[2] - p[2])
+            dist = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+            d = (d[0] / dist, d[1] / dist, d[2] / dist)
+            for i in range(n_prims):
+                if hit_analytic(geo, i, p, d, 1e-9, dist) == INF:
+                    continue
+                found = False
+                for j in range(n):
+                    if listed[j] == i:
+                        found = True
+                if not found:
+                    unlisted += 1
+    return counts, unlisted
+
+
+def _cluttered_scene():
+    rng = np.random.default_rng(7)
+    objects = [whitted.Plane(point=(0, 0, 0), normal=(0, 1, 0))]
+    for _ in range(14):
+        c = rng.uniform((-4, 0.2, -4), (4, 3, 4))
+        objects.append(whitted.Sphere(center=tuple(c), radius=float(rng.uniform(0.2, 0.7))))
+    for _ in range(4):
+        c = rng.uniform((-4, 0.5, -4), (4, 2, 4))
+        objects.append(whitted.Box(
+            min=(-0.4, -0.3, -0.5), max=(0.4, 0.3, 0.5),
+            transform=whitted.Transform(rotate=tuple(rng.uniform(-60, 60, 3)),
+                                        translate=tuple(c))))
+    verts, faces = uv_sphere(8, 12)
+    objects.append(whitted.Mesh(vertices=verts * 0.8 + (1.0, 1.2, -1.0), faces=faces))
+    objects.append(whitted.Rectangle(corner=(-1, 2.5, 2), edge1=(1.5, 0, 0), edge2=(0, 0.2, 1)))
+    return whitted.Scene(objects=objects, lights=[])
+
+
+def test_every_primitive_a_bundle_ray_hits_is_listed():
+    compiled = compile_scene(_cluttered_scene())
+    rng = np.random.default_rng(3)
+    # shaded points on the ground and in the air among the objects
+    points = rng.uniform((-5, 0.0, -5), (5, 3.0, 5), (400, 3))
+    points[:200, 1] = 0.0
+    centre = np.array([-1.0, 6.0, 1.5])
+    counts, unlisted = _audit_bundles(compiled.geometry, points, centre, np.array([1.0, 0, 0]),
+                                      np.array([0, 0, 1.0]), 1.5, 64, 11)
+    assert unlisted == 0
+    n_prims = compiled.geometry.prim_info.shape[0]
+    listed = counts[counts >= 0]
+    assert len(listed) > 300  # the lists rarely overflow here
+    # ...and they prune: a point sees far fewer candidates than the scene has primitives
+    assert n_prims > 150 and np.median(listed) < 10
+
+
+def test_a_clear_point_lists_only_the_unbounded_planes():
+    scene = whitted.Scene(objects=[whitted.Plane(point=(0, 0, 0), normal=(0, 1, 0)),
+                                   whitted.Sphere(center=(5, 1, 0), radius=1)], lights=[])
+    compiled = compile_scene(scene)
+    counts, unlisted = _audit_bundles(
+        compiled.geometry, np.array([[-5.0, 0.0, 0.0], [5.0, 0.0, 0.0]]),
+        np.array([-5.0, 5.0, 0.0]), np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), 1.0, 16, 1)
+    assert counts.tolist() == [1, 2]  # the plane alone; the plane and the sphere overhead
+    assert unlisted == 0
+
+
+coords = st.floats(-3.0, 3.0, allow_nan=False)
+
+
+@settings(max_examples=300, deadline=None)
+@given(p=st.tuples(coords, coords, coords), axis=st.tuples(coords, coords, coords),
+       radius=st.floats(0.0, 2.0), lo=st.tuples(coords, coords, coords),
+       size=st.tuples(st.floats(0, 2), st.floats(0, 2), st.floats(0, 2)),
+       t=st.floats(0.0, 1.0), u=st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(-1, 1)))
+def test_cone_box_test_never_misses_a_box_the_cone_enters(p, axis, radius, lo, size, t, u):
+    """A point of the cone (apex p, ball of ``radius`` around p + axis) inside the box means
+    the test must say the cone meets it."""
+    norm = math.sqrt(sum(c * c for c in u))
+    if norm > 1.0:
+        u = tuple(c / norm for c in u)
+    x = tuple(p[k] + t * (axis[k] + radius * u[k]) for k in range(3))
+    box = np.array([[lo, tuple(lo[k] + size[k] for k in range(3))]])
+    inside = all(box[0, 0, k] <= x[k] <= box[0, 1, k] for k in range(3))
+    if inside:
+        assert _cone_meets_box(box, 0, p, axis, radius)
+
+
+def test_cone_box_test_rejects_boxes_off_the_cone():
+    box = np.array([[(4.0, 8.0, -1.0), (5.0, 10.0, 1.0)]])
+    # a thin cone along +y from the origin passes far from a box at x = 4..5, y = 8..10
+    assert not _cone_meets_box(box, 0, (0.0, 0.0, 0.0), (0.0, 10.0, 0.0), 1.0)
+    # widened to radius 5 at its base (4.5 at y = 9), it reaches it
+    assert _cone_meets_box(box, 0, (0.0, 0.0, 0.0), (0.0, 10.0, 0.0), 5.0)
+    # behind the apex there is nothing
+    assert not _cone_meets_box(box, 0, (6.0, 0.0, 0.0), (10.0, 0.0, 0.0), 1.0)
