@@ -168,7 +168,8 @@ def test_every_shape_light_and_texture_is_written(tmp_path):
     sdl = scene_to_pov(every_shape_scene(tmp_path))
     for keyword in ("plane {", "sphere {", "box { <0, 0, 0>, <1, 1, 1> matrix", "cylinder {",
                     "cone {", " open", "disc {", "mesh {", "mesh2 {", "uv_vectors",
-                    "normal_vectors", "inside_vector", "area_light", "circular", "parallel",
+                    "normal_vectors", "inside_vector", "area_light", "circular",
+                    "area_illumination on", "parallel",
                     "fade_power 2", "fade_power 1 ", "uv_mapping image_map", "checker",
                     "gradient y", "phong 0.5 phong_size 32", "ambient rgb <0.25, 0, 0>",
                     "fade_power 1001"):

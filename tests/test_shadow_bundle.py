@@ -18,21 +18,25 @@ from whitted.kernels.accel import hit_analytic
 from whitted.kernels.intersect import INF
 from whitted.kernels.lighting import SHADOW_LIST_CAP, _cone_meets_box, list_bundle_occluders
 
+EPS = 1e-6  # the shadow rays' tmin
+
 
 @njit(cache=False)
-def _audit_bundles(geo, points, centre, u_axis, v_axis, radius, n_rays, seed):
-    """For each point: the length of its list (-1: too many), and how many primitives one
-    of its shadow rays to a random point of the disk hits without their being listed."""
+def _audit_bundles(geo, mats, points, centre, u_axis, v_axis, radius, n_rays, seed):
+    """For each point: the length of its list (-1: too many) and whether all it lists are
+    opaque, and how many primitives one of its shadow rays to a random point of the disk hits
+    (beyond EPS) without their being listed."""
     np.random.seed(seed)
     stack = np.empty(128, np.int32)
     listed = np.empty(SHADOW_LIST_CAP, np.int32)
     n_prims = geo.prim_info.shape[0]
     counts = np.empty(points.shape[0], np.int64)
+    opaque = np.empty(points.shape[0], np.bool_)
     unlisted = 0
     for k in range(points.shape[0]):
         p = (points[k, 0], points[k, 1], points[k, 2])
-        axis = (centre[0] - p[0], centre[1] - p[1], centre[2] - p[2])
-        n = list_bundle_occluders(geo, p, axis, radius, stack, listed)
+        c = (centre[0], centre[1], centre[2])
+        n, opaque[k] = list_bundle_occluders(geo, mats, p, c, radius, EPS, stack, listed)
         counts[k] = n
         if n < 0:
             continue
@@ -47,7 +51,7 @@ def _audit_bundles(geo, points, centre, u_axis, v_axis, radius, n_rays, seed):
             dist = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
             d = (d[0] / dist, d[1] / dist, d[2] / dist)
             for i in range(n_prims):
-                if hit_analytic(geo, i, p, d, 1e-9, dist) == INF:
+                if hit_analytic(geo, i, p, d, EPS, dist - EPS) == INF:
                     continue
                 found = False
                 for j in range(n):
@@ -55,7 +59,7 @@ def _audit_bundles(geo, points, centre, u_axis, v_axis, radius, n_rays, seed):
                         found = True
                 if not found:
                     unlisted += 1
-    return counts, unlisted
+    return counts, opaque, unlisted
 
 
 def _cluttered_scene():
@@ -83,8 +87,9 @@ def test_every_primitive_a_bundle_ray_hits_is_listed():
     points = rng.uniform((-5, 0.0, -5), (5, 3.0, 5), (400, 3))
     points[:200, 1] = 0.0
     centre = np.array([-1.0, 6.0, 1.5])
-    counts, unlisted = _audit_bundles(compiled.geometry, points, centre, np.array([1.0, 0, 0]),
-                                      np.array([0, 0, 1.0]), 1.5, 64, 11)
+    counts, _, unlisted = _audit_bundles(compiled.geometry, compiled.materials, points, centre,
+                                         np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), 1.5, 64,
+                                         11)
     assert unlisted == 0
     n_prims = compiled.geometry.prim_info.shape[0]
     listed = counts[counts >= 0]
@@ -93,15 +98,29 @@ def test_every_primitive_a_bundle_ray_hits_is_listed():
     assert n_prims > 150 and np.median(listed) < 10
 
 
-def test_a_clear_point_lists_only_the_unbounded_planes():
-    scene = whitted.Scene(objects=[whitted.Plane(point=(0, 0, 0), normal=(0, 1, 0)),
-                                   whitted.Sphere(center=(5, 1, 0), radius=1)], lights=[])
+def test_planes_the_light_and_the_point_are_clear_of_are_left_out():
+    scene = whitted.Scene(
+        objects=[whitted.Plane(point=(0, 0, 0), normal=(0, 1, 0)),
+                 whitted.Plane(point=(0, 0, -3), normal=(0, 0, 1)),  # a wall behind
+                 whitted.Sphere(center=(5, 1, 0), radius=1, material="glass")],
+        materials={"glass": whitted.Material(preset="glass")}, lights=[])
     compiled = compile_scene(scene)
-    counts, unlisted = _audit_bundles(
-        compiled.geometry, np.array([[-5.0, 0.0, 0.0], [5.0, 0.0, 0.0]]),
-        np.array([-5.0, 5.0, 0.0]), np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), 1.0, 16, 1)
-    assert counts.tolist() == [1, 2]  # the plane alone; the plane and the sphere overhead
+    points = np.array([[-5.0, 0.0, 0.0],  # on the floor, nothing overhead
+                       [-5.0, -1e-12, 0.0],  # a hair under it (rounding): the same
+                       [5.0, 0.0, 0.0],  # under the glass sphere
+                       [-5.0, 1.0, -4.0],  # behind the wall: the wall is in the way
+                       [-5.0, -1.0, 0.0]])  # under the floor: the floor is in the way
+    counts, opaque, unlisted = _audit_bundles(
+        compiled.geometry, compiled.materials, points, np.array([-5.0, 5.0, 0.0]),
+        np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), 1.0, 16, 1)
+    assert counts.tolist() == [0, 0, 1, 1, 1]
+    assert opaque.tolist()[2:] == [False, True, True]  # the sphere is glass
     assert unlisted == 0
+    # a light straddling the wall's plane keeps the wall listed
+    counts, _, unlisted = _audit_bundles(
+        compiled.geometry, compiled.materials, points[:1], np.array([-5.0, 5.0, -3.0]),
+        np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), 1.0, 16, 1)
+    assert counts.tolist() == [1] and unlisted == 0
 
 
 coords = st.floats(-3.0, 3.0, allow_nan=False)

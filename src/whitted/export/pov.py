@@ -16,7 +16,9 @@ How the Whitted model maps onto POV-Ray's (see docs/scene-format.md for ours):
   (POV-Ray multiplies it by the pigment, i.e. Cd);
 - point light → ``light_source``; directional → ``parallel`` light far up-stream; disk →
   ``area_light`` with ``circular`` over the disk's own plane (a fixed disk, as ours, rather
-  than ``orient``, which would turn it to face every shaded point), n×n ≈ samples, ``jitter``;
+  than ``orient``, which would turn it to face every shaded point), n×n ≈ samples, ``jitter``,
+  ``area_illumination on`` (each sample shades the point from its own direction, as ours do;
+  without it POV-Ray shades from the disk's centre and samples only the shadow);
 - falloff ``linear`` (dist_scale/d) and ``inverse_square`` (1/d²): POV-Ray fades by
   2 / (1 + (d/fade_distance)^fade_power); with a fade_distance 1e-5 of the
   light's distance to the camera and the colour scaled to match, that is ours to 1e-5;
@@ -320,7 +322,8 @@ class _PovWriter:
             n = max(1, round(math.sqrt(samples)))
             u, v = _perpendicular_basis(light.normal)
             extra.insert(0, f"area_light {mirrored(u * 2 * light.radius)}, "
-                            f"{mirrored(v * 2 * light.radius)}, {n}, {n} circular jitter")
+                            f"{mirrored(v * 2 * light.radius)}, {n}, {n} circular jitter "
+                            "area_illumination on")
         return (f"light_source {{ {mirrored(position)} {_colour(radiance)}"
                 + "".join(f"\n  {e}" for e in extra) + " }")
 

@@ -41,7 +41,9 @@ from .layout import (
     PRIM_MATERIAL,
     PRIM_SOLID,
     PRIM_TYPE,
+    PRIM_XFORM,
     RAY_SHADOW,
+    SHAPE_PLANE,
     SHAPE_TRIANGLE,
 )
 from .media import media_enter, media_leave
@@ -139,22 +141,75 @@ def _cone_meets_box(box, node, p, axis, radius):
     return t_lo <= t_hi * (1.0 + 1e-9) + 1e-12
 
 
+@kernel
+def _plane_clear_of_bundle(P, i, p, centre, radius, tmin):
+    """True when no ray from ``p`` to the ball of ``radius`` around ``centre`` can meet plane
+    primitive ``i`` beyond ``tmin``: the ball lies wholly on one side and ``p`` on the same
+    side, or so close to the plane that the crossing comes before ``tmin`` (a point on the
+    plane itself, shaded on the side facing the light)."""
+    nrm = vload(P, i, 3)
+    s_p = dot(sub(p, vload(P, i, 0)), nrm)
+    s_c = dot(sub(centre, vload(P, i, 0)), nrm)
+    if s_c < 0.0:  # look from the light's side
+        s_p = -s_p
+        s_c = -s_c
+    s_min = s_c - radius
+    if s_min <= 0.0:
+        return False  # the light straddles the plane
+    if s_p >= 0.0:
+        return True
+    reach = math.sqrt(dot(sub(centre, p), sub(centre, p))) + radius
+    return -s_p * reach < 0.5 * tmin * (s_min - s_p)
+
+
 @kernel(inline="always")
-def list_bundle_occluders(geo, p, axis, radius, stack, listed):
+def list_bundle_occluders(geo, mats, p, centre, radius, tmin, stack, listed):
     """Every analytic primitive that could block a ray from ``p`` to the ball of ``radius``
-    around ``p + axis`` (an area light seen from a shaded point): the unbounded ones, and
-    those in the scene BVH's leaves whose boxes meet the cone of such rays. They go into
-    ``listed``; returns their count, or -1 when there are more than SHADOW_LIST_CAP (the
-    bundle's rays then walk the BVH one by one). The shadow rays of the bundle test only the
-    listed primitives: the same hits as a walk, found without one."""
+    around ``centre`` (an area light seen from a shaded point) beyond ``tmin``: the unbounded
+    ones the light does not lie clear of, and those in the scene BVH's leaves whose boxes meet
+    the cone of such rays. They go into ``listed``. Returns (their count, whether all are
+    opaque); the count is -1 when there are more than SHADOW_LIST_CAP (the bundle's rays then
+    walk the BVH one by one). The shadow rays of the bundle test only the listed primitives:
+    the same hits as a walk, found without one."""
     n = 0
+    opaque = True
     for j in range(geo.unbounded.shape[0]):
+        i = geo.unbounded[j]
+        if (geo.prim_info[i, PRIM_TYPE] == SHAPE_PLANE and geo.prim_info[i, PRIM_XFORM] < 0
+                and _plane_clear_of_bundle(geo.prim_params, i, p, centre, radius, tmin)):
+            continue
         if n == SHADOW_LIST_CAP:
-            return -1
-        listed[n] = geo.unbounded[j]
+            return -1, False
+        listed[n] = i
         n += 1
+        opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
     if geo.node_box.shape[0] == 0:
-        return n
+        return n, opaque
+    axis = sub(centre, p)
+    radius = radius * (1.0 + 1e-7) + 1e-12
+    top = 0
+    stack[0] = 0
+    while top >= 0:
+        node = stack[top]
+        top -= 1
+        if not _cone_meets_box(geo.node_box, node, p, axis, radius):
+            continue
+        count = geo.node_link[node, 1]
+        if count == 0:
+            top += 1
+            stack[top] = node + 1
+            top += 1
+            stack[top] = geo.node_link[node, 0]
+            continue
+        if n + count > SHADOW_LIST_CAP:
+            return -1, False
+        first = geo.node_link[node, 0]
+        for leaf in range(first, first + count):
+            i = geo.node_prims[leaf]
+            listed[n] = i
+            n += 1
+            opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
+    return n, opaque
     radius = radius * (1.0 + 1e-7) + 1e-12
     top = 0
     stack[0] = 0
@@ -273,7 +328,7 @@ def _absorb(mats, scratch, count, length, trans):
 
 @kernel(inline="always")
 def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch, stack, hits,
-                         blocker, listed, n_listed):
+                         blocker, listed, n_listed, listed_opaque):
     """Fraction of light (per channel) that reaches ``o`` from ``dist`` along unit ``d``.
 
     The segment starts at ``epsilon`` along the ray (not offset along the normal), so a
@@ -288,9 +343,15 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
     from the same point (the next sample of the same area light, say): it is tried first, and
     when it blocks this ray too no walk is needed. When ``n_listed`` >= 0, the ray's possible
     occluders are ``listed[:n_listed]`` (see :func:`list_bundle_occluders`) and no BVH walk is
-    made. Returns (transmittance, the opaque primitive that blocked the ray or -1)."""
+    made; when they are all opaque (``listed_opaque``) the first one hit ends the search.
+    Returns (transmittance, the opaque primitive that blocked the ray or -1)."""
     if blocker >= 0 and hit_analytic(geo, blocker, o, d, params.epsilon, dist) < INF:
         return (0.0, 0.0, 0.0), blocker
+    if n_listed >= 0 and listed_opaque:
+        for k in range(n_listed):
+            if hit_analytic(geo, listed[k], o, d, params.epsilon, dist) < INF:
+                return (0.0, 0.0, 0.0), listed[k]
+        return _absorb(mats, media, n_media, dist - params.epsilon, (1.0, 1.0, 1.0)), -1
     for k in range(n_media):
         scratch[k] = media[k]
     count = n_media
@@ -300,13 +361,11 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
         # walks gather the surfaces on the segment, sorted, a buffer-full at a time; one
         # closer than ``epsilon`` to the previous crossing is the same crossing (a shared
         # edge, a touching pair) and is skipped, as the stepping walk below would
-        for window in range(64):
+        for _ in range(64):
             n, full = gather_transparent_hits(geo, mats, o, d, t_from, dist, params.epsilon,
                                               stack, hits, listed, n_listed)
             if n == -1:
                 return (0.0, 0.0, 0.0), int(hits[1])
-            if n == 0 and window == 0:
-                return (1.0, 1.0, 1.0), -1
             for k in range(n):
                 t = hits[2 * k]
                 if t <= t_from:
@@ -321,8 +380,8 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
                 break
         return _absorb(mats, scratch, count, dist - t_from, trans), -1
     state = any_occluder(geo, mats, o, d, params.epsilon, dist, stack)
-    if state == 0:
-        return (1.0, 1.0, 1.0), -1
+    if state == 0:  # only the medium the point is in, if any, dims the light
+        return _absorb(mats, media, n_media, dist - params.epsilon, (1.0, 1.0, 1.0)), -1
     if state == 1:
         return (0.0, 0.0, 0.0), -1
     for _ in range(64):
@@ -398,9 +457,10 @@ def direct_light(
         centre = vload(lights, j, LIGHT_POSITION)
         blocker = -1  # what shadowed this light's previous sample from p
         n_listed = -1  # the samples' shared list of possible occluders (-1: none, walk)
+        listed_opaque = False
         if kind == LIGHT_DISK and n_samples >= MIN_BUNDLE_SAMPLES and not has_instances(geo):
-            n_listed = list_bundle_occluders(geo, p, sub(centre, p), lights[j, LIGHT_RADIUS],
-                                             stack, listed)
+            n_listed, listed_opaque = list_bundle_occluders(
+                geo, mats, p, centre, lights[j, LIGHT_RADIUS], params.epsilon, stack, listed)
         for s in range(n_samples):
             # one shadow ray per sample (one call site: the shadow code is inlined once)
             if kind == LIGHT_DIRECTIONAL:
@@ -432,7 +492,7 @@ def direct_light(
             counters[RAY_SHADOW] += 1
             vis, found = shadow_transmittance(
                 geo, mats, params, p, ldir, tmax, media, n_media, scratch, stack, hits, blocker,
-                listed, n_listed,
+                listed, n_listed, listed_opaque,
             )
             if found >= 0:
                 blocker = found
