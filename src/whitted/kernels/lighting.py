@@ -48,7 +48,7 @@ from .layout import (
 )
 from .media import media_enter, media_leave
 from .mesh import OPAQUE_KT
-from .sampling import concentric_disk, random01, stratum
+from .sampling import concentric_disk, random_pair, stratum
 from .traverse import box_entry, inverse_direction, next_scene_candidate, start_scene_walk
 from .vec import dot, madd, normalize, sub, vload
 
@@ -473,8 +473,9 @@ def direct_light(
                 target = centre
                 if kind == LIGHT_DISK:
                     cx, cy, m_cols, m_rows = stratum(s, n_samples)
-                    u = (cx + random01(params.seed, rng[0], rng[1], dim)) / m_cols
-                    w = (cy + random01(params.seed, rng[0], rng[1], dim + 1)) / m_rows
+                    ju, jw = random_pair(params.seed, rng[0], rng[1], dim)
+                    u = (cx + ju) / m_cols
+                    w = (cy + jw) / m_rows
                     dim += 2
                     dx, dy = concentric_disk(u, w)
                     rad = lights[j, LIGHT_RADIUS]

@@ -33,6 +33,18 @@ def random01(seed, pixel, sample, dim):
 
 
 @kernel
+def random_pair(seed, pixel, sample, dim):
+    """Two uniform numbers in [0, 1) determined only by (seed, pixel, sample, dim): the
+    first as :func:`random01` draws it, the second hashed on from the first. One chain of
+    dependent steps: four mixes instead of six, and nothing for the compiler to pack into
+    64-bit vector multiplies, which x86 lacks (that doubled the cost of sampling)."""
+    h = mix32(sample * 0x27D4EB2F + dim)
+    h = mix32(pixel * 0x85EBCA77 + h)
+    h = mix32(seed * 0x9E3779B1 + h)
+    return h * INV_2_32, mix32(h + 0x632BE5AB) * INV_2_32
+
+
+@kernel
 def stratum(index, count):
     """Cell (column, row) and grid size (m, rows) of sample ``index`` out of ``count`` on a
     near-square grid, for stratified sampling of the unit square."""

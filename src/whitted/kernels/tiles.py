@@ -21,7 +21,7 @@ from .layout import (
     RAY_PRIMARY,
 )
 from .lighting import MAX_SHADOW_HITS, SHADOW_LIST_CAP
-from .sampling import random01, stratum
+from .sampling import random_pair, stratum
 from .vec import madd, normalize
 
 BVH_STACK = 128
@@ -82,8 +82,9 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
                         jy = 0.5
                     else:
                         cx, cy, m, rows = stratum(s, spp)
-                        jx = (cx + random01(params.seed, pixel, s, 0)) / m
-                        jy = (cy + random01(params.seed, pixel, s, 1)) / rows
+                        ux, uy = random_pair(params.seed, pixel, s, 0)
+                        jx = (cx + ux) / m
+                        jy = (cy + uy) / rows
                     o, d = camera_ray(params, px + jx, py + jy)
                     cnt[RAY_PRIMARY] += 1
                     c = trace_path(geo, mats, lights, params, o, d, pixel, s, st_f, st_i,
