@@ -461,7 +461,15 @@ def direct_light(
         if kind == LIGHT_DISK and n_samples >= MIN_BUNDLE_SAMPLES and not has_instances(geo):
             n_listed, listed_opaque = list_bundle_occluders(
                 geo, mats, p, centre, lights[j, LIGHT_RADIUS], params.epsilon, stack, listed)
-        for s in range(n_samples):
+        # samples are stratified over a grid of m_cols x m_rows cells, walked cell by cell
+        _, _, m_cols, m_rows = stratum(0, n_samples)
+        cx = -1
+        cy = 0
+        for _s in range(n_samples):
+            cx += 1
+            if cx == m_cols:
+                cx = 0
+                cy += 1
             # one shadow ray per sample (one call site: the shadow code is inlined once)
             if kind == LIGHT_DIRECTIONAL:
                 travel = vload(lights, j, LIGHT_DIRECTION)
@@ -472,7 +480,6 @@ def direct_light(
             else:
                 target = centre
                 if kind == LIGHT_DISK:
-                    cx, cy, m_cols, m_rows = stratum(s, n_samples)
                     ju, jw = random_pair(params.seed, rng[0], rng[1], dim)
                     u = (cx + ju) / m_cols
                     w = (cy + jw) / m_rows
