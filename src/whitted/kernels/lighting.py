@@ -210,28 +210,6 @@ def list_bundle_occluders(geo, mats, p, centre, radius, tmin, stack, listed):
             n += 1
             opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
     return n, opaque
-    radius = radius * (1.0 + 1e-7) + 1e-12
-    top = 0
-    stack[0] = 0
-    while top >= 0:
-        node = stack[top]
-        top -= 1
-        if not _cone_meets_box(geo.node_box, node, p, axis, radius):
-            continue
-        count = geo.node_link[node, 1]
-        if count == 0:
-            top += 1
-            stack[top] = node + 1
-            top += 1
-            stack[top] = geo.node_link[node, 0]
-            continue
-        if n + count > SHADOW_LIST_CAP:
-            return -1
-        first = geo.node_link[node, 0]
-        for leaf in range(first, first + count):
-            listed[n] = geo.node_prims[leaf]
-            n += 1
-    return n
 
 
 @kernel
