@@ -16,7 +16,8 @@ from meshgen import uv_sphere
 from whitted.compile.flatten import compile_scene
 from whitted.kernels.accel import hit_analytic
 from whitted.kernels.intersect import INF
-from whitted.kernels.lighting import SHADOW_LIST_CAP, _cone_meets_box, list_bundle_occluders
+from whitted.kernels.lighting import SHADOW_LIST_CAP, list_bundle_occluders
+from whitted.kernels.traverse import cone_meets_box
 
 EPS = 1e-6  # the shadow rays' tmin
 
@@ -141,14 +142,14 @@ def test_cone_box_test_never_misses_a_box_the_cone_enters(p, axis, radius, lo, s
     box = np.array([[lo, tuple(lo[k] + size[k] for k in range(3))]])
     inside = all(box[0, 0, k] <= x[k] <= box[0, 1, k] for k in range(3))
     if inside:
-        assert _cone_meets_box(box, 0, p, axis, radius)
+        assert cone_meets_box(box, 0, p, axis, radius)
 
 
 def test_cone_box_test_rejects_boxes_off_the_cone():
     box = np.array([[(4.0, 8.0, -1.0), (5.0, 10.0, 1.0)]])
     # a thin cone along +y from the origin passes far from a box at x = 4..5, y = 8..10
-    assert not _cone_meets_box(box, 0, (0.0, 0.0, 0.0), (0.0, 10.0, 0.0), 1.0)
+    assert not cone_meets_box(box, 0, (0.0, 0.0, 0.0), (0.0, 10.0, 0.0), 1.0)
     # widened to radius 5 at its base (4.5 at y = 9), it reaches it
-    assert _cone_meets_box(box, 0, (0.0, 0.0, 0.0), (0.0, 10.0, 0.0), 5.0)
+    assert cone_meets_box(box, 0, (0.0, 0.0, 0.0), (0.0, 10.0, 0.0), 5.0)
     # behind the apex there is nothing
-    assert not _cone_meets_box(box, 0, (6.0, 0.0, 0.0), (10.0, 0.0, 0.0), 1.0)
+    assert not cone_meets_box(box, 0, (6.0, 0.0, 0.0), (10.0, 0.0, 0.0), 1.0)

@@ -61,6 +61,7 @@ from ..kernels.layout import (
     SHAPE_SPHERE,
     SHAPE_TRIANGLE,
     GeometryArrays,
+    LightArrays,
     RenderParams,
 )
 from ..scene.lights import AmbientLight, DirectionalLight, DiskLight, PointLight
@@ -68,6 +69,7 @@ from ..scene.materials import Material
 from ..scene.scene import RenderSettings, Scene
 from ..scene.shapes import Box, Cone, Cylinder, Disk, Mesh, Plane, Rectangle, Sphere, Triangle
 from .bvh import build_bvh
+from .light_buffers import build_light_buffers
 from .meshes import MeshSource, MeshTable
 from .textures import compile_textures
 
@@ -78,7 +80,7 @@ class CompiledScene:
 
     geometry: GeometryArrays
     materials: np.ndarray  # (M, N_MAT_PARAMS) float64
-    lights: np.ndarray  # (L, N_LIGHT_PARAMS) float64, ambient lights excluded
+    lights: LightArrays  # the light table (ambient lights excluded) and light buffers
     ambient: tuple[float, float, float]
     bounds_min: np.ndarray  # (3,) of all bounded primitives (inf when there are none)
     bounds_max: np.ndarray
@@ -512,7 +514,9 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT) -> CompiledS
     )
     mat_table = np.array(materials.rows, dtype=np.float64).reshape(len(materials.rows),
                                                                     N_MAT_PARAMS)
-    lights, ambient = _light_rows(scene)
+    light_table, ambient = _light_rows(scene)
+    lights = build_light_buffers(geometry, mat_table, light_table,
+                                 has_instances=len(instances) > 0)
     if finite.any():
         bmin, bmax = lo[finite].min(axis=0), hi[finite].max(axis=0)
     else:

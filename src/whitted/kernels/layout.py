@@ -75,7 +75,14 @@ LIGHT_FALLOFF = 12  # 0 none, 1 linear (dist_scale / d), 2 inverse square
 LIGHT_DIST_SCALE = 13
 LIGHT_DISK_U = 14  # 14:17, unit tangent of the disk
 LIGHT_DISK_V = 17  # 17:20, unit bitangent
-N_LIGHT_PARAMS = 20
+LIGHT_BUFFER = 20  # point lights: first row of their cells in LightArrays.buffer_cells, or -1
+LIGHT_BUFFER_SIDE = 21  # cells along a side of each cube face of that light buffer
+N_LIGHT_PARAMS = 22
+
+# light-buffer cell columns (LightArrays.buffer_cells)
+CELL_FIRST = 0
+CELL_COUNT = 1  # -1: too many primitives to list (shadow rays through the cell walk the BVH)
+CELL_OPAQUE = 2
 
 FALLOFF_CODES = {"none": 0, "linear": 1, "inverse_square": 2}
 
@@ -137,6 +144,19 @@ class GeometryArrays(NamedTuple):
     # textures (see texture_layout.py): one row per texture, all image texels in one array
     tex_info: np.ndarray  # (X, N_TEX_PARAMS) float64
     tex_pixels: np.ndarray  # (P,) float32 linear RGB
+
+
+class LightArrays(NamedTuple):
+    """The lights (ambient ones excluded) and the light buffers of the point lights.
+
+    A light buffer (see light_buffer.py) divides the directions leaving a point light into the
+    cells of a cube map, LIGHT_BUFFER_RES x LIGHT_BUFFER_RES per face, and lists for each cell
+    the analytic primitives that could block a shadow ray travelling through it: a shadow ray
+    tests those instead of walking the BVH."""
+
+    table: np.ndarray  # (L, N_LIGHT_PARAMS) float64
+    buffer_cells: np.ndarray  # (C, 3) int32: CELL_FIRST, CELL_COUNT, CELL_OPAQUE
+    buffer_prims: np.ndarray  # (N,) int32 primitive indices
 
 
 class RenderParams(NamedTuple):

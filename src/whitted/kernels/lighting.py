@@ -18,6 +18,11 @@ from .features import has_instances
 from .intersect import INF
 from .jit import kernel
 from .layout import (
+    CELL_COUNT,
+    CELL_FIRST,
+    CELL_OPAQUE,
+    LIGHT_BUFFER,
+    LIGHT_BUFFER_SIDE,
     LIGHT_DIRECTION,
     LIGHT_DIRECTIONAL,
     LIGHT_DISK,
@@ -46,10 +51,17 @@ from .layout import (
     SHAPE_PLANE,
     SHAPE_TRIANGLE,
 )
+from .light_buffer import cube_cell
 from .media import media_enter, media_leave
 from .mesh import OPAQUE_KT
 from .sampling import concentric_disk, random_pair, stratum
-from .traverse import box_entry, inverse_direction, next_scene_candidate, start_scene_walk
+from .traverse import (
+    box_entry,
+    cone_meets_box,
+    inverse_direction,
+    next_scene_candidate,
+    start_scene_walk,
+)
 from .vec import dot, madd, normalize, sub, vload
 
 
@@ -112,35 +124,6 @@ SHADOW_LIST_CAP = 48  # primitives a soft-shadow bundle may list; past that its 
 MIN_BUNDLE_SAMPLES = 4  # area lights with fewer samples per point skip the bundle listing
 
 
-@kernel(inline="always")
-def _cone_meets_box(box, node, p, axis, radius):
-    """Could the cone from apex ``p`` to the ball of ``radius`` around ``p + axis`` (which
-    holds an area light's disk) meet box ``node``? Conservative: the cone's cross-section at
-    parameter t along the axis, a disk of radius t·radius, is widened to the square of that
-    half-width, and the box test becomes six linear bounds on t in [0, 1]."""
-    t_lo = 0.0
-    t_hi = 1.0
-    for k in range(3):
-        lo = box[node, 0, k] - p[k]
-        hi = box[node, 1, k] - p[k]
-        a = axis[k] + radius  # the square's far edge reaches the box's low face: t·a >= lo
-        if a > 0.0:
-            t_lo = max(t_lo, lo / a)
-        elif a < 0.0:
-            t_hi = min(t_hi, lo / a)
-        elif lo > 0.0:
-            return False
-        b = axis[k] - radius  # its near edge stays below the box's high face: t·b <= hi
-        if b > 0.0:
-            t_hi = min(t_hi, hi / b)
-        elif b < 0.0:
-            t_lo = max(t_lo, hi / b)
-        elif hi < 0.0:
-            return False
-    # the relative slack keeps flat boxes (a rectangle in a plane) in
-    return t_lo <= t_hi * (1.0 + 1e-9) + 1e-12
-
-
 @kernel
 def _plane_clear_of_bundle(P, i, p, centre, radius, tmin):
     """True when no ray from ``p`` to the ball of ``radius`` around ``centre`` can meet plane
@@ -192,7 +175,7 @@ def list_bundle_occluders(geo, mats, p, centre, radius, tmin, stack, listed):
     while top >= 0:
         node = stack[top]
         top -= 1
-        if not _cone_meets_box(geo.node_box, node, p, axis, radius):
+        if not cone_meets_box(geo.node_box, node, p, axis, radius):
             continue
         count = geo.node_link[node, 1]
         if count == 0:
@@ -233,9 +216,11 @@ def _keep_nearest(hits, n, t, prim, full):
 
 
 @kernel(inline="always")
-def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, listed, n_listed):
+def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, listed, list_first,
+                            n_listed):
     """The analytic surface crossings on the segment (tmin, tmax), in one walk of the scene
-    BVH (or, when ``n_listed`` >= 0, of the primitives ``listed[:n_listed]``), into ``hits``
+    BVH (or, when ``n_listed`` >= 0, of the primitives ``listed[list_first:][:n_listed]``),
+    into ``hits``
     as (t, primitive) pairs sorted by t: both crossings of a closed body (they are convex: at
     most two, the second searched from ``step`` past the first), the nearest MAX_SHADOW_HITS
     of them. Returns (n, full): full when there were more (walk again from past the last one);
@@ -250,7 +235,7 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
         if n_listed >= 0:
             if k == n_listed:
                 break
-            i = listed[k]
+            i = listed[list_first + k]
             k += 1
         else:
             i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, tmax, stack,
@@ -306,7 +291,7 @@ def _absorb(mats, scratch, count, length, trans):
 
 @kernel(inline="always")
 def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch, stack, hits,
-                         blocker, listed, n_listed, listed_opaque):
+                         blocker, listed, list_first, n_listed, listed_opaque):
     """Fraction of light (per channel) that reaches ``o`` from ``dist`` along unit ``d``.
 
     The segment starts at ``epsilon`` along the ray (not offset along the normal), so a
@@ -320,13 +305,14 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
     ``blocker`` (or -1) is an opaque analytic primitive that blocked a previous shadow ray
     from the same point (the next sample of the same area light, say): it is tried first, and
     when it blocks this ray too no walk is needed. When ``n_listed`` >= 0, the ray's possible
-    occluders are ``listed[:n_listed]`` (see :func:`list_bundle_occluders`) and no BVH walk is
-    made; when they are all opaque (``listed_opaque``) the first one hit ends the search.
+    occluders are ``listed[list_first:][:n_listed]`` (a bundle's list, see
+    :func:`list_bundle_occluders`, or a light-buffer cell's) and no BVH walk is made; when
+    they are all opaque (``listed_opaque``) the first one hit ends the search.
     Returns (transmittance, the opaque primitive that blocked the ray or -1)."""
     if blocker >= 0 and hit_analytic(geo, blocker, o, d, params.epsilon, dist) < INF:
         return (0.0, 0.0, 0.0), blocker
     if n_listed >= 0 and listed_opaque:
-        for k in range(n_listed):
+        for k in range(list_first, list_first + n_listed):
             if hit_analytic(geo, listed[k], o, d, params.epsilon, dist) < INF:
                 return (0.0, 0.0, 0.0), listed[k]
         return _absorb(mats, media, n_media, dist - params.epsilon, (1.0, 1.0, 1.0)), -1
@@ -341,7 +327,7 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
         # edge, a touching pair) and is skipped, as the stepping walk below would
         for _ in range(64):
             n, full = gather_transparent_hits(geo, mats, o, d, t_from, dist, params.epsilon,
-                                              stack, hits, listed, n_listed)
+                                              stack, hits, listed, list_first, n_listed)
             if n == -1:
                 return (0.0, 0.0, 0.0), int(hits[1])
             for k in range(n):
@@ -388,6 +374,28 @@ def _falloff(lights, j, dist):
     return 1.0
 
 
+MAX_SQUARING_EXPONENT = 4096  # whole shininess up to this is raised by repeated squaring
+
+
+@kernel
+def highlight_power(c, shininess):
+    """c ** shininess for the highlight (0 < c <= 1). A whole exponent, as shininess nearly
+    always is, takes a few multiplications by repeated squaring (a general ``pow`` cost about
+    a tenth of the benchmark's render time); any other goes to ``pow``."""
+    k = int(shininess)
+    if k != shininess or k <= 0 or k > MAX_SQUARING_EXPONENT:
+        return c**shininess
+    result = 1.0
+    base = c
+    while True:
+        if k & 1:
+            result *= base
+        k >>= 1
+        if k == 0:
+            return result
+        base *= base
+
+
 @kernel
 def _brdf(mats, m, albedo, n, v, ldir):
     """Diffuse + specular response (per channel) for unit light direction ``ldir``; n·l > 0.
@@ -405,7 +413,7 @@ def _brdf(mats, m, albedo, n, v, ldir):
             r = (2.0 * ndl * n[0] - ldir[0], 2.0 * ndl * n[1] - ldir[1], 2.0 * ndl * n[2] - ldir[2])
             c = dot(r, v)
         if c > 0.0:
-            spec = ks * c**shin
+            spec = ks * highlight_power(c, shin)
     return (
         kd * albedo[0] + spec * mats[m, MAT_SPECULAR],
         kd * albedo[1] + spec * mats[m, MAT_SPECULAR + 1],
@@ -420,25 +428,29 @@ def direct_light(
 ):
     """Light reflected toward ``v`` at point ``p`` with shading normal ``n`` (facing ``v``) by
     every non-ambient light; ``albedo`` is the diffuse colour there. ``rng`` = (pixel, sample,
-    first dimension) for area-light samples."""
+    first dimension) for area-light samples. A point light's shadow ray tests the list of its
+    light-buffer cell; an area light's samples share the list of their bundle."""
     r = 0.0
     g = 0.0
     b = 0.0
     if mats[m, MAT_KD] == 0.0 and mats[m, MAT_KS] == 0.0:
         return (r, g, b)
     dim = rng[2]
-    for j in range(lights.shape[0]):
-        kind = lights[j, LIGHT_TYPE]
-        radiance = vload(lights, j, LIGHT_RADIANCE)
-        n_samples = int(lights[j, LIGHT_SAMPLES]) if kind == LIGHT_DISK else 1
+    table = lights.table
+    for j in range(table.shape[0]):
+        kind = table[j, LIGHT_TYPE]
+        radiance = vload(table, j, LIGHT_RADIANCE)
+        n_samples = int(table[j, LIGHT_SAMPLES]) if kind == LIGHT_DISK else 1
         share = 1.0 / n_samples
-        centre = vload(lights, j, LIGHT_POSITION)
+        centre = vload(table, j, LIGHT_POSITION)
         blocker = -1  # what shadowed this light's previous sample from p
+        occluders = listed  # the array holding the list of possible occluders
+        list_first = 0
         n_listed = -1  # the samples' shared list of possible occluders (-1: none, walk)
         listed_opaque = False
         if kind == LIGHT_DISK and n_samples >= MIN_BUNDLE_SAMPLES and not has_instances(geo):
             n_listed, listed_opaque = list_bundle_occluders(
-                geo, mats, p, centre, lights[j, LIGHT_RADIUS], params.epsilon, stack, listed)
+                geo, mats, p, centre, table[j, LIGHT_RADIUS], params.epsilon, stack, listed)
         # samples are stratified over a grid of m_cols x m_rows cells, walked cell by cell
         _, _, m_cols, m_rows = stratum(0, n_samples)
         cx = -1
@@ -450,8 +462,9 @@ def direct_light(
                 cy += 1
             # one shadow ray per sample (one call site: the shadow code is inlined once)
             if kind == LIGHT_DIRECTIONAL:
-                travel = vload(lights, j, LIGHT_DIRECTION)
+                travel = vload(table, j, LIGHT_DIRECTION)
                 ldir = (-travel[0], -travel[1], -travel[2])
+                to_light = ldir
                 dist = INF
                 tmax = INF
                 weight = 1.0
@@ -463,22 +476,30 @@ def direct_light(
                     w = (cy + jw) / m_rows
                     dim += 2
                     dx, dy = concentric_disk(u, w)
-                    rad = lights[j, LIGHT_RADIUS]
-                    target = madd(madd(centre, vload(lights, j, LIGHT_DISK_U), dx * rad),
-                                  vload(lights, j, LIGHT_DISK_V), dy * rad)
+                    rad = table[j, LIGHT_RADIUS]
+                    target = madd(madd(centre, vload(table, j, LIGHT_DISK_U), dx * rad),
+                                  vload(table, j, LIGHT_DISK_V), dy * rad)
                 to_light = sub(target, p)
                 dist = math.sqrt(dot(to_light, to_light))
                 if dist == 0.0:
                     continue
                 ldir = (to_light[0] / dist, to_light[1] / dist, to_light[2] / dist)
                 tmax = dist - params.epsilon
-                weight = share * _falloff(lights, j, dist)
+                weight = share * _falloff(table, j, dist)
             if dot(n, ldir) <= 0.0:
                 continue
+            buffer = int(table[j, LIGHT_BUFFER])
+            if buffer >= 0 and not has_instances(geo):
+                cell = buffer + cube_cell((-to_light[0], -to_light[1], -to_light[2]),
+                                          int(table[j, LIGHT_BUFFER_SIDE]))
+                occluders = lights.buffer_prims
+                list_first = lights.buffer_cells[cell, CELL_FIRST]
+                n_listed = lights.buffer_cells[cell, CELL_COUNT]
+                listed_opaque = lights.buffer_cells[cell, CELL_OPAQUE] != 0
             counters[RAY_SHADOW] += 1
             vis, found = shadow_transmittance(
                 geo, mats, params, p, ldir, tmax, media, n_media, scratch, stack, hits, blocker,
-                listed, n_listed, listed_opaque,
+                occluders, list_first, n_listed, listed_opaque,
             )
             if found >= 0:
                 blocker = found

@@ -1,6 +1,7 @@
 """Helpers every BVH walk shares (the scene's, the instances' and each mesh's own): the slab
-test of a node box, a ray's safe inverse direction, and pushing a node's children nearest
-last. The boxes may be float64 (scene level) or float32 rounded outward (meshes)."""
+test of a node box, a ray's safe inverse direction, pushing a node's children nearest
+last, and the test of a node box against a cone of rays (shadow bundles, light buffers). The
+boxes may be float64 (scene level) or float32 rounded outward (meshes)."""
 
 from __future__ import annotations
 
@@ -70,6 +71,36 @@ def push_children(box, link, node, o, inv, tmin, tmax, stack, top):
             top += 1
             stack[top] = right
     return top
+
+
+@kernel(inline="always")
+def cone_meets_box(box, node, p, axis, radius):
+    """Could the cone from apex ``p`` to the ball of ``radius`` around ``p + axis`` (an area
+    light's disk seen from a shaded point, a light-buffer cell's rays) meet box ``node``?
+    Conservative: the cone's cross-section at parameter t along the axis, a disk of radius
+    t·radius, is widened to the square of that half-width, and the box test becomes six
+    linear bounds on t in [0, 1]."""
+    t_lo = 0.0
+    t_hi = 1.0
+    for k in range(3):
+        lo = box[node, 0, k] - p[k]
+        hi = box[node, 1, k] - p[k]
+        a = axis[k] + radius  # the square's far edge reaches the box's low face: t·a >= lo
+        if a > 0.0:
+            t_lo = max(t_lo, lo / a)
+        elif a < 0.0:
+            t_hi = min(t_hi, lo / a)
+        elif lo > 0.0:
+            return False
+        b = axis[k] - radius  # its near edge stays below the box's high face: t·b <= hi
+        if b > 0.0:
+            t_hi = min(t_hi, hi / b)
+        elif b < 0.0:
+            t_lo = max(t_lo, hi / b)
+        elif hi < 0.0:
+            return False
+    # the relative slack keeps flat boxes (a rectangle in a plane) in
+    return t_lo <= t_hi * (1.0 + 1e-9) + 1e-12
 
 
 @kernel

@@ -141,8 +141,8 @@ def _kernel_variant(compiled: CompiledScene) -> bool:
 def warm_up_kernels(compiled: CompiledScene | None = None) -> float:
     """Compile (first run) or load from the on-disk cache (later runs) the render kernels:
     the variant for scenes like ``compiled`` (kernels are specialised for scenes with and
-    without mesh instances), or without meshes when None; the BVH builder too. Returns the
-    seconds it took; 0 when that variant was already loaded in this process."""
+    without mesh instances), or without meshes when None; the BVH and light-buffer builders
+    too. Returns the seconds it took; 0 when that variant was already loaded in this process."""
     with _kernel_lock:
         if compiled is not None and _kernel_variant(compiled) in _kernels_ready:
             return 0.0
@@ -150,9 +150,11 @@ def warm_up_kernels(compiled: CompiledScene | None = None) -> float:
             return 0.0
         start = time.perf_counter()
         from ..kernels.tiles import lane_workspace, render_aovs, render_tiles
+        from ..scene.lights import PointLight
         from ..scene.shapes import Sphere
 
-        scene = Scene(objects=[Sphere(radius=1.0)])  # one bounded shape: the BVH builder too
+        # one bounded shape and a point light: the BVH and light-buffer builders too
+        scene = Scene(objects=[Sphere(radius=1.0)], lights=[PointLight(position=(0, 5, 0))])
         if compiled is None:
             compiled = compile_scene(scene)
         params = render_params(scene, compiled, scene.render.model_copy(update={"width": 1,

@@ -1,0 +1,176 @@
+"""Build the light buffers of the point lights (see kernels/light_buffer.py for the idea and
+the cell layout): for every cell of the cube map around a light, the analytic primitives a
+shadow ray through that cell could hit.
+
+The list of a cell is conservative: a primitive is listed when its BVH leaf box meets a cone
+that holds the cell's whole pyramid of rays out to the far side of the scene's bounds, and an
+unbounded plane unless every ray of the cell runs away from it. Scenes with mesh instances
+get no light buffers (their shadow rays walk both BVH levels as before).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..kernels.jit import kernel
+from ..kernels.layout import (
+    CELL_COUNT,
+    CELL_FIRST,
+    CELL_OPAQUE,
+    LIGHT_BUFFER,
+    LIGHT_BUFFER_SIDE,
+    LIGHT_POINT,
+    LIGHT_POSITION,
+    LIGHT_TYPE,
+    MAT_KT,
+    PRIM_MATERIAL,
+    PRIM_TYPE,
+    PRIM_XFORM,
+    SHAPE_PLANE,
+    GeometryArrays,
+    LightArrays,
+)
+from ..kernels.light_buffer import (
+    LIGHT_BUFFER_CAP,
+    LIGHT_BUFFER_CELLS,
+    LIGHT_BUFFER_RES,
+    cell_cone,
+    cell_direction,
+)
+from ..kernels.mesh import OPAQUE_KT
+from ..kernels.traverse import cone_meets_box
+
+CONE_SLACK = 1e-6  # relative widening of each cell's cone (rounding of the ray directions)
+PLANE_SLACK = 1e-9  # a cell's corner must run this clearly away from a plane to drop it
+
+
+@kernel
+def _plane_out_of_reach(P, i, light, cell, res):
+    """True when no ray from ``light`` through ``cell`` meets plane primitive ``i``: every
+    corner direction of the cell runs parallel to or away from the plane (the cell's
+    directions are spanned by its corners, and the sign of d·n is linear in them)."""
+    n = (P[i, 3], P[i, 4], P[i, 5])
+    s = (light[0] - P[i, 0]) * n[0] + (light[1] - P[i, 1]) * n[1] + (light[2] - P[i, 2]) * n[2]
+    if s == 0.0:
+        return False
+    face = cell // (res * res)
+    iu = (cell // res) % res
+    iv = cell % res
+    for du in range(2):
+        for dv in range(2):
+            d = cell_direction(face, -1.0 + 2.0 * (iu + du) / res, -1.0 + 2.0 * (iv + dv) / res)
+            away = (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]) * (1.0 if s > 0.0 else -1.0)
+            if away < PLANE_SLACK:
+                return False
+    return True
+
+
+@kernel
+def list_cell_occluders(geo, mats, light, reach, res, lists, counts, opaque, stack):
+    """Fill ``lists[cell, :counts[cell]]`` with the primitives that may block rays leaving
+    ``light`` through each cell (``counts[cell]`` = -1 when there are more than the row holds)
+    and ``opaque[cell]`` with whether they are all opaque. ``reach`` is at least the distance
+    from the light to the farthest corner of the scene BVH's root box."""
+    cap = lists.shape[1]
+    for cell in range(6 * res * res):
+        n = 0
+        all_opaque = True
+        for j in range(geo.unbounded.shape[0]):
+            i = geo.unbounded[j]
+            if (geo.prim_info[i, PRIM_TYPE] == SHAPE_PLANE and geo.prim_info[i, PRIM_XFORM] < 0
+                    and _plane_out_of_reach(geo.prim_params, i, light, cell, res)):
+                continue
+            if n == cap:
+                n = -1
+                break
+            lists[cell, n] = i
+            n += 1
+            all_opaque = all_opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
+        if n >= 0 and geo.node_box.shape[0] > 0:
+            c, tan_half = cell_cone(cell, res)
+            axis = (c[0] * reach, c[1] * reach, c[2] * reach)
+            radius = reach * tan_half * (1.0 + CONE_SLACK) + reach * CONE_SLACK
+            top = 0
+            stack[0] = 0
+            while top >= 0 and n >= 0:
+                node = stack[top]
+                top -= 1
+                if not cone_meets_box(geo.node_box, node, light, axis, radius):
+                    continue
+                count = geo.node_link[node, 1]
+                if count == 0:
+                    top += 1
+                    stack[top] = node + 1
+                    top += 1
+                    stack[top] = geo.node_link[node, 0]
+                    continue
+                if n + count > cap:
+                    n = -1
+                    break
+                first = geo.node_link[node, 0]
+                for leaf in range(first, first + count):
+                    i = geo.node_prims[leaf]
+                    lists[cell, n] = i
+                    n += 1
+                    all_opaque = (all_opaque
+                                  and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT)
+        counts[cell] = n
+        opaque[cell] = 1 if (n >= 0 and all_opaque) else 0
+
+
+def _reach(geo: GeometryArrays, light: np.ndarray) -> float:
+    """Distance from ``light`` to the farthest corner of the scene BVH's root box, widened."""
+    if geo.node_box.shape[0] == 0:
+        return 1.0
+    lo, hi = geo.node_box[0]
+    far = np.maximum(np.abs(lo - light), np.abs(hi - light))
+    return float(np.linalg.norm(far)) * (1.0 + 1e-6) + 1e-9
+
+
+def buffer_side(n_point_lights: int, res: int = LIGHT_BUFFER_RES) -> int:
+    """Cells along a cube-face side for each of ``n_point_lights`` buffers: ``res``, less when
+    so many lights share the LIGHT_BUFFER_CELLS budget."""
+    if n_point_lights == 0:
+        return 0
+    fit = int(np.sqrt(LIGHT_BUFFER_CELLS / (6 * n_point_lights)))
+    return max(1, min(res, fit))
+
+
+def build_light_buffers(geo: GeometryArrays, materials: np.ndarray, table: np.ndarray,
+                        has_instances: bool, res: int = LIGHT_BUFFER_RES,
+                        cap: int = LIGHT_BUFFER_CAP) -> LightArrays:
+    """The light table with a light buffer for each point light (its LIGHT_BUFFER column set
+    to its first cell; -1 for other lights, and for every light when the scene has mesh
+    instances or ``res`` is 0)."""
+    table = table.copy()
+    res = buffer_side(int(np.sum(table[:, LIGHT_TYPE] == LIGHT_POINT)), res)
+    table[:, LIGHT_BUFFER] = -1.0
+    cells = [np.zeros((0, 3), np.int32)]
+    prims = [np.zeros(0, np.int32)]
+    n_cells = 6 * res * res
+    first_cell = 0
+    first_prim = 0
+    stack = np.empty(128, np.int32)
+    for j in range(table.shape[0]):
+        if has_instances or res <= 0 or table[j, LIGHT_TYPE] != LIGHT_POINT:
+            continue
+        light = table[j, LIGHT_POSITION : LIGHT_POSITION + 3].copy()
+        lists = np.empty((n_cells, cap), np.int32)
+        counts = np.empty(n_cells, np.int32)
+        opaque = np.empty(n_cells, np.int32)
+        list_cell_occluders(geo, materials, (float(light[0]), float(light[1]), float(light[2])),
+                            _reach(geo, light), res, lists, counts, opaque, stack)
+        listed = np.maximum(counts, 0)
+        block = np.empty((n_cells, 3), np.int32)
+        block[:, CELL_FIRST] = first_prim + np.concatenate(([0], np.cumsum(listed)[:-1]))
+        block[:, CELL_COUNT] = counts
+        block[:, CELL_OPAQUE] = opaque
+        keep = np.arange(cap)[None, :] < listed[:, None]
+        prims.append(lists[keep].astype(np.int32))
+        cells.append(block)
+        table[j, LIGHT_BUFFER] = first_cell
+        table[j, LIGHT_BUFFER_SIDE] = res
+        first_cell += n_cells
+        first_prim += int(listed.sum())
+    return LightArrays(table=table, buffer_cells=np.ascontiguousarray(np.concatenate(cells)),
+                       buffer_prims=np.ascontiguousarray(np.concatenate(prims)))
