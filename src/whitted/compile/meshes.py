@@ -80,6 +80,7 @@ class MeshTable:
         self.node_box: list[np.ndarray] = []
         self.node_link: list[np.ndarray] = []
         self.node_tris: list[np.ndarray] = []
+        self.leaf_corners: list[np.ndarray] = []
         self.n_vertices = 0
         self.n_tris = 0
         self.n_nodes = 0
@@ -176,6 +177,7 @@ class MeshTable:
         offset = np.where(leaf, bvh.node_offset + self.n_tris, bvh.node_offset + self.n_nodes)
         self.node_link.append(np.stack([offset, bvh.node_count], axis=1).astype(np.int32))
         self.node_tris.append((bvh.prim_order + self.n_tris).astype(np.int32))
+        self.leaf_corners.append(verts32[faces[bvh.prim_order]])
         lo = np.array(bvh.node_min[0], np.float64)  # the root box: all triangles
         hi = np.array(bvh.node_max[0], np.float64)
         self.n_vertices += len(verts32)
@@ -201,5 +203,6 @@ class MeshTable:
             "mesh_box": cat(self.node_box, (0, 2, 3), np.float32),
             "mesh_link": cat(self.node_link, (0, 2), np.int32),
             "mesh_node_tris": cat(self.node_tris, (0,), np.int32),
+            "mesh_leaf_corners": cat(self.leaf_corners, (0, 3, 3), np.float32),
         }
 

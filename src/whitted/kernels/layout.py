@@ -141,6 +141,9 @@ class GeometryArrays(NamedTuple):
     mesh_box: np.ndarray  # (N, 2, 3) float32 bottom-level node boxes (rounded outward)
     mesh_link: np.ndarray  # (N, 2) int32 (leaf offsets index mesh_node_tris)
     mesh_node_tris: np.ndarray  # (T,) int32 triangle indices in leaf order
+    # (T, 3, 3) float32 corners of the triangles in leaf order (entry j: mesh_node_tris[j]):
+    # the walks read a leaf's triangles from consecutive memory, not through two indirections
+    mesh_leaf_corners: np.ndarray
     # textures (see texture_layout.py): one row per texture, all image texels in one array
     tex_info: np.ndarray  # (X, N_TEX_PARAMS) float64
     tex_pixels: np.ndarray  # (P,) float32 linear RGB

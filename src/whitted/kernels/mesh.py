@@ -1,12 +1,16 @@
 """Triangle meshes: watertight ray/triangle intersection and the bottom-level BVH walk.
 
 A mesh is stored once in its own space (``mesh_vertices``, ``mesh_faces``) with its own BVH;
-the caller maps the ray into that space (instancing). Triangles are intersected with the
-watertight algorithm of Woop, Benthin and Wald (JCGT 2013): the ray is sheared so it runs
-along +z, and each edge's 2D edge function is evaluated from the same two vertices whichever
-triangle it belongs to. Two triangles sharing an edge therefore compute exactly opposite
-values there and a ray through the edge (or a shared vertex) hits at least one of them: no
-cracks, whatever the floating-point rounding.
+the caller maps the ray into that space (instancing). The walks read each triangle's corners
+from ``mesh_leaf_corners``, a copy laid out in the BVH's leaf order, so a leaf's triangles
+lie side by side in memory (mesh1m: 0.720 -> 0.671 s CPU). The copy holds the same float32
+values as ``mesh_vertices``, so edges shared by two triangles stay exactly shared.
+
+Triangles are intersected with the watertight algorithm of Woop, Benthin and Wald (JCGT
+2013): the ray is sheared so it runs along +z, and each edge's 2D edge function is evaluated
+from the same two vertices whichever triangle it belongs to. Two triangles sharing an edge
+therefore compute exactly opposite values there and a ray through the edge (or a shared
+vertex) hits at least one of them: no cracks, whatever the floating-point rounding.
 """
 
 from __future__ import annotations
@@ -41,21 +45,19 @@ def shear_setup(d):
 
 
 @kernel(fastmath=False)  # exact rounding: see the module docstring
-def intersect_mesh_triangle(verts, faces, tri, o, kx, ky, kz, sx, sy, sz, tmin, tmax):
-    """(t, b1, b2) of the ray with triangle ``tri``: hit point = (1-b1-b2)·v0 + b1·v1 + b2·v2;
-    t = INF on a miss. ``kx..sz`` come from :func:`shear_setup` of the ray direction."""
-    i0 = faces[tri, 0]
-    i1 = faces[tri, 1]
-    i2 = faces[tri, 2]
-    az = verts[i0, kz] - o[kz]
-    bz = verts[i1, kz] - o[kz]
-    cz = verts[i2, kz] - o[kz]
-    ax = verts[i0, kx] - o[kx] - sx * az
-    ay = verts[i0, ky] - o[ky] - sy * az
-    bx = verts[i1, kx] - o[kx] - sx * bz
-    by = verts[i1, ky] - o[ky] - sy * bz
-    cx = verts[i2, kx] - o[kx] - sx * cz
-    cy = verts[i2, ky] - o[ky] - sy * cz
+def intersect_mesh_triangle(corners, j, o, kx, ky, kz, sx, sy, sz, tmin, tmax):
+    """(t, b1, b2) of the ray with the triangle at leaf entry ``j`` (corners ``corners[j]``):
+    hit point = (1-b1-b2)·v0 + b1·v1 + b2·v2; t = INF on a miss. ``kx..sz`` come from
+    :func:`shear_setup` of the ray direction."""
+    az = corners[j, 0, kz] - o[kz]
+    bz = corners[j, 1, kz] - o[kz]
+    cz = corners[j, 2, kz] - o[kz]
+    ax = corners[j, 0, kx] - o[kx] - sx * az
+    ay = corners[j, 0, ky] - o[ky] - sy * az
+    bx = corners[j, 1, kx] - o[kx] - sx * bz
+    by = corners[j, 1, ky] - o[ky] - sy * bz
+    cx = corners[j, 2, kx] - o[kx] - sx * cz
+    cy = corners[j, 2, ky] - o[ky] - sy * cz
     e0 = cx * by - cy * bx  # weight of v0
     e1 = ax * cy - ay * cx  # weight of v1
     e2 = bx * ay - by * ax  # weight of v2
@@ -76,8 +78,7 @@ def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
     """Nearest triangle of mesh ``mesh`` hit by the ray (mesh space) in (tmin, tmax):
     (t, triangle, b1, b2), t = INF on a miss. ``stack[base:]`` is scratch."""
     kx, ky, kz, sx, sy, sz = shear_setup(d)
-    verts = geo.mesh_vertices
-    faces = geo.mesh_faces
+    corners = geo.mesh_leaf_corners
     box = geo.mesh_box
     best_t = tmax
     best = -1
@@ -95,20 +96,18 @@ def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
         if count > 0:
             first = geo.mesh_link[node, 0]
             for j in range(first, first + count):
-                tri = geo.mesh_node_tris[j]
-                t, b1, b2 = intersect_mesh_triangle(verts, faces, tri, o, kx, ky, kz, sx, sy,
-                                                    sz, tmin, best_t)
+                t, b1, b2 = intersect_mesh_triangle(corners, j, o, kx, ky, kz, sx, sy, sz,
+                                                    tmin, best_t)
                 if t < best_t:
                     best_t = t
-                    best = tri
+                    best = j
                     best_b1 = b1
                     best_b2 = b2
             continue
-        top = push_children(box, geo.mesh_link, node, o, inv, tmin, best_t, stack,
-                            top)
+        top = push_children(box, geo.mesh_link, node, o, inv, tmin, best_t, stack, top)
     if best < 0:
         return INF, -1, 0.0, 0.0
-    return best_t, best, best_b1, best_b2
+    return best_t, geo.mesh_node_tris[best], best_b1, best_b2
 
 
 @kernel
@@ -120,8 +119,7 @@ def mesh_occlusion(geo, mats, mesh, material, o, d, inv, tmin, tmax, stack, base
         t, tri, _, _ = mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base)
         return 2 if tri >= 0 else 0
     kx, ky, kz, sx, sy, sz = shear_setup(d)
-    verts = geo.mesh_vertices
-    faces = geo.mesh_faces
+    corners = geo.mesh_leaf_corners
     box = geo.mesh_box
     seen = 0
     top = base
@@ -135,11 +133,10 @@ def mesh_occlusion(geo, mats, mesh, material, o, d, inv, tmin, tmax, stack, base
         if count > 0:
             first = geo.mesh_link[node, 0]
             for j in range(first, first + count):
-                tri = geo.mesh_node_tris[j]
-                t, _, _ = intersect_mesh_triangle(verts, faces, tri, o, kx, ky, kz, sx, sy, sz,
-                                                  tmin, tmax)
+                t, _, _ = intersect_mesh_triangle(corners, j, o, kx, ky, kz, sx, sy, sz, tmin,
+                                                  tmax)
                 if t < INF:
-                    m = material if material >= 0 else geo.tri_material[tri]
+                    m = material if material >= 0 else geo.tri_material[geo.mesh_node_tris[j]]
                     if mats[m, MAT_KT] < OPAQUE_KT:
                         return 1
                     seen = 2
