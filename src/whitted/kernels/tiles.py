@@ -1,8 +1,8 @@
 """Entry points called from Python: render a batch of tiles in parallel, or the AOVs.
 
-The kernels release the GIL, so the render API runs one *lane* per Python thread: lane k renders
-tiles k, k + lanes, k + 2·lanes, ... so cheap sky tiles and expensive glass tiles spread evenly.
-Each pixel's value depends only on the scene, the seed and its coordinates, so the image is
+The kernels release the GIL, so the render API runs one *lane* per Python thread, each taking
+runs of tiles from a shared counter until none is left (``render_tiles`` can also split a batch
+itself: lane k of n renders tiles k, k + n, ...). Each pixel's value depends only on the scene, the seed and its coordinates, so the image is
 bit-identical whatever the thread count.
 """
 

@@ -265,17 +265,33 @@ class RenderJob:
         done = 0
         lock = threading.Lock()
 
-        def lane_work(lane: int, n: int) -> None:
-            """Lane ``lane`` renders tiles lane, lane + n, ... in small calls, with no barrier
-            between lanes, checking for cancellation and reporting progress between calls."""
+        next_tile = 0
+        most_per_call = max(1, -(-len(tiles) // (64 * lanes)))  # ~64 progress updates a lane
+
+        def take_tiles(n: int) -> np.ndarray:
+            """The next run of tiles for a lane: shorter as the image nears its end (a
+            quarter of what is left per lane, at most ``most_per_call``), so the lanes finish
+            together however unevenly the work is spread over the image."""
+            nonlocal next_tile
+            with lock:
+                left = len(tiles) - next_tile
+                count = min(left, most_per_call, max(1, left // (4 * n)))
+                start = next_tile
+                next_tile += count
+            return np.arange(start, start + count)
+
+        def lane_work(_lane: int, n: int) -> None:
+            """A lane takes runs of tiles (in image order) until none is left, with no
+            barrier between lanes, checking for cancellation and reporting progress between
+            runs. Pixels do not depend on which lane renders them."""
             nonlocal done
-            mine = np.arange(lane, len(tiles), n)
-            per_call = max(1, -(-len(mine) // 64))  # ~64 progress updates per lane
             work = lane_workspace(params.max_depth)
-            for start in range(0, len(mine), per_call):
+            while True:
                 if self.cancel_token.cancelled:
                     return
-                idx = mine[start : start + per_call]
+                idx = take_tiles(n)
+                if len(idx) == 0:
+                    return
                 part = np.ascontiguousarray(tiles[idx])
                 part_counters = np.zeros((len(idx), N_RAY_KINDS), np.int64)
                 render_tiles(part, self.framebuffer, compiled.geometry, compiled.materials,
