@@ -155,7 +155,8 @@ def test_planes_out_of_a_cells_reach_are_left_out():
 
 def test_scenes_with_mesh_instances_and_other_lights_get_no_buffer():
     verts, faces = uv_sphere(8, 12)
-    scene = whitted.Scene(objects=[whitted.Mesh(vertices=verts, faces=faces), whitted.Sphere(radius=1.0)],
+    scene = whitted.Scene(objects=[whitted.Mesh(vertices=verts, faces=faces),
+                                   whitted.Sphere(radius=1.0)],
                           lights=[whitted.PointLight(position=(0, 5, 0))])
     assert compile_scene(scene).lights.table[0, LIGHT_BUFFER] == 0  # the mesh flattened
     instanced = compile_scene(scene, flatten_limit=0)

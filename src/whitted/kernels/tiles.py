@@ -1,9 +1,10 @@
 """Entry points called from Python: render a batch of tiles in parallel, or the AOVs.
 
 The kernels release the GIL, so the render API runs one *lane* per Python thread, each taking
-runs of tiles from a shared counter until none is left (``render_tiles`` can also split a batch
-itself: lane k of n renders tiles k, k + n, ...). Each pixel's value depends only on the scene, the seed and its coordinates, so the image is
-bit-identical whatever the thread count.
+runs of tiles from a shared counter until none is left (``render_tiles`` can also split a
+batch itself: lane k of n renders tiles k, k + n, ...). Each pixel's value depends only on
+the scene, the seed and its coordinates, so the image is bit-identical whatever the thread
+count.
 """
 
 from __future__ import annotations
