@@ -37,8 +37,8 @@ from ..kernels.light_buffer import (
     cell_cone,
     cell_direction,
 )
+from ..kernels.lighting import list_cone_leaves
 from ..kernels.mesh import OPAQUE_KT
-from ..kernels.traverse import cone_meets_box
 
 CONE_SLACK = 1e-6  # relative widening of each cell's cone (rounding of the ray directions)
 PLANE_SLACK = 1e-9  # a cell's corner must run this clearly away from a plane to drop it
@@ -86,34 +86,12 @@ def list_cell_occluders(geo, mats, light, reach, res, lists, counts, opaque, sta
             lists[cell, n] = i
             n += 1
             all_opaque = all_opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
-        if n >= 0 and geo.node_box.shape[0] > 0:
+        if n >= 0:
             c, tan_half = cell_cone(cell, res)
-            axis = (c[0] * reach, c[1] * reach, c[2] * reach)
-            radius = reach * tan_half * (1.0 + CONE_SLACK) + reach * CONE_SLACK
-            top = 0
-            stack[0] = 0
-            while top >= 0 and n >= 0:
-                node = stack[top]
-                top -= 1
-                if not cone_meets_box(geo.node_box, node, light, axis, radius):
-                    continue
-                count = geo.node_link[node, 1]
-                if count == 0:
-                    top += 1
-                    stack[top] = node + 1
-                    top += 1
-                    stack[top] = geo.node_link[node, 0]
-                    continue
-                if n + count > cap:
-                    n = -1
-                    break
-                first = geo.node_link[node, 0]
-                for leaf in range(first, first + count):
-                    i = geo.node_prims[leaf]
-                    lists[cell, n] = i
-                    n += 1
-                    all_opaque = (all_opaque
-                                  and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT)
+            n, all_opaque = list_cone_leaves(
+                geo, mats, light, (c[0] * reach, c[1] * reach, c[2] * reach),
+                reach * tan_half * (1.0 + CONE_SLACK) + reach * CONE_SLACK, stack, lists[cell],
+                n, cap, all_opaque)
         counts[cell] = n
         opaque[cell] = 1 if (n >= 0 and all_opaque) else 0
 

@@ -166,16 +166,25 @@ def list_bundle_occluders(geo, mats, p, centre, radius, tmin, stack, listed):
         listed[n] = i
         n += 1
         opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
+    return list_cone_leaves(geo, mats, p, sub(centre, p), radius * (1.0 + 1e-7) + 1e-12, stack,
+                            listed, n, SHADOW_LIST_CAP, opaque)
+
+
+@kernel(inline="always")
+def list_cone_leaves(geo, mats, apex, axis, radius, stack, out, n, cap, opaque):
+    """Append to ``out[n:]`` the primitives of the scene BVH's leaves whose boxes meet the
+    cone from ``apex`` to the ball of ``radius`` around ``apex + axis`` (see
+    :func:`cone_meets_box`). ``opaque`` says whether those already listed are all opaque.
+    Returns (the new count, whether all listed are opaque); the count is -1 when they would
+    be more than ``cap``."""
     if geo.node_box.shape[0] == 0:
         return n, opaque
-    axis = sub(centre, p)
-    radius = radius * (1.0 + 1e-7) + 1e-12
     top = 0
     stack[0] = 0
     while top >= 0:
         node = stack[top]
         top -= 1
-        if not cone_meets_box(geo.node_box, node, p, axis, radius):
+        if not cone_meets_box(geo.node_box, node, apex, axis, radius):
             continue
         count = geo.node_link[node, 1]
         if count == 0:
@@ -184,12 +193,12 @@ def list_bundle_occluders(geo, mats, p, centre, radius, tmin, stack, listed):
             top += 1
             stack[top] = geo.node_link[node, 0]
             continue
-        if n + count > SHADOW_LIST_CAP:
+        if n + count > cap:
             return -1, False
         first = geo.node_link[node, 0]
         for leaf in range(first, first + count):
             i = geo.node_prims[leaf]
-            listed[n] = i
+            out[n] = i
             n += 1
             opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
     return n, opaque
