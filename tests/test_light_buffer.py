@@ -108,7 +108,7 @@ def test_every_primitive_a_shadow_ray_hits_is_in_its_cells_list():
     for j in range(2):
         first = int(lights.table[j, LIGHT_BUFFER])
         side = int(lights.table[j, LIGHT_BUFFER_SIDE])
-        assert first >= 0 and side == buffer_side(2)
+        assert first >= 0 and side == buffer_side(2, compiled.geometry.prim_info.shape[0])
         light = lights.table[j, 4:7].copy()
         counts, unlisted = _audit_cells(compiled.geometry, lights.buffer_cells,
                                         lights.buffer_prims, first, side, light, points)
@@ -168,9 +168,12 @@ def test_scenes_with_mesh_instances_and_other_lights_get_no_buffer():
     assert (compile_scene(scene).lights.table[:, LIGHT_BUFFER] == -1).all()
 
 
-def test_many_lights_share_the_cell_budget():
-    assert buffer_side(1) == 128 and buffer_side(10) == 128
-    assert 6 * buffer_side(40) ** 2 * 40 <= LIGHT_BUFFER_CELLS < 6 * (buffer_side(40) + 1) ** 2 * 40
+def test_many_lights_share_the_cell_budget_and_small_scenes_get_coarse_cells():
+    assert buffer_side(1, 1000) == 128 and buffer_side(10, 1000) == 128
+    side = buffer_side(40, 1000)
+    assert 6 * side**2 * 40 <= LIGHT_BUFFER_CELLS < 6 * (side + 1) ** 2 * 40
+    # a tiny scene gets coarse cells: it has nothing finer cells could separate
+    assert buffer_side(1, 1) == 6 and buffer_side(1, 200) == 92
 
 
 unit = st.floats(-1.0, 1.0, allow_nan=False)

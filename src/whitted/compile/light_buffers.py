@@ -41,6 +41,8 @@ from ..kernels.lighting import list_cone_leaves
 from ..kernels.mesh import OPAQUE_KT
 
 CONE_SLACK = 1e-6  # relative widening of each cell's cone (rounding of the ray directions)
+CELLS_PER_PRIMITIVE = 256  # cells per light for each primitive, at most: finer cells would
+# barely shorten the lists (seed000, 660 primitives, keeps its 128 cells a side)
 PLANE_SLACK = 1e-9  # a cell's corner must run this clearly away from a plane to drop it
 
 
@@ -105,13 +107,15 @@ def _reach(geo: GeometryArrays, light: np.ndarray) -> float:
     return float(np.linalg.norm(far)) * (1.0 + 1e-6) + 1e-9
 
 
-def buffer_side(n_point_lights: int, res: int = LIGHT_BUFFER_RES) -> int:
-    """Cells along a cube-face side for each of ``n_point_lights`` buffers: ``res``, less when
-    so many lights share the LIGHT_BUFFER_CELLS budget."""
+def buffer_side(n_point_lights: int, n_prims: int, res: int = LIGHT_BUFFER_RES) -> int:
+    """Cells along a cube-face side for each of ``n_point_lights`` buffers over ``n_prims``
+    primitives: ``res``, less when so many lights share the LIGHT_BUFFER_CELLS budget, and
+    less for a scene so small that finer cells would barely part its primitives further (at
+    most CELLS_PER_PRIMITIVE cells each: a one-sphere scene gets 6 a side and builds at once)."""
     if n_point_lights == 0:
         return 0
-    fit = int(np.sqrt(LIGHT_BUFFER_CELLS / (6 * n_point_lights)))
-    return max(1, min(res, fit))
+    fit = min(LIGHT_BUFFER_CELLS / n_point_lights, CELLS_PER_PRIMITIVE * max(1, n_prims))
+    return max(1, min(res, int(np.sqrt(fit / 6))))
 
 
 def build_light_buffers(geo: GeometryArrays, materials: np.ndarray, table: np.ndarray,
@@ -121,7 +125,7 @@ def build_light_buffers(geo: GeometryArrays, materials: np.ndarray, table: np.nd
     to its first cell; -1 for other lights, and for every light when the scene has mesh
     instances or ``res`` is 0)."""
     table = table.copy()
-    res = buffer_side(int(np.sum(table[:, LIGHT_TYPE] == LIGHT_POINT)), res)
+    res = buffer_side(int(np.sum(table[:, LIGHT_TYPE] == LIGHT_POINT)), len(geo.prim_info), res)
     table[:, LIGHT_BUFFER] = -1.0
     cells = [np.zeros((0, 3), np.int32)]
     prims = [np.zeros(0, np.int32)]
