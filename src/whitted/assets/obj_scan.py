@@ -25,7 +25,8 @@ spans of their (trimmed) argument, with the triangle count at which each ``usemt
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from ..kernels.jit import builder
 
 # Result codes (``info[INFO_CODE]``); the Python side turns them into messages.
 OK = 0
@@ -70,7 +71,7 @@ _NUMBER_NOT_FINITE = 3
 
 # Compiled without the Numba runtime: arrays pass between these functions without atomic
 # reference counting (several times faster here); none of them allocates.
-_scanner = njit(cache=True, nogil=True, _nrt=False)
+_scanner = builder(_nrt=False)
 
 _EXACT_POWERS_OF_TEN = np.array([float(f"1e{k}") for k in range(23)])
 _INDEX_LIMIT = 10**15  # larger indices saturate (and are out of range)
@@ -566,7 +567,7 @@ def scan_obj(data, fill, info, positions, texcoords, normals, corner_v, corner_v
     info[INFO_LINES] = line
 
 
-@njit(cache=True, nogil=True)  # allocates its results
+@builder  # allocates its results
 def split_corners(vertex_count, corner_v, corner_vt, corner_vn):
     """Per-vertex attributes from per-corner indices, without moving any vertex.
 

@@ -25,7 +25,8 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+
+from ..kernels.jit import builder
 
 LEAF_HARD_CAP = 16  # a node with more primitives than this is always split
 MAX_DEPTH = 60  # root has depth 0; no leaf is deeper than this
@@ -47,7 +48,7 @@ class BVH(NamedTuple):
     prim_order: np.ndarray  # (N,) int32 primitive indices in leaf order
 
 
-@njit(cache=True, nogil=True)
+@builder
 def _ceil_log2(n):
     k = 0
     v = 1
@@ -57,7 +58,7 @@ def _ceil_log2(n):
     return k
 
 
-@njit(cache=True, nogil=True)
+@builder
 def _half_area(lx, ly, lz, hx, hy, hz):
     dx = hx - lx
     dy = hy - ly
@@ -65,7 +66,7 @@ def _half_area(lx, ly, lz, hx, hy, hz):
     return dx * dy + dy * dz + dz * dx
 
 
-@njit(cache=True, nogil=True)
+@builder
 def _range_bounds(rows, start, end, out):
     """Box bounds (out[0:6]) and centroid bounds (out[6:12]) of rows[start:end]."""
     for k in range(3):
@@ -88,18 +89,18 @@ def _range_bounds(rows, start, end, out):
                 out[9 + k] = c
 
 
-@njit(cache=True, nogil=True)
+@builder
 def _centroid(rows, j, k):
     return rows[j, 6 + k]
 
 
-@njit(cache=True, nogil=True)
+@builder
 def _bin_of(rows, j, axis, cmin, scale, nb):
     b = int((_centroid(rows, j, axis) - cmin) * scale)
     return nb - 1 if b >= nb else b
 
 
-@njit(cache=True, nogil=True)
+@builder
 def _grow_centroids(f, rows, j):
     """Grow the centroid bounds f[6:12] by the centroid of row j."""
     cx = _centroid(rows, j, 0)
@@ -113,7 +114,7 @@ def _grow_centroids(f, rows, j):
     f[11] = max(f[11], cz)
 
 
-@njit(cache=True, nogil=True)
+@builder
 def _pack(bmin, bmax, rows, idx):
     """Fill the working rows (caller-allocated: NumPy's large allocations fault in faster)."""
     for i in range(bmin.shape[0]):
@@ -127,7 +128,7 @@ def _pack(bmin, bmax, rows, idx):
             rows[i, 6 + k] = 0.5 * lo + 0.5 * hi
 
 
-@njit(cache=True, nogil=True)
+@builder
 def _swap(rows, idx, a, b):
     for k in range(_NCOL):
         t = rows[a, k]
@@ -138,7 +139,7 @@ def _swap(rows, idx, a, b):
     idx[b] = t2
 
 
-@njit(cache=True, nogil=True)
+@builder
 def _sort_range(rows, idx, start, end, axis):
     """Sort rows[start:end] (and idx) by centroid on ``axis``; stable, hence deterministic."""
     keys = np.empty(end - start, np.float64)
@@ -154,7 +155,7 @@ def _sort_range(rows, idx, start, end, axis):
         idx[start + j] = tmp_idx[o]
 
 
-@njit(cache=True, nogil=True)
+@builder
 def _sah_axis(rows, start, end, axis, cmin, scale, nb, bin_cnt, bin_box, r_area, r_cnt):
     """Bin rows[start:end] by centroid on ``axis`` into nb bins (filling bin_cnt and bin_box)
     and score every bin boundary. Returns (s, cost, imbalance) of the cheapest boundary, where
@@ -225,7 +226,7 @@ def _sah_axis(rows, start, end, axis, cmin, scale, nb, bin_cnt, bin_box, r_area,
     return best_s, best_cost, best_imb
 
 
-@njit(cache=True, nogil=True)
+@builder
 def _build(rows, idx, n_bins, leaf_cap, node_min, node_max, node_offset, node_count, node_axis,
            traversal_cost):
     """Build the tree in place; returns the number of nodes written."""
@@ -252,7 +253,8 @@ def _build(rows, idx, n_bins, leaf_cap, node_min, node_max, node_offset, node_co
     st_i[0, 1] = n
     st_i[0, 2] = -1
     st_i[0, 3] = 0
-    st_f[0, :] = cur
+    for k in range(12):  # a loop: a slice copy compiles Numba's shape-error machinery (1.3 s)
+        st_f[0, k] = cur[k]
     sp = 1
     n_nodes = 0
 

@@ -12,10 +12,11 @@ files that repeat a vertex per face (STL) smooth as well.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from ..kernels.jit import builder
 
 
-@njit(cache=True, nogil=True)
+@builder
 def _corner_normals(corner_angle, face_unit, order, starts, cos_crease, out):
     n_keys = starts.shape[0] - 1
     for k in range(n_keys):

@@ -267,7 +267,7 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
     return n, full
 
 
-@kernel
+@kernel(specialise_constants=True)  # a variant per call site: LLVM inlines each
 def _pass_surface(geo, mats, prim, tri, b1, b2, o, d, t, scratch, count, trans):
     """Light crossing the transparent surface hit at t: media pushed or popped, kt·colour
     applied where it enters. Returns (media count, transmittance)."""
