@@ -26,6 +26,7 @@ from ..kernels.layout import (
 )
 from ..output.image import Image
 from ..scene.scene import RenderSettings, Scene
+from .warm_up import warm_up_kernels
 
 RAY_KIND_NAMES = {
     RAY_PRIMARY: "primary",
@@ -128,47 +129,6 @@ def tile_grid(width: int, height: int, tile: int = DEFAULT_TILE) -> np.ndarray:
     ys = np.arange(0, height, tile)
     grid = [(x, y, min(x + tile, width), min(y + tile, height)) for y in ys for x in xs]
     return np.array(grid, dtype=np.int32).reshape(-1, 4)
-
-
-_kernel_lock = threading.Lock()
-_kernels_ready: set[bool] = set()  # kernel variants loaded: with / without mesh instances
-
-
-def _kernel_variant(compiled: CompiledScene) -> bool:
-    return compiled.geometry.inst_box.dtype == np.float64
-
-
-def warm_up_kernels(compiled: CompiledScene | None = None) -> float:
-    """Compile (first run) or load from the on-disk cache (later runs) the render kernels:
-    the variant for scenes like ``compiled`` (kernels are specialised for scenes with and
-    without mesh instances), or without meshes when None; the BVH and light-buffer builders
-    too. Returns the seconds it took; 0 when that variant was already loaded in this process."""
-    with _kernel_lock:
-        if compiled is not None and _kernel_variant(compiled) in _kernels_ready:
-            return 0.0
-        if compiled is None and False in _kernels_ready:
-            return 0.0
-        start = time.perf_counter()
-        from ..kernels.tiles import lane_workspace, render_aovs, render_tiles
-        from ..scene.lights import PointLight
-        from ..scene.shapes import Sphere
-
-        # one bounded shape and a point light: the BVH and light-buffer builders too
-        scene = Scene(objects=[Sphere(radius=1.0)], lights=[PointLight(position=(0, 5, 0))])
-        if compiled is None:
-            compiled = compile_scene(scene)
-        params = render_params(scene, compiled, scene.render.model_copy(update={"width": 1,
-                                                                                 "height": 1}))
-        fb = np.zeros((1, 1, 3), np.float32)
-        counters = np.zeros((1, N_RAY_KINDS), np.int64)
-        no_tiles = np.zeros((0, 4), np.int32)  # compiles (or loads) without rendering
-        render_tiles(no_tiles, fb, compiled.geometry, compiled.materials, compiled.lights,
-                     params, counters, lane_workspace(params.max_depth), 0, 1)
-        render_aovs(compiled.geometry, params._replace(height=0), np.zeros((1, 1), np.float32),
-                    np.zeros((1, 1, 3), np.float32), np.zeros((1, 1), np.int32),
-                    lane_workspace(0), 0, 1)
-        _kernels_ready.add(_kernel_variant(compiled))
-        return time.perf_counter() - start
 
 
 class RenderJob:

@@ -1,0 +1,54 @@
+"""The warm-up that gets kernels ready before a render, and its compile helper process."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+from whitted.compile.flatten import render_params
+from whitted.kernels import tiles
+from whitted.kernels.callees import render_callees
+from whitted.kernels.jit import kernel
+from whitted.kernels.layout import N_RAY_KINDS
+from whitted.render import warm_up
+from whitted.scene.scene import RenderSettings, Scene
+
+
+def test_helper_compiles_the_signatures_render_tiles_calls():
+    """The helper's work is only of use if render_tiles asks for exactly these variants.
+
+    A copy of render_tiles without a cache is compiled here: its callees then load (or
+    compile) the variants it asks for, which is what their ``overloads`` list."""
+    stand_in = warm_up.stand_in_scene(False)
+    fresh_render_tiles = kernel(cache=False)(tiles.render_tiles.py_func)
+    params = render_params(Scene(), stand_in, RenderSettings(width=1, height=1))
+    fresh_render_tiles(np.zeros((0, 4), np.int32), np.zeros((1, 1, 3), np.float32),
+                       stand_in.geometry, stand_in.materials, stand_in.lights, params,
+                       np.zeros((1, N_RAY_KINDS), np.int64), tiles.lane_workspace(1), 0, 1)
+    for dispatcher, argument_types in render_callees(stand_in.geometry, stand_in.materials):
+        assert tuple(argument_types) in dispatcher.overloads, (
+            f"{dispatcher.py_func.__name__}: render_tiles compiled "
+            f"{list(dispatcher.overloads)}, the helper would compile {argument_types}")
+
+
+def test_warm_up_marks_the_cache_folder():
+    warm_up.warm_up_kernels()
+    assert warm_up._marker(False).exists()
+    assert warm_up.warm_up_kernels() == 0.0  # already loaded in this process
+
+
+def test_helper_process_runs_to_completion():
+    """``python -m whitted.render.warm_up`` (with the cache already warm: it loads)."""
+    warm_up.warm_up_kernels()
+    result = subprocess.run([sys.executable, "-m", "whitted.render.warm_up", "plain"],
+                            capture_output=True, text=True, env=dict(os.environ),
+                            timeout=300)
+    assert result.returncode == 0, result.stderr
+
+
+def test_no_helper_when_disabled(monkeypatch):
+    monkeypatch.setenv("WHITTED_COMPILE_HELPER", "0")
+    assert warm_up._start_helper(False) is None
