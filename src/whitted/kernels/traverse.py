@@ -137,7 +137,26 @@ def next_scene_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top,
             leaf = geo.node_link[node, 0]
             leaf_end = leaf + count
         elif ordered:
-            top = push_children(box, geo.node_link, node, o, inv, tmin, tmax, stack, top)
+            # down the nearer child directly (its box was just tested against this tmax);
+            # the farther one waits on the stack and is tested again when popped
+            while count == 0:
+                near = node + 1
+                far = geo.node_link[node, 0]
+                t_near = box_entry(box, near, o, inv, tmin, tmax)
+                t_far = box_entry(box, far, o, inv, tmin, tmax)
+                if t_far < t_near:
+                    near, far = far, near
+                    t_near, t_far = t_far, t_near
+                if t_far != INF:
+                    top += 1
+                    stack[top] = far
+                if t_near == INF:
+                    break
+                node = near
+                count = geo.node_link[node, 1]
+            if count > 0:
+                leaf = geo.node_link[node, 0]
+                leaf_end = leaf + count
         else:
             top += 1
             stack[top] = node + 1
