@@ -49,9 +49,24 @@ def box_entry(box, node, o, inv, tmin, tmax):
 
 
 @kernel(inline="always")
+def order_children(box, link, node, o, inv, tmin, tmax):
+    """The children of interior ``node`` nearer first, with the ray's entry distances:
+    (near, t_near, far, t_far); INF where the ray misses a child's box. Ties go to the
+    left child."""
+    near = node + 1
+    far = link[node, 0]
+    t_near = box_entry(box, near, o, inv, tmin, tmax)
+    t_far = box_entry(box, far, o, inv, tmin, tmax)
+    if t_far < t_near:
+        return far, t_far, near, t_near
+    return near, t_near, far, t_far
+
+
+@kernel(inline="always")
 def push_children(box, link, node, o, inv, tmin, tmax, stack, top):
     """Push the children of interior ``node`` that the ray meets, the farther one first so
-    the nearer one is visited next; returns the new stack top."""
+    the nearer one is visited next; returns the new stack top. (Written out rather than on
+    top of :func:`order_children`: through that the mesh walk ran 20 % slower.)"""
     left = node + 1
     right = link[node, 0]
     t_left = box_entry(box, left, o, inv, tmin, tmax)
@@ -133,32 +148,24 @@ def next_scene_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top,
         if box_entry(box, node, o, inv, tmin, tmax) == INF:
             continue
         count = geo.node_link[node, 1]
-        if count > 0:
-            leaf = geo.node_link[node, 0]
-            leaf_end = leaf + count
-        elif ordered:
-            # down the nearer child directly (its box was just tested against this tmax);
-            # the farther one waits on the stack and is tested again when popped
-            while count == 0:
-                near = node + 1
-                far = geo.node_link[node, 0]
-                t_near = box_entry(box, near, o, inv, tmin, tmax)
-                t_far = box_entry(box, far, o, inv, tmin, tmax)
-                if t_far < t_near:
-                    near, far = far, near
-                    t_near, t_far = t_far, t_near
-                if t_far != INF:
-                    top += 1
-                    stack[top] = far
-                if t_near == INF:
-                    break
-                node = near
-                count = geo.node_link[node, 1]
-            if count > 0:
-                leaf = geo.node_link[node, 0]
-                leaf_end = leaf + count
-        else:
+        if count == 0 and not ordered:
             top += 1
             stack[top] = node + 1
             top += 1
             stack[top] = geo.node_link[node, 0]
+            continue
+        # down the nearer child directly (its box was just tested against this tmax); the
+        # farther one waits on the stack and is tested again when popped
+        while count == 0:
+            near, t_near, far, t_far = order_children(box, geo.node_link, node, o, inv, tmin,
+                                                      tmax)
+            if t_far != INF:
+                top += 1
+                stack[top] = far
+            if t_near == INF:
+                break
+            node = near
+            count = geo.node_link[node, 1]
+        if count > 0:
+            leaf = geo.node_link[node, 0]
+            leaf_end = leaf + count
