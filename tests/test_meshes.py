@@ -307,3 +307,43 @@ def test_small_meshes_are_flattened_big_ones_instanced():
     np.testing.assert_array_equal(np.isfinite(t_flat), np.isfinite(t_inst))
     hit = np.isfinite(t_flat)
     np.testing.assert_allclose(t_flat[hit], t_inst[hit], rtol=1e-6)
+
+
+def test_mesh_nodes_are_sibling_pairs_on_cache_lines():
+    """Two different meshes (so two node blocks): every interior node's children sit side by
+    side on one 64-byte line, each child's box lies inside its parent's, and the leaves list
+    every triangle of their mesh exactly once; the int32 link columns share the rows' memory."""
+    v1, f1 = uv_sphere(12, 24)
+    v2, f2 = cube()
+    scene = whitted.Scene(objects=[whitted.Mesh(v1, f1), whitted.Mesh(v2, f2)])
+    geo = compile_scene(scene, flatten_limit=0).geometry
+    nodes, ints = geo.mesh_nodes, geo.mesh_node_ints
+    assert nodes.shape[1] == 8 and nodes.dtype == np.float32 and ints.dtype == np.int32
+    assert np.shares_memory(nodes, ints)
+    assert nodes.ctypes.data % 64 == 0
+    assert len(geo.mesh_info) == 2
+    for mesh, tri_count in enumerate((len(f1), len(f2))):
+        root = int(geo.mesh_info[mesh, 0])
+        tri_offset = int(geo.mesh_info[mesh, 1])
+        assert root % 2 == 0
+        seen = []
+        stack = [root]
+        while stack:
+            node = stack.pop()
+            count = int(ints[node, 7])
+            if count > 0:
+                first = int(ints[node, 6])
+                seen.extend(range(first, first + count))
+                continue
+            first = int(ints[node, 6])
+            assert first % 2 == 0 and first > root  # the pair fills one cache line
+            for child in (first, first + 1):
+                assert np.all(nodes[child, :3] >= nodes[node, :3])
+                assert np.all(nodes[child, 3:6] <= nodes[node, 3:6])
+                stack.append(child)
+        entries = np.sort(np.array(seen))
+        np.testing.assert_array_equal(entries, tri_offset + np.arange(tri_count))
+        tris = np.sort(geo.mesh_node_tris[entries])
+        np.testing.assert_array_equal(tris, tri_offset + np.arange(tri_count))
+        # the padding row after the root holds an empty box: no ray can enter it
+        assert np.all(nodes[root + 1, :3] > nodes[root + 1, 3:6])

@@ -294,7 +294,7 @@ def info(
         if stored:
             parts.append(f"{len(geo.mesh_info)} stored for instancing ({stored:,} triangles, "
                          f"{compiled.instanced_triangles - flat:,} with instances, "
-                         f"{len(geo.mesh_link):,} mesh BVH nodes)")
+                         f"{len(geo.mesh_nodes):,} mesh BVH nodes)")
         out.print("meshes: " + "; ".join(parts))
     for warning in compiled.warnings:
         out.print(f"warning: {warning}", markup=False, highlight=False)

@@ -17,6 +17,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..kernels.layout import (
+    MESH_NODE_COUNT,
+    MESH_NODE_HI,
+    MESH_NODE_LO,
+    MESH_NODE_OFFSET,
+    MESH_NODE_WIDTH,
     MESH_NORMALS,
     MESH_ROOT,
     MESH_TRI_COUNT,
@@ -65,6 +70,32 @@ def _round_up32(a: np.ndarray) -> np.ndarray:
     under = out.astype(np.float64) < a
     out[under] = np.nextafter(out[under], np.float32(np.inf))
     return out
+
+
+def sibling_pairs(lo: np.ndarray, hi: np.ndarray, offset: np.ndarray, count: np.ndarray):
+    """A mesh BVH from the builder's depth-first layout (left child ``i + 1``, right child
+    ``offset[i]``) in the layout the mesh walks read: the two children of an interior node
+    side by side, ``first`` and ``first + 1``, so one 64-byte cache line holds both boxes.
+    Row 0 is the root, row 1 padding (an empty box) so every pair starts on an even row; the
+    pairs follow in the depth-first order of their parents. Returns (box (N+1, 2, 3) float32,
+    link (N+1, 2) int32: interior (first child, 0), leaf (first entry, count))."""
+    n = len(count)
+    interior = np.flatnonzero(count == 0)
+    first = 2 + 2 * np.arange(len(interior))  # the pair of the k-th interior node
+    where = np.zeros(n, np.int64)  # new row of every node
+    where[interior + 1] = first
+    where[offset[interior]] = first + 1
+    rows = n + 1
+    box = np.empty((rows, 2, 3), np.float32)
+    box[:, 0] = np.inf
+    box[:, 1] = -np.inf
+    box[where, 0] = lo
+    box[where, 1] = hi
+    link = np.zeros((rows, 2), np.int32)
+    link[where, 0] = offset
+    link[where[interior], 0] = first
+    link[where, 1] = count
+    return box, link
 
 
 class MeshTable:
@@ -167,23 +198,39 @@ class MeshTable:
         self.vertices.append(verts32)
         self.faces.append((faces + self.n_vertices).astype(np.int32))
         self.tri_material.append(np.asarray(material_rows, np.int32)[face_material])
-        box = np.empty((len(bvh.node_count), 2, 3), np.float32)
-        box[:, 0] = _round_down32(bvh.node_min)
-        box[:, 1] = _round_up32(bvh.node_max)
-        self.node_box.append(box)
-        leaf = bvh.node_count > 0
-        # global indices: interior nodes name their right child among all meshes' nodes,
+        box, link = sibling_pairs(_round_down32(bvh.node_min), _round_up32(bvh.node_max),
+                                  bvh.node_offset, bvh.node_count)
+        # global indices: interior nodes name their first child among all meshes' nodes,
         # leaves their first entry among all meshes' node_tris
-        offset = np.where(leaf, bvh.node_offset + self.n_tris, bvh.node_offset + self.n_nodes)
-        self.node_link.append(np.stack([offset, bvh.node_count], axis=1).astype(np.int32))
+        leaf = link[:, 1] > 0
+        link[:, 0] += np.where(leaf, self.n_tris, self.n_nodes)
+        self.node_box.append(box)
+        self.node_link.append(link)
         self.node_tris.append((bvh.prim_order + self.n_tris).astype(np.int32))
         self.leaf_corners.append(verts32[faces[bvh.prim_order]])
         lo = np.array(bvh.node_min[0], np.float64)  # the root box: all triangles
         hi = np.array(bvh.node_max[0], np.float64)
         self.n_vertices += len(verts32)
         self.n_tris += t
-        self.n_nodes += len(bvh.node_count)
+        self.n_nodes += len(link)
         return CompiledMesh(index, lo, hi, t)
+
+    def node_rows(self) -> dict[str, np.ndarray]:
+        """The mesh BVH nodes as 32-byte rows (box, then link) starting on a 64-byte cache
+        line: ``mesh_nodes`` and its int32 view ``mesh_node_ints``."""
+        n = self.n_nodes
+        raw = np.empty(n * MESH_NODE_WIDTH + 16, np.float32)
+        skip = (-raw.ctypes.data % 64) // 4
+        rows = raw[skip:skip + n * MESH_NODE_WIDTH].reshape(n, MESH_NODE_WIDTH)
+        ints = rows.view(np.int32)
+        if n:
+            box = np.concatenate(self.node_box)
+            rows[:, MESH_NODE_LO:MESH_NODE_LO + 3] = box[:, 0]
+            rows[:, MESH_NODE_HI:MESH_NODE_HI + 3] = box[:, 1]
+            link = np.concatenate(self.node_link)
+            ints[:, MESH_NODE_OFFSET] = link[:, 0]
+            ints[:, MESH_NODE_COUNT] = link[:, 1]
+        return {"mesh_nodes": rows, "mesh_node_ints": ints}
 
     def arrays(self) -> dict[str, np.ndarray]:
         def cat(parts, shape, dtype):
@@ -200,8 +247,7 @@ class MeshTable:
             "tri_material": cat(self.tri_material, (0,), np.int32),
             "tri_normals": cat(self.tri_normals, (0, 3, 3), np.float32),
             "tri_uvs": cat(self.tri_uvs, (0, 3, 2), np.float32),
-            "mesh_box": cat(self.node_box, (0, 2, 3), np.float32),
-            "mesh_link": cat(self.node_link, (0, 2), np.int32),
+            **self.node_rows(),
             "mesh_node_tris": cat(self.node_tris, (0,), np.int32),
             "mesh_leaf_corners": cat(self.leaf_corners, (0, 3, 3), np.float32),
         }

@@ -109,6 +109,12 @@ N_PRIM_INFO = 5
 # interior node (count 0) has its left child at n + 1 and its right child at offset.
 LINK_OFFSET = 0
 LINK_COUNT = 1
+# mesh BVH node rows (GeometryArrays.mesh_nodes): lower corner 0:3, upper corner 3:6, link 6:8
+MESH_NODE_LO = 0
+MESH_NODE_HI = 3
+MESH_NODE_OFFSET = 6
+MESH_NODE_COUNT = 7
+MESH_NODE_WIDTH = 8
 
 
 class GeometryArrays(NamedTuple):
@@ -138,8 +144,12 @@ class GeometryArrays(NamedTuple):
     tri_material: np.ndarray  # (T,) int32 material row of each triangle
     tri_normals: np.ndarray  # (Tn, 3, 3) float32 corner normals of smooth-shaded triangles
     tri_uvs: np.ndarray  # (Tu, 3, 2) float32 corner texture coordinates
-    mesh_box: np.ndarray  # (N, 2, 3) float32 bottom-level node boxes (rounded outward)
-    mesh_link: np.ndarray  # (N, 2) int32 (leaf offsets index mesh_node_tris)
+    # bottom-level nodes, one 32-byte row each (a box test and the node's link read one cache
+    # line): columns MESH_NODE_LO, MESH_NODE_HI of mesh_nodes are the box (float32, rounded
+    # outward); columns MESH_NODE_LINK of mesh_node_ints, an int32 view of the same memory,
+    # the (offset, count) link (leaf offsets index mesh_node_tris)
+    mesh_nodes: np.ndarray  # (N, 8) float32
+    mesh_node_ints: np.ndarray  # (N, 8) int32, the same memory
     mesh_node_tris: np.ndarray  # (T,) int32 triangle indices in leaf order
     # (T, 3, 3) float32 corners of the triangles in leaf order (entry j: mesh_node_tris[j]):
     # the walks read a leaf's triangles from consecutive memory, not through two indirections
