@@ -125,9 +125,11 @@ class MeshTable:
         counts them. None when nothing is left."""
         faces = np.ascontiguousarray(src.faces, dtype=np.int64).reshape(-1, 3)
         corners = v[faces]  # (T, 3, 3)
-        area2 = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
-                                        corners[:, 2] - corners[:, 0]), axis=1)
-        keep = np.isfinite(corners).all(axis=(1, 2)) & (area2 > 0.0)
+        normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        keep = np.einsum("ij,ij->i", normal, normal) > 0.0  # twice the area, squared
+        finite = np.isfinite(v).all(axis=1)  # per vertex: a ninth of the work per corner
+        if not finite.all():
+            keep &= finite[faces].all(axis=1)
         dropped = int(len(faces) - keep.sum())
         if dropped:
             self.warnings.append(f"{src.label}: dropped {dropped} degenerate triangle"
@@ -171,8 +173,9 @@ class MeshTable:
             return None
         faces, face_material, corners = kept
         t = len(faces)
-        lo_tri = corners.min(axis=1)
-        hi_tri = corners.max(axis=1)
+        # pairwise minimum/maximum: NumPy's reduction over an axis of three is 5x slower
+        lo_tri = np.minimum(np.minimum(corners[:, 0], corners[:, 1]), corners[:, 2])
+        hi_tri = np.maximum(np.maximum(corners[:, 0], corners[:, 1]), corners[:, 2])
         del corners
         bvh = build_bvh(lo_tri, hi_tri, traversal_cost=MESH_TRAVERSAL_COST)
         del lo_tri, hi_tri
