@@ -70,23 +70,26 @@ def hit_analytic(geo, i, o, d, tmin, tmax):
 
 
 @kernel
-def hit_instance(geo, i, o, d, tmin, tmax, stack):
-    """(t, triangle, b1, b2) of the ray with mesh instance ``i``; t = INF on a miss."""
+def hit_instance(geo, i, o, d, inv, tmin, tmax, stack):
+    """(t, triangle, b1, b2) of the ray with mesh instance ``i``; t = INF on a miss. ``inv``
+    is the world ray's inverse direction (reused when the instance has no transform)."""
     xf = geo.prim_info[i, PRIM_XFORM]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
-    return mesh_closest_hit(geo, int(geo.prim_params[i, 0]), o, d, inverse_direction(d), tmin,
-                            tmax, stack, MESH_STACK_BASE)
+        inv = inverse_direction(d)
+    return mesh_closest_hit(geo, int(geo.prim_params[i, 0]), o, d, inv, tmin, tmax, stack,
+                            MESH_STACK_BASE)
 
 
 @kernel
-def instance_occludes(geo, mats, i, o, d, tmin, tmax, stack):
-    """:func:`occludes` for a mesh instance."""
+def instance_occludes(geo, mats, i, o, d, inv, tmin, tmax, stack):
+    """:func:`occludes` for a mesh instance (``inv`` as in :func:`hit_instance`)."""
     xf = geo.prim_info[i, PRIM_XFORM]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
+        inv = inverse_direction(d)
     return mesh_occlusion(geo, mats, int(geo.prim_params[i, 0]), geo.prim_info[i, PRIM_MATERIAL],
-                          o, d, inverse_direction(d), tmin, tmax, stack, MESH_STACK_BASE)
+                          o, d, inv, tmin, tmax, stack, MESH_STACK_BASE)
 
 
 @kernel
@@ -168,15 +171,15 @@ def surface_normals(geo, prim, tri, b1, b2, p):
 
 
 @kernel
-def closest_instance_hit(geo, o, d, tmin, tmax, stack):
-    """Nearest mesh-instance hit in (tmin, tmax), as :func:`closest_hit` returns it."""
+def closest_instance_hit(geo, o, d, inv, tmin, tmax, stack):
+    """Nearest mesh-instance hit in (tmin, tmax), as :func:`closest_hit` returns it
+    (``inv``: the inverse direction)."""
     best_t = tmax
     best = -1
     best_tri = -1
     best_b1 = 0.0
     best_b2 = 0.0
     box = geo.inst_box
-    inv = inverse_direction(d)
     top = 0
     stack[0] = 0
     while top >= 0:
@@ -192,7 +195,7 @@ def closest_instance_hit(geo, o, d, tmin, tmax, stack):
         first = geo.inst_link[node, 0]
         for j in range(first, first + count):
             i = geo.inst_prims[j]
-            t, tri, b1, b2 = hit_instance(geo, i, o, d, tmin, best_t, stack)
+            t, tri, b1, b2 = hit_instance(geo, i, o, d, inv, tmin, best_t, stack)
             if t < best_t:
                 best_t = t
                 best = i
@@ -224,7 +227,7 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
             best_t = t
             best = i
     if has_instances(geo):
-        t, prim, tri, b1, b2 = closest_instance_hit(geo, o, d, tmin, best_t, stack)
+        t, prim, tri, b1, b2 = closest_instance_hit(geo, o, d, inv, tmin, best_t, stack)
         if prim >= 0:
             return t, prim, tri, b1, b2
     return best_t, best, -1, 0.0, 0.0

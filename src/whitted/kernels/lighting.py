@@ -66,11 +66,10 @@ from .vec import dot, madd, normalize, sub, vload
 
 
 @kernel
-def _instances_occlusion(geo, mats, o, d, tmin, tmax, stack):
-    """:func:`any_occluder` over the mesh instances' BVH."""
+def _instances_occlusion(geo, mats, o, d, inv, tmin, tmax, stack):
+    """:func:`any_occluder` over the mesh instances' BVH (``inv``: the inverse direction)."""
     seen_transparent = 0
     box = geo.inst_box
-    inv = inverse_direction(d)
     top = 0
     stack[0] = 0
     while top >= 0:
@@ -87,7 +86,8 @@ def _instances_occlusion(geo, mats, o, d, tmin, tmax, stack):
             continue
         first = geo.inst_link[node, 0]
         for j in range(first, first + count):
-            state = instance_occludes(geo, mats, geo.inst_prims[j], o, d, tmin, tmax, stack)
+            state = instance_occludes(geo, mats, geo.inst_prims[j], o, d, inv, tmin, tmax,
+                                      stack)
             if state == 1:
                 return 1
             seen_transparent = max(seen_transparent, state)
@@ -112,7 +112,7 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
             return 1
         seen_transparent = max(seen_transparent, state)
     if has_instances(geo):
-        state = _instances_occlusion(geo, mats, o, d, tmin, tmax, stack)
+        state = _instances_occlusion(geo, mats, o, d, inv, tmin, tmax, stack)
         if state == 1:
             return 1
         seen_transparent = max(seen_transparent, state)
