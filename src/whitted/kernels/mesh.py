@@ -21,6 +21,8 @@ vertex) hits at least one of them: no cracks, whatever the floating-point roundi
 
 from __future__ import annotations
 
+import numpy as np
+
 from .intersect import INF
 from .jit import kernel
 from .layout import (
@@ -92,6 +94,7 @@ def intersect_mesh_triangle(corners, j, o, kx, ky, kz, sx, sy, sz, tmin, tmax):
 def node_entry(nodes, node, o, inv, tmin, tmax):
     """Entry distance of the ray into the box of mesh BVH node ``node`` when it overlaps
     (tmin, tmax), else INF (the slab test of :func:`.traverse.box_entry` on a node row)."""
+    node = np.uint64(node)  # unsigned: no negative-index wraparound code
     t0 = (nodes[node, MESH_NODE_LO] - o[0]) * inv[0]
     t1 = (nodes[node, MESH_NODE_HI] - o[0]) * inv[0]
     tn = min(t0, t1)
@@ -113,7 +116,7 @@ def node_entry(nodes, node, o, inv, tmin, tmax):
 def push_mesh_children(nodes, ints, node, o, inv, tmin, tmax, stack, top):
     """Push the children of interior mesh node ``node`` that the ray meets, the farther one
     first so the nearer one is visited next; returns the new stack top."""
-    left = ints[node, MESH_NODE_OFFSET]
+    left = ints[np.uint64(node), MESH_NODE_OFFSET]
     right = left + 1
     t_left = node_entry(nodes, left, o, inv, tmin, tmax)
     t_right = node_entry(nodes, right, o, inv, tmin, tmax)
@@ -154,9 +157,9 @@ def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
     while top >= base:
         node = stack[top]
         top -= 1
-        count = ints[node, MESH_NODE_COUNT]
+        count = ints[np.uint64(node), MESH_NODE_COUNT]
         if count > 0:
-            first = ints[node, MESH_NODE_OFFSET]
+            first = ints[np.uint64(node), MESH_NODE_OFFSET]
             for j in range(first, first + count):
                 t, b1, b2 = intersect_mesh_triangle(corners, j, o, kx, ky, kz, sx, sy, sz,
                                                     tmin, best_t)
@@ -192,9 +195,9 @@ def mesh_occlusion(geo, mats, mesh, material, o, d, inv, tmin, tmax, stack, base
         top -= 1
         if node_entry(nodes, node, o, inv, tmin, tmax) == INF:
             continue
-        count = ints[node, MESH_NODE_COUNT]
+        count = ints[np.uint64(node), MESH_NODE_COUNT]
         if count > 0:
-            first = ints[node, MESH_NODE_OFFSET]
+            first = ints[np.uint64(node), MESH_NODE_OFFSET]
             for j in range(first, first + count):
                 t, _, _ = intersect_mesh_triangle(corners, j, o, kx, ky, kz, sx, sy, sz, tmin,
                                                   tmax)
@@ -204,7 +207,7 @@ def mesh_occlusion(geo, mats, mesh, material, o, d, inv, tmin, tmax, stack, base
                         return 1
                     seen = 2
             continue
-        first = ints[node, MESH_NODE_OFFSET]
+        first = ints[np.uint64(node), MESH_NODE_OFFSET]
         top += 1
         stack[top] = first + 1
         top += 1
