@@ -66,6 +66,11 @@ def intersect_mesh_triangle(corners, j, o, kx, ky, kz, sx, sy, sz, tmin, tmax):
     """(t, b1, b2) of the ray with the triangle at leaf entry ``j`` (corners ``corners[j]``):
     hit point = (1-b1-b2)·v0 + b1·v1 + b2·v2; t = INF on a miss. ``kx..sz`` come from
     :func:`shear_setup` of the ray direction."""
+    # unsigned indices: no negative-index wraparound code on the nine loads
+    j = np.uint64(j)
+    kx = np.uint64(kx)
+    ky = np.uint64(ky)
+    kz = np.uint64(kz)
     az = corners[j, 0, kz] - o[kz]
     bz = corners[j, 1, kz] - o[kz]
     cz = corners[j, 2, kz] - o[kz]
