@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .jit import kernel
 from .layout import (
     SHAPE_BOX,
@@ -225,6 +227,7 @@ def intersect_frustum(P, i, o, d, tmin, tmax):
 @kernel
 def intersect_local(typ, P, i, o, d, tmin, tmax):
     """Dispatch on the shape code; ``o`` and ``d`` in the primitive's own space."""
+    i = np.uint64(i)  # unsigned: no negative-index wraparound code on the parameter loads
     if typ == SHAPE_SPHERE:
         return intersect_sphere(P, i, o, d, tmin, tmax)
     if typ == SHAPE_TRIANGLE:

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .intersect import INF
 from .jit import kernel
 
@@ -30,6 +32,7 @@ def inverse_direction(d):
 @kernel
 def box_entry(box, node, o, inv, tmin, tmax):
     """Entry distance of the ray into box ``node`` when it overlaps (tmin, tmax), else INF."""
+    node = np.uint64(node)  # unsigned: no negative-index wraparound code on the six loads
     t0 = (box[node, 0, 0] - o[0]) * inv[0]
     t1 = (box[node, 1, 0] - o[0]) * inv[0]
     tn = min(t0, t1)
@@ -147,7 +150,7 @@ def next_scene_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top,
         top -= 1
         if box_entry(box, node, o, inv, tmin, tmax) == INF:
             continue
-        count = geo.node_link[node, 1]
+        count = geo.node_link[np.uint64(node), 1]
         if count == 0 and not ordered:
             top += 1
             stack[top] = node + 1
@@ -165,7 +168,7 @@ def next_scene_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top,
             if t_near == INF:
                 break
             node = near
-            count = geo.node_link[node, 1]
+            count = geo.node_link[np.uint64(node), 1]
         if count > 0:
             leaf = geo.node_link[node, 0]
             leaf_end = leaf + count
