@@ -57,7 +57,7 @@ def order_children(box, link, node, o, inv, tmin, tmax):
     (near, t_near, far, t_far); INF where the ray misses a child's box. Ties go to the
     left child."""
     near = node + 1
-    far = link[node, 0]
+    far = link[np.uint64(node), 0]
     t_near = box_entry(box, near, o, inv, tmin, tmax)
     t_far = box_entry(box, far, o, inv, tmin, tmax)
     if t_far < t_near:
@@ -71,7 +71,7 @@ def push_children(box, link, node, o, inv, tmin, tmax, stack, top):
     the nearer one is visited next; returns the new stack top. (Written out rather than on
     top of :func:`order_children`: through that the mesh walk ran 20 % slower.)"""
     left = node + 1
-    right = link[node, 0]
+    right = link[np.uint64(node), 0]
     t_left = box_entry(box, left, o, inv, tmin, tmax)
     t_right = box_entry(box, right, o, inv, tmin, tmax)
     if t_left <= t_right:
@@ -141,9 +141,9 @@ def next_scene_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top,
     box = geo.node_box
     while True:
         if j < geo.unbounded.shape[0]:
-            return geo.unbounded[j], j + 1, leaf, leaf_end, top
+            return geo.unbounded[np.uint64(j)], j + 1, leaf, leaf_end, top
         if leaf < leaf_end:
-            return geo.node_prims[leaf], j, leaf + 1, leaf_end, top
+            return geo.node_prims[np.uint64(leaf)], j, leaf + 1, leaf_end, top
         if top < 0:
             return -1, j, leaf, leaf_end, top
         node = stack[top]
@@ -170,5 +170,5 @@ def next_scene_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top,
             node = near
             count = geo.node_link[np.uint64(node), 1]
         if count > 0:
-            leaf = geo.node_link[node, 0]
+            leaf = geo.node_link[np.uint64(node), 0]
             leaf_end = leaf + count
