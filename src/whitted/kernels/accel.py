@@ -10,7 +10,9 @@ the barycentric coordinates on the triangle.
 
 from __future__ import annotations
 
-from .features import has_instances
+from numba.extending import overload
+
+from .features import has_instances, instances_possible
 from .intersect import INF, intersect_local, normal_local, triangle_barycentric
 from .jit import kernel
 from .layout import (
@@ -153,6 +155,19 @@ def _triangle_shading_normal(geo, i, p, fallback):
     return normalize(ns)
 
 
+def mesh_normals_if_instances(geo, mesh, tri, b1, b2):
+    """:func:`.mesh.mesh_normals`, never compiled for scenes without instances (see
+    features.py)."""
+    return mesh_normals(geo, mesh, tri, b1, b2)
+
+
+@overload(mesh_normals_if_instances)
+def _mesh_normals_if_instances(geo, mesh, tri, b1, b2):
+    if not instances_possible(geo):
+        return lambda geo, mesh, tri, b1, b2: ((0.0, 0.0, 1.0), (0.0, 0.0, 1.0))
+    return lambda geo, mesh, tri, b1, b2: mesh_normals(geo, mesh, tri, b1, b2)
+
+
 @kernel
 def surface_normals(geo, prim, tri, b1, b2, p):
     """(geometric, shading) unit normals in world space of a hit at ``p``. They differ only on
@@ -163,7 +178,7 @@ def surface_normals(geo, prim, tri, b1, b2, p):
         if geo.prim_info[prim, PRIM_TYPE] == SHAPE_TRIANGLE and smooth:
             return n, _triangle_shading_normal(geo, prim, p, n)
         return n, n
-    ng, ns = mesh_normals(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
+    ng, ns = mesh_normals_if_instances(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
     xf = geo.prim_info[prim, PRIM_XFORM]
     if xf < 0:
         return ng, ns
@@ -205,6 +220,19 @@ def closest_instance_hit(geo, o, d, inv, tmin, tmax, stack):
     return best_t, best, best_tri, best_b1, best_b2
 
 
+def closest_instance_hit_if_instances(geo, o, d, inv, tmin, tmax, stack):
+    """:func:`closest_instance_hit`, never compiled for scenes without instances."""
+    return closest_instance_hit(geo, o, d, inv, tmin, tmax, stack)
+
+
+@overload(closest_instance_hit_if_instances)
+def _closest_instance_hit_if_instances(geo, o, d, inv, tmin, tmax, stack):
+    if not instances_possible(geo):
+        return lambda geo, o, d, inv, tmin, tmax, stack: (tmax, -1, -1, 0.0, 0.0)
+    return lambda geo, o, d, inv, tmin, tmax, stack: closest_instance_hit(geo, o, d, inv, tmin,
+                                                                          tmax, stack)
+
+
 @kernel
 def closest_hit(geo, o, d, tmin, tmax, stack):
     """Nearest hit in (tmin, tmax): (t, primitive, triangle, b1, b2), or (tmax, -1, -1, 0, 0).
@@ -227,7 +255,8 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
             best_t = t
             best = i
     if has_instances(geo):
-        t, prim, tri, b1, b2 = closest_instance_hit(geo, o, d, inv, tmin, best_t, stack)
+        t, prim, tri, b1, b2 = closest_instance_hit_if_instances(geo, o, d, inv, tmin, best_t,
+                                                                 stack)
         if prim >= 0:
             return t, prim, tri, b1, b2
     return best_t, best, -1, 0.0, 0.0

@@ -6,6 +6,12 @@ once per kind of scene, and in the kind without instances :func:`has_instances` 
 constant False: the instance walks, and the mesh branches of shading that depend on a
 triangle index, are removed from the machine code. Measured on the analytic benchmark: the
 mere presence of that code cost a third of the speed.
+
+Numba types (and so compiles) the code behind a branch even when the branch is constant
+False, so the kinds without instances call the instance walks and the mesh lookups through
+the ``*_if_instances`` functions (in accel.py, lighting.py and uv.py): overloads that resolve,
+while the caller is typed, to the real kernel or to a stand-in returning the same types. The
+default scene's cold compile then never compiles the mesh kernels (2 s of it).
 """
 
 from __future__ import annotations
@@ -21,9 +27,15 @@ def has_instances(geo):
     return geo.inst_box.shape[0] > 0
 
 
+def instances_possible(geo_type) -> bool:
+    """Whether a GeometryArrays of this Numba type may hold mesh instances (False for the
+    kind without, whose ``inst_box`` is float32)."""
+    field_type = dict(zip(geo_type.fields, geo_type.types, strict=True))["inst_box"]
+    return field_type.dtype != types.float32
+
+
 @overload(has_instances, inline="always")
 def _has_instances(geo):
-    field_type = dict(zip(geo.fields, geo.types, strict=True))["inst_box"]
-    if field_type.dtype == types.float32:
+    if not instances_possible(geo):
         return lambda geo: False
     return lambda geo: geo.inst_box.shape[0] > 0

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import math
 
+from numba.extending import overload
+
 from .accel import (
     closest_hit,
     hit_analytic,
@@ -14,7 +16,7 @@ from .accel import (
     occludes,
     surface_normals,
 )
-from .features import has_instances
+from .features import has_instances, instances_possible
 from .intersect import INF
 from .jit import kernel
 from .layout import (
@@ -94,6 +96,19 @@ def _instances_occlusion(geo, mats, o, d, inv, tmin, tmax, stack):
     return seen_transparent
 
 
+def instances_occlusion_if_instances(geo, mats, o, d, inv, tmin, tmax, stack):
+    """:func:`_instances_occlusion`, never compiled for scenes without instances."""
+    return _instances_occlusion(geo, mats, o, d, inv, tmin, tmax, stack)
+
+
+@overload(instances_occlusion_if_instances)
+def _instances_occlusion_if_instances(geo, mats, o, d, inv, tmin, tmax, stack):
+    if not instances_possible(geo):
+        return lambda geo, mats, o, d, inv, tmin, tmax, stack: 0
+    return lambda geo, mats, o, d, inv, tmin, tmax, stack: _instances_occlusion(
+        geo, mats, o, d, inv, tmin, tmax, stack)
+
+
 @kernel
 def any_occluder(geo, mats, o, d, tmin, tmax, stack):
     """0: nothing on the segment (tmin, tmax) of the ray; 1: an opaque occluder (the search
@@ -112,7 +127,7 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
             return 1
         seen_transparent = max(seen_transparent, state)
     if has_instances(geo):
-        state = _instances_occlusion(geo, mats, o, d, inv, tmin, tmax, stack)
+        state = instances_occlusion_if_instances(geo, mats, o, d, inv, tmin, tmax, stack)
         if state == 1:
             return 1
         seen_transparent = max(seen_transparent, state)

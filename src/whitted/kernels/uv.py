@@ -16,7 +16,10 @@ from __future__ import annotations
 
 import math
 
+from numba.extending import overload
+
 from .accel import to_object
+from .features import instances_possible
 from .intersect import _box_local, triangle_barycentric
 from .jit import kernel
 from .layout import (
@@ -93,12 +96,24 @@ def _frustum_uv(P, i, p):
     return angle * INV_TWO_PI + 0.5, z / P[i, 6]
 
 
+def mesh_uv_if_instances(geo, mesh, tri, b1, b2):
+    """:func:`.mesh.mesh_uv`, never compiled for scenes without instances (see features.py)."""
+    return mesh_uv(geo, mesh, tri, b1, b2)
+
+
+@overload(mesh_uv_if_instances)
+def _mesh_uv_if_instances(geo, mesh, tri, b1, b2):
+    if not instances_possible(geo):
+        return lambda geo, mesh, tri, b1, b2: (b1, b2)
+    return lambda geo, mesh, tri, b1, b2: mesh_uv(geo, mesh, tri, b1, b2)
+
+
 @kernel
 def surface_uv(geo, prim, tri, b1, b2, p):
     """Texture coordinates of the hit at world point ``p`` (see the module docstring)."""
     typ = geo.prim_info[prim, PRIM_TYPE]
     if typ == SHAPE_MESH:
-        return mesh_uv(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
+        return mesh_uv_if_instances(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
     xf = geo.prim_info[prim, PRIM_XFORM]
     if xf >= 0:
         p, _ = to_object(geo.xforms, xf, p, p)
