@@ -17,6 +17,7 @@ from __future__ import annotations
 from numba import typeof, types
 
 from .accel import surface_normals
+from .features import instances_possible
 from .layout import GeometryArrays
 from .lighting import any_occluder
 from .texture import texture_color
@@ -33,10 +34,12 @@ def render_callees(geometry: GeometryArrays, materials):
     variant: with or without mesh instances)."""
     geo = typeof(geometry)
     mats = typeof(materials)
-    return [
+    callees = [
         (surface_normals, (geo, INT, INT, REAL, REAL, VEC3)),
         (surface_uv, (geo, INT, INT, REAL, REAL, VEC3)),
         (texture_color, (typeof(geometry.tex_info), typeof(geometry.tex_pixels), INT, REAL,
                          REAL)),
-        (any_occluder, (geo, mats, VEC3, VEC3, REAL, REAL, STACK)),
     ]
+    if instances_possible(geo):  # without instances shadow rays never take the any-hit walk
+        callees.append((any_occluder, (geo, mats, VEC3, VEC3, REAL, REAL, STACK)))
+    return callees

@@ -313,6 +313,54 @@ def _absorb(mats, scratch, count, length, trans):
             trans[2] * math.exp(-mats[m, MAT_ATTEN + 2] * length))
 
 
+@kernel(inline="always")  # as when it was written inside shadow_transmittance
+def _shadow_through_instances(geo, mats, params, o, d, dist, media, n_media, scratch, stack):
+    """:func:`shadow_transmittance` in scenes with mesh instances: an any-hit walk first,
+    then, only when it met transparent surfaces, the crossings one nearest hit at a time.
+    ``scratch[:n_media]`` already holds a copy of ``media[:n_media]``."""
+    count = n_media
+    trans = (1.0, 1.0, 1.0)
+    t_from = params.epsilon
+    state = any_occluder(geo, mats, o, d, params.epsilon, dist, stack)
+    if state == 0:  # only the medium the point is in, if any, dims the light
+        return _absorb(mats, media, n_media, dist - params.epsilon, (1.0, 1.0, 1.0)), -1
+    if state == 1:
+        return (0.0, 0.0, 0.0), -1
+    for _ in range(64):
+        t, prim, tri, b1, b2 = closest_hit(geo, o, d, t_from, dist, stack)
+        seg_end = t if prim >= 0 else dist
+        trans = _absorb(mats, scratch, count, seg_end - t_from, trans)
+        if prim < 0:
+            break
+        if mats[hit_material(geo, prim, tri), MAT_KT] < OPAQUE_KT:
+            return (0.0, 0.0, 0.0), -1
+        count, trans = _pass_surface(geo, mats, prim, tri, b1, b2, o, d, t, scratch, count,
+                                     trans)
+        if max(trans[0], max(trans[1], trans[2])) < 1e-4:
+            return (0.0, 0.0, 0.0), -1
+        t_from = t * (1.0 + 1e-12) + params.epsilon
+    return trans, -1
+
+
+def shadow_through_instances_if_instances(geo, mats, params, o, d, dist, media, n_media,
+                                          scratch, stack):
+    """:func:`_shadow_through_instances`, never compiled for scenes without instances (see
+    features.py)."""
+    return _shadow_through_instances(geo, mats, params, o, d, dist, media, n_media, scratch,
+                                     stack)
+
+
+@overload(shadow_through_instances_if_instances, inline="always")
+def _shadow_through_instances_if_instances(geo, mats, params, o, d, dist, media, n_media,
+                                           scratch, stack):
+    if not instances_possible(geo):
+        return (lambda geo, mats, params, o, d, dist, media, n_media, scratch, stack:
+                ((1.0, 1.0, 1.0), -1))
+    return (lambda geo, mats, params, o, d, dist, media, n_media, scratch, stack:
+            _shadow_through_instances(geo, mats, params, o, d, dist, media, n_media, scratch,
+                                      stack))
+
+
 @kernel(inline="always")
 def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch, stack, hits,
                          blocker, listed, list_first, n_listed, listed_opaque):
@@ -367,25 +415,8 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
             if not full:
                 break
         return _absorb(mats, scratch, count, dist - t_from, trans), -1
-    state = any_occluder(geo, mats, o, d, params.epsilon, dist, stack)
-    if state == 0:  # only the medium the point is in, if any, dims the light
-        return _absorb(mats, media, n_media, dist - params.epsilon, (1.0, 1.0, 1.0)), -1
-    if state == 1:
-        return (0.0, 0.0, 0.0), -1
-    for _ in range(64):
-        t, prim, tri, b1, b2 = closest_hit(geo, o, d, t_from, dist, stack)
-        seg_end = t if prim >= 0 else dist
-        trans = _absorb(mats, scratch, count, seg_end - t_from, trans)
-        if prim < 0:
-            break
-        if mats[hit_material(geo, prim, tri), MAT_KT] < OPAQUE_KT:
-            return (0.0, 0.0, 0.0), -1
-        count, trans = _pass_surface(geo, mats, prim, tri, b1, b2, o, d, t, scratch, count,
-                                     trans)
-        if max(trans[0], max(trans[1], trans[2])) < 1e-4:
-            return (0.0, 0.0, 0.0), -1
-        t_from = t * (1.0 + 1e-12) + params.epsilon
-    return trans, -1
+    return shadow_through_instances_if_instances(geo, mats, params, o, d, dist, media, n_media,
+                                                 scratch, stack)
 
 
 @kernel
