@@ -36,6 +36,7 @@ from .layout import (
     MESH_TRI_OFFSET,
     MESH_UVS,
 )
+from .traverse import slab_entry
 from .vec import cross, normalize
 
 OPAQUE_KT = 0.01  # the lecture's rule: an occluder with kt below this blocks the light
@@ -98,23 +99,12 @@ def intersect_mesh_triangle(corners, j, o, kx, ky, kz, sx, sy, sz, tmin, tmax):
 @kernel
 def node_entry(nodes, node, o, inv, tmin, tmax):
     """Entry distance of the ray into the box of mesh BVH node ``node`` when it overlaps
-    (tmin, tmax), else INF (the slab test of :func:`.traverse.box_entry` on a node row)."""
+    (tmin, tmax), else INF (:func:`.traverse.slab_entry` on a node row)."""
     node = np.uint64(node)  # unsigned: no negative-index wraparound code
-    t0 = (nodes[node, MESH_NODE_LO] - o[0]) * inv[0]
-    t1 = (nodes[node, MESH_NODE_HI] - o[0]) * inv[0]
-    tn = min(t0, t1)
-    tf = max(t0, t1)
-    t0 = (nodes[node, MESH_NODE_LO + 1] - o[1]) * inv[1]
-    t1 = (nodes[node, MESH_NODE_HI + 1] - o[1]) * inv[1]
-    tn = max(tn, min(t0, t1))
-    tf = min(tf, max(t0, t1))
-    t0 = (nodes[node, MESH_NODE_LO + 2] - o[2]) * inv[2]
-    t1 = (nodes[node, MESH_NODE_HI + 2] - o[2]) * inv[2]
-    tn = max(tn, min(t0, t1))
-    tf = min(tf, max(t0, t1))
-    if tf * (1.0 + 1e-9) + 1e-12 < max(tn, tmin) or tn > tmax:
-        return INF
-    return tn
+    return slab_entry(nodes[node, MESH_NODE_LO], nodes[node, MESH_NODE_LO + 1],
+                      nodes[node, MESH_NODE_LO + 2], nodes[node, MESH_NODE_HI],
+                      nodes[node, MESH_NODE_HI + 1], nodes[node, MESH_NODE_HI + 2], o, inv,
+                      tmin, tmax)
 
 
 @kernel(inline="always")

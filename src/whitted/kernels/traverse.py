@@ -29,26 +29,34 @@ def inverse_direction(d):
     return (_safe_inverse(d[0]), _safe_inverse(d[1]), _safe_inverse(d[2]))
 
 
-@kernel
-def box_entry(box, node, o, inv, tmin, tmax):
-    """Entry distance of the ray into box ``node`` when it overlaps (tmin, tmax), else INF."""
-    node = np.uint64(node)  # unsigned: no negative-index wraparound code on the six loads
-    t0 = (box[node, 0, 0] - o[0]) * inv[0]
-    t1 = (box[node, 1, 0] - o[0]) * inv[0]
+@kernel(inline="always")
+def slab_entry(lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, o, inv, tmin, tmax):
+    """Entry distance of the ray into the box (lo, hi) when it overlaps (tmin, tmax), else
+    INF: the slab test every node box of every BVH level goes through."""
+    t0 = (lo_x - o[0]) * inv[0]
+    t1 = (hi_x - o[0]) * inv[0]
     tn = min(t0, t1)
     tf = max(t0, t1)
-    t0 = (box[node, 0, 1] - o[1]) * inv[1]
-    t1 = (box[node, 1, 1] - o[1]) * inv[1]
+    t0 = (lo_y - o[1]) * inv[1]
+    t1 = (hi_y - o[1]) * inv[1]
     tn = max(tn, min(t0, t1))
     tf = min(tf, max(t0, t1))
-    t0 = (box[node, 0, 2] - o[2]) * inv[2]
-    t1 = (box[node, 1, 2] - o[2]) * inv[2]
+    t0 = (lo_z - o[2]) * inv[2]
+    t1 = (hi_z - o[2]) * inv[2]
     tn = max(tn, min(t0, t1))
     tf = min(tf, max(t0, t1))
     # the relative slack keeps flat boxes (a rectangle in a plane) from being missed
     if tf * (1.0 + 1e-9) + 1e-12 < max(tn, tmin) or tn > tmax:
         return INF
     return tn
+
+
+@kernel
+def box_entry(box, node, o, inv, tmin, tmax):
+    """Entry distance of the ray into box ``node`` when it overlaps (tmin, tmax), else INF."""
+    node = np.uint64(node)  # unsigned: no negative-index wraparound code on the six loads
+    return slab_entry(box[node, 0, 0], box[node, 0, 1], box[node, 0, 2], box[node, 1, 0],
+                      box[node, 1, 1], box[node, 1, 2], o, inv, tmin, tmax)
 
 
 @kernel(inline="always")
