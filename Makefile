@@ -10,7 +10,7 @@ export WHITTED_CACHE_DIR ?= $(CURDIR)/.cache
 $(BIN)/whitted: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e .
+	$(BIN)/python -m pip install --quiet -e '.[all]'
 	@touch $@
 
 $(VENV)/.test-deps: $(BIN)/whitted
