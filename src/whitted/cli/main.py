@@ -15,6 +15,7 @@ from pydantic import ValidationError
 from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeRemainingColumn
+from rich.text import Text
 
 try:  # typer vendors click from 0.2x on; older releases depend on click itself
     from typer._click.exceptions import UsageError
@@ -22,7 +23,7 @@ except ImportError:  # pragma: no cover - depends on the installed typer
     from click.exceptions import UsageError
 
 from .. import __version__
-from ..errors import WhittedError
+from ..errors import WhittedError, shorten
 from ..scene import Scene, load_scene
 from ..scene.default import default_scene
 
@@ -32,18 +33,32 @@ app = typer.Typer(
     help="whitted: a fast Whitted ray tracer. Render scene files (TOML/JSON) to images.",
     pretty_exceptions_enable=False,
 )
-err = Console(stderr=True, highlight=False, soft_wrap=True)
-out = Console(highlight=False, soft_wrap=True)
+# emoji=False: a user's ":100:" (a line number, a name) is printed as it is, never as an emoji
+err = Console(stderr=True, highlight=False, soft_wrap=True, emoji=False)
+out = Console(highlight=False, soft_wrap=True, emoji=False)
 
 AOV_NAMES = ("depth", "normal", "id")
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 130
+EXIT_TERMINATED = 143  # 128 + SIGTERM
+#: The longest error line printed (a file may hold a huge key or value: it is cut, not echoed).
+MESSAGE_LIMIT = 400
+
+
+def one_line(message: str) -> str:
+    """``message`` as one line of at most :data:`MESSAGE_LIMIT` characters."""
+    return shorten(" ".join(str(message).split()), MESSAGE_LIMIT)
 
 
 def fail(message: str) -> typer.Exit:
-    """One line on stderr, exit status 2: the way every user mistake ends."""
-    err.print(f"[bold red]error:[/] {escape(message)}", soft_wrap=True)
+    """One line on stderr, exit status 2: the way every user mistake ends. The message is
+    printed literally (no rich markup, no emoji codes)."""
+    err.print(Text.assemble(("error:", "bold red"), " ", one_line(message)), soft_wrap=True)
     return typer.Exit(EXIT_USER_ERROR)
+
+
+def _note(message: str) -> None:
+    err.print(Text(one_line(message)), soft_wrap=True)
 
 
 def _version(value: bool) -> None:
@@ -105,58 +120,105 @@ def render(
     process_start = time.perf_counter()
     aovs = _parse_aovs(aov)
     try:
-        image_format(output)
-        check_bit_depth(bit_depth, output)
+        check_bit_depth(bit_depth, image_format(output))
     except ValueError as exc:
         raise fail(f"{output}: {exc}") from None
     if transfer not in (None, "srgb", "linear"):
-        raise fail(f"--transfer: unknown transfer {transfer!r} (use srgb or linear)")
+        raise fail(f"--transfer: unknown transfer {shorten(transfer)!r} (use srgb or linear)")
     try:
         scene, name = _load(scene_path)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    try:
         scene = scene.with_settings(width=width, height=height, samples=samples,
                                     max_depth=max_depth, threads=threads, seed=seed,
                                     transfer=transfer)
-    except WhittedError as exc:
-        raise fail(str(exc)) from None
     except ValidationError as exc:  # a command-line override out of range
         raise fail(_override_error(exc)) from None
-    if not output.parent.exists():
-        raise fail(f"{output}: the folder {output.parent} does not exist")
+    outputs = [output] + [output.with_name(f"{output.stem}.{a}.npy") for a in aovs]
+    try:
+        from ..output.safety import check_memory, check_outputs
 
-    job = RenderJob(scene)
+        check_outputs(outputs, scene, scene_path)
+        check_memory(scene.render.width, scene.render.height, image_format(output), bit_depth)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+
+    try:
+        job = RenderJob(scene)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
     interrupted = threading.Event()
-    previous = signal.getsignal(signal.SIGINT)
+    signals: list[int] = []
+    handled = [signal.SIGINT, signal.SIGTERM]
+    previous = {sig: signal.getsignal(sig) for sig in handled}
 
-    def on_interrupt(signum, frame) -> None:  # Ctrl-C: stop after the tiles in flight
+    def on_interrupt(signum, frame) -> None:  # Ctrl-C, SIGTERM: stop after the tiles in flight
+        signals.append(signum)
         interrupted.set()
         job.cancel()
 
-    signal.signal(signal.SIGINT, on_interrupt)
+    for sig in handled:
+        signal.signal(sig, on_interrupt)
     try:
-        _run_with_progress(job, quiet)
+        _run_with_progress(job, quiet, interrupted)
     except WhittedError as exc:  # a model or texture file the scene names is unusable
-        raise fail(str(exc)) from None
+        raise fail(_with_scene_key(exc, scene, name)) from None
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for sig in handled:
+            signal.signal(sig, previous[sig])
+    exit_code = EXIT_TERMINATED if signal.SIGTERM in signals else EXIT_INTERRUPTED
+    stats = job.stats
+    if interrupted.is_set() and (job.running or stats.tiles_done == 0):
+        # stopped while compiling, or before any tile was finished: there is nothing to keep,
+        # and an existing file at the output path is left as it was
+        what = "terminated" if signal.SIGTERM in signals else "interrupted"
+        _note(f"{what} before any tile was finished: nothing written ({output} is unchanged)")
+        raise typer.Exit(exit_code)
     image = job.image
     assert image is not None
-    stats = job.stats
     for warning in stats.warnings:
-        err.print(f"warning: {warning}", markup=False, highlight=False)
-    image.save(output, bit_depth=bit_depth)
+        err.print(Text(f"warning: {warning}"))
     written = [str(output)]
-    if aovs and not interrupted.is_set():
-        planes = render_aovs(scene)
-        for aov_name in aovs:
-            path = output.with_name(f"{output.stem}.{aov_name}.npy")
-            _save_npy(path, planes[aov_name])
-            written.append(str(path))
+    try:
+        image.save(output, bit_depth=bit_depth)
+        if aovs and not interrupted.is_set():
+            planes = render_aovs(scene)
+            for path, aov_name in zip(outputs[1:], aovs, strict=True):
+                _save_npy(path, planes[aov_name])
+                written.append(str(path))
+    except OSError as exc:
+        raise fail(f"{getattr(exc, 'filename', None) or output}: cannot write: "
+                   f"{exc.strerror or exc}") from None
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
     stats.wall_seconds = time.perf_counter() - process_start
     if not quiet or interrupted.is_set():
-        out.print(f"{stats.summary()} -> {', '.join(written)}")
+        out.print(Text(f"{stats.summary()} -> {', '.join(written)}"))
     if interrupted.is_set():
-        err.print(f"interrupted: kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")
-        raise typer.Exit(EXIT_INTERRUPTED)
+        what = "terminated" if signal.SIGTERM in signals else "interrupted"
+        _note(f"{what}: kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")
+        raise typer.Exit(exit_code)
+
+
+def _with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
+    """A model or texture error from the render, with the scene file and key that name it."""
+    from ..scene.io import named_files
+
+    file = getattr(exc, "file", None)
+    if not file:
+        return str(exc)
+    for keys, named in named_files(scene):
+        try:
+            target = scene.resolve_path(named)
+        except (OSError, RuntimeError, ValueError):
+            continue
+        from ..assets.files import same_file
+
+        if same_file(target, file) or str(target) == file:
+            where = "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in keys).lstrip(".")
+            return f"{name}: {where}: {exc}"
+    return f"{name}: {exc}"
 
 
 def _save_npy(path: Path, array: np.ndarray) -> None:
@@ -177,12 +239,20 @@ def _override_error(exc: ValidationError) -> str:
     return f"{option}: {_clean_message(e)}"
 
 
-def _run_with_progress(job, quiet: bool) -> None:
+def _wait(job, interrupted: threading.Event) -> None:
+    """Wait for the job; after an interrupt, stop waiting at once if no tile is being rendered
+    yet (the first compile of the kernels takes many seconds and cannot be cut short)."""
+    while job.running:
+        job.join(0.1)
+        if interrupted.is_set() and not job.rendering:
+            return
+    job.wait()
+
+
+def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
     if quiet or not err.is_terminal:
         job.start()
-        while job.wait(0.1) is None and job.running:
-            pass
-        job.wait()
+        _wait(job, interrupted)
         return
     columns = (
         TextColumn("[bold]rendering"),
@@ -199,9 +269,7 @@ def _run_with_progress(job, quiet: bool) -> None:
 
         job.progress = update
         job.start()
-        while job.wait(0.1) is None and job.running:
-            pass
-        job.wait()
+        _wait(job, interrupted)
 
 
 def _model_info(path: Path) -> None:
