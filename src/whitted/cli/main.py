@@ -13,7 +13,6 @@ import numpy as np
 import typer
 from pydantic import ValidationError
 from rich.console import Console
-from rich.markup import escape
 from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeRemainingColumn
 from rich.text import Text
 
@@ -280,7 +279,7 @@ def _model_info(path: Path) -> None:
         mesh = load_mesh(path)
     except WhittedError as exc:
         raise fail(str(exc)) from None
-    out.print(f"[bold]{path}[/]", highlight=False)
+    out.print(Text(str(path), style="bold"))
     out.print(f"vertices: {mesh.vertex_records}")
     out.print(f"triangles: {mesh.triangle_records}")
     if len(mesh.vertices) != mesh.vertex_records:
@@ -300,13 +299,13 @@ def _model_info(path: Path) -> None:
         colour = ", ".join(f"{c:.3g}" for c in mat.color)
         tex = f" texture={mat.texture.file}" if getattr(mat.texture, "file", None) else ""
         out.print(f"  [{k}] color=({colour}) kt={mat.kt:.3g} triangles={counts[k]}{tex}",
-                  highlight=False)
+                  highlight=False, markup=False)
     out.print(f"textures: {len(mesh.texture_files)}")
     for file in mesh.texture_files:
-        out.print(f"  {file}", highlight=False)
+        out.print(f"  {file}", highlight=False, markup=False)
     out.print(f"warnings: {len(mesh.warnings)}")
     for warning in mesh.warnings:
-        out.print(f"  {warning}", markup=False, highlight=False)
+        out.print(Text(f"  {warning}"))
 
 
 @app.command()
@@ -329,7 +328,7 @@ def info(
     except WhittedError as exc:
         raise fail(str(exc)) from None
     r = scene.render
-    out.print(f"[bold]{name}[/]")
+    out.print(Text(name, style="bold"))
     out.print(f"image: {r.width}x{r.height}, {r.samples} sample(s)/pixel, max depth "
               f"{r.max_depth}, min weight {r.min_weight}")
     out.print(f"objects: {len(scene.objects)}")
@@ -339,10 +338,10 @@ def info(
             else "from the file" if obj.type == "mesh" and getattr(obj, "file", None)
             else "default")
         label = f" '{obj.name}'" if obj.name else ""
-        out.print(f"  [{i}] {obj.type}{label} material={mat}")
+        out.print(f"  [{i}] {obj.type}{label} material={mat}", markup=False)
     out.print(f"lights: {len(scene.lights)}")
     for i, light in enumerate(scene.lights):
-        out.print(f"  [{i}] {light.type} intensity={light.intensity}")
+        out.print(f"  [{i}] {light.type} intensity={light.intensity}", markup=False)
     out.print(f"materials: {len(compiled.materials)} distinct")
     if np.all(np.isfinite(compiled.bounds_min)):
         lo = ", ".join(f"{v:.3g}" for v in compiled.bounds_min)
@@ -365,7 +364,7 @@ def info(
                          f"{len(geo.mesh_nodes):,} mesh BVH nodes)")
         out.print("meshes: " + "; ".join(parts))
     for warning in compiled.warnings:
-        out.print(f"warning: {warning}", markup=False, highlight=False)
+        out.print(Text(f"warning: {warning}"))
     shadow = sum(
         (light.samples or r.shadow_samples) if light.type == "disk" else 1
         for light in scene.lights if light.type != "ambient"
@@ -416,19 +415,23 @@ def export(
         raise fail(f"--format: unknown format {export_format!r} (known: pov)")
     try:
         scene, name = _load(scene_path)
-        scene = scene.with_settings(width=width, height=height)
-        if output is None:
-            output = Path(scene_path.stem if scene_path else "default").with_suffix(".pov")
-        if not output.parent.exists():
-            raise fail(f"{output}: the folder {output.parent} does not exist")
-        export_pov(scene, output, source=name)
     except WhittedError as exc:
         raise fail(str(exc)) from None
+    try:
+        scene = scene.with_settings(width=width, height=height)
     except ValidationError as exc:
         raise fail(_override_error(exc)) from None
+    if output is None:  # the whole stem: scene.v1.toml -> scene.v1.pov
+        output = Path((scene_path.stem if scene_path else "default") + ".pov")
+    try:
+        export_pov(scene, output, source=str(scene_path) if scene_path else name)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    except OSError as exc:
+        raise fail(f"{output}: cannot write: {exc.strerror or exc}") from None
     r = scene.render
-    out.print(f"{name} -> {output} (POV-Ray 3.7; render with: povray +I{output} "
-              f"+W{r.width} +H{r.height} -A)")
+    out.print(Text(f"{name} -> {output} (POV-Ray 3.7; render with: povray +I{output} "
+                   f"+W{r.width} +H{r.height} -A)"))
 
 
 @app.command()
@@ -454,7 +457,20 @@ def bench(
 ) -> None:
     """Render the benchmark scenes (benchmarks/) and print times, rays and memory."""
     from ..bench.command import bench_main
+    from ..bench.scenes import SCENES
 
+    for name in scene or []:  # checked before the header line: a mistake is one line
+        if name not in SCENES and not name.startswith("generated/"):
+            raise fail(f"--scene: unknown benchmark scene {shorten(name)!r} "
+                       f"(known: {', '.join(SCENES)})")
+    from ..output.safety import check_output_place
+
+    for option, path in (("--json", json_path), ("--plot", plot), ("--markdown", markdown)):
+        try:
+            if path is not None:
+                check_output_place(path)
+        except WhittedError as exc:
+            raise fail(f"{option}: {exc}") from None
     try:
         bench_main(scenes=scene, runs=runs, threads=threads, quick=quick, compare=compare,
                    study=study, json_path=json_path, plot_path=plot, markdown_path=markdown,
@@ -464,7 +480,10 @@ def bench(
 
 
 def main() -> None:
-    """Console entry point: usage mistakes end as one ``error:`` line and status 2."""
+    """Console entry point: usage mistakes end as one ``error:`` line and status 2; nothing
+    ends in a traceback (set WHITTED_DEBUG=1 to see one for an internal error)."""
+    import os
+
     try:
         code = app(standalone_mode=False)
     except UsageError as exc:
@@ -472,10 +491,24 @@ def main() -> None:
             f"whitted {exc.ctx.info_name}"
         )
         hint = f" (see '{command} --help')"
-        err.print(f"[bold red]error:[/] {escape(exc.format_message())}{hint}", soft_wrap=True)
+        err.print(Text.assemble(("error:", "bold red"), " ",
+                                one_line(exc.format_message()) + hint), soft_wrap=True)
         sys.exit(EXIT_USER_ERROR)
     except typer.Abort:
         sys.exit(EXIT_INTERRUPTED)
     except KeyboardInterrupt:
         sys.exit(EXIT_INTERRUPTED)
+    except WhittedError as exc:  # a user mistake a command did not catch itself
+        err.print(Text.assemble(("error:", "bold red"), " ", one_line(str(exc))), soft_wrap=True)
+        sys.exit(EXIT_USER_ERROR)
+    except MemoryError:
+        err.print(Text.assemble(("error:", "bold red"), " ", "out of memory"), soft_wrap=True)
+        sys.exit(EXIT_USER_ERROR)
+    except Exception as exc:  # noqa: BLE001 - a bug: one line, the traceback on request
+        if os.environ.get("WHITTED_DEBUG"):
+            raise
+        err.print(Text.assemble(("internal error:", "bold red"), " ", one_line(
+            f"{type(exc).__name__}: {exc} (please report it; WHITTED_DEBUG=1 shows the "
+            "traceback)")), soft_wrap=True)
+        sys.exit(1)
     sys.exit(code if isinstance(code, int) else 0)

@@ -112,7 +112,7 @@ def _finite_vector(value: object) -> tuple[float, float, float]:
 
 def _nonzero_vector(value: object) -> tuple[float, float, float]:
     v = _finite_vector(value)
-    if math.sqrt(v[0] ** 2 + v[1] ** 2 + v[2] ** 2) < 1e-12:
+    if math.hypot(*v) < 1e-12:  # hypot: no overflow for components above 1e154
         raise ValueError("must not be the zero vector")
     return v
 
