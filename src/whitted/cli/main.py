@@ -81,6 +81,13 @@ def _load(scene_path: Path | None) -> tuple[Scene, str]:
     return load_scene(scene_path), str(scene_path)
 
 
+def _is_dir(path: Path) -> bool:
+    try:
+        return path.is_dir()
+    except (OSError, ValueError):  # a name too long, a NUL byte: reported by the checks later
+        return False
+
+
 def _parse_aovs(text: str | None) -> list[str]:
     if not text:
         return []
@@ -118,6 +125,8 @@ def render(
 
     process_start = time.perf_counter()
     aovs = _parse_aovs(aov)
+    if _is_dir(output):
+        raise fail(f"{output}: is a directory (give a file name such as {output / 'render.png'})")
     try:
         check_bit_depth(bit_depth, image_format(output))
     except ValueError as exc:
@@ -382,7 +391,11 @@ def gui(
 ) -> None:
     """Open the scene editor (a desktop window) on SCENE, or on the built-in default scene."""
     scene = None
-    if scene_path is not None and scene_path.exists():
+    try:
+        exists = scene_path is not None and scene_path.exists()
+    except (OSError, ValueError) as exc:
+        raise fail(f"{scene_path}: {getattr(exc, 'strerror', None) or exc}") from None
+    if exists:
         try:
             scene = load_scene(scene_path)
         except WhittedError as exc:

@@ -361,7 +361,7 @@ def atomic_write(path: PathLike, write_fn: Callable[[str], object]) -> pathlib.P
 
 #: Rows encoded at a time: the tonemap/transfer/quantize steps work in float64, so they run
 #: on strips of rows and an 8-bit image costs a few bytes per pixel beyond its framebuffer.
-STRIP_PIXELS = 1 << 20
+STRIP_PIXELS = 1 << 16
 
 
 def _strips(height: int, width: int):

@@ -6,6 +6,7 @@ import functools
 import math
 import types
 import typing
+from contextvars import ContextVar
 from typing import Annotated, Any
 
 import numpy as np
@@ -21,6 +22,9 @@ from pydantic import (
 
 from ..errors import SceneValidationError
 
+_strict: ContextVar[bool] = ContextVar("whitted_strict_validation", default=False)
+_depth: ContextVar[int] = ContextVar("whitted_validation_depth", default=0)
+
 
 class Strict(BaseModel):
     """Base of every scene model: unknown keys are errors, values are re-validated on assignment.
@@ -35,12 +39,19 @@ class Strict(BaseModel):
     )
 
     def __init__(self, /, **data: Any) -> None:
+        # pydantic calls a custom __init__ for nested models too: the strictness of the
+        # outermost call travels in a context variable, and only the outermost call turns
+        # pydantic's error into the library's own
+        depth = _depth.set(_depth.get() + 1)
         try:
-            super().__init__(**data)
-        except SceneValidationError:
-            raise
+            self.__pydantic_validator__.validate_python(
+                data, self_instance=self, strict=_strict.get() or None)
         except ValidationError as exc:
+            if _depth.get() > 1 or isinstance(exc, SceneValidationError):
+                raise
             raise SceneValidationError.wrap(exc, type(self)) from None
+        finally:
+            _depth.reset(depth)
 
     def __setattr__(self, name: str, value: Any) -> None:
         try:
@@ -51,13 +62,18 @@ class Strict(BaseModel):
             raise SceneValidationError.wrap(exc, type(self)) from None
 
     @classmethod
-    def model_validate(cls, obj: Any, *args: Any, **kwargs: Any) -> Any:
+    def model_validate(cls, obj: Any, *, strict: bool | None = None, **kwargs: Any) -> Any:
+        strictness = _strict.set(bool(strict))
+        depth = _depth.set(_depth.get() + 1)
         try:
-            return super().model_validate(obj, *args, **kwargs)
-        except SceneValidationError:
-            raise
+            return super().model_validate(obj, strict=strict, **kwargs)
         except ValidationError as exc:
+            if _depth.get() > 1 or isinstance(exc, SceneValidationError):
+                raise
             raise SceneValidationError.wrap(exc, cls) from None
+        finally:
+            _depth.reset(depth)
+            _strict.reset(strictness)
 
     @model_validator(mode="before")
     @classmethod
