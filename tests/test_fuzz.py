@@ -35,6 +35,7 @@ def assert_clean(result: tuple[int, str, str]) -> None:
     code, out, err = result
     assert "Traceback" not in out + err, err
     assert "internal error" not in err, err
+    assert "Warning" not in err, err  # no raw numpy or Pillow warnings
     if code == 0:
         return
     assert code == 2, (code, out, err)

@@ -150,6 +150,21 @@ def test_a1_render_aov_over_an_input_is_refused(tmp_path: Path, no_render):
     assert (tmp_path / "out.depth.npy").read_bytes() == before
 
 
+def test_a1_the_model_material_library_and_its_texture_are_inputs_too(tmp_path: Path,
+                                                                       no_render):
+    (tmp_path / "m.obj").write_text("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\n"
+                                    "vt 1 0\nvt 0 1\nusemtl skin\nf 1/1 2/2 3/3\n")
+    (tmp_path / "m.mtl").write_text("newmtl skin\nKd 1 1 1\nmap_Kd skin.png\n")
+    texture = png_bytes(tmp_path / "skin.png")
+    write(tmp_path / "scene.toml", SCENE + '\n[[objects]]\ntype = "mesh"\nfile = "m.obj"\n')
+    one_line_error(run_main("render", "scene.toml", "-o", "skin.png", cwd=tmp_path),
+                   "skin.png", "input")
+    one_line_error(run_main("export", "scene.toml", "-o", "m.mtl", cwd=tmp_path),
+                   "m.mtl", "input")
+    assert (tmp_path / "skin.png").read_bytes() == texture
+    assert "map_Kd" in (tmp_path / "m.mtl").read_text()
+
+
 def test_a2_export_names_the_output_from_the_whole_stem(tmp_path: Path):
     write(tmp_path / "scene.v1.toml", SCENE)
     write(tmp_path / "scene.v2.toml", SCENE.replace("radius = 1.0", "radius = 0.5"))
@@ -169,6 +184,7 @@ def _slow_compile(monkeypatch, signum: int, release: threading.Event) -> None:
         if compiled is None:
             os.kill(os.getpid(), signum)
             release.wait(30)
+            raise RuntimeError("the stand-in compile ends the abandoned job here")
         return 0.0
 
     monkeypatch.setattr(api, "warm_up_kernels", warm_up)
@@ -670,6 +686,21 @@ def test_e_render_job_states(tmp_path: Path):
     assert image is not None and image.width == 8
     ran = whitted.RenderJob(scene)
     assert ran.run() is ran.wait()  # run() then wait(): the image, not an error
+
+
+def test_e_other_public_functions_raise_the_documented_errors(tmp_path: Path):
+    pixels = np.zeros((2, 2, 3), np.float32)
+    with pytest.raises(ArgumentError, match="unsupported image format"):
+        whitted.Image(pixels).save(tmp_path / "x.gif")
+    with pytest.raises(ArgumentError, match="bit_depth=16 is only supported for .png"):
+        whitted.Image(pixels).save(tmp_path / "x.jpg", bit_depth=16)
+    with pytest.raises(ArgumentError, match="shape"):
+        whitted.Image(np.zeros((2, 2)))
+    with pytest.raises(ArgumentError, match="path of a scene file"):
+        whitted.load_scene(3)
+    with pytest.raises(ArgumentError, match="colorspace"):
+        whitted.assets.images.load_image(tmp_path / "x.png", colorspace="rgb")
+    assert issubclass(ArgumentError, ValueError)  # what these raised before
 
 
 def test_e_error_classes_are_documented():
