@@ -38,6 +38,7 @@ from whitted.errors import (
 from whitted.output import encode
 
 WHITTED = [sys.executable, "-m", "whitted"]
+cli_main.EXIT_AT_ONCE_WHEN_ABANDONED = False  # in-process runs must not end the test process
 
 SCENE = """\
 [render]
@@ -209,6 +210,33 @@ def test_a3_a4_signal_during_the_first_compile_stops_at_once_and_writes_nothing(
     assert (tmp_path / "out.png").read_bytes() == good  # the good image is kept
 
 
+LONG_COMPILE = """
+import os, signal, sys, time
+from whitted.render import api
+def warm_up(compiled=None):
+    if compiled is None:
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(120)  # a first compile that takes long and cannot be cut short
+    return 0.0
+api.warm_up_kernels = warm_up
+from whitted.cli.main import main
+sys.argv = ["whitted", "render", "scene.toml", "-o", "out.png"]
+main()
+"""
+
+
+@pytest.mark.skipif(os.name != "posix", reason="POSIX signals")
+def test_a3_ctrl_c_during_the_first_compile_ends_the_process_at_once(tmp_path: Path):
+    write(tmp_path / "scene.toml", SCENE)
+    start = time.perf_counter()
+    result = subprocess.run([sys.executable, "-c", LONG_COMPILE], cwd=tmp_path,
+                            capture_output=True, text=True, timeout=100)
+    assert time.perf_counter() - start < 60  # not the 120 s of the compile
+    assert result.returncode == 130, result.stderr
+    assert "interrupted before any tile was finished: nothing written" in result.stderr
+    assert not (tmp_path / "out.png").exists()
+
+
 def test_a3_interrupt_before_the_first_tile_keeps_the_old_image(tmp_path: Path, monkeypatch):
     """Ctrl-C after the compile but before a tile is finished: nothing to keep, nothing
     written (an existing image is not replaced by a black one)."""
@@ -288,14 +316,15 @@ def test_a4_temporary_files_of_a_killed_write_are_removed_by_the_next(tmp_path: 
 def test_a5_png_and_jpeg_encode_in_strips(tmp_path: Path):
     """An 8-bit image costs a few bytes per pixel at the encoder, not ~130 (float64 copies of
     the whole image): measured with tracemalloc (NumPy's allocations)."""
-    pixels = np.random.default_rng(1).random((1000, 2000, 3), dtype=np.float32) * 1.5
+    pixels = np.random.default_rng(1).random((1000, 1000, 3), dtype=np.float32) * 1.5
     expected = encode.encode_ldr(pixels, bits=8, transfer="srgb", tonemap="reinhard")
     for name in ("a.png", "a.jpg"):
         tracemalloc.start()
         encode.write_image(tmp_path / name, pixels, tonemap="reinhard")
         peak = tracemalloc.get_traced_memory()[1]
         tracemalloc.stop()
-        assert peak < 16 * pixels.shape[0] * pixels.shape[1] / 2, (name, peak)
+        # ~8 MB for the strips (one of 65,536 pixels at a time); whole-image: ~130 MB
+        assert peak < 24 * pixels.shape[0] * pixels.shape[1], (name, peak)
     # strips change nothing: the PNG holds exactly the whole-image encoding
     assert np.array_equal(np.asarray(PILImage.open(tmp_path / "a.png")), expected)
     encode.write_image(tmp_path / "b.png", pixels, bit_depth=16)

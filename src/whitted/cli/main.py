@@ -40,6 +40,11 @@ AOV_NAMES = ("depth", "normal", "id")
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 130
 EXIT_TERMINATED = 143  # 128 + SIGTERM
+#: After an interrupt during the first compile the render thread is abandoned; the process
+#: then ends at once (os._exit) instead of waiting for the compiler to let the interpreter
+#: shut down (seconds). Tests that run the command in-process turn this off.
+EXIT_AT_ONCE_WHEN_ABANDONED = True
+_abandoned: list[bool] = []
 #: The longest error line printed (a file may hold a huge key or value: it is cut, not echoed).
 MESSAGE_LIMIT = 400
 
@@ -182,6 +187,8 @@ def render(
         # and an existing file at the output path is left as it was
         what = "terminated" if signal.SIGTERM in signals else "interrupted"
         _note(f"{what} before any tile was finished: nothing written ({output} is unchanged)")
+        if job.running:
+            _abandoned.append(True)
         raise typer.Exit(exit_code)
     image = job.image
     assert image is not None
@@ -497,8 +504,11 @@ def main() -> None:
     ends in a traceback (set WHITTED_DEBUG=1 to see one for an internal error)."""
     import os
 
+    _abandoned.clear()
     try:
         code = app(standalone_mode=False)
+        if _abandoned and EXIT_AT_ONCE_WHEN_ABANDONED:
+            _exit_now(code if isinstance(code, int) else 0)
     except UsageError as exc:
         command = "whitted" if exc.ctx is None or exc.ctx.parent is None else (
             f"whitted {exc.ctx.info_name}"
@@ -511,6 +521,8 @@ def main() -> None:
         sys.exit(EXIT_INTERRUPTED)
     except KeyboardInterrupt:
         sys.exit(EXIT_INTERRUPTED)
+    except typer.Exit as exc:  # raised with standalone_mode=False only by an eager callback
+        sys.exit(exc.exit_code)
     except WhittedError as exc:  # a user mistake a command did not catch itself
         err.print(Text.assemble(("error:", "bold red"), " ", one_line(str(exc))), soft_wrap=True)
         sys.exit(EXIT_USER_ERROR)
@@ -525,3 +537,14 @@ def main() -> None:
             "traceback)")), soft_wrap=True)
         sys.exit(1)
     sys.exit(code if isinstance(code, int) else 0)
+
+
+def _exit_now(code: int) -> None:
+    """End the process now (output flushed), not waiting for an abandoned render thread."""
+    import contextlib
+    import os
+
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(OSError, ValueError):
+            stream.flush()
+    os._exit(code)
