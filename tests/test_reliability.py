@@ -412,6 +412,8 @@ def test_b1_fifo_scene_and_texture_do_not_hang(tmp_path: Path):
     one_line_error(run_main("info", "scene.toml", cwd=tmp_path), "objects[1]", "named pipe")
     with pytest.raises(SceneError, match="named pipe"):
         whitted.assets.images.load_image(tmp_path / "tex.png")
+    with pytest.raises(ArgumentError, match="named pipe"):
+        whitted.Image.load(tmp_path / "tex.png")
 
 
 def test_b1_scene_size_limit(tmp_path: Path, monkeypatch):
@@ -608,9 +610,10 @@ def test_d5_model_errors_name_the_scene_key_and_no_internals(tmp_path: Path):
     (tmp_path / "bad.ply").write_text(
         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n0\n1\n2\n")
     write(tmp_path / "scene.toml", SCENE + '\n[[objects]]\ntype = "mesh"\nfile = "bad.ply"\n')
-    one_line_error(run_main("render", "scene.toml", "-o", "x.png", cwd=tmp_path),
-                   "scene.toml", "objects[1].file", "bad.ply", "PLY",
-                   "missing element or property 'y'")
+    for command in (["render", "scene.toml", "-o", "x.png"], ["info", "scene.toml"],
+                    ["export", "scene.toml"]):
+        one_line_error(run_main(*command, cwd=tmp_path), "scene.toml", "objects[1].file",
+                       "bad.ply", "PLY", "missing element or property 'y'")
     (tmp_path / "latin.stl").write_bytes(
         "solid caf\xe9\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
         "vertex 0 1 0\nendloop\nendfacet\nendsolid\n".encode("latin-1"))

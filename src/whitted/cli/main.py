@@ -221,7 +221,7 @@ def _with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
     from ..scene.io import named_files
 
     file = getattr(exc, "file", None)
-    if not file:
+    if not file or file == name:
         return str(exc)
     for keys, named in named_files(scene):
         try:
@@ -340,9 +340,12 @@ def info(
         return
     try:
         scene, name = _load(scene_path)
-        compiled = compile_scene(scene)
     except WhittedError as exc:
         raise fail(str(exc)) from None
+    try:
+        compiled = compile_scene(scene)
+    except WhittedError as exc:  # a model or texture file the scene names is unusable
+        raise fail(_with_scene_key(exc, scene, name)) from None
     r = scene.render
     out.print(Text(name, style="bold"))
     out.print(f"image: {r.width}x{r.height}, {r.samples} sample(s)/pixel, max depth "
@@ -446,7 +449,7 @@ def export(
     try:
         export_pov(scene, output, source=str(scene_path) if scene_path else name)
     except WhittedError as exc:
-        raise fail(str(exc)) from None
+        raise fail(_with_scene_key(exc, scene, name)) from None
     except OSError as exc:
         raise fail(f"{output}: cannot write: {exc.strerror or exc}") from None
     r = scene.render

@@ -575,6 +575,11 @@ def read_image(path: PathLike, *, transfer: str = "srgb") -> np.ndarray:
     check_transfer(transfer)
     fmt = image_format(path)
     p = os.fspath(path)
+    from ..assets.files import path_problem
+
+    problem = path_problem(p)
+    if problem is not None:  # only regular files: a pipe or a device would hang or never end
+        raise ArgumentError(f"{p}: {problem}")
     if fmt == "exr":
         return _read_exr(p)
     if fmt == "pfm":
