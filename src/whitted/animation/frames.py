@@ -156,7 +156,8 @@ class FrameResult:
     cancelled: bool = False  # stopped part way: nothing was written
     seconds: float = 0.0
     stats: RenderStats | None = field(default=None, repr=False)
-    reused_geometry: bool = False
+    #: what the compile reused from the frame before: all, geometry, bvh, none ('' if skipped)
+    reuse: str = ""
 
 
 class FrameRenderer:
@@ -168,15 +169,20 @@ class FrameRenderer:
         self.threads = threads
         self._cache: Any = None  # reuse.CompileCache, created on first use
         self.frames_rendered = 0
-        self.geometry_reused = 0
 
-    def compile(self, still: Scene) -> tuple[Any, bool]:
-        """The compiled scene of ``still`` and whether its geometry was reused."""
+    def compile(self, still: Scene) -> tuple[Any, str]:
+        """The compiled scene of ``still`` and what was reused (see :mod:`.reuse`)."""
+        return self.cache.compile(still)
+
+    @property
+    def cache(self) -> Any:
+        """The :class:`~whitted.animation.reuse.CompileCache` (its ``stats`` say what was
+        reused)."""
         from .reuse import CompileCache
 
         if self._cache is None:
             self._cache = CompileCache()
-        return self._cache.compile(still)
+        return self._cache
 
     def render(
         self,
@@ -197,19 +203,18 @@ class FrameRenderer:
         if not force and frame_is_current(path, digest):
             return FrameResult(frame, path, digest, rendered=False)
         start = time.perf_counter()
-        compiled, reused = self.compile(still)
+        compiled, reuse = self.compile(still)
         job = RenderJob(still, progress=progress, cancel=cancel, threads=self.threads,
                         compiled=compiled)
         image = job.run()
         seconds = time.perf_counter() - start
         if job.stats.cancelled:
             return FrameResult(frame, path, digest, rendered=False, cancelled=True,
-                               seconds=seconds, stats=job.stats, reused_geometry=reused)
+                               seconds=seconds, stats=job.stats, reuse=reuse)
         _write_frame_png(path, image, digest, frame)
         self.frames_rendered += 1
-        self.geometry_reused += int(reused)
         return FrameResult(frame, path, digest, rendered=True, seconds=seconds,
-                           stats=job.stats, reused_geometry=reused)
+                           stats=job.stats, reuse=reuse)
 
 
 def render_frame(

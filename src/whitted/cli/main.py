@@ -430,3 +430,7 @@ def main() -> None:
     except KeyboardInterrupt:
         sys.exit(EXIT_INTERRUPTED)
     sys.exit(code if isinstance(code, int) else 0)
+
+
+# Commands in their own modules register themselves on `app` when imported.
+from . import animate as _animate  # noqa: E402, F401
