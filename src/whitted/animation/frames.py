@@ -15,6 +15,7 @@ them (kernels, and compiled geometry when only camera, lights or material values
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import math
@@ -85,13 +86,18 @@ def _feed_file(h: Any, path: Path) -> None:
         h.update(f"<missing {path}>".encode())
 
 
+@functools.cache
+def _kernel_sources() -> str:
+    from .._cache import kernel_source_hash
+
+    return kernel_source_hash()
+
+
 def frame_digest(still: Scene, frame: int) -> str:
     """Hex SHA-256 of what the pixels of ``still`` (the scene of frame ``frame``) depend on;
     the render's thread count is left out."""
-    from .._cache import kernel_source_hash
-
     h = hashlib.sha256(_HASH_VERSION)
-    h.update(kernel_source_hash().encode())
+    h.update(_kernel_sources().encode())
     h.update(f"frame={int(frame)}".encode())
     _feed(h, still.render.model_copy(update={"threads": 0}), still)
     for name in type(still).model_fields:

@@ -219,7 +219,7 @@ class _FilmProgress:
                 TaskProgressColumn(), TimeRemainingColumn(), console=err, transient=True)
             self._progress.__enter__()
             self._frames = self._progress.add_task("frames", total=self.total)
-            self._tiles = self._progress.add_task("frame", total=1.0)
+            self._tiles = self._progress.add_task("frame tiles", total=None)
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -228,11 +228,11 @@ class _FilmProgress:
 
     def start_frame(self, frame: int) -> None:
         if self._progress is not None:
-            self._progress.reset(self._tiles, total=1.0, description=f"frame {frame}")
+            self._progress.reset(self._tiles, total=None, description=f"frame {frame} tiles")
 
     def tiles(self, p) -> None:
         if self._progress is not None:
-            self._progress.update(self._tiles, completed=p.fraction)
+            self._progress.update(self._tiles, completed=p.tiles_done, total=p.tiles_total)
 
     def frame_done(self, frame: int, result) -> None:
         self.done += 1

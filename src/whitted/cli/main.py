@@ -276,11 +276,17 @@ def info(
         return
     try:
         scene, name = _load(scene_path)
-        compiled = compile_scene(scene)
+        compiled = compile_scene(scene.at_frame(0) if scene.is_animated else scene)
     except WhittedError as exc:
         raise fail(str(exc)) from None
     r = scene.render
     out.print(f"[bold]{name}[/]")
+    if scene.animation is not None:
+        a = scene.animation
+        out.print(f"animation: {a.frames} frames at {a.fps:g} fps ({a.frames / a.fps:.2f} s), "
+                  f"{len(a.tracks)} track(s): "
+                  + ", ".join(f"{t.path} ({t.interpolation})" for t in a.tracks),
+                  markup=False, highlight=False)
     out.print(f"image: {r.width}x{r.height}, {r.samples} sample(s)/pixel, max depth "
               f"{r.max_depth}, min weight {r.min_weight}")
     out.print(f"objects: {len(scene.objects)}")
