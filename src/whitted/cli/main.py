@@ -250,7 +250,7 @@ def info(
     """Print a scene's objects, lights, bounds and an estimate of the work; or what a model
     file (OBJ, PLY, STL, OFF, glTF) holds: vertices, triangles, bounds, materials, textures."""
     from ..assets.mesh import SUPPORTED_SUFFIXES
-    from ..compile.flatten import compile_scene
+    from ..compile.scene import compile_scene
 
     if scene_path is not None and scene_path.suffix.lower() in SUPPORTED_SUFFIXES:
         _model_info(scene_path)

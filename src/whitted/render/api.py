@@ -16,7 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..compile.flatten import CompiledScene, compile_scene, render_params
+from ..compile.params import render_params
+from ..compile.scene import CompiledScene, compile_scene
 from ..kernels.layout import (
     N_RAY_KINDS,
     RAY_PRIMARY,
