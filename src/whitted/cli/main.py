@@ -25,6 +25,7 @@ from .. import __version__
 from ..errors import WhittedError
 from ..scene import Scene, load_scene
 from ..scene.default import default_scene
+from .farm import ClusterOption, SchedulerOption, render_still_on_farm
 
 app = typer.Typer(
     add_completion=False,
@@ -97,6 +98,8 @@ def render(
         str | None, typer.Option("--transfer", help="srgb or linear (default: the scene's)")
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
+    cluster: ClusterOption = None,
+    scheduler: SchedulerOption = None,
 ) -> None:
     """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG)."""
     from ..output.encode import check_bit_depth, image_format
@@ -122,6 +125,9 @@ def render(
         raise fail(_override_error(exc)) from None
     if not output.parent.exists():
         raise fail(f"{output}: the folder {output.parent} does not exist")
+    if cluster is not None or scheduler is not None:  # bands on a Dask cluster (cli/farm.py)
+        render_still_on_farm(scene, output, cluster=cluster, scheduler=scheduler,
+                             threads=threads, quiet=quiet, bit_depth=bit_depth, aovs=aovs)
 
     job = RenderJob(scene)
     interrupted = threading.Event()

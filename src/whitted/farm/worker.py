@@ -38,9 +38,18 @@ def set_worker_threads(threads: int) -> None:
     """Render with ``threads`` lanes in this process, and cap Numba's own pool there too."""
     global _threads
     _threads = max(1, int(threads))
-    os.environ["NUMBA_NUM_THREADS"] = os.environ.get("NUMBA_NUM_THREADS", str(_threads))
     import numba
+    from numba.np.ufunc import parallel
 
+    # Numba re-reads its environment at each compile and refuses a NUMBA_NUM_THREADS that
+    # differs from the pool it launched; a worker may have imported Numba before Dask set
+    # its environment (a spawned worker re-imports the client's main module), so the two
+    # are made to agree here, before the pool starts.
+    if not getattr(parallel, "_is_initialized", False):
+        os.environ["NUMBA_NUM_THREADS"] = str(_threads)
+        numba.config.reload_config()
+    else:
+        os.environ["NUMBA_NUM_THREADS"] = str(numba.config.NUMBA_NUM_THREADS)
     numba.set_num_threads(min(_threads, numba.config.NUMBA_NUM_THREADS))
 
 
