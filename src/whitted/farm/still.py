@@ -17,7 +17,7 @@ from ..output.image import Image
 from ..render.api import DEFAULT_TILE, RenderStats
 from ..scene.scene import Scene
 from ._dask import Client, as_completed
-from .transfer import AssetMode, ship_assets
+from .transfer import AssetMode, Shipment, ship_assets
 from .worker import render_band
 
 BANDS_PER_WORKER = 4
@@ -28,7 +28,7 @@ def band_ranges(height: int, bands: int, tile: int = DEFAULT_TILE) -> list[tuple
     """``bands`` (at most one per tile row) ranges of whole tile rows covering the image."""
     tile_rows = -(-height // tile)
     bands = max(1, min(bands, tile_rows))
-    cuts = [round(k * tile_rows / bands) * tile for k in range(bands + 1)]
+    cuts = [k * tile_rows // bands * tile for k in range(bands + 1)]
     return [(a, min(b, height)) for a, b in zip(cuts, cuts[1:], strict=False) if a < b]
 
 
@@ -37,18 +37,20 @@ def render_still(
     scene: Scene,
     *,
     bands: int | None = None,
-    assets: AssetMode = "auto",
+    assets: AssetMode | Shipment = "auto",
     progress: Callable[[int, int], None] | None = None,
     retries: int = RETRIES,
 ) -> Image:
     """Render ``scene`` on the cluster behind ``client`` and return the whole
     :class:`~whitted.output.Image`, bit-identical to :func:`whitted.render.api.render`.
-    ``progress(bands_done, bands_total)`` is called as bands arrive."""
+    ``assets``: how the scene's files reach the workers ("auto", "ship", "shared": see
+    :func:`~whitted.farm.transfer.ship_assets`), or a :class:`Shipment` made earlier for this
+    scene. ``progress(bands_done, bands_total)`` is called as bands arrive."""
     start = time.perf_counter()
     s = scene.render
     n_workers = max(1, len(client.scheduler_info().get("workers", {})))
     ranges = band_ranges(s.height, bands or BANDS_PER_WORKER * n_workers)
-    shipment = ship_assets(client, [scene], assets)
+    shipment = assets if isinstance(assets, Shipment) else ship_assets(client, [scene], assets)
     manifest, blobs = shipment.for_scenes([0])
     [scene_future] = client.scatter([scene], broadcast=True, hash=False)
     futures = [client.submit(render_band, scene_future, a, b, manifest, blobs, pure=False,
