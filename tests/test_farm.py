@@ -16,9 +16,12 @@ distributed = pytest.importorskip("distributed")
 
 from whitted import load_scene  # noqa: E402
 from whitted.farm import (  # noqa: E402
+    FrameFailed,
     WhittedWorker,
     band_ranges,
+    chunk_size,
     collect_assets,
+    render_film,
     render_still,
     ship_assets,
 )
@@ -153,3 +156,189 @@ def test_files_reach_workers_that_cannot_see_the_scene_folder(client, textured_c
         assert set(cwd.values()) == {str(workdir)}
     finally:
         hidden.rename(textured_copy.parent)
+
+
+# ------------------------------------------------------------------------------ films
+
+FILM = """
+[render]
+width = 48
+height = 32
+samples = 2
+max_depth = 3
+
+[camera]
+position = [0, 1.5, 5]
+look_at = [0, 0.5, 0]
+
+[[lights]]
+type = "point"
+position = [3, 5, 4]
+
+[[objects]]
+type = "plane"
+material = { kd = 0.8, texture = { type = "image", file = "tex/tiles.png" } }
+
+[[objects]]
+name = "ball"
+type = "sphere"
+center = [-0.8, 0.5, 0]
+radius = 0.5
+material = "glass"
+
+[[objects]]
+name = "blade"
+type = "mesh"
+file = "seq/blade_{frame:02d}.obj"
+
+[animation]
+frames = FRAMES
+fps = 12
+
+[[animation.tracks]]
+path = "camera.position"
+keys = [[0, [0, 1.5, 5]], [LAST, [3, 1.5, 4]]]
+
+[[animation.tracks]]
+path = "objects[ball].material.kt"
+keys = [[0, 1.0], [LAST, 0.2]]
+"""
+
+
+def write_film_scene(folder: Path, examples_dir: Path, frames: int) -> Path:
+    """An animated scene with a camera move, a material track, an image texture and a mesh
+    sequence (one OBJ per frame, a triangle that turns)."""
+    (folder / "seq").mkdir(parents=True)
+    (folder / "tex").mkdir()
+    shutil.copy(examples_dir / "textures/tiles.png", folder / "tex/tiles.png")
+    for k in range(frames):
+        x = 0.8 + 0.1 * k
+        (folder / f"seq/blade_{k:02d}.obj").write_text(
+            f"v {x} 0 0\nv {x + 0.8} 0 0\nv {x} {1.0 + 0.05 * k} 0.2\nf 1 2 3\n")
+    path = folder / "film.toml"
+    path.write_text(FILM.replace("FRAMES", str(frames)).replace("LAST", str(frames - 1)))
+    return path
+
+
+@pytest.fixture(scope="module")
+def film_scene(tmp_path_factory, examples_dir):
+    folder = tmp_path_factory.mktemp("film")
+    return load_scene(write_film_scene(folder / "project", examples_dir, 8))
+
+
+@pytest.fixture(scope="module")
+def local_frames(film_scene, tmp_path_factory) -> dict[int, bytes]:
+    """Every frame of the film as the local ``whitted animate`` writes it (PNG bytes)."""
+    from whitted.animation.frames import render_frame
+
+    folder = tmp_path_factory.mktemp("local-frames")
+    frames = {}
+    for k in range(film_scene.frame_count):
+        path = folder / f"{k:04d}.png"
+        render_frame(film_scene, k, path, threads=2)
+        frames[k] = path.read_bytes()
+    return frames
+
+
+def png_pixels(data: bytes) -> np.ndarray:
+    import io
+
+    from PIL import Image as PILImage
+
+    return np.asarray(PILImage.open(io.BytesIO(data)).convert("RGB"))
+
+
+def assert_frames_match(folder: Path, local_frames: dict[int, bytes], frames) -> None:
+    written = sorted(p.name for p in folder.iterdir())
+    assert written == [f"{k:04d}.png" for k in frames]  # no temporary or half files left
+    for k in frames:
+        data = (folder / f"{k:04d}.png").read_bytes()
+        assert np.array_equal(png_pixels(data), png_pixels(local_frames[k])), f"frame {k}"
+        assert data == local_frames[k], f"frame {k}: the PNG differs from the local one"
+
+
+def test_chunk_size_packs_short_frames_and_keeps_every_worker_busy():
+    assert chunk_size(48, 32, 2, 240, 2) == 40  # 1e6 samples a task wanted, 40 at most
+    assert chunk_size(48, 32, 2, 8, 2) == 1  # 8 frames: 3 tasks a worker come first
+    assert chunk_size(1920, 1080, 4, 1000, 10) == 1  # a long frame is a task of its own
+
+
+def test_film_on_two_workers_is_the_local_film_frame_by_frame(client, film_scene,
+                                                              local_frames, tmp_path):
+    folder = tmp_path / "frames"
+    arrived = []
+    result = render_film(client, film_scene, folder, assets="ship", chunk=3,
+                         progress=lambda done, total, frame: arrived.append((done, frame)))
+    assert result.tasks == 3 and result.chunk == 3  # 8 frames: 3 + 3 + 2
+    assert sorted(result.rendered) == list(range(8)) and result.kept == []
+    assert [done for done, _ in arrived] == list(range(1, 9))
+    assert result.asset_bytes > 0
+    assert_frames_match(folder, local_frames, range(8))
+
+
+def test_resume_renders_only_the_missing_frames(client, film_scene, local_frames, tmp_path):
+    folder = tmp_path / "frames"
+
+    def stop_after_three(done, total, frame):
+        if done == 3:
+            raise KeyboardInterrupt  # the user stops the client
+
+    with pytest.raises(KeyboardInterrupt):
+        render_film(client, film_scene, folder, chunk=1, progress=stop_after_three)
+    first = sorted(int(p.stem) for p in folder.glob("*.png"))
+    assert len(first) == 3
+    again = render_film(client, film_scene, folder, chunk=1)
+    assert sorted(again.kept) == first
+    assert sorted(again.rendered) == sorted(set(range(8)) - set(first))
+    assert_frames_match(folder, local_frames, range(8))
+
+
+def test_a_failing_frame_is_named_after_the_others_are_saved(client, examples_dir, tmp_path):
+    path = write_film_scene(tmp_path / "project", examples_dir, 5)
+    bad = tmp_path / "project/seq/blade_03.obj"
+    bad.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n")  # no vertex 7
+    scene = load_scene(path).with_settings(width=24, height=16, samples=1)
+    folder = tmp_path / "frames"
+    with pytest.raises(FrameFailed) as failure:
+        render_film(client, scene, folder, assets="ship", chunk=2)
+    message = str(failure.value)
+    assert message.startswith(f"frame 3: {bad}:4:")  # the client's file name, its line
+    assert "\n" not in message
+    assert sorted(p.name for p in folder.iterdir()) == [f"{k:04d}.png" for k in (0, 1, 2, 4)]
+
+
+def test_a_worker_killed_mid_film_costs_only_a_retry(client, film_scene, tmp_path):
+    import signal
+
+    from whitted.animation.frames import render_frame
+
+    settings = {"width": 96, "height": 64, "samples": 4}  # frames long enough to be caught
+    local = {}
+    for k in range(film_scene.frame_count):
+        render_frame(film_scene, k, tmp_path / "local.png", threads=2, **settings)
+        local[k] = (tmp_path / "local.png").read_bytes()
+    folder = tmp_path / "frames"
+    pids = client.run(os.getpid)
+    victim_address, victim = sorted(pids.items())[0]
+    killed = []
+
+    def kill_one_worker(done, total, frame):
+        if not killed:
+            os.kill(victim, signal.SIGKILL)  # the worker process, without warning
+            killed.append(frame)
+
+    result = render_film(client, film_scene, folder, chunk=1, retries=0,
+                         progress=kill_one_worker, **settings)
+    assert killed
+    assert sorted(result.rendered) == list(range(8))  # each frame written exactly once
+    assert len(result.rendered) == 8
+    assert_frames_match(folder, local, range(8))
+    assert victim not in client.run(os.getpid).values()
+
+    def lost_frame_tasks(dask_scheduler, address=victim_address) -> int:
+        """Frame tasks that were running on the killed worker when it went."""
+        return sum(1 for key, start, *_, stimulus, _ in dask_scheduler.transition_log
+                   if "render_frame_chunk" in str(key) and start == "processing"
+                   and "worker" in str(stimulus) and "cleanup" in str(stimulus))
+
+    assert client.run_on_scheduler(lost_frame_tasks) >= 1  # the kill cost a task a rerun

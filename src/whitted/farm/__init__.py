@@ -20,6 +20,7 @@ from __future__ import annotations
 from ._dask import INSTALL_HINT
 from .assets import AssetManifest, collect_assets, scene_file_names
 from .cluster import FarmError, farm_client, local_cluster, parse_cluster
+from .film import FilmResult, FrameFailed, chunk_size, render_film
 from .still import band_ranges, render_still
 from .transfer import Shipment, ship_assets
 from .worker import WhittedWorker
@@ -28,13 +29,17 @@ __all__ = [
     "INSTALL_HINT",
     "AssetManifest",
     "FarmError",
+    "FilmResult",
+    "FrameFailed",
     "Shipment",
     "WhittedWorker",
     "band_ranges",
+    "chunk_size",
     "collect_assets",
     "farm_client",
     "local_cluster",
     "parse_cluster",
+    "render_film",
     "render_still",
     "scene_file_names",
     "ship_assets",

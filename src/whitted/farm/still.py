@@ -47,6 +47,8 @@ def render_still(
     :func:`~whitted.farm.transfer.ship_assets`), or a :class:`Shipment` made earlier for this
     scene. ``progress(bands_done, bands_total)`` is called as bands arrive."""
     start = time.perf_counter()
+    if scene.is_animated:  # as the render API does: an animated scene renders its frame 0
+        scene = scene.at_frame(0)
     s = scene.render
     n_workers = max(1, len(client.scheduler_info().get("workers", {})))
     ranges = band_ranges(s.height, bands or BANDS_PER_WORKER * n_workers)

@@ -16,7 +16,12 @@ from __future__ import annotations
 
 import asyncio
 import os
+import tempfile
 import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -85,10 +90,15 @@ class WhittedWorker(WorkerPlugin):
             await asyncio.get_running_loop().run_in_executor(None, warm_worker)
 
 
-def _prepared(scene: Scene, manifest: AssetManifest | None, blobs: dict[str, bytes]) -> Scene:
+def _prepared(scene: Scene, manifest: AssetManifest | None,
+              blobs: dict[str, bytes]) -> tuple[Scene, Callable[[str], str]]:
+    """The scene re-pointed at this worker's copy of its files, and a function that turns
+    the worker's file names in a message back into the client's."""
     if manifest is None:  # the workers see the client's files
-        return scene
-    return worker_scene(scene, manifest, materialise(manifest, blobs))
+        return scene, str
+    tree = materialise(manifest, blobs)
+    return worker_scene(scene, manifest, tree), lambda text: text.replace(
+        str(tree), manifest.client_root)
 
 
 def render_band(scene: Scene, start: int, stop: int, manifest: AssetManifest | None = None,
@@ -96,7 +106,63 @@ def render_band(scene: Scene, start: int, stop: int, manifest: AssetManifest | N
     """Rows [start, stop) of the still: (start, the float32 rows, the band's statistics)."""
     from ..render.api import RenderJob
 
-    job = RenderJob(_prepared(scene, manifest, blobs or {}), threads=_threads,
-                    rows=(start, stop))
+    prepared, _ = _prepared(scene, manifest, blobs or {})
+    job = RenderJob(prepared, threads=_threads, rows=(start, stop))
     job.run()
     return start, job.framebuffer[start:stop].copy(), job.stats
+
+
+@dataclass
+class FrameOutcome:
+    """One frame from a worker: its PNG's bytes, or why there are none."""
+
+    frame: int
+    png: bytes | None
+    error: str = ""
+    seconds: float = 0.0
+    warnings: list[str] = field(default_factory=list)
+
+
+def frame_png(image: Any, digest: str, frame: int) -> bytes:
+    """The bytes of the frame PNG the animation feature writes for ``image`` (its writer,
+    into a temporary file: the same bytes ``whitted animate`` writes)."""
+    from ..animation.frames import _write_frame_png
+
+    with tempfile.TemporaryDirectory(prefix="whitted-frame-") as tmp:
+        path = Path(tmp) / "frame.png"
+        _write_frame_png(path, image, digest, frame)
+        return path.read_bytes()
+
+
+_renderer = None  # this worker's FrameRenderer: geometry reused between consecutive frames
+
+
+def render_frame_chunk(scene: Scene, frames: list[int], digests: list[str],
+                       settings: dict[str, Any], manifest: AssetManifest | None = None,
+                       blobs: dict[str, bytes] | None = None) -> list[FrameOutcome]:
+    """Frames ``frames`` of the animated ``scene`` (with render ``settings`` replaced), each
+    as the PNG bytes that carry the client's ``digests``. A frame that fails is returned with
+    its reason (the others still render); anything else raised fails the task (retried)."""
+    global _renderer
+    from ..animation.frames import FrameRenderer, still_for_frame
+    from ..render.api import RenderJob
+
+    if _renderer is None:
+        _renderer = FrameRenderer(_threads)
+    prepared, client_names = _prepared(scene, manifest, blobs or {})
+    outcomes = []
+    for frame, digest in zip(frames, digests, strict=True):
+        start = time.perf_counter()
+        try:
+            still = still_for_frame(prepared, frame, **settings)
+            compiled, _ = _renderer.compile(still)
+            job = RenderJob(still, threads=_threads, compiled=compiled)
+            png = frame_png(job.run(), digest, frame)
+        except Exception as exc:  # noqa: BLE001 - this frame's own failure, told to the client
+            reason = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+            outcomes.append(FrameOutcome(frame, None,
+                                         client_names(reason) or type(exc).__name__))
+            continue
+        outcomes.append(FrameOutcome(frame, png, seconds=time.perf_counter() - start,
+                                     warnings=list(job.stats.warnings)))
+    return outcomes
