@@ -126,14 +126,14 @@ def test_files_reach_workers_that_cannot_see_the_scene_folder(client, textured_c
     scene = load_scene(textured_copy).with_settings(width=96, height=54)
     reference = local_pixels(scene)
     manifest, _, _ = collect_assets([scene])
-    assert workers_see(client, manifest)  # same machine: "auto" would ship nothing
+    assert workers_see(client, manifest.stamps)  # same machine: "auto" would ship nothing
     shipment = ship_assets(client, [scene], "ship")
     assert shipment.bytes == sum((textured_copy.parent / p).stat().st_size
                                  for p in manifest.files)
     hidden = textured_copy.parent.with_name("hidden")
     textured_copy.parent.rename(hidden)  # now no process sees the scene's folder
     try:
-        assert not workers_see(client, manifest)
+        assert not workers_see(client, manifest.stamps)
         image = render_still(client, scene, assets=shipment, bands=4)
         assert np.array_equal(image.pixels, reference)
 

@@ -189,21 +189,30 @@ def scene_assets(scene: Scene) -> list[Path]:
     return files
 
 
-def collect_assets(scenes: Iterable[Scene]) -> tuple[AssetManifest, dict[str, Path],
-                                                      list[list[str]]]:
+def file_stamps(scenes: Iterable[Scene]) -> tuple[dict[str, tuple[int, int]],
+                                                  list[list[Path]]]:
+    """(size, mtime_ns) of every file the scenes need, by absolute path, and each scene's
+    files: cheap (no file is read), enough to tell whether workers see the same files."""
+    per_scene = [scene_assets(s) for s in scenes]
+    stamps = {}
+    for p in sorted({p for files in per_scene for p in files}):
+        st = p.stat()
+        stamps[str(p)] = (st.st_size, st.st_mtime_ns)
+    return stamps, per_scene
+
+
+def collect_assets(scenes: Iterable[Scene], stamped: tuple | None = None
+                   ) -> tuple[AssetManifest, dict[str, Path], list[list[str]]]:
     """The manifest of every file the scenes need (they share one base folder), each blob's
-    client path by digest, and, per scene, the tree paths that scene needs."""
+    client path by digest, and, per scene, the tree paths that scene needs. ``stamped``:
+    :func:`file_stamps` of the same scenes, when already made."""
     scenes = list(scenes)
     base = _absolute(scenes[0].base_dir)
-    per_scene = [scene_assets(s) for s in scenes]
-    every = sorted({p for files in per_scene for p in files})
+    stamps, per_scene = stamped if stamped is not None else file_stamps(scenes)
+    every = [Path(name) for name in stamps]
     root = Path(os.path.commonpath([base, *every])) if every else base
     digests: dict[Path, str] = {p: file_digest(p) for p in every}
     files = {p.relative_to(root).as_posix(): digests[p] for p in every}
-    stamps = {}
-    for p in every:
-        st = p.stat()
-        stamps[str(p)] = (st.st_size, st.st_mtime_ns)
     manifest = AssetManifest(files, base.relative_to(root).as_posix(), str(root), stamps)
     blobs = {digests[p]: p for p in every}
     needs = [[p.relative_to(root).as_posix() for p in files_] for files_ in per_scene]

@@ -16,7 +16,13 @@ from typing import Literal
 
 from ..scene.scene import Scene
 from ._dask import Client, Future
-from .assets import ASSET_KEY_PREFIX, AssetManifest, collect_assets, files_visible
+from .assets import (
+    ASSET_KEY_PREFIX,
+    AssetManifest,
+    collect_assets,
+    file_stamps,
+    files_visible,
+)
 
 AssetMode = Literal["auto", "ship", "shared"]
 ASSET_MODES = ("auto", "ship", "shared")
@@ -50,11 +56,12 @@ class Shipment:
         return part, {digest: self.blobs[digest] for digest in set(part.files.values())}
 
 
-def workers_see(client: Client, manifest: AssetManifest) -> bool:
-    """Whether every worker (at least one) sees every file as the client does."""
-    if not manifest.stamps:
+def workers_see(client: Client, stamps: dict[str, tuple[int, int]]) -> bool:
+    """Whether every worker (at least one) sees every file as the client does (``stamps``:
+    size and modification time by absolute path, from :func:`file_stamps`)."""
+    if not stamps:
         return True
-    answers = client.run(files_visible, manifest.stamps)
+    answers = client.run(files_visible, stamps)
     return bool(answers) and all(answers.values())
 
 
@@ -66,9 +73,10 @@ def ship_assets(client: Client, scenes: Sequence[Scene], mode: AssetMode = "auto
         raise ValueError(f"assets: unknown mode {mode!r} (use {', '.join(ASSET_MODES)})")
     if mode == "shared":
         return Shipment()
-    manifest, paths, needs = collect_assets(scenes)
-    if not manifest.files or (mode == "auto" and workers_see(client, manifest)):
+    stamped = file_stamps(scenes)  # sizes and times only: no file is read yet
+    if not stamped[0] or (mode == "auto" and workers_see(client, stamped[0])):
         return Shipment()
+    manifest, paths, needs = collect_assets(scenes, stamped)
     data = {ASSET_KEY_PREFIX + digest: path.read_bytes() for digest, path in paths.items()}
     scattered = client.scatter(data, hash=False)
     n_workers = len(client.scheduler_info().get("workers", {}))
