@@ -17,6 +17,7 @@ from __future__ import annotations
 import asyncio
 import os
 import tempfile
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -33,10 +34,6 @@ from .assets import AssetManifest, materialise, worker_scene
 PLUGIN_NAME = "whitted-worker"
 _threads = 1  # render threads of this worker process (set by the plugin)
 _warm_seconds: float | None = None
-
-
-def worker_threads() -> int:
-    return _threads
 
 
 def set_worker_threads(threads: int) -> None:
@@ -106,9 +103,10 @@ def render_band(scene: Scene, start: int, stop: int, manifest: AssetManifest | N
     """Rows [start, stop) of the still: (start, the float32 rows, the band's statistics)."""
     from ..render.api import RenderJob
 
-    prepared, _ = _prepared(scene, manifest, blobs or {})
+    prepared, client_names = _prepared(scene, manifest, blobs or {})
     job = RenderJob(prepared, threads=_threads, rows=(start, stop))
     job.run()
+    job.stats.warnings = [client_names(w) for w in job.stats.warnings]
     return start, job.framebuffer[start:stop].copy(), job.stats
 
 
@@ -134,7 +132,8 @@ def frame_png(image: Any, digest: str, frame: int) -> bytes:
         return path.read_bytes()
 
 
-_renderer = None  # this worker's FrameRenderer: geometry reused between consecutive frames
+_renderers = threading.local()  # a FrameRenderer per Dask thread: geometry reused between
+#                                 the consecutive frames one thread renders
 
 
 def render_frame_chunk(scene: Scene, frames: list[int], digests: list[str],
@@ -143,19 +142,19 @@ def render_frame_chunk(scene: Scene, frames: list[int], digests: list[str],
     """Frames ``frames`` of the animated ``scene`` (with render ``settings`` replaced), each
     as the PNG bytes that carry the client's ``digests``. A frame that fails is returned with
     its reason (the others still render); anything else raised fails the task (retried)."""
-    global _renderer
     from ..animation.frames import FrameRenderer, still_for_frame
     from ..render.api import RenderJob
 
-    if _renderer is None:
-        _renderer = FrameRenderer(_threads)
+    renderer = getattr(_renderers, "renderer", None)
+    if renderer is None:
+        renderer = _renderers.renderer = FrameRenderer(_threads)
     prepared, client_names = _prepared(scene, manifest, blobs or {})
     outcomes = []
     for frame, digest in zip(frames, digests, strict=True):
         start = time.perf_counter()
         try:
             still = still_for_frame(prepared, frame, **settings)
-            compiled, _ = _renderer.compile(still)
+            compiled, _ = renderer.compile(still)
             job = RenderJob(still, threads=_threads, compiled=compiled)
             png = frame_png(job.run(), digest, frame)
         except Exception as exc:  # noqa: BLE001 - this frame's own failure, told to the client
@@ -164,5 +163,5 @@ def render_frame_chunk(scene: Scene, frames: list[int], digests: list[str],
                                          client_names(reason) or type(exc).__name__))
             continue
         outcomes.append(FrameOutcome(frame, png, seconds=time.perf_counter() - start,
-                                     warnings=list(job.stats.warnings)))
+                                     warnings=[client_names(w) for w in job.stats.warnings]))
     return outcomes
