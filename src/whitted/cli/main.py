@@ -25,6 +25,7 @@ from .. import __version__
 from ..errors import WhittedError, shorten
 from ..scene import Scene, load_scene
 from ..scene.default import default_scene
+from .farm import ClusterOption, SchedulerOption, render_still_on_farm
 
 app = typer.Typer(
     add_completion=False,
@@ -133,6 +134,8 @@ def render(
     set_values: Annotated[
         list[str] | None, typer.Option("--set", help="PATH=VALUE: change a scene value")
     ] = None,
+    cluster: ClusterOption = None,
+    scheduler: SchedulerOption = None,
 ) -> None:
     """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG).
     An animated scene renders frame 0, or the frame --frame names."""
@@ -172,6 +175,9 @@ def render(
         check_memory(scene.render.width, scene.render.height, image_format(output), bit_depth)
     except WhittedError as exc:
         raise fail(str(exc)) from None
+    if cluster is not None or scheduler is not None:  # bands on a Dask cluster (cli/farm.py)
+        render_still_on_farm(scene, output, cluster=cluster, scheduler=scheduler,
+                             threads=threads, quiet=quiet, bit_depth=bit_depth, aovs=aovs)
 
     try:
         job = RenderJob(scene)
