@@ -42,7 +42,9 @@ def rebuild_scene(scene: Scene, **update: Any) -> Scene:
     return new.with_base_dir(getattr(scene, "_base_dir", None))
 
 
-def item_of(scene: Scene, key: SelectionKey) -> BaseModel | None:
+def item_of(scene: Scene, key: SelectionKey | None) -> BaseModel | None:
+    if key is None:
+        return None
     if key in SINGLETONS:
         return getattr(scene, key[0])
     if len(key) == 2 and key[0] in ("lights", "objects"):
@@ -107,6 +109,8 @@ class SceneDocument(QObject):
     open) with the key to select; ``reset`` after New/Open."""
 
     changed = Signal(object)  # selection key
+    #: the one selection of the tree, the properties panel and the picture changed
+    selection_changed = Signal(object)
     reset = Signal()
     path_changed = Signal()
 
@@ -137,6 +141,7 @@ class SceneDocument(QObject):
         self.path_changed.emit()
         self.reset.emit()
         self.changed.emit(self.selection)
+        self.selection_changed.emit(self.selection)
 
     def mark_saved(self, path: Path, scene: Scene) -> None:
         self.scene = scene
@@ -147,8 +152,13 @@ class SceneDocument(QObject):
     def item(self, key: SelectionKey | None = None) -> BaseModel | None:
         return item_of(self.scene, self.selection if key is None else key)
 
-    def select(self, key: SelectionKey) -> None:
-        self.selection = key
+    def select(self, key: SelectionKey | None) -> None:
+        """Select ``key`` (None: nothing); every view follows through ``selection_changed``."""
+        if key is not None and item_of(self.scene, key) is None:
+            key = None
+        if key != self.selection:
+            self.selection = key
+            self.selection_changed.emit(key)
 
     # ------------------------------------------------------------------ edits
 
@@ -229,11 +239,14 @@ class SceneDocument(QObject):
         """Called by the undo commands only."""
         self.scene = scene
         self.revision += 1
+        before = self.selection
         if select is not None and item_of(scene, select) is not None:
             self.selection = select
-        elif item_of(scene, self.selection) is None:
-            self.selection = CAMERA
+        elif self.selection is not None and item_of(scene, self.selection) is None:
+            self.selection = None
         self.changed.emit(self.selection)
+        if self.selection != before:
+            self.selection_changed.emit(self.selection)
 
 
 def label_of(item: Any) -> str:

@@ -449,9 +449,9 @@ class MainWindow(QMainWindow):
     # ------------------------------------------------------------------ edits
 
     def select(self, key) -> None:
+        """Select ``key`` (None: nothing): the tree, the properties panel and the picture's
+        outline all follow the document's one selection."""
         self.doc.select(key)
-        self.tree.select_key(key)
-        self.properties.refresh()
 
     def add_object(self, kind: str) -> tuple:
         obj = catalog.new_object(self.doc.scene, kind)
@@ -481,8 +481,9 @@ class MainWindow(QMainWindow):
         return self.doc.duplicate(self.doc.selection)
 
     def rename_selected(self) -> None:
-        item = self.tree.item_for(self.doc.selection)
-        if item is not None and len(self.doc.selection) == 2:
+        key = self.doc.selection
+        item = self.tree.item_for(key) if key is not None else None
+        if item is not None and len(key) == 2:
             self.tree.editItem(item, 0)
 
     def _camera_edit(self, camera, text: str, merge) -> None:

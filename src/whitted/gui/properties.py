@@ -87,6 +87,8 @@ class PropertyPanel(QWidget):
         self.material_combo: QComboBox | None = None
         self.material_row: FieldRow | None = None
         self._signature: object = None
+        #: the item this panel shows, and the only one its edits go to
+        self.key: tuple | None = None
         self.title = QLabel(self)
         self.title.setStyleSheet("font-weight: bold; font-size: 11pt;")
         self.scroll = QScrollArea(self)
@@ -98,6 +100,7 @@ class PropertyPanel(QWidget):
         box.addWidget(self.scroll, 1)
         self.form: QWidget | None = None
         doc.changed.connect(self.refresh)
+        doc.selection_changed.connect(self.refresh)
         self.refresh()
 
     # ------------------------------------------------------------------ building
@@ -119,8 +122,10 @@ class PropertyPanel(QWidget):
     def refresh(self, *_: object) -> None:
         key = self.doc.selection
         item = self.doc.item(key)
+        self.key = key if item is not None else None
         if item is None:
             self.title.setText("Nothing selected")
+            self._signature = None
             self._rebuild(key, [])
             return
         specs = self.specs_for(key, item)
@@ -276,9 +281,10 @@ class PropertyPanel(QWidget):
     # ------------------------------------------------------------------ edits
 
     def commit(self, spec: F.Spec, value: Any, continuous: bool = False) -> bool:
-        """Apply one field's new value; False (and a message at the field) if refused."""
-        key = self.doc.selection
-        item = self.doc.item(key)
+        """Apply one field's new value to the item this panel shows; False (and a message at
+        the field) if refused."""
+        key = self.key
+        item = self.doc.item(key) if key is not None else None
         row = self.rows.get(spec.path)
         if item is None:
             return False
@@ -335,8 +341,8 @@ class PropertyPanel(QWidget):
     def choose_material(self, choice: str) -> None:
         """``default:``, ``named:NAME``, ``preset:NAME`` or ``custom:`` (the drop-down)."""
         kind, _, name = choice.partition(":")
-        key = self.doc.selection
-        item = self.doc.item(key)
+        key = self.key
+        item = self.doc.item(key) if key is not None else None
         if item is None or key[0] != "objects":
             return
         data = item.model_dump()
