@@ -76,16 +76,26 @@ def type_into(qtbot, line: QLineEdit, text: str, *, finish: bool = True) -> None
 
 def wheel(widget: QWidget, notches: float = -1.0, pos: QPoint | None = None,
           modifiers=NO_MOD) -> bool:
-    """Turn the mouse wheel over ``widget`` at ``pos`` (its centre): the event goes to the
-    widget under the pointer and, if it ignores it, up to its parents, as Qt delivers it.
-    Returns whether someone accepted it."""
+    """Turn the mouse wheel over ``widget`` at ``pos`` (its centre). Qt gives a real wheel
+    turn to the widget under the pointer and, while nobody accepts it, to its parents (for
+    spontaneous events only, which a test cannot make): this does the same walk. Returns
+    whether someone accepted it."""
     pos = widget.rect().center() if pos is None else pos
-    local = QPointF(pos)
     glob = QPointF(widget.mapToGlobal(pos))
-    event = QWheelEvent(local, glob, QPoint(0, 0), QPoint(0, round(120 * notches)),
-                        Qt.MouseButton.NoButton, modifiers, Qt.ScrollPhase.NoScrollPhase, False)
-    QApplication.sendEvent(widget, event)
-    return event.isAccepted()
+    w = widget
+    while w is not None:
+        local = QPointF(w.mapFromGlobal(glob.toPoint()))
+        event = QWheelEvent(local, glob, QPoint(0, 0), QPoint(0, round(120 * notches)),
+                            Qt.MouseButton.NoButton, modifiers, Qt.ScrollPhase.NoScrollPhase,
+                            False)
+        event.setAccepted(True)
+        handled = QApplication.sendEvent(w, event)
+        if handled and event.isAccepted():
+            return True
+        if w.isWindow():
+            return False
+        w = w.parentWidget()
+    return False
 
 
 def mouse(widget: QWidget, kind: str, pos, button=LEFT, modifiers=NO_MOD) -> None:

@@ -9,7 +9,7 @@ pytest.importorskip("PySide6.QtWidgets")
 
 from PySide6.QtCore import Qt  # noqa: E402
 
-from gui_input import click_tree, make_window, type_into  # noqa: E402, F401
+from gui_input import click_tree, make_window, type_into, wheel  # noqa: E402, F401
 from whitted.gui.document import CAMERA  # noqa: E402
 
 
@@ -48,3 +48,30 @@ def test_tree_panel_and_edit_target_are_one_selection(window, qtbot):
     assert window.doc.selection == ("objects", 1)
     assert "ball" in window.properties.title.text()
     assert window.tree.currentItem() is window.tree.item_for(("objects", 1))
+
+
+def test_the_wheel_scrolls_the_panel_and_changes_only_a_focused_field(window, qtbot):
+    window.object_actions["sphere"].trigger()
+    key = window.doc.selection
+    panel = window.properties
+    asked = []
+    panel.choose_file = lambda title, filters: asked.append(title)
+    before = window.doc.scene
+    bar = panel.scroll.verticalScrollBar()
+    assert bar.maximum() > 0  # the sphere's panel is taller than the window
+    texture = panel.row("material", "texture", "type").editor.combo
+    slider = panel.row("material", "kd").editor.slider
+    for widget in (texture, slider, panel.material_combo):
+        for notches in (-1, 1, -1):  # down, up, down: scrolling past it
+            start = bar.value()
+            wheel(widget, notches)
+            if notches < 0 and start < bar.maximum():
+                assert bar.value() > start  # the panel scrolled instead
+    assert window.doc.scene == before and not asked
+    assert texture.currentText() == "none"
+    assert panel.material_combo.currentData() == "preset:plastic"
+    # a field with the focus does take the wheel
+    slider.setFocus()
+    qtbot.waitUntil(slider.hasFocus)
+    wheel(slider, 1)
+    assert window.doc.scene.material_of(key[1]).kd != before.material_of(key[1]).kd

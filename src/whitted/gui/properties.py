@@ -46,6 +46,7 @@ from .widgets import (
     NumberEditor,
     TextEditor,
     VectorEditor,
+    guard_wheel,
 )
 
 SMOOTH = {None: "auto", True: "on", False: "off"}
@@ -185,6 +186,7 @@ class PropertyPanel(QWidget):
         if key == CAMERA:
             outer.addWidget(self._camera_tools())
         outer.addStretch(1)
+        guard_wheel(self.form)
         self.scroll.setWidget(self.form)
 
     def _add_material_source(self, form: QFormLayout) -> None:

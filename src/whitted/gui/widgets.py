@@ -7,9 +7,11 @@ from __future__ import annotations
 import itertools
 import re
 
-from PySide6.QtCore import Qt, Signal
+from PySide6.QtCore import QEvent, QObject, Qt, Signal
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import (
+    QAbstractSlider,
+    QAbstractSpinBox,
     QCheckBox,
     QColorDialog,
     QComboBox,
@@ -390,6 +392,36 @@ class FieldRow(QWidget):
     @property
     def error(self) -> str:
         return self.message.text()
+
+
+class WheelGuard(QObject):
+    """Lets the mouse wheel change a drop-down, slider or number box only while it has the
+    keyboard focus; otherwise the turn goes on to the scroll area under it (scrolling the
+    panel never changes a value that passes under the pointer)."""
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:  # noqa: N802 - Qt's name
+        if event.type() == QEvent.Type.Wheel and isinstance(watched, QWidget) \
+                and not watched.hasFocus():
+            event.ignore()  # not accepted: Qt hands it to the parents (the scroll area)
+            return True
+        return False
+
+
+_wheel_guard: WheelGuard | None = None
+WHEEL_GUARDED = (QComboBox, QAbstractSlider, QAbstractSpinBox)
+
+
+def guard_wheel(root: QWidget) -> None:
+    """Install the :class:`WheelGuard` on every drop-down, slider and number box in ``root``
+    (and take away their wheel focus: a wheel turn does not focus them either)."""
+    global _wheel_guard
+    if _wheel_guard is None:
+        _wheel_guard = WheelGuard()
+    widgets = [root, *root.findChildren(QWidget)]
+    for w in widgets:
+        if isinstance(w, WHEEL_GUARDED):
+            w.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+            w.installEventFilter(_wheel_guard)
 
 
 def _hbox(widget: QWidget, child: QWidget) -> QHBoxLayout:
