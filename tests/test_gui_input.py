@@ -7,9 +7,17 @@ import pytest
 
 pytest.importorskip("PySide6.QtWidgets")
 
-from PySide6.QtCore import Qt  # noqa: E402
+from PySide6.QtCore import QPoint, Qt  # noqa: E402
 
-from gui_input import click_tree, make_window, type_into, wheel  # noqa: E402, F401
+import whitted  # noqa: E402
+from gui_input import (  # noqa: E402, F401
+    CTRL,
+    SHIFT,
+    click_tree,
+    make_window,
+    type_into,
+    wheel,
+)
 from whitted.gui.document import CAMERA  # noqa: E402
 
 
@@ -75,3 +83,38 @@ def test_the_wheel_scrolls_the_panel_and_changes_only_a_focused_field(window, qt
     qtbot.waitUntil(slider.hasFocus)
     wheel(slider, 1)
     assert window.doc.scene.material_of(key[1]).kd != before.material_of(key[1]).kd
+
+
+def test_shortcuts_work_after_typing_in_a_field(window, qtbot, tmp_path):
+    window.object_actions["sphere"].trigger()
+    key = window.doc.selection
+    line = window.properties.row("radius").editor.line
+    type_into(qtbot, line, "0.9")
+    assert window.doc.item(key).radius == 0.9 and line.hasFocus()
+    # Ctrl+Z in the field, the edit committed: the scene's undo, not the field's
+    qtbot.keyClick(line, Qt.Key.Key_Z, CTRL)
+    assert window.doc.item(key).radius == 0.5
+    qtbot.keyClick(window.properties.row("radius").editor.line, Qt.Key.Key_Z, CTRL | SHIFT)
+    assert window.doc.item(key).radius == 0.9
+    # while a value is being typed, Ctrl+Z is the field's own undo (the scene keeps 0.9)
+    line = window.properties.row("radius").editor.line
+    type_into(qtbot, line, "0.3", finish=False)
+    qtbot.keyClick(line, Qt.Key.Key_Z, CTRL)
+    assert window.doc.item(key).radius == 0.9 and line.text() != "0.3"
+    # Ctrl+S while typing saves what is typed (the field's value is committed first)
+    path = tmp_path / "typed.toml"
+    window.ask_save_path = lambda: path
+    type_into(qtbot, line, "0.7", finish=False)
+    qtbot.keyClick(line, Qt.Key.Key_S, CTRL)
+    assert path.exists() and whitted.load_scene(path).objects[key[1]].radius == 0.7
+    # a render from the keyboard with the focus in a field
+    qtbot.keyClick(window.properties.row("radius").editor.line, Qt.Key.Key_R, CTRL)
+    assert window.controller.rendering
+    window.controller.shutdown()
+    # Delete with the focus on the picture deletes the selected object
+    n = len(window.doc.scene.objects)
+    qtbot.mouseClick(window.viewport, Qt.MouseButton.LeftButton, CTRL,
+                     window.viewport.rect().topLeft() + QPoint(2, 2))
+    window.select(key)
+    qtbot.keyClick(window.viewport, Qt.Key.Key_Delete)
+    assert len(window.doc.scene.objects) == n - 1

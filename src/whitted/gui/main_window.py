@@ -10,6 +10,7 @@ from pathlib import Path
 from PySide6.QtCore import QSettings, Qt, QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
+    QApplication,
     QDockWidget,
     QFileDialog,
     QLabel,
@@ -178,6 +179,7 @@ class MainWindow(QMainWindow):
         self.act_rename.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
         for a in (self.act_duplicate, self.act_rename, self.act_delete):
             self.tree.addAction(a)
+            self.viewport.addAction(a)  # also with the focus on the picture
         self.act_render = self._action("&Render", self.start_render, K("Ctrl+R"),
                                        "render the full picture, tile by tile")
         self.act_stop = self._action("&Stop", self.stop_render, K("Esc"),
@@ -380,12 +382,22 @@ class MainWindow(QMainWindow):
         self.statusBar().showMessage(f"Recovered the unsaved changes from {auto.name}", 5000)
         return True
 
+    def commit_pending_edit(self) -> None:
+        """A value typed in a field but not yet committed (no Enter, no focus change) is
+        committed before the scene is saved or rendered."""
+        focus = QApplication.focusWidget()
+        finish = getattr(focus, "finish", None)
+        if focus is not None and self.isAncestorOf(focus) and callable(finish):
+            finish()
+
     def save(self) -> bool:
+        self.commit_pending_edit()
         if self.doc.path is None:
             return self.save_as()
         return self.save_to(self.doc.path)
 
     def save_as(self, path: Path | None = None) -> bool:
+        self.commit_pending_edit()
         path = path if path is not None else self.ask_save_path()
         return self.save_to(Path(path)) if path is not None else False
 
@@ -437,6 +449,7 @@ class MainWindow(QMainWindow):
             self.recent_menu.addAction("(none)").setEnabled(False)
 
     def closeEvent(self, event: QCloseEvent) -> None:  # noqa: N802
+        self.commit_pending_edit()
         if not self.maybe_save():
             event.ignore()
             return
@@ -536,6 +549,7 @@ class MainWindow(QMainWindow):
         self.controller.request_preview(scene)
 
     def start_render(self) -> None:
+        self.commit_pending_edit()
         self.controller.render(self.doc.scene)
         self.progress.setValue(0)
         self.eta.setText("starting…")

@@ -10,6 +10,7 @@ from typing import Any
 from pydantic import BaseModel
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (
+    QApplication,
     QComboBox,
     QFormLayout,
     QGroupBox,
@@ -149,6 +150,12 @@ class PropertyPanel(QWidget):
         return f"{kind}: {label_of(item)} ({item.type})"
 
     def _rebuild(self, key: tuple, specs: list[F.Spec]) -> None:
+        # the focus must not stay in the old form (a window of its own once taken out of
+        # the scroll area, where the window's shortcuts would no longer reach)
+        focus = QApplication.focusWidget()
+        had_focus = self.form is not None and focus is not None and self.form.isAncestorOf(focus)
+        focused_path = next((p for p, r in self.rows.items()
+                             if had_focus and r.isAncestorOf(focus)), None)
         if self.form is not None:  # deleted later: its editor may be emitting right now
             old = self.scroll.takeWidget()
             if old is not None:
@@ -188,6 +195,11 @@ class PropertyPanel(QWidget):
         outer.addStretch(1)
         guard_wheel(self.form)
         self.scroll.setWidget(self.form)
+        if had_focus:
+            row = self.rows.get(focused_path) if focused_path is not None else None
+            inputs = [w for w in row.editor.findChildren(QWidget)
+                      if w.focusPolicy() != Qt.FocusPolicy.NoFocus] if row is not None else []
+            (inputs[0] if inputs else self.scroll).setFocus()
 
     def _add_material_source(self, form: QFormLayout) -> None:
         combo = QComboBox()

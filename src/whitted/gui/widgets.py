@@ -8,7 +8,7 @@ import itertools
 import re
 
 from PySide6.QtCore import QEvent, QObject, Qt, Signal
-from PySide6.QtGui import QColor
+from PySide6.QtGui import QColor, QKeyEvent, QKeySequence
 from PySide6.QtWidgets import (
     QAbstractSlider,
     QAbstractSpinBox,
@@ -84,14 +84,31 @@ class FieldEditor(QWidget):
             edit.setStyleSheet(ERROR_STYLE if bad else "")
 
 
+#: keys a field hands on to the window unless the user is typing a value in it
+_SCENE_KEYS = (QKeySequence.StandardKey.Undo, QKeySequence.StandardKey.Redo)
+
+
 class _Line(QLineEdit):
     """A line edit that remembers what it last showed, so leaving it unchanged commits
-    nothing."""
+    nothing. Its own undo/redo (Ctrl+Z, Ctrl+Shift+Z) works only while a value is being
+    typed; once committed (or untouched) those keys undo and redo the scene."""
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
         self.shown = ""
         self.setMinimumWidth(48)
+
+    def event(self, event) -> bool:  # noqa: D102 - Qt's name
+        if event.type() == QEvent.Type.ShortcutOverride and isinstance(event, QKeyEvent) \
+                and not self.changed and any(event.matches(k) for k in _SCENE_KEYS):
+            event.ignore()  # not ours: the window's shortcut runs
+            return True
+        return super().event(event)
+
+    def finish(self) -> None:
+        """Commit what is typed now (the window calls this before Save, Render...)."""
+        if self.changed:
+            self.editingFinished.emit()
 
     def show_text(self, text: str) -> None:
         self.shown = text
