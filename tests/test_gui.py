@@ -398,7 +398,7 @@ def test_camera_position_rotation_and_mouse(window, qtbot):
     assert np.linalg.norm(np.subtract(after.position, target)) == pytest.approx(
         np.linalg.norm(np.subtract(before.position, target)), rel=1e-5)
     assert window.doc.undo_stack.count() == steps + 1
-    vp.zoom.emit(0.5)
+    vp.zoom.emit(0.5, -1.0, -1.0)
     zoomed = window.doc.scene.camera
     assert np.linalg.norm(np.subtract(zoomed.position, target)) == pytest.approx(
         0.5 * np.linalg.norm(np.subtract(after.position, target)), rel=1e-4)

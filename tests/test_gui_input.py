@@ -7,13 +7,15 @@ import pytest
 
 pytest.importorskip("PySide6.QtWidgets")
 
-from PySide6.QtCore import QPoint, Qt  # noqa: E402
+from PySide6.QtCore import QPoint, QPointF, Qt  # noqa: E402
 
 import whitted  # noqa: E402
 from gui_input import (  # noqa: E402, F401
     CTRL,
     SHIFT,
+    SLOW,
     click_tree,
+    drag,
     make_window,
     type_into,
     wheel,
@@ -22,8 +24,13 @@ from whitted.gui.document import CAMERA  # noqa: E402
 
 
 @pytest.fixture
-def window(make_window):  # noqa: F811 - the fixture of gui_input
-    return make_window(preview=False, warm_up=False)
+def new_window(make_window):  # noqa: F811 - the fixture of gui_input
+    return make_window
+
+
+@pytest.fixture
+def window(new_window):
+    return new_window(preview=False, warm_up=False)
 
 
 def test_tree_panel_and_edit_target_are_one_selection(window, qtbot):
@@ -118,3 +125,32 @@ def test_shortcuts_work_after_typing_in_a_field(window, qtbot, tmp_path):
     window.select(key)
     qtbot.keyClick(window.viewport, Qt.Key.Key_Delete)
     assert len(window.doc.scene.objects) == n - 1
+
+
+def test_a_shaky_click_does_not_stop_a_render_and_the_render_shows_at_1_to_1(new_window, qtbot):
+    scene = whitted.default_scene().with_settings(width=320, height=240, samples=64)
+    window = new_window(scene=scene, preview=False)
+    vp = window.viewport
+    window.act_render.trigger()
+    qtbot.waitUntil(lambda: window.controller.full is None
+                    or window.controller.full.latest is not None, timeout=SLOW)
+    camera = window.doc.scene.camera
+    c = QPointF(vp.rect().center())
+    drag(vp, c, [c + QPointF(1, 1), c + QPointF(2, 1)])  # a two-pixel slip of the hand
+    assert window.doc.scene.camera == camera
+    assert window.controller.rendering
+    # Esc stops it, and says so at once
+    qtbot.keyClick(vp, Qt.Key.Key_Escape)
+    assert window.statusBar().currentMessage() == "Stopping…"
+    assert vp.caption == "Stopping…"
+    qtbot.waitUntil(lambda: not window.controller.rendering, timeout=SLOW)
+    assert vp.caption != "Stopping…"
+    # the picture at 1:1, zoomed in about the pointer, and fitted again
+    qtbot.keyClick(vp, Qt.Key.Key_1, CTRL)
+    assert vp.picture_rect().width() == pytest.approx(320)
+    assert vp.picture_rect().height() == pytest.approx(240)
+    wheel(vp, 2, modifiers=CTRL)
+    assert vp.picture_rect().width() == pytest.approx(320 * 1.25 ** 2)
+    assert window.doc.scene.camera == camera  # the picture zoomed, not the camera
+    qtbot.keyClick(vp, Qt.Key.Key_0, CTRL)
+    assert vp.picture_scale is None

@@ -182,8 +182,20 @@ class MainWindow(QMainWindow):
             self.viewport.addAction(a)  # also with the focus on the picture
         self.act_render = self._action("&Render", self.start_render, K("Ctrl+R"),
                                        "render the full picture, tile by tile")
-        self.act_stop = self._action("&Stop", self.stop_render, K("Esc"),
-                                     "stop the render and keep the picture so far")
+        self.act_stop = self._action("&Stop", self.stop_render, None,
+                                     "stop the render and keep the picture so far (Esc)")
+        self.act_escape = self._action("Stop the render, or &deselect", self.escape, K("Esc"),
+                                       "Esc: stops a running render, else deselects")
+        self.act_fit = self._action("&Fit the picture", lambda: self.viewport.set_picture_scale(
+            None), K("Ctrl+0"), "show the whole picture, as large as fits")
+        self.act_one_to_one = self._action(
+            "&Actual pixels (1:1)", lambda: self.viewport.set_picture_scale(1.0), K("Ctrl+1"),
+            "one render pixel per screen pixel")
+        self.act_zoom_in = self._action(
+            "Zoom the picture &in", lambda: self.viewport.zoom_picture(1.25),
+            [K("Ctrl+="), K("Ctrl++")], "also Ctrl+wheel; Ctrl+drag moves the zoomed picture")
+        self.act_zoom_out = self._action(
+            "Zoom the picture &out", lambda: self.viewport.zoom_picture(0.8), K("Ctrl+-"))
         self.act_preview = QAction("Interactive &preview", self, checkable=True, checked=True)
         self.act_preview.toggled.connect(self._toggle_preview)
         self.act_settings = self._action("Render &settings…",
@@ -213,6 +225,8 @@ class MainWindow(QMainWindow):
         edit.addActions([self.act_undo, self.act_redo])
         edit.addSeparator()
         edit.addActions([self.act_duplicate, self.act_rename, self.act_delete])
+        edit.addSeparator()
+        edit.addAction(self.act_escape)
         add = bar.addMenu("&Add")
         self.add_object_menu = add.addMenu("&Object")
         self.add_object_menu.addActions(list(self.object_actions.values()))
@@ -220,6 +234,9 @@ class MainWindow(QMainWindow):
         self.add_object_menu.addAction(self.act_model)
         self.add_light_menu = add.addMenu("&Light")
         self.add_light_menu.addActions(list(self.light_actions.values()))
+        view = bar.addMenu("&View")
+        self.view_menu = view
+        view.addActions([self.act_fit, self.act_one_to_one, self.act_zoom_in, self.act_zoom_out])
         render = bar.addMenu("&Render")
         render.addActions([self.act_render, self.act_stop])
         render.addSeparator()
@@ -519,9 +536,10 @@ class MainWindow(QMainWindow):
             return
         self._camera_edit(camera, "Pan camera", ("pan", drag))
 
-    def _zoom(self, factor: float) -> None:
+    def _zoom(self, factor: float, u: float = -1.0, v: float = -1.0) -> None:
+        s = self.doc.scene.render
         try:
-            camera = camera_ops.zoom(self.doc.scene.camera, factor)
+            camera = camera_ops.zoom_to(self.doc.scene.camera, factor, s.width, s.height, u, v)
         except ValueError:
             return
         # wheel notches in a row zoom as one step
@@ -555,10 +573,21 @@ class MainWindow(QMainWindow):
         self.eta.setText("starting…")
         self._update_render_actions()
 
+    def escape(self) -> None:
+        """Esc: stop a running render; with none running, deselect."""
+        if self.controller.rendering:
+            self.stop_render()
+        else:
+            self.select(None)
+
     def stop_render(self) -> None:
         if self.controller.rendering:
             self.controller.stop()
             self.eta.setText("stopping…")
+            self.statusBar().showMessage("Stopping…")
+            self.viewport.caption = "Stopping…"
+            self.viewport.update()
+            self.act_stop.setEnabled(False)  # until it has stopped
 
     def _update_render_actions(self) -> None:
         running = self.controller.rendering
@@ -573,6 +602,9 @@ class MainWindow(QMainWindow):
         self.viewport.caption = "preview" if kind == "preview" else ""
 
     def _render_finished(self, kind: str, text: str) -> None:
+        if self.viewport.caption == "Stopping…":
+            self.viewport.caption = ""
+            self.viewport.update()
         self.statusBar().showMessage(text, 8000)
         self._update_render_actions()
 
