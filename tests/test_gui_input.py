@@ -154,3 +154,33 @@ def test_a_shaky_click_does_not_stop_a_render_and_the_render_shows_at_1_to_1(new
     assert window.doc.scene.camera == camera  # the picture zoomed, not the camera
     qtbot.keyClick(vp, Qt.Key.Key_0, CTRL)
     assert vp.picture_scale is None
+
+
+def test_a_refused_value_does_not_move_the_form_and_speaks_plainly(window, qtbot):
+    window.object_actions["sphere"].trigger()
+    key = window.doc.selection
+    panel = window.properties
+
+    def layout():
+        return {path: row.mapTo(panel.form, QPoint(0, 0)) for path, row in panel.rows.items()}
+
+    before = layout()
+    line = panel.row("radius").editor.line
+    type_into(qtbot, line, "-1")
+    row = panel.row("radius")
+    assert row.error == "radius must be greater than 0"
+    assert not row.message.isHidden()
+    assert layout() == before  # nothing moved: the next click lands where it was aimed
+    # the message floats just under the field
+    assert row.message.mapTo(panel.form, QPoint(0, 0)).y() == row.mapTo(
+        panel.form, QPoint(0, row.height())).y()
+    # typing the scene's value back clears it, as does a new valid value
+    type_into(qtbot, line, "0.5")
+    assert row.message.isHidden() and row.error == ""
+    type_into(qtbot, line, "0")
+    assert row.error == "radius must be greater than 0"
+    type_into(qtbot, line, "0.25")
+    assert row.message.isHidden() and window.doc.item(key).radius == 0.25
+    # other fields name themselves the way their labels do
+    type_into(qtbot, panel.row("material", "kr").editor.line, "1.5")
+    assert panel.row("material", "kr").error == "reflection kr must be at most 1"

@@ -12,8 +12,8 @@ from PySide6.QtCore import QObject, Signal
 from PySide6.QtGui import QUndoStack
 
 from ..scene import Scene
-from ..scene.io import validation_message
 from .commands import SceneEdit
+from .messages import friendly_message
 
 #: what is selected: ("camera",), ("render",), ("background",), ("lights", i), ("objects", i)
 SelectionKey = tuple
@@ -24,7 +24,12 @@ SINGLETONS = (CAMERA, RENDER, BACKGROUND)
 
 
 class EditRefused(ValueError):
-    """An edit the scene model rejects; the message is one short line for the field."""
+    """An edit the scene model rejects; the message is one short line for the field.
+    ``validation`` keeps the model's error, so the panel can name the field its way."""
+
+    def __init__(self, message: str, validation: ValidationError | None = None) -> None:
+        super().__init__(message)
+        self.validation = validation
 
 
 def scene_fields(scene: Scene) -> dict[str, Any]:
@@ -38,7 +43,7 @@ def rebuild_scene(scene: Scene, **update: Any) -> Scene:
     try:
         new = Scene(**fields)
     except ValidationError as exc:
-        raise EditRefused(validation_message(exc)) from None
+        raise EditRefused(friendly_message(exc), exc) from None
     return new.with_base_dir(getattr(scene, "_base_dir", None))
 
 
@@ -68,7 +73,7 @@ def validate_like(model: BaseModel, data: dict[str, Any]) -> BaseModel:
     try:
         return type(model).model_validate(data)
     except ValidationError as exc:
-        raise EditRefused(validation_message(exc)) from None
+        raise EditRefused(friendly_message(exc), exc) from None
 
 
 def set_path(data: Any, path: tuple, value: Any) -> Any:

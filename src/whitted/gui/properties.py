@@ -36,6 +36,7 @@ from .document import (
     label_of,
     set_path,
 )
+from .messages import friendly_message
 from .widgets import (
     BoolEditor,
     ChoiceEditor,
@@ -309,12 +310,21 @@ class PropertyPanel(QWidget):
             self.doc.edit_item(key, data, f"Change {spec.label.lower()}", merge_key=merge)
         except EditRefused as exc:
             if row is not None:
-                row.show_error(str(exc))
+                row.show_error(self._message(exc, spec))
             return False
         row = self.rows.get(spec.path)  # the form may have been rebuilt by the edit
         if row is not None:
             row.clear_error()
         return True
+
+    @staticmethod
+    def _message(exc: EditRefused, spec: F.Spec) -> str:
+        """The refusal in the user's words, naming the field as its label does."""
+        if exc.validation is None:
+            return str(exc)
+        label = spec.label.split(" (")[0].lower()
+        field = next((p for p in reversed(spec.path) if isinstance(p, str)), None)
+        return friendly_message(exc.validation, label, field)
 
     def _data_with(self, key: tuple, item: BaseModel, spec: F.Spec, value: Any) -> dict:
         path = spec.path

@@ -7,9 +7,10 @@ from __future__ import annotations
 import itertools
 import re
 
-from PySide6.QtCore import QEvent, QObject, Qt, Signal
+from PySide6.QtCore import QEvent, QObject, QPoint, Qt, Signal
 from PySide6.QtGui import QColor, QKeyEvent, QKeySequence
 from PySide6.QtWidgets import (
+    QAbstractScrollArea,
     QAbstractSlider,
     QAbstractSpinBox,
     QCheckBox,
@@ -75,6 +76,8 @@ class FieldEditor(QWidget):
 
     committed = Signal(object, bool)
     refused = Signal(str)
+    #: the field holds the scene's value again (typed back): its message goes away
+    restored = Signal()
 
     def set_value(self, value: object) -> None:
         raise NotImplementedError
@@ -136,6 +139,8 @@ class TextEditor(FieldEditor):
     def _finish(self) -> None:
         if self.line.changed:
             self.committed.emit(self.line.text().strip() or None, False)
+        else:
+            self.restored.emit()
 
 
 class NumberEditor(FieldEditor):
@@ -154,6 +159,7 @@ class NumberEditor(FieldEditor):
 
     def _finish(self) -> None:
         if not self.line.changed:
+            self.restored.emit()
             return
         if self.optional and not self.line.text().strip():
             self.committed.emit(None, False)
@@ -197,6 +203,7 @@ class VectorEditor(FieldEditor):
 
     def _finish(self) -> None:
         if not any(line.changed for line in self.lines):
+            self.restored.emit()
             return
         out = []
         for axis, line in zip("xyz", self.lines, strict=True):
@@ -268,6 +275,7 @@ class CoefficientEditor(FieldEditor):
 
     def _finish(self) -> None:
         if not self.line.changed:
+            self.restored.emit()
             return
         text = self.line.text()
         parts = [p for p in re.split(r"[,;\s]+", text.strip()) if p]
@@ -317,6 +325,7 @@ class ColourEditor(FieldEditor):
 
     def _finish(self) -> None:
         if not self.line.changed:
+            self.restored.emit()
             return
         text = self.line.text().strip()
         if not text.startswith("#"):
@@ -376,35 +385,73 @@ class FileEditor(FieldEditor):
     def _finish(self) -> None:
         if self.line.changed:
             self.committed.emit(self.line.text().strip(), False)
+        else:
+            self.restored.emit()
 
 
 class FieldRow(QWidget):
-    """An editor with its error message under it (red, shown only while there is one)."""
+    """An editor with its error message. The message floats just under the field, over what
+    follows (never moving the form, so the next click lands where the user aimed), and goes
+    away when the field holds a valid value again."""
 
     def __init__(self, editor: FieldEditor, parent=None) -> None:
         super().__init__(parent)
         self.editor = editor
         self.message = QLabel(self)
         self.message.setWordWrap(True)
-        self.message.setStyleSheet("color: #c01010;")
+        self.message.setStyleSheet(
+            "QLabel { color: #a00000; background: #fff3f3; border: 1px solid #d88;"
+            " padding: 1px 4px; }")
         self.message.hide()
         box = QVBoxLayout(self)
         box.setContentsMargins(0, 0, 0, 0)
         box.setSpacing(1)
         box.addWidget(editor)
-        box.addWidget(self.message)
         editor.refused.connect(self.show_error)
+        editor.restored.connect(self.clear_error)
+
+    def _host(self) -> QWidget:
+        """The widget the message floats in: the scroll area's page (or the window)."""
+        host: QWidget = self
+        while host.parentWidget() is not None and not host.isWindow():
+            parent = host.parentWidget()
+            if parent.parentWidget() is not None and isinstance(
+                    parent.parentWidget(), QAbstractScrollArea):
+                return host
+            host = parent
+        return host
+
+    def _place(self) -> None:
+        host = self._host()
+        if self.message.parentWidget() is not host:
+            self.message.setParent(host)
+        width = max(self.width(), 120)
+        self.message.setFixedWidth(width)
+        self.message.adjustSize()
+        self.message.move(self.mapTo(host, QPoint(0, self.height())))
+        self.message.raise_()
 
     def show_error(self, message: str) -> None:
         self.message.setText(message)
+        self._place()
         self.message.show()
         self.editor.set_error(True)
 
     def clear_error(self) -> None:
-        if self.message.isVisible() or self.message.text():
+        if not self.message.isHidden() or self.message.text():
             self.message.clear()
             self.message.hide()
             self.editor.set_error(False)
+
+    def resizeEvent(self, event) -> None:  # noqa: N802
+        super().resizeEvent(event)
+        if not self.message.isHidden():
+            self._place()
+
+    def moveEvent(self, event) -> None:  # noqa: N802
+        super().moveEvent(event)
+        if not self.message.isHidden():
+            self._place()
 
     @property
     def error(self) -> str:
