@@ -44,6 +44,7 @@ def make_window(qtbot, tmp_path):
         window.show()
         qtbot.waitExposed(window)
         window.activateWindow()
+        qtbot.waitUntil(window.isActiveWindow, timeout=5000)  # the keys go to it
         return window
 
     return make

@@ -25,6 +25,7 @@ from ..errors import WhittedError
 from ..scene import Scene, load_scene, save_scene
 from ..scene.default import default_scene
 from ..scene.io import rebase_files
+from ..scene.toml_document import save_scene_toml
 from . import camera_ops, catalog
 from .autosave import Autosave, recovery_for
 from .document import (
@@ -76,6 +77,7 @@ class MainWindow(QMainWindow):
         if path is not None:
             scene = scene.with_base_dir(Path(path).parent)
         self.doc = SceneDocument(scene, Path(path) if path is not None else None, self)
+        self._remember_source(scene, path)
         self.controller = RenderController(self)
         self.controller.preview_enabled = preview
         self.autosave = Autosave(self.doc, interval_ms=autosave_interval_ms,
@@ -356,6 +358,7 @@ class MainWindow(QMainWindow):
             return False
         self.controller.stop()
         self.doc.set_scene(starter_scene(), None)
+        self._remember_source(None, None)
         return True
 
     def open_dialog(self) -> bool:
@@ -378,9 +381,22 @@ class MainWindow(QMainWindow):
             return False
         self.controller.stop()
         self.doc.set_scene(scene, path)
+        self._remember_source(scene, path)
         self.recent.add(path)
         self.offer_recovery()
         return True
+
+    def _remember_source(self, scene: Scene | None, path: Path | None,
+                         text: str | None = None) -> None:
+        """Keep the TOML file's text as read (or written) and the scene it holds: saving
+        writes only the edits into it (comments and layout stay)."""
+        self.source_text: str | None = text
+        self.source_scene: Scene | None = scene
+        if text is None and path is not None and Path(path).suffix.lower() == ".toml":
+            try:
+                self.source_text = Path(path).read_text(encoding="utf-8")
+            except OSError:
+                self.source_text = None
 
     def offer_recovery(self) -> bool:
         """If an autosave of the current scene is newer than the file, offer it back."""
@@ -421,13 +437,22 @@ class MainWindow(QMainWindow):
     def save_to(self, path: Path) -> bool:
         old_path = self.doc.path
         scene = self.doc.scene
+        text = None
         try:
             if path.parent.resolve() != scene.base_dir.resolve():
                 scene = rebase_files(scene, path.parent)
-            save_scene(scene, path)
+            if path.suffix.lower() == ".toml":
+                same_folder = old_path is not None and old_path.parent.resolve() == \
+                    path.parent.resolve()
+                text = save_scene_toml(
+                    scene, path, text=self.source_text if same_folder else None,
+                    loaded=self.source_scene if same_folder else None)
+            else:
+                save_scene(scene, path)
         except (WhittedError, OSError, ValueError) as exc:
             self.show_error("Cannot save the scene", str(exc))
             return False
+        self._remember_source(scene, path, text)
         if old_path is not None and old_path != path:
             self.autosave.discard(old_path)
         self.doc.mark_saved(path, scene.with_base_dir(path.parent))
