@@ -184,3 +184,29 @@ def test_a_refused_value_does_not_move_the_form_and_speaks_plainly(window, qtbot
     # other fields name themselves the way their labels do
     type_into(qtbot, panel.row("material", "kr").editor.line, "1.5")
     assert panel.row("material", "kr").error == "reflection kr must be at most 1"
+
+
+def test_a_model_shows_the_material_of_its_file_and_can_override_it(window, qtbot, tmp_path):
+    (tmp_path / "red.mtl").write_text("newmtl red\nKd 1 0 0\nKa 0 0 0\n")
+    obj = tmp_path / "tetra.obj"
+    obj.write_text("mtllib red.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nusemtl red\n"
+                   "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
+    key = window.add_model(obj)
+    click_tree(qtbot, window.tree, ("objects", 0))
+    click_tree(qtbot, window.tree, key)
+    panel = window.properties
+    assert panel.material_combo.currentText() == "From the model file (tetra.obj)"
+    assert panel.row("material", "color").editor.line.text() == "#ff0000"
+    assert window.doc.item(key).material is None
+    # an edit overrides the file's material with this one, starting from what it showed
+    type_into(qtbot, panel.row("material", "kr").editor.line, "0.5")
+    material = window.doc.scene.material_of(key[1])
+    assert material.kr == 0.5 and material.color == (1.0, 0.0, 0.0)
+    assert panel.material_combo.currentText() == "Custom"
+    # back to the file's materials from the drop-down, with the keyboard
+    combo = panel.material_combo
+    combo.setFocus()
+    for _ in range(combo.count()):
+        qtbot.keyClick(combo, Qt.Key.Key_Up)
+    assert window.doc.item(key).material is None
+    assert panel.material_combo.currentText() == "From the model file (tetra.obj)"

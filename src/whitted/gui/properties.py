@@ -5,6 +5,7 @@ marked red, with the model's message under it, and never reaches the scene."""
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from pydantic import BaseModel
@@ -120,7 +121,29 @@ class PropertyPanel(QWidget):
         specs = F.object_specs(item)
         geometry = [s for s in specs if s.group != F.TRANSFORM]
         placement = [s for s in specs if s.group == F.TRANSFORM]
-        return geometry + F.material_specs(self.doc.scene.material_of(key[1])) + placement
+        return geometry + F.material_specs(self.shown_material(key)) + placement
+
+    def file_materials(self, key: tuple) -> list[Material] | None:
+        """The materials of a model file (its MTL...) when the object uses them (no
+        ``material`` of its own); None otherwise or when the file cannot be read."""
+        if key is None or key[0] != "objects":
+            return None
+        obj = self.doc.item(key)
+        if getattr(obj, "type", None) != "mesh" or obj.file is None or obj.material is not None:
+            return None
+        try:
+            from ..assets import load_mesh
+
+            return list(load_mesh(self.doc.scene.resolve_path(obj.file)).materials)
+        except Exception:  # noqa: BLE001 - an unreadable file shows the default instead
+            return None
+
+    def shown_material(self, key: tuple) -> Material:
+        """The material the panel shows for an object: its own, or its model file's first."""
+        from_file = self.file_materials(key)
+        if from_file:
+            return from_file[0]
+        return self.doc.scene.material_of(key[1])
 
     def refresh(self, *_: object) -> None:
         key = self.doc.selection
@@ -247,7 +270,7 @@ class PropertyPanel(QWidget):
     def value_of(self, key: tuple, item: BaseModel, spec: F.Spec) -> Any:
         path = spec.path
         if path[0] == "material" and key[0] == "objects":
-            material = self.doc.scene.material_of(key[1])
+            material = self.shown_material(key)
             if path[1:] == ("texture", "type"):
                 return getattr(material.texture, "type", "none")
             if path[1] == "specular_color" and material.specular_color is None:
@@ -275,6 +298,15 @@ class PropertyPanel(QWidget):
         combo = self.material_combo
         assert combo is not None
         combo.clear()
+        obj_file = getattr(item, "file", None) if getattr(item, "type", None) == "mesh" else None
+        if obj_file:
+            count = len(self.file_materials(key) or []) if item.material is None else 0
+            name = Path(obj_file).name
+            combo.addItem(f"From the model file ({name})" if not count or count == 1 else
+                          f"From the model file ({name}, {count} materials)", "file:")
+            combo.setItemData(0, "the materials the model's own file gives (its MTL, glTF...);"
+                                 " editing a value overrides them all with this one",
+                              Qt.ItemDataRole.ToolTipRole)
         combo.addItem("Default (grey)", "default:")
         for name in self.doc.scene.materials:
             combo.addItem(f"{name} (scene material)", f"named:{name}")
@@ -282,10 +314,14 @@ class PropertyPanel(QWidget):
             combo.addItem(f"{name} (preset)", f"preset:{name}")
         combo.addItem("Custom", "custom:")
         ref = item.material
-        if ref is None:
+        if ref is None and obj_file:
+            current = "file:"
+        elif ref is None:
             current = "default:"
         elif isinstance(ref, str):
             current = f"named:{ref}" if ref in self.doc.scene.materials else f"preset:{ref}"
+        elif not isinstance(ref, str) and ref == Material() and obj_file:
+            current = "default:"
         elif ref.preset is not None and ref == Material(preset=ref.preset):
             current = f"preset:{ref.preset}"
         else:
@@ -330,7 +366,7 @@ class PropertyPanel(QWidget):
         path = spec.path
         data = item.model_dump()
         if path[0] == "material" and key[0] == "objects":
-            material = self.doc.scene.material_of(key[1]).model_dump()
+            material = self.shown_material(key).model_dump()
             if path[1:] == ("texture", "type"):
                 material["texture"] = self._new_texture(value, material.get("texture"))
             else:
@@ -370,14 +406,16 @@ class PropertyPanel(QWidget):
         if item is None or key[0] != "objects":
             return
         data = item.model_dump()
-        if kind == "default":
+        if kind == "file":  # a model without a material of its own: its file's materials
             data["material"] = None
+        elif kind == "default":  # (a model's "none" is its file's: grey is an override)
+            data["material"] = {} if getattr(item, "file", None) else None
         elif kind == "named":
             data["material"] = name
         elif kind == "preset":
             data["material"] = {"preset": name}
         else:  # custom: this object's own copy of what it shows now
-            data["material"] = self.doc.scene.material_of(key[1]).model_dump()
+            data["material"] = self.shown_material(key).model_dump()
         try:
             self.doc.edit_item(key, data, "Change material")
         except EditRefused as exc:
