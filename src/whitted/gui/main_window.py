@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 from PySide6.QtCore import QSettings, Qt, QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
@@ -42,6 +43,7 @@ from .picking import IdBuffer, id_at, outline_image
 from .properties import PropertyPanel
 from .recent import RecentFiles
 from .render_controller import RenderController
+from .transform_tool import TransformTool, object_bounds, object_centre
 from .tree import SceneTree
 from .viewport import Viewport
 
@@ -119,6 +121,7 @@ class MainWindow(QMainWindow):
         self.ids.ready.connect(self._update_outline)
         self.doc.selection_changed.connect(lambda *_: self._update_outline())
         self.viewport.clicked.connect(self.pick)
+        self.viewport.key_handler = self._viewport_key
         self.viewport.orbit.connect(self._orbit)
         self.viewport.pan.connect(self._pan)
         self.viewport.zoom.connect(self._zoom)
@@ -578,6 +581,109 @@ class MainWindow(QMainWindow):
             self.viewport.outline = outline
             self.viewport.update()
 
+    def _viewport_key(self, event) -> bool:
+        """The picture's keys: G/R/S move, rotate, scale the selection; F frames it, Home
+        frames everything; numpad 1/3/7 (or 1/3/7) look from the front, the right, the top
+        (with Ctrl: the back, the left, the bottom)."""
+        key = event.key()
+        mods = event.modifiers()
+        ctrl = bool(mods & Qt.KeyboardModifier.ControlModifier)
+        tools = {Qt.Key.Key_G: "move", Qt.Key.Key_R: "rotate", Qt.Key.Key_S: "scale"}
+        if key in tools and not ctrl:
+            return self.start_tool(tools[key])
+        if key == Qt.Key.Key_F and not ctrl:
+            return self.frame_selection()
+        if key == Qt.Key.Key_Home:
+            return self.frame_all()
+        views = {Qt.Key.Key_1: (0.0, 0.0, 1.0), Qt.Key.Key_3: (1.0, 0.0, 0.0),
+                 Qt.Key.Key_7: (0.0, 1.0, 0.0)}
+        if key in views and (not ctrl or mods & Qt.KeyboardModifier.KeypadModifier):
+            d = np.asarray(views[key]) * (-1.0 if ctrl else 1.0)
+            return self.view_from(d, {Qt.Key.Key_1: "front", Qt.Key.Key_3: "side",
+                                      Qt.Key.Key_7: "top"}[key])
+        return False
+
+    def start_tool(self, mode: str) -> bool:
+        key = self.doc.selection
+        if key is None or key[0] != "objects" or self.viewport.tool is not None:
+            return False
+        start = self.viewport.hover
+        if self.viewport.to_picture(start) is None:
+            start = self.viewport.picture_rect().center()
+        tool = TransformTool(mode, self.doc.scene, key[1], start,
+                             (self.viewport.width(), self.viewport.height()),
+                             apply=lambda t, merge: self._tool_edit(key, t, merge, mode),
+                             finish=self._tool_finished,
+                             status=lambda text: self.statusBar().showMessage(text))
+        tool.start_uv = tool.uv = self.viewport.to_picture(start)
+        self.viewport.tool = tool
+        self._tool_edits = 0
+        return True
+
+    def _tool_edit(self, key, transform, merge, mode: str) -> None:
+        item = self.doc.item(key)
+        data = item.model_dump()
+        data["transform"] = transform.model_dump()
+        try:
+            before = self.doc.undo_stack.index()
+            self.doc.edit_item(key, data, f"{TransformTool.NAMES[mode]} {label_of(item)}",
+                               merge_key=merge)
+            self._tool_edits += self.doc.undo_stack.index() != before or self._tool_edits > 0
+        except EditRefused as exc:
+            self.statusBar().showMessage(str(exc), 3000)
+
+    def _tool_finished(self, confirmed: bool, tool) -> None:
+        self.viewport.tool = None
+        if not confirmed and self._tool_edits:
+            stack = self.doc.undo_stack
+            command = stack.command(stack.index() - 1)
+            if command is not None and getattr(command, "merge_key", None) == tool.merge_key:
+                command.forget_on_undo = True  # no redo of a cancelled move
+                stack.undo()
+        self.statusBar().showMessage("" if confirmed else "Cancelled", 2000)
+        self.viewport.update()
+
+    def frame_selection(self) -> bool:
+        key = self.doc.selection
+        if key is None or key[0] != "objects":
+            return self.frame_all()
+        bounds = object_bounds(self.doc.scene, key[1])
+        if bounds is None:
+            c = object_centre(self.doc.scene, key[1])
+            bounds = (c - 1.0, c + 1.0)
+        self._frame(*bounds, "Frame selection")
+        return True
+
+    def frame_all(self) -> bool:
+        scene = self.doc.scene
+        boxes = [b for i in range(len(scene.objects))
+                 if (b := object_bounds(scene, i)) is not None]
+        if not boxes:
+            return False
+        lo = np.min([b[0] for b in boxes], axis=0)
+        hi = np.max([b[1] for b in boxes], axis=0)
+        self._frame(lo, hi, "Frame all")
+        return True
+
+    def _frame(self, lo, hi, text: str) -> None:
+        s = self.doc.scene.render
+        try:
+            camera = camera_ops.frame_bounds(self.doc.scene.camera, s.width, s.height, lo, hi)
+        except ValueError:
+            return
+        self._camera_edit(camera, text, None)
+
+    def view_from(self, direction, name: str) -> bool:
+        camera = self.doc.scene.camera
+        target = camera_ops.target_of(camera)
+        distance = float(np.linalg.norm(np.subtract(camera.position, target)))
+        try:
+            camera = camera_ops.look_from(camera, direction, target, distance)
+        except ValueError:
+            return False
+        self._camera_edit(camera, f"View from the {name}", None)
+        return True
+
     def _camera_edit(self, camera, text: str, merge) -> None:
         try:
             self.doc.edit_item(CAMERA, camera.model_dump(), text, merge_key=merge)
@@ -638,8 +744,10 @@ class MainWindow(QMainWindow):
         self._update_render_actions()
 
     def escape(self) -> None:
-        """Esc: stop a running render; with none running, deselect."""
-        if self.controller.rendering:
+        """Esc: cancel a G/R/S move; else stop a running render; else deselect."""
+        if self.viewport.tool is not None:
+            self.viewport.tool.cancel()
+        elif self.controller.rendering:
             self.stop_render()
         else:
             self.select(None)
