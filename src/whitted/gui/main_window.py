@@ -122,6 +122,8 @@ class MainWindow(QMainWindow):
         self.doc.selection_changed.connect(lambda *_: self._update_outline())
         self.viewport.clicked.connect(self.pick)
         self.viewport.key_handler = self._viewport_key
+        self.viewport.drag_started.connect(lambda: self.controller.set_interacting(True))
+        self.viewport.drag_finished.connect(lambda: self.controller.set_interacting(False))
         self.viewport.orbit.connect(self._orbit)
         self.viewport.pan.connect(self._pan)
         self.viewport.zoom.connect(self._zoom)
@@ -130,6 +132,7 @@ class MainWindow(QMainWindow):
         self._update_title()
         self._update_render_actions()
         self.viewport.set_aspect(scene.render.width, scene.render.height)
+        self._update_preview_target()
         if warm_up:
             self.viewport.caption = "Loading the render kernels (the first run compiles them)…"
             self.controller.warm_up()
@@ -618,6 +621,7 @@ class MainWindow(QMainWindow):
         tool.start_uv = tool.uv = self.viewport.to_picture(start)
         self.viewport.tool = tool
         self._tool_edits = 0
+        self.controller.set_interacting(True)
         return True
 
     def _tool_edit(self, key, transform, merge, mode: str) -> None:
@@ -634,6 +638,7 @@ class MainWindow(QMainWindow):
 
     def _tool_finished(self, confirmed: bool, tool) -> None:
         self.viewport.tool = None
+        self.controller.set_interacting(False)
         if not confirmed and self._tool_edits:
             stack = self.doc.undo_stack
             command = stack.command(stack.index() - 1)
@@ -725,7 +730,14 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ rendering
 
+    def _update_preview_target(self) -> None:
+        """Previews refine, when the input stops, up to the picture's size on screen."""
+        r = self.viewport.fit_rect()
+        ratio = self.viewport.devicePixelRatioF()
+        self.controller.target_pixels = max(1, int(r.width() * r.height() * ratio * ratio))
+
     def _scene_changed(self, key=None) -> None:
+        self._update_preview_target()
         scene = self.doc.scene
         if self.doc.selection is not None and self.doc.selection[0] == "objects":
             self.ids.request(scene)  # the outline follows

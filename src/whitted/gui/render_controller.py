@@ -26,6 +26,9 @@ BACKDROP_DIM = 0.6  # the preview under unrendered tiles, dimmed so the finished
 PREVIEW_PIXELS = 160 * 120
 PREVIEW_MIN_PIXELS, PREVIEW_MAX_PIXELS = 64 * 48, 480 * 360
 PREVIEW_TARGET_S = 0.15
+#: while the user drags (orbit, slider, G/R/S) a preview aims at this, for >= 10 updates/s
+INTERACTIVE_TARGET_S = 0.06
+REFINE_FACTOR = 4  # each idle refinement step has this many times the pixels
 PREVIEW_DEPTH = 2
 PREVIEW_SHADOW_SAMPLES = 4
 
@@ -61,6 +64,8 @@ class _Active:
     kind: str  # "preview" or "render"
     started: float
     scene: Scene
+    pixels: int = 0  # a preview's pixel budget
+    refining: bool = False  # an idle refinement step (not a first look at an edit)
     latest: Progress | None = None
     shown_tiles: int = -1
     first_pixels: float | None = None
@@ -111,6 +116,15 @@ class RenderController(QObject):
         self.last_preview: Image | None = None
         self.previews_done = 0
         self.last_preview_seconds: float | None = None
+        #: the user is dragging: coarse previews, no refinement until it stops
+        self.interacting = False
+        #: pixels of a preview at full viewport size (the refinement's goal)
+        self.target_pixels = PREVIEW_MAX_PIXELS
+        self.interactive_pixels = PREVIEW_PIXELS // 2
+        self._requested_at: float | None = None
+        #: measurements: edit -> first picture, last edit -> full-size picture (seconds)
+        self.edit_to_frame: list[float] = []
+        self.edit_to_full: list[float] = []
         self.first_pixels_seconds: float | None = None
         self._pending: Scene | None = None
         self._poll = QTimer(self)
@@ -120,6 +134,7 @@ class RenderController(QObject):
         self._throttle.setSingleShot(True)
         self._throttle.setInterval(preview_delay_ms)
         self._throttle.timeout.connect(self._start_preview)
+        self._shown: _Active | None = None  # the preview on screen
         self._warm = threading.Event()
         self._warm_seconds = 0.0
 
@@ -182,6 +197,9 @@ class RenderController(QObject):
         """Preview ``scene`` soon (edits in quick succession coalesce into one preview)."""
         if not self.preview_enabled:
             return
+        if self._pending is None and self._requested_at is None:
+            self._requested_at = time.perf_counter()
+        self._last_edit = time.perf_counter()
         self._pending = scene
         if not self._throttle.isActive():
             self._throttle.start()
@@ -195,12 +213,42 @@ class RenderController(QObject):
                 self._pending = scene
                 self._throttle.start()
             return
+        if self.preview is not None and not self.preview.refining \
+                and self.preview.job.running:
+            # a preview of an earlier edit is nearly there: show it, then this one (cancelling
+            # it would show nothing at all while edits come faster than previews)
+            self._pending = scene
+            return
         self._cancel_preview()
-        small = preview_scene(scene, self.preview_pixels)
-        active = _Active(RenderJob(small), "preview", time.perf_counter(), scene)
+        pixels = self.interactive_pixels if self.interacting else self.preview_pixels
+        self._start_preview_job(scene, pixels, refining=False)
+
+    def _start_preview_job(self, scene: Scene, pixels: int, *, refining: bool) -> None:
+        small = preview_scene(scene, pixels)
+        active = _Active(RenderJob(small), "preview", time.perf_counter(), scene,
+                         pixels=pixels, refining=refining)
         self.preview = active
         active.job.start()
         self._poll.start()
+
+    def set_interacting(self, on: bool) -> None:
+        """A drag started (coarse, fast previews) or ended (refine to full size)."""
+        self.interacting = on
+        if not on and self.preview is None and self._pending is None \
+                and self._shown is not None:
+            self._refine(self._shown)
+
+    def _refine(self, done: _Active) -> None:
+        """The next, larger preview of the same scene, while nothing else is asked for."""
+        if self.interacting or self._pending is not None or self.full is not None \
+                or not self.preview_enabled:
+            return
+        s = done.scene.render
+        goal = min(self.target_pixels, s.width * s.height)
+        if done.job.settings.width * done.job.settings.height >= goal * 0.98:
+            return
+        self._start_preview_job(done.scene, min(goal, done.pixels * REFINE_FACTOR),
+                                refining=True)
 
     def _cancel_preview(self) -> None:
         if self.preview is not None:
@@ -215,6 +263,8 @@ class RenderController(QObject):
             self._warm_seconds = -1.0
         if self.preview is not None and not self.preview.job.running:
             self._preview_done(self.preview)
+            if self._pending is not None and self.preview is None:
+                self._start_preview()  # the edits that came in meanwhile, at once
         if self.full is not None:
             self._full_tick(self.full)
         if self.full is None and self.preview is None and self._warm_seconds < 0:
@@ -228,17 +278,34 @@ class RenderController(QObject):
             return
         if job.cancel_token.cancelled or job.image is None:
             return
-        seconds = time.perf_counter() - active.started
+        now = time.perf_counter()
+        seconds = now - active.started
         render_seconds = job.stats.render_seconds + job.stats.build_seconds
-        if job.stats.compile_seconds == 0:  # adapt the resolution to the time it took
-            ratio = PREVIEW_TARGET_S / max(render_seconds, 1e-3)
-            self.preview_pixels = int(np.clip(self.preview_pixels * min(max(ratio, 0.5), 2.0),
-                                              PREVIEW_MIN_PIXELS, PREVIEW_MAX_PIXELS))
+        if job.stats.compile_seconds == 0 and not active.refining:
+            # adapt the resolution to the time it took (the dragging budget separately)
+            target = INTERACTIVE_TARGET_S if self.interacting else PREVIEW_TARGET_S
+            ratio = min(max(target / max(render_seconds, 1e-3), 0.5), 2.0)
+            if self.interacting:
+                self.interactive_pixels = int(np.clip(self.interactive_pixels * ratio,
+                                                      PREVIEW_MIN_PIXELS, PREVIEW_MAX_PIXELS))
+            else:
+                self.preview_pixels = int(np.clip(self.preview_pixels * ratio,
+                                                  PREVIEW_MIN_PIXELS, PREVIEW_MAX_PIXELS))
+        if self._requested_at is not None:
+            self.edit_to_frame.append(now - self._requested_at)
+            self._requested_at = None
+        s0 = active.scene.render
+        full = job.settings.width * job.settings.height >= 0.98 * min(
+            self.target_pixels, s0.width * s0.height)
+        if full and active.refining and getattr(self, "_last_edit", None) is not None:
+            self.edit_to_full.append(now - self._last_edit)
         self.last_preview = job.image
         self.last_preview_seconds = seconds
         self.previews_done += 1
         s = job.settings
+        self._shown = active
         self.frame.emit(to_qimage(job.framebuffer, s.transfer, s.tonemap), "preview")
+        self._refine(active)
 
     def _full_tick(self, active: _Active) -> None:
         job = active.job
