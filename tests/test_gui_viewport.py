@@ -124,3 +124,24 @@ def test_frame_selection_home_and_the_numpad_views(window, qtbot):
     assert cam.position[2] > cam.look_at[2] and cam.position[0] == pytest.approx(cam.look_at[0])
     qtbot.keyClick(vp, Qt.Key.Key_Home)  # everything bounded (the ball; the floor is endless)
     assert window.doc.scene.camera.look_at == pytest.approx((0.0, 0.8, 0.0))
+
+
+def test_a_light_is_drawn_picked_and_moved_with_g(make_window, qtbot):  # noqa: F811
+    scene = whitted.gui.main_window.starter_scene().with_settings(width=160, height=120)
+    lights = [*scene.lights, whitted.PointLight(name="bulb", position=(1.0, 2.0, 0.0))]
+    scene = scene.model_copy(update={"lights": lights})
+    window = make_window(scene, preview=False, warm_up=False)
+    vp = window.viewport
+    marks = dict(window._light_marks())
+    uv = marks[("lights", 2)]
+    at = vp.to_widget(*uv)
+    picture = vp.grab().toImage()
+    colour = picture.pixelColor(round(at.x()), round(at.y()))
+    assert colour.red() > 200 and colour.green() > 180 and colour.blue() < 150  # the mark
+    qtbot.mouseClick(vp, Qt.MouseButton.LeftButton, pos=QPoint(round(at.x()) + 3,
+                                                                round(at.y()) + 2))
+    assert window.doc.selection == ("lights", 2)
+    assert "bulb" in window.properties.title.text()
+    qtbot.keyClicks(vp, "gy1")
+    qtbot.keyClick(vp, Qt.Key.Key_Return)
+    assert window.doc.item(("lights", 2)).position == pytest.approx((1.0, 3.0, 0.0))

@@ -5,11 +5,12 @@ tests can answer them)."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QSettings, Qt, QTimer
-from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
+from PySide6.QtCore import QPointF, QSettings, Qt, QTimer
+from PySide6.QtGui import QAction, QCloseEvent, QColor, QKeySequence, QPainter, QPen
 from PySide6.QtWidgets import (
     QApplication,
     QDockWidget,
@@ -43,7 +44,7 @@ from .picking import IdBuffer, id_at, outline_image
 from .properties import PropertyPanel
 from .recent import RecentFiles
 from .render_controller import RenderController
-from .transform_tool import TransformTool, object_bounds, object_centre
+from .transform_tool import TransformTool, light_position, object_bounds, object_centre
 from .tree import SceneTree
 from .viewport import Viewport
 
@@ -122,6 +123,7 @@ class MainWindow(QMainWindow):
         self.doc.selection_changed.connect(lambda *_: self._update_outline())
         self.viewport.clicked.connect(self.pick)
         self.viewport.key_handler = self._viewport_key
+        self.viewport.overlay = self._draw_overlay
         self.viewport.drag_started.connect(lambda: self.controller.set_interacting(True))
         self.viewport.drag_finished.connect(lambda: self.controller.set_interacting(False))
         self.viewport.orbit.connect(self._orbit)
@@ -564,10 +566,79 @@ class MainWindow(QMainWindow):
         except WhittedError as exc:
             self.statusBar().showMessage(f"Cannot pick: {exc}", 4000)
             return None
+        light = self.light_at(u, v)
         index = id_at(ids, u, v)
-        key = ("objects", index) if index >= 0 else None
+        key = light if light is not None else ("objects", index) if index >= 0 else None
         self.select(key)
         return key
+
+    LIGHT_PICK_PX = 12
+
+    def _light_marks(self):
+        """(key, picture point (u, v)) of every light with a place in the scene."""
+        scene = self.doc.scene
+        s = scene.render
+        for i, light in enumerate(scene.lights):
+            p = light_position(light)
+            uv = camera_ops.project(scene.camera, s.width, s.height, p) if p else None
+            if uv is not None:
+                yield ("lights", i), uv
+
+    def light_at(self, u: float, v: float):
+        """The light whose mark is within a few pixels of (u, v), if any."""
+        here = self.viewport.to_widget(u, v)
+        best, best_d = None, float(self.LIGHT_PICK_PX)
+        for key, (lu, lv) in self._light_marks():
+            p = self.viewport.to_widget(lu, lv)
+            d = math.hypot(p.x() - here.x(), p.y() - here.y())
+            if d <= best_d:
+                best, best_d = key, d
+        return best
+
+    def _draw_overlay(self, p: QPainter, to_widget) -> None:
+        """Over the picture: lights (a sun mark, named), the camera's target (a cross), and
+        the selected object's bounding box."""
+        scene = self.doc.scene
+        s = scene.render
+        cam = scene.camera
+        selected = self.doc.selection
+        if selected is not None and selected[0] == "objects":
+            bounds = object_bounds(scene, selected[1])
+            if bounds is not None:
+                lo, hi = bounds
+                corners = [(x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                           for z in (lo[2], hi[2])]
+                uvs = [camera_ops.project(cam, s.width, s.height, c) for c in corners]
+                pen = QPen(QColor(255, 150, 20, 170), 1, Qt.PenStyle.DashLine)
+                p.setPen(pen)
+                for a in range(8):
+                    for b in range(a + 1, 8):
+                        if bin(a ^ b).count("1") == 1 and uvs[a] and uvs[b]:
+                            p.drawLine(to_widget(*uvs[a]), to_widget(*uvs[b]))
+        target = camera_ops.project(cam, s.width, s.height, camera_ops.target_of(cam))
+        if target is not None:
+            c = to_widget(*target)
+            p.setPen(QPen(QColor(255, 255, 255, 150), 1))
+            p.drawLine(c + QPointF(-7, 0), c + QPointF(7, 0))
+            p.drawLine(c + QPointF(0, -7), c + QPointF(0, 7))
+        for key, uv in self._light_marks():
+            c = to_widget(*uv)
+            light = scene.lights[key[1]]
+            colour = QColor(255, 150, 20) if key == selected else QColor(255, 230, 90)
+            p.setPen(QPen(QColor(0, 0, 0, 160), 3))
+            p.drawEllipse(c, 5, 5)
+            p.setPen(QPen(colour, 1.5))
+            p.setBrush(colour)
+            p.drawEllipse(c, 4, 4)
+            p.setBrush(Qt.BrushStyle.NoBrush)
+            for k in range(8):
+                a = k * math.pi / 4
+                d = QPointF(math.cos(a), math.sin(a))
+                p.drawLine(c + d * 6.5, c + d * 10)
+            p.setPen(QColor(0, 0, 0))
+            p.drawText(c + QPointF(13, 5), label_of(light))
+            p.setPen(colour)
+            p.drawText(c + QPointF(12, 4), label_of(light))
 
     def _update_outline(self) -> None:
         """The selected object's outline over the picture (from the current id image)."""
@@ -608,7 +679,10 @@ class MainWindow(QMainWindow):
 
     def start_tool(self, mode: str) -> bool:
         key = self.doc.selection
-        if key is None or key[0] != "objects" or self.viewport.tool is not None:
+        if key is None or len(key) != 2 or self.viewport.tool is not None:
+            return False
+        if key[0] == "lights" and (mode != "move" or light_position(
+                self.doc.item(key)) is None):
             return False
         start = self.viewport.hover
         if self.viewport.to_picture(start) is None:
@@ -617,7 +691,8 @@ class MainWindow(QMainWindow):
                              (self.viewport.width(), self.viewport.height()),
                              apply=lambda t, merge: self._tool_edit(key, t, merge, mode),
                              finish=self._tool_finished,
-                             status=lambda text: self.statusBar().showMessage(text))
+                             status=lambda text: self.statusBar().showMessage(text),
+                             kind=key[0])
         tool.start_uv = tool.uv = self.viewport.to_picture(start)
         self.viewport.tool = tool
         self._tool_edits = 0
@@ -627,7 +702,13 @@ class MainWindow(QMainWindow):
     def _tool_edit(self, key, transform, merge, mode: str) -> None:
         item = self.doc.item(key)
         data = item.model_dump()
-        data["transform"] = transform.model_dump()
+        if key[0] == "lights":  # a light moves by the vector: from where it was at the start
+            tool = self.viewport.tool
+            field = "position" if "position" in data else "center"
+            start = tool.centre if tool is not None else np.asarray(data[field])
+            data[field] = tuple(round(float(v), 6) + 0.0 for v in start + transform)
+        else:
+            data["transform"] = transform.model_dump()
         try:
             before = self.doc.undo_stack.index()
             self.doc.edit_item(key, data, f"{TransformTool.NAMES[mode]} {label_of(item)}",

@@ -91,6 +91,12 @@ def object_centre(scene: Scene, index: int) -> np.ndarray:
         if obj.transform is not None else p
 
 
+def light_position(light) -> tuple[float, float, float] | None:
+    """Where a light is drawn and moved from: a point light's position, a disk light's
+    centre (None for ambient and directional lights)."""
+    return getattr(light, "position", None) or getattr(light, "center", None)
+
+
 def euler_xyz(r: np.ndarray) -> tuple[float, float, float]:
     """Degrees about x, then y, then z (R = Rz·Ry·Rx), as ``Transform.rotate`` takes them."""
     ry = math.asin(max(-1.0, min(1.0, -r[2, 0])))
@@ -156,12 +162,14 @@ class TransformTool:
 
     def __init__(self, mode: str, scene: Scene, index: int, start: QPointF,
                  picture_size: tuple[float, float], apply: Callable, finish: Callable,
-                 status: Callable[[str], None]) -> None:
+                 status: Callable[[str], None], kind: str = "objects") -> None:
         self.mode = mode
         self.scene = scene
         self.index = index
-        self.obj = scene.objects[index]
-        self.centre = object_centre(scene, index)
+        self.kind = kind  # "objects", or "lights" (G only: ``apply`` gets the move's vector)
+        self.obj = getattr(scene, kind)[index]
+        self.centre = object_centre(scene, index) if kind == "objects" else \
+            np.asarray(light_position(self.obj), np.float64)
         self.start = start
         self.pointer = start
         self.start_uv: tuple[float, float] | None = None
@@ -260,10 +268,15 @@ class TransformTool:
             factor = 1e-3
         return scaled(self.obj, self.centre, factor, self.axis)
 
+    def delta(self) -> np.ndarray:
+        typed = self._typed_value()
+        return AXES[self.axis or "x"] * typed if typed is not None else self._ground_delta()
+
     def update(self) -> None:
         self.show_status()
         try:
-            self._apply(self.transform(), self.merge_key)
+            self._apply(self.transform() if self.kind == "objects" else self.delta(),
+                        self.merge_key)
         except ValueError as exc:
             self._status(f"{self.NAMES[self.mode]}: {exc}")
 
