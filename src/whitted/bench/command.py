@@ -64,6 +64,12 @@ def bench_main(
         if povray_executable() is None:
             raise BenchUsageError("--compare povray: povray is not installed "
                                   "(Debian: apt-get install povray)")
+    if study:
+        import importlib.util
+
+        if importlib.util.find_spec("matplotlib") is None:  # checked before the long study
+            raise BenchUsageError(f"--study {study}: the plot needs matplotlib: "
+                                  "pip install 'whitted[plots]'")
     options = BenchOptions(scenes=scenes or None, runs=runs, threads=parse_threads(threads),
                            quick=quick, compare=compare, in_process=in_process,
                            size=parse_size(size))

@@ -7,24 +7,50 @@ import sys
 import threading
 import time
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
-import numpy as np
 import typer
-from pydantic import ValidationError
-from rich.console import Console
-from rich.markup import escape
-from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeRemainingColumn
 
 try:  # typer vendors click from 0.2x on; older releases depend on click itself
     from typer._click.exceptions import UsageError
 except ImportError:  # pragma: no cover - depends on the installed typer
     from click.exceptions import UsageError
 
-from .. import __version__
 from ..errors import WhittedError
-from ..scene import Scene, load_scene
-from ..scene.default import default_scene
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from ..scene import Scene
+
+# NumPy, pydantic, rich, the scene models and the renderer are imported inside the commands
+# that use them: `whitted --help` and the import of this module stay far under 0.2 s
+# (tests/test_startup.py).
+
+
+class _LazyConsole:
+    """A rich ``Console`` made on first use (importing rich costs about 40 ms)."""
+
+    def __init__(self, **options) -> None:
+        self._options = options
+        self._made = None
+
+    @property
+    def console(self):
+        if self._made is None:
+            from rich.console import Console
+
+            self._made = Console(**self._options)
+        return self._made
+
+    def __getattr__(self, name: str):
+        return getattr(self.console, name)
+
+
+def escape(text: str) -> str:
+    from rich.markup import escape as rich_escape
+
+    return rich_escape(text)
 
 app = typer.Typer(
     add_completion=False,
@@ -32,8 +58,8 @@ app = typer.Typer(
     help="whitted: a fast Whitted ray tracer. Render scene files (TOML/JSON) to images.",
     pretty_exceptions_enable=False,
 )
-err = Console(stderr=True, highlight=False, soft_wrap=True)
-out = Console(highlight=False, soft_wrap=True)
+err = _LazyConsole(stderr=True, highlight=False, soft_wrap=True)
+out = _LazyConsole(highlight=False, soft_wrap=True)
 
 AOV_NAMES = ("depth", "normal", "id")
 EXIT_USER_ERROR = 2
@@ -48,6 +74,8 @@ def fail(message: str) -> typer.Exit:
 
 def _version(value: bool) -> None:
     if value:
+        from .. import __version__
+
         out.print(f"whitted {__version__}")
         raise typer.Exit()
 
@@ -62,6 +90,9 @@ def main_options(
 
 
 def _load(scene_path: Path | None) -> tuple[Scene, str]:
+    from ..scene import load_scene
+    from ..scene.default import default_scene
+
     if scene_path is None:
         return default_scene(), "<default scene>"
     return load_scene(scene_path), str(scene_path)
@@ -99,6 +130,8 @@ def render(
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
 ) -> None:
     """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG)."""
+    from pydantic import ValidationError
+
     from ..output.encode import check_bit_depth, image_format
     from ..render.api import RenderJob, render_aovs
 
@@ -160,12 +193,14 @@ def render(
 
 
 def _save_npy(path: Path, array: np.ndarray) -> None:
+    import numpy as np
+
     from ..output.encode import atomic_write
 
     atomic_write(path, lambda tmp: np.save(tmp, array))
 
 
-def _override_error(exc: ValidationError) -> str:
+def _override_error(exc) -> str:
     """One line for a command-line value the render settings reject."""
     from ..scene.io import _clean_message
 
@@ -184,6 +219,14 @@ def _run_with_progress(job, quiet: bool) -> None:
             pass
         job.wait()
         return
+    from rich.progress import (
+        BarColumn,
+        Progress,
+        TaskProgressColumn,
+        TextColumn,
+        TimeRemainingColumn,
+    )
+
     columns = (
         TextColumn("[bold]rendering"),
         BarColumn(),
@@ -191,7 +234,7 @@ def _run_with_progress(job, quiet: bool) -> None:
         TextColumn("{task.fields[rays]} rays"),
         TimeRemainingColumn(),
     )
-    with Progress(*columns, console=err, transient=True) as bar:
+    with Progress(*columns, console=err.console, transient=True) as bar:
         task = bar.add_task("render", total=1.0, rays="0")
 
         def update(p) -> None:
@@ -206,6 +249,8 @@ def _run_with_progress(job, quiet: bool) -> None:
 
 def _model_info(path: Path) -> None:
     """``whitted info MODEL``: what the loader reads from a model file."""
+    import numpy as np
+
     from ..assets import load_mesh
 
     try:
@@ -249,6 +294,8 @@ def info(
 ) -> None:
     """Print a scene's objects, lights, bounds and an estimate of the work; or what a model
     file (OBJ, PLY, STL, OFF, glTF) holds: vertices, triangles, bounds, materials, textures."""
+    import numpy as np
+
     from ..assets.mesh import SUPPORTED_SUFFIXES
     from ..compile.flatten import compile_scene
 
@@ -317,15 +364,19 @@ def gui(
     scene = None
     if scene_path is not None and scene_path.exists():
         try:
+            from ..scene import load_scene
+
             scene = load_scene(scene_path)
         except WhittedError as exc:
             raise fail(str(exc)) from None
     elif scene_path is not None and scene_path.suffix.lower() not in (".toml", ".json"):
         raise fail(f"{scene_path}: unknown scene format {scene_path.suffix!r} (use .toml or .json)")
     try:  # Qt is imported here only, so the other commands start without it
+        import PySide6.QtWidgets  # noqa: F401  (gui.app imports it only when it runs)
+
         from ..gui.app import run_editor
     except ImportError as exc:
-        raise fail(f"the editor needs PySide6 (pip install PySide6-Essentials): {exc}") from None
+        raise fail(f"the editor needs PySide6 ({exc}): pip install 'whitted[gui]'") from None
     raise typer.Exit(run_editor(scene, scene_path))
 
 
@@ -342,6 +393,8 @@ def export(
     height: Annotated[int | None, typer.Option("--height", "-H", help="Image height")] = None,
 ) -> None:
     """Write SCENE for another renderer: POV-Ray 3.7 scene language (--format pov)."""
+    from pydantic import ValidationError
+
     from ..export.pov import export_pov
 
     if export_format != "pov":
