@@ -7,24 +7,28 @@ import sys
 import threading
 import time
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
-import numpy as np
 import typer
-from pydantic import ValidationError
-from rich.console import Console
-from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeRemainingColumn
-from rich.text import Text
 
 try:  # typer vendors click from 0.2x on; older releases depend on click itself
     from typer._click.exceptions import UsageError
 except ImportError:  # pragma: no cover - depends on the installed typer
     from click.exceptions import UsageError
 
-from .. import __version__
 from ..errors import WhittedError, shorten
-from ..scene import Scene, load_scene
-from ..scene.default import default_scene
+from .console import Text, err, out
+from .farm import ClusterOption, SchedulerOption, render_still_on_farm
+
+if TYPE_CHECKING:
+    import numpy as np
+    from pydantic import ValidationError
+
+    from ..scene import Scene
+
+# NumPy, pydantic, rich, the scene models and the renderer are imported inside the commands
+# that use them: `whitted --help` and the import of this module stay far under 0.2 s
+# (tests/test_startup.py).
 
 app = typer.Typer(
     add_completion=False,
@@ -32,9 +36,6 @@ app = typer.Typer(
     help="whitted: a fast Whitted ray tracer. Render scene files (TOML/JSON) to images.",
     pretty_exceptions_enable=False,
 )
-# emoji=False: a user's ":100:" (a line number, a name) is printed as it is, never as an emoji
-err = Console(stderr=True, highlight=False, soft_wrap=True, emoji=False)
-out = Console(highlight=False, soft_wrap=True, emoji=False)
 
 AOV_NAMES = ("depth", "normal", "id")
 EXIT_USER_ERROR = 2
@@ -67,6 +68,8 @@ def _note(message: str) -> None:
 
 def _version(value: bool) -> None:
     if value:
+        from .. import __version__
+
         out.print(f"whitted {__version__}")
         raise typer.Exit()
 
@@ -81,9 +84,21 @@ def main_options(
 
 
 def _load(scene_path: Path | None) -> tuple[Scene, str]:
+    from ..scene import load_scene
+    from ..scene.default import default_scene
+
     if scene_path is None:
         return default_scene(), "<default scene>"
     return load_scene(scene_path), str(scene_path)
+
+
+def apply_set_options(scene: Scene, set_values: list[str] | None) -> Scene:
+    """The scene with every ``--set PATH=VALUE`` applied (SceneError on a bad one)."""
+    if not set_values:
+        return scene
+    from ..animation.overrides import apply_overrides, parse_assignment
+
+    return apply_overrides(scene, [parse_assignment(text) for text in set_values])
 
 
 def _is_dir(path: Path) -> bool:
@@ -123,8 +138,19 @@ def render(
         str | None, typer.Option("--transfer", help="srgb or linear (default: the scene's)")
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
+    frame: Annotated[
+        int | None, typer.Option("--frame", "-f", help="Frame of an animated scene (from 0)")
+    ] = None,
+    set_values: Annotated[
+        list[str] | None, typer.Option("--set", help="PATH=VALUE: change a scene value")
+    ] = None,
+    cluster: ClusterOption = None,
+    scheduler: SchedulerOption = None,
 ) -> None:
-    """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG)."""
+    """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG).
+    An animated scene renders frame 0, or the frame --frame names."""
+    from pydantic import ValidationError
+
     from ..output.encode import check_bit_depth, image_format
     from ..render.api import RenderJob, render_aovs
 
@@ -140,14 +166,19 @@ def render(
         raise fail(f"--transfer: unknown transfer {shorten(transfer)!r} (use srgb or linear)")
     try:
         scene, name = _load(scene_path)
+        scene = apply_set_options(scene, set_values)
     except WhittedError as exc:
         raise fail(str(exc)) from None
     try:
         scene = scene.with_settings(width=width, height=height, samples=samples,
                                     max_depth=max_depth, threads=threads, seed=seed,
                                     transfer=transfer)
+        if frame is not None or scene.is_animated:
+            scene = scene.at_frame(frame or 0)
     except ValidationError as exc:  # a command-line override out of range
         raise fail(_override_error(exc)) from None
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
     outputs = [output] + [output.with_name(f"{output.stem}.{a}.npy") for a in aovs]
     try:
         from ..output.safety import check_memory, check_outputs
@@ -156,6 +187,9 @@ def render(
         check_memory(scene.render.width, scene.render.height, image_format(output), bit_depth)
     except WhittedError as exc:
         raise fail(str(exc)) from None
+    if cluster is not None or scheduler is not None:  # bands on a Dask cluster (cli/farm.py)
+        render_still_on_farm(scene, output, cluster=cluster, scheduler=scheduler,
+                             threads=threads, quiet=quiet, bit_depth=bit_depth, aovs=aovs)
 
     try:
         job = RenderJob(scene)
@@ -237,6 +271,8 @@ def _with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
 
 
 def _save_npy(path: Path, array: np.ndarray) -> None:
+    import numpy as np
+
     from ..output.encode import atomic_write
 
     atomic_write(path, lambda tmp: np.save(tmp, array))
@@ -269,6 +305,14 @@ def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
         job.start()
         _wait(job, interrupted)
         return
+    from rich.progress import (
+        BarColumn,
+        Progress,
+        TaskProgressColumn,
+        TextColumn,
+        TimeRemainingColumn,
+    )
+
     columns = (
         TextColumn("[bold]rendering"),
         BarColumn(),
@@ -289,6 +333,8 @@ def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
 
 def _model_info(path: Path) -> None:
     """``whitted info MODEL``: what the loader reads from a model file."""
+    import numpy as np
+
     from ..assets import load_mesh
 
     try:
@@ -332,8 +378,10 @@ def info(
 ) -> None:
     """Print a scene's objects, lights, bounds and an estimate of the work; or what a model
     file (OBJ, PLY, STL, OFF, glTF) holds: vertices, triangles, bounds, materials, textures."""
+    import numpy as np
+
     from ..assets.mesh import SUPPORTED_SUFFIXES
-    from ..compile.flatten import compile_scene
+    from ..compile.scene import compile_scene
 
     if scene_path is not None and scene_path.suffix.lower() in SUPPORTED_SUFFIXES:
         _model_info(scene_path)
@@ -343,11 +391,17 @@ def info(
     except WhittedError as exc:
         raise fail(str(exc)) from None
     try:
-        compiled = compile_scene(scene)
+        compiled = compile_scene(scene.at_frame(0) if scene.is_animated else scene)
     except WhittedError as exc:  # a model or texture file the scene names is unusable
         raise fail(_with_scene_key(exc, scene, name)) from None
     r = scene.render
     out.print(Text(name, style="bold"))
+    if scene.animation is not None:
+        a = scene.animation
+        out.print(f"animation: {a.frames} frames at {a.fps:g} fps ({a.frames / a.fps:.2f} s), "
+                  f"{len(a.tracks)} track(s): "
+                  + ", ".join(f"{t.path} ({t.interpolation})" for t in a.tracks),
+                  markup=False, highlight=False)
     out.print(f"image: {r.width}x{r.height}, {r.samples} sample(s)/pixel, max depth "
               f"{r.max_depth}, min weight {r.min_weight}")
     out.print(f"objects: {len(scene.objects)}")
@@ -400,6 +454,8 @@ def gui(
     ] = None,
 ) -> None:
     """Open the scene editor (a desktop window) on SCENE, or on the built-in default scene."""
+    from ..scene import load_scene
+
     scene = None
     try:
         exists = scene_path is not None and scene_path.exists()
@@ -413,9 +469,11 @@ def gui(
     elif scene_path is not None and scene_path.suffix.lower() not in (".toml", ".json"):
         raise fail(f"{scene_path}: unknown scene format {scene_path.suffix!r} (use .toml or .json)")
     try:  # Qt is imported here only, so the other commands start without it
+        import PySide6.QtWidgets  # noqa: F401  (gui.app imports it only when it runs)
+
         from ..gui.app import run_editor
     except ImportError as exc:
-        raise fail(f"the editor needs PySide6 (pip install PySide6-Essentials): {exc}") from None
+        raise fail(f"the editor needs PySide6 ({exc}): pip install 'whitted[gui]'") from None
     raise typer.Exit(run_editor(scene, scene_path))
 
 
@@ -432,6 +490,8 @@ def export(
     height: Annotated[int | None, typer.Option("--height", "-H", help="Image height")] = None,
 ) -> None:
     """Write SCENE for another renderer: POV-Ray 3.7 scene language (--format pov)."""
+    from pydantic import ValidationError
+
     from ..export.pov import export_pov
 
     if export_format != "pov":
@@ -551,3 +611,8 @@ def _exit_now(code: int) -> None:
         with contextlib.suppress(OSError, ValueError):
             stream.flush()
     os._exit(code)
+
+
+# Commands in their own modules register themselves on `app` when imported.
+from . import animate as _animate  # noqa: E402, F401
+from . import sweep as _sweep  # noqa: E402, F401

@@ -16,7 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..compile.flatten import CompiledScene, compile_scene, render_params
+from ..compile.params import render_params
+from ..compile.scene import CompiledScene, compile_scene
 from ..errors import ArgumentError, JobStateError
 from ..kernels.layout import (
     N_RAY_KINDS,
@@ -147,11 +148,14 @@ def run_lanes(fn: Callable[[int, int], object], lanes: int, pool: ThreadPoolExec
         future.result()
 
 
-def tile_grid(width: int, height: int, tile: int = DEFAULT_TILE) -> np.ndarray:
-    """All tiles of the image in row-major order, rows of (x0, y0, x1, y1)."""
+def tile_grid(width: int, height: int, tile: int = DEFAULT_TILE,
+              rows: tuple[int, int] | None = None) -> np.ndarray:
+    """All tiles of the image in row-major order, rows of (x0, y0, x1, y1); only those of the
+    image rows ``rows = (start, stop)`` when given."""
+    y_start, y_stop = (0, height) if rows is None else rows
     xs = np.arange(0, width, tile)
-    ys = np.arange(0, height, tile)
-    grid = [(x, y, min(x + tile, width), min(y + tile, height)) for y in ys for x in xs]
+    ys = np.arange(y_start, y_stop, tile)
+    grid = [(x, y, min(x + tile, width), min(y + tile, y_stop)) for y in ys for x in xs]
     return np.array(grid, dtype=np.int32).reshape(-1, 4)
 
 
@@ -167,11 +171,15 @@ class RenderJob:
         cancel: CancelToken | None = None,
         threads: int | None = None,
         tile_size: int = DEFAULT_TILE,
+        compiled: CompiledScene | None = None,
+        rows: tuple[int, int] | None = None,
     ) -> None:
         """``scene``: a Scene (or the path of a scene file); ``threads``: 1..1024, 0 or None
         for the scene's setting (0 there: every core); ``tile_size``: pixels per tile side,
         1..4096. Bad arguments raise :class:`~whitted.errors.ArgumentError`."""
         scene = _as_scene(scene)
+        if scene.is_animated:  # an animated scene renders as its first frame
+            scene = scene.at_frame(0)
         if progress is not None and not callable(progress):
             raise ArgumentError(f"progress must be callable, got {type(progress).__name__}")
         if cancel is not None and not isinstance(cancel, CancelToken):
@@ -180,6 +188,8 @@ class RenderJob:
             threads = _whole_number("threads", threads, 0, MAX_THREADS)
         tile_size = _whole_number("tile_size", tile_size, 1, MAX_TILE)
         self.scene = scene
+        #: the compiled ``scene`` when the caller has it already (films reuse geometry)
+        self.compiled = compiled
         self.settings: RenderSettings = scene.render
         self.progress = progress
         self.cancel_token = cancel or CancelToken()
@@ -187,6 +197,8 @@ class RenderJob:
         self.threads = max(1, n or available_threads())
         self.tile_size = tile_size
         self.rendering = False  # True while tiles are being rendered (after the compile)
+        #: render only the image rows [start, stop) (the farm's bands); the other rows stay 0
+        self.rows = None if rows is None else _checked_rows(rows, self.settings.height)
         self.framebuffer = np.zeros((self.settings.height, self.settings.width, 3), np.float32)
         self.stats = RenderStats(
             width=self.settings.width,
@@ -258,13 +270,14 @@ class RenderJob:
         wall_start = time.perf_counter()
         stats = self.stats
         stats.compile_seconds = warm_up_kernels()
-        compiled: CompiledScene = compile_scene(self.scene)
+        compiled: CompiledScene = (self.compiled if self.compiled is not None
+                                   else compile_scene(self.scene))
         stats.compile_seconds += warm_up_kernels(compiled)
         stats.build_seconds = compiled.build_seconds
         stats.warnings = list(compiled.warnings)
         stats.triangles = compiled.triangles
         params = render_params(self.scene, compiled, self.settings)
-        tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size)
+        tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size, self.rows)
         counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
         stats.tiles_total = len(tiles)
         lanes = self.threads
@@ -325,6 +338,13 @@ class RenderJob:
         self.image = Image(self.framebuffer, transfer=self.settings.transfer,
                            tonemap=self.settings.tonemap, meta={"stats": stats})
         return self.image
+
+
+def _checked_rows(rows: tuple[int, int], height: int) -> tuple[int, int]:
+    start, stop = (int(r) for r in rows)
+    if not 0 <= start < stop <= height:
+        raise ArgumentError(f"rows {start}:{stop} are not a range of the image's {height} rows")
+    return start, stop
 
 
 def render(

@@ -83,7 +83,15 @@ def named_files(scene: Scene) -> list[tuple[list[str | int], str]]:
     for key, mat in scene.materials.items():
         if mat.texture is not None and getattr(mat.texture, "file", None):
             named.append((["materials", key, "texture", "file"], mat.texture.file))
-    return named
+    from ..animation.timeline import is_sequence, sequence_file
+
+    expanded: list[tuple[list[str | int], str]] = []
+    for keys, pattern in named:
+        if len(keys) == 3 and is_sequence(pattern):  # a mesh sequence: every frame's file
+            expanded.extend((keys, sequence_file(pattern, k)) for k in range(scene.frame_count))
+        else:
+            expanded.append((keys, pattern))
+    return expanded
 
 
 def _check_files(scene: Scene, name: str | None, text: str | None, data: Any) -> None:
@@ -305,7 +313,8 @@ def _scene_error(
     else:
         message = _clean_message(best)
     where = _format_path(keys)
-    m = re.match(r"^((?:objects|lights)\[\d+\](?:\.\w+)*): (.*)$", message)
+    m = re.match(r"^((?:objects|lights)\[\d+\](?:\.\w+)*"
+                 r"|animation\.tracks\[\d+\](?:\.\w+)*(?:\[\d+\])?): (.*)$", message)
     if not keys and m:
         where, message = m.group(1), m.group(2)
         keys = _parse_path(where)
