@@ -259,6 +259,40 @@ def test_a3_interrupt_before_the_first_tile_keeps_the_old_image(tmp_path: Path, 
     assert (tmp_path / "out.png").read_bytes() == good
 
 
+def test_a4_sigterm_during_the_write_lets_it_finish(tmp_path: Path, monkeypatch):
+    write(tmp_path / "scene.toml", SCENE)
+    original = encode._write_png8
+
+    def write_and_terminate(tmp, *args):
+        os.kill(os.getpid(), signal.SIGTERM)  # arrives while the file is being written
+        original(tmp, *args)
+
+    monkeypatch.setattr(encode, "_write_png8", write_and_terminate)
+    code, out, err = run_main("render", "scene.toml", "-o", "out.png", cwd=tmp_path)
+    assert code == 143, err
+    assert "terminated: kept 1/1 tiles" in err
+    assert PILImage.open(tmp_path / "out.png").size == (16, 12)
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
+
+
+def test_a4_a_second_ctrl_c_stops_at_once_and_undoes_the_write(tmp_path: Path, monkeypatch):
+    write(tmp_path / "scene.toml", SCENE)
+    good = png_bytes(tmp_path / "out.png")
+
+    def slow_write(tmp, *args):
+        Path(tmp).write_bytes(b"partial")
+        os.kill(os.getpid(), signal.SIGINT)
+        os.kill(os.getpid(), signal.SIGINT)  # the user insists
+        time.sleep(1)
+        pytest.fail("the second Ctrl-C did not stop the write")
+
+    monkeypatch.setattr(encode, "_write_png8", slow_write)
+    code, _out, _err = run_main("render", "scene.toml", "-o", "out.png", cwd=tmp_path)
+    assert code == 130
+    assert (tmp_path / "out.png").read_bytes() == good
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
+
+
 SIGTERM_AFTER_FIRST_TILES = """
 import os, signal, sys
 from whitted.render import api
@@ -515,6 +549,8 @@ def test_c_json_nesting_and_huge_integer(tmp_path: Path):
     one_line_error(run_main("info", "deep.json", cwd=tmp_path), "nested more than")
     write(tmp_path / "big.json", '{"render": {"width": ' + "9" * 5000 + "}}")
     one_line_error(run_main("info", "big.json", cwd=tmp_path), "too large")
+    write(tmp_path / "big.toml", "[render]\nwidth = " + "9" * 5000 + "\n")
+    one_line_error(run_main("info", "big.toml", cwd=tmp_path), "big.toml")
 
 
 def test_c_path_component_over_255_bytes(tmp_path: Path):

@@ -152,7 +152,7 @@ def render(
     from pydantic import ValidationError
 
     from ..output.encode import check_bit_depth, image_format
-    from ..render.api import RenderJob, render_aovs
+    from ..render.api import RenderJob
 
     process_start = time.perf_counter()
     aovs = _parse_aovs(aov)
@@ -201,19 +201,31 @@ def render(
     previous = {sig: signal.getsignal(sig) for sig in handled}
 
     def on_interrupt(signum, frame) -> None:  # Ctrl-C, SIGTERM: stop after the tiles in flight
+        if interrupted.is_set():  # the second one: stop now (a write in progress is undone)
+            raise KeyboardInterrupt
         signals.append(signum)
         interrupted.set()
         job.cancel()
 
+    # the handlers stay until the image is written: a signal during the write lets it finish
     for sig in handled:
         signal.signal(sig, on_interrupt)
+    try:
+        _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
+                          interrupted, signals, process_start)
+    finally:
+        for sig in handled:
+            signal.signal(sig, previous[sig])
+
+
+def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet, interrupted,
+                      signals, process_start) -> None:
+    from ..render.api import render_aovs
+
     try:
         _run_with_progress(job, quiet, interrupted)
     except WhittedError as exc:  # a model or texture file the scene names is unusable
         raise fail(_with_scene_key(exc, scene, name)) from None
-    finally:
-        for sig in handled:
-            signal.signal(sig, previous[sig])
     exit_code = EXIT_TERMINATED if signal.SIGTERM in signals else EXIT_INTERRUPTED
     stats = job.stats
     if interrupted.is_set() and (job.running or stats.tiles_done == 0):
@@ -244,10 +256,10 @@ def render(
     stats.wall_seconds = time.perf_counter() - process_start
     if not quiet or interrupted.is_set():
         out.print(Text(f"{stats.summary()} -> {', '.join(written)}"))
-    if interrupted.is_set():
+    if interrupted.is_set():  # (a signal may have come during the write)
         what = "terminated" if signal.SIGTERM in signals else "interrupted"
         _note(f"{what}: kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")
-        raise typer.Exit(exit_code)
+        raise typer.Exit(EXIT_TERMINATED if signal.SIGTERM in signals else EXIT_INTERRUPTED)
 
 
 def _with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
@@ -468,9 +480,12 @@ def gui(
             raise fail(str(exc)) from None
     elif scene_path is not None and scene_path.suffix.lower() not in (".toml", ".json"):
         raise fail(f"{scene_path}: unknown scene format {scene_path.suffix!r} (use .toml or .json)")
-    try:  # Qt is imported here only, so the other commands start without it
-        import PySide6.QtWidgets  # noqa: F401  (gui.app imports it only when it runs)
+    import importlib.util
 
+    # Qt is imported by the editor only, after its check of the system libraries Qt needs
+    if importlib.util.find_spec("PySide6") is None:
+        raise fail("the editor needs PySide6, which is not installed: pip install 'whitted[gui]'")
+    try:
         from ..gui.app import run_editor
     except ImportError as exc:
         raise fail(f"the editor needs PySide6 ({exc}): pip install 'whitted[gui]'") from None
