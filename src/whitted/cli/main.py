@@ -67,6 +67,15 @@ def _load(scene_path: Path | None) -> tuple[Scene, str]:
     return load_scene(scene_path), str(scene_path)
 
 
+def apply_set_options(scene: Scene, set_values: list[str] | None) -> Scene:
+    """The scene with every ``--set PATH=VALUE`` applied (SceneError on a bad one)."""
+    if not set_values:
+        return scene
+    from ..animation.overrides import apply_overrides, parse_assignment
+
+    return apply_overrides(scene, [parse_assignment(text) for text in set_values])
+
+
 def _parse_aovs(text: str | None) -> list[str]:
     if not text:
         return []
@@ -97,8 +106,15 @@ def render(
         str | None, typer.Option("--transfer", help="srgb or linear (default: the scene's)")
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
+    frame: Annotated[
+        int | None, typer.Option("--frame", "-f", help="Frame of an animated scene (from 0)")
+    ] = None,
+    set_values: Annotated[
+        list[str] | None, typer.Option("--set", help="PATH=VALUE: change a scene value")
+    ] = None,
 ) -> None:
-    """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG)."""
+    """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG).
+    An animated scene renders frame 0, or the frame --frame names."""
     from ..output.encode import check_bit_depth, image_format
     from ..render.api import RenderJob, render_aovs
 
@@ -113,9 +129,12 @@ def render(
         raise fail(f"--transfer: unknown transfer {transfer!r} (use srgb or linear)")
     try:
         scene, name = _load(scene_path)
+        scene = apply_set_options(scene, set_values)
         scene = scene.with_settings(width=width, height=height, samples=samples,
                                     max_depth=max_depth, threads=threads, seed=seed,
                                     transfer=transfer)
+        if frame is not None or scene.is_animated:
+            scene = scene.at_frame(frame or 0)
     except WhittedError as exc:
         raise fail(str(exc)) from None
     except ValidationError as exc:  # a command-line override out of range
@@ -250,7 +269,7 @@ def info(
     """Print a scene's objects, lights, bounds and an estimate of the work; or what a model
     file (OBJ, PLY, STL, OFF, glTF) holds: vertices, triangles, bounds, materials, textures."""
     from ..assets.mesh import SUPPORTED_SUFFIXES
-    from ..compile.flatten import compile_scene
+    from ..compile.scene import compile_scene
 
     if scene_path is not None and scene_path.suffix.lower() in SUPPORTED_SUFFIXES:
         _model_info(scene_path)

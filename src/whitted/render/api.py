@@ -16,7 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..compile.flatten import CompiledScene, compile_scene, render_params
+from ..compile.params import render_params
+from ..compile.scene import CompiledScene, compile_scene
 from ..kernels.layout import (
     N_RAY_KINDS,
     RAY_PRIMARY,
@@ -143,8 +144,13 @@ class RenderJob:
         cancel: CancelToken | None = None,
         threads: int | None = None,
         tile_size: int = DEFAULT_TILE,
+        compiled: CompiledScene | None = None,
     ) -> None:
+        if scene.is_animated:  # an animated scene renders as its first frame
+            scene = scene.at_frame(0)
         self.scene = scene
+        #: the compiled ``scene`` when the caller has it already (films reuse geometry)
+        self.compiled = compiled
         self.settings: RenderSettings = scene.render
         self.progress = progress
         self.cancel_token = cancel or CancelToken()
@@ -211,7 +217,8 @@ class RenderJob:
         wall_start = time.perf_counter()
         stats = self.stats
         stats.compile_seconds = warm_up_kernels()
-        compiled: CompiledScene = compile_scene(self.scene)
+        compiled: CompiledScene = (self.compiled if self.compiled is not None
+                                   else compile_scene(self.scene))
         stats.compile_seconds += warm_up_kernels(compiled)
         stats.build_seconds = compiled.build_seconds
         stats.warnings = list(compiled.warnings)

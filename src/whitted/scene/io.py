@@ -70,7 +70,13 @@ def _check_files(scene: Scene, name: str | None, text: str | None, data: Any) ->
     for key, mat in scene.materials.items():
         if mat.texture is not None and getattr(mat.texture, "file", None):
             named.append((["materials", key, "texture", "file"], mat.texture.file))
-    for keys, file in named:
+    from ..animation.timeline import is_sequence, sequence_file
+
+    for keys, pattern in named:
+        files = [pattern]
+        if len(keys) == 3 and is_sequence(pattern):  # a mesh sequence: every frame's file
+            files = [sequence_file(pattern, k) for k in range(scene.frame_count)]
+        file = next((f for f in files if not scene.resolve_path(f).is_file()), files[0])
         target = scene.resolve_path(file)
         if not target.is_file():
             line = None
@@ -167,7 +173,8 @@ def _scene_error(
     else:
         message = _clean_message(best)
     where = _format_path(keys)
-    m = re.match(r"^((?:objects|lights)\[\d+\](?:\.\w+)*): (.*)$", message)
+    m = re.match(r"^((?:objects|lights)\[\d+\](?:\.\w+)*"
+                 r"|animation\.tracks\[\d+\](?:\.\w+)*(?:\[\d+\])?): (.*)$", message)
     if not keys and m:
         where, message = m.group(1), m.group(2)
         keys = _parse_path(where)
