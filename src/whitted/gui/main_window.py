@@ -38,6 +38,7 @@ from .document import (
     rebuild_scene,
     set_path,
 )
+from .picking import IdBuffer, id_at, outline_image
 from .properties import PropertyPanel
 from .recent import RecentFiles
 from .render_controller import RenderController
@@ -114,6 +115,10 @@ class MainWindow(QMainWindow):
         self.controller.failed.connect(self._render_failed)
         self.controller.kernels_ready.connect(self._kernels_ready)
         self.autosave.saved.connect(self._status)
+        self.ids = IdBuffer(self)
+        self.ids.ready.connect(self._update_outline)
+        self.doc.selection_changed.connect(lambda *_: self._update_outline())
+        self.viewport.clicked.connect(self.pick)
         self.viewport.orbit.connect(self._orbit)
         self.viewport.pan.connect(self._pan)
         self.viewport.zoom.connect(self._zoom)
@@ -541,6 +546,38 @@ class MainWindow(QMainWindow):
         if item is not None and len(key) == 2:
             self.tree.editItem(item, 0)
 
+    # ------------------------------------------------------------------ pointing
+
+    def pick(self, u: float, v: float, modifiers=None) -> tuple | None:
+        """A click on the picture at (u, v): select the object seen there (through the
+        renderer's object-id image); a click on the background deselects."""
+        if not (0 <= u <= 1 and 0 <= v <= 1):
+            return None
+        try:
+            ids = self.ids.ids_for(self.doc.scene)
+        except WhittedError as exc:
+            self.statusBar().showMessage(f"Cannot pick: {exc}", 4000)
+            return None
+        index = id_at(ids, u, v)
+        key = ("objects", index) if index >= 0 else None
+        self.select(key)
+        return key
+
+    def _update_outline(self) -> None:
+        """The selected object's outline over the picture (from the current id image)."""
+        key = self.doc.selection
+        ids = self.ids.ids if self.ids.scene is self.doc.scene else None
+        if key is None or key[0] != "objects":
+            outline = None
+        elif ids is None:
+            self.ids.request(self.doc.scene)
+            return
+        else:
+            outline = outline_image(ids, key[1])
+        if outline is not self.viewport.outline:
+            self.viewport.outline = outline
+            self.viewport.update()
+
     def _camera_edit(self, camera, text: str, merge) -> None:
         try:
             self.doc.edit_item(CAMERA, camera.model_dump(), text, merge_key=merge)
@@ -584,6 +621,8 @@ class MainWindow(QMainWindow):
 
     def _scene_changed(self, key=None) -> None:
         scene = self.doc.scene
+        if self.doc.selection is not None and self.doc.selection[0] == "objects":
+            self.ids.request(scene)  # the outline follows
         self.viewport.set_aspect(scene.render.width, scene.render.height)
         self._update_title()
         if self.controller.rendering:
