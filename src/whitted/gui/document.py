@@ -154,6 +154,11 @@ class SceneDocument(QObject):
         self.undo_stack.setClean()
         self.path_changed.emit()
 
+    def show_pose(self, scene: Scene) -> None:
+        """Make ``scene`` current without an undo step: the timeline posing the scene at a
+        frame (the values its tracks drive), which is a view of the scene, not an edit."""
+        self._replace(scene, self.selection)
+
     def item(self, key: SelectionKey | None = None) -> BaseModel | None:
         return item_of(self.scene, self.selection if key is None else key)
 
