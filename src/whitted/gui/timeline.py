@@ -81,8 +81,7 @@ class KeySlider(QSlider):
             self.keys = keys
             self.update()
 
-    def x_of(self, frame: float) -> int:
-        """The widget x of a frame (the centre of the handle when it sits there)."""
+    def _geometry(self) -> tuple[QRect, QRect]:
         opt = QStyleOptionSlider()
         self.initStyleOption(opt)
         style = self.style()
@@ -90,10 +89,32 @@ class KeySlider(QSlider):
                                       QStyle.SubControl.SC_SliderGroove, self)
         handle = style.subControlRect(QStyle.ComplexControl.CC_Slider, opt,
                                       QStyle.SubControl.SC_SliderHandle, self)
+        return groove, handle
+
+    def x_of(self, frame: float) -> int:
+        """The widget x of a frame (the centre of the handle when it sits there)."""
+        groove, handle = self._geometry()
         span = groove.width() - handle.width()
         lo, hi = self.minimum(), self.maximum()
         t = 0.0 if hi <= lo else (frame - lo) / (hi - lo)
         return round(groove.x() + handle.width() / 2 + t * span)
+
+    def frame_at(self, x: float) -> int:
+        """The frame whose handle position is nearest to widget x."""
+        groove, handle = self._geometry()
+        span = max(1, groove.width() - handle.width())
+        lo, hi = self.minimum(), self.maximum()
+        t = (x - groove.x() - handle.width() / 2) / span
+        return max(lo, min(hi, round(lo + t * (hi - lo))))
+
+    def mousePressEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        """A click on the groove jumps to that frame (not a page step), and a drag from
+        there scrubs, as a timeline does."""
+        if event.button() == Qt.MouseButton.LeftButton:
+            _, handle = self._geometry()
+            if not handle.contains(event.position().toPoint()):
+                self.setValue(self.frame_at(event.position().x()))
+        super().mousePressEvent(event)
 
     def paintEvent(self, event) -> None:  # noqa: N802 - Qt's name
         super().paintEvent(event)

@@ -1,0 +1,282 @@
+"""The editor's timeline (issue 15, section 4), driven as a person drives it: clicks on the frame
+slider and the Play button, the I key wherever the focus is, Ctrl+Z, Ctrl+S; offscreen."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+
+import numpy as np
+import pytest
+
+pytest.importorskip("PySide6.QtWidgets")
+
+from PySide6.QtCore import QPoint, Qt  # noqa: E402
+
+import whitted  # noqa: E402
+from gui_input import CTRL, SHIFT, SLOW, click_tree, make_window, type_into  # noqa: E402, F401
+from whitted.gui.document import CAMERA  # noqa: E402
+from whitted.gui.render_controller import preview_scene  # noqa: E402
+
+LEFT = Qt.MouseButton.LeftButton
+NO_MOD = Qt.KeyboardModifier.NoModifier
+BALL = ("objects", 1)
+
+ROLLING_BALL = """\
+# A small animated scene: the ball rolls to the right over eight frames.
+
+[render]
+width = 64
+height = 48
+max_depth = 2
+
+[camera]
+position = [0, 1.5, 6]
+look_at = [0, 0.6, 0]
+fov = 40
+
+[[lights]]
+type = "ambient"
+intensity = 0.2
+
+[[lights]]
+type = "point"
+name = "lamp"
+position = [-4, 6, 5]
+intensity = 0.9
+
+[[objects]]
+type = "plane"
+name = "floor"
+material = "matte"
+
+[[objects]]
+type = "sphere"
+name = "ball"
+center = [-1, 0.8, 0]
+radius = 0.8
+material = "plastic"
+
+[animation]
+frames = 8
+fps = 24
+
+[[animation.tracks]]
+path = "objects[ball].center"   # left to right
+keys = [
+  [0, [-1, 0.8, 0]],
+  [7, [1.5, 0.8, 0]],
+]
+"""
+
+
+def ball_x(frame: float) -> float:
+    return -1 + 2.5 * frame / 7
+
+
+@pytest.fixture
+def rolling(tmp_path):
+    path = tmp_path / "rolling.toml"
+    path.write_text(ROLLING_BALL, encoding="utf-8")
+    return path
+
+
+@pytest.fixture
+def open_rolling(make_window, rolling):  # noqa: F811 - the fixture of gui_input
+    def make(**options):
+        return make_window(whitted.load_scene(rolling), rolling, **options)
+
+    return make
+
+
+def click_frame(qtbot, timeline, frame: int) -> None:
+    slider = timeline.slider
+    qtbot.mouseClick(slider, LEFT, NO_MOD, QPoint(slider.x_of(frame), slider.height() // 2))
+
+
+def center_shown(window) -> tuple[float, ...]:
+    return tuple(float(line.text()) for line in window.properties.row("center").editor.lines)
+
+
+def test_a_click_on_the_slider_previews_that_frame(open_rolling, rolling, qtbot):
+    window = open_rolling()
+    timeline, controller = window.timeline, window.controller
+    assert timeline.isVisible() and timeline.slider.maximum() == 7
+    qtbot.waitUntil(lambda: controller.previews_done >= 1, timeout=SLOW)
+
+    click_frame(qtbot, timeline, 5)
+    assert timeline.frame == 5 and timeline.frame_box.value() == 5
+    expected = whitted.load_scene(rolling).at_frame(5)
+    assert expected.objects[1].center == pytest.approx((ball_x(5), 0.8, 0.0))
+    assert timeline.still(window.doc.scene) == expected
+    click_tree(qtbot, window.tree, BALL)  # the panel shows frame 5's values
+    assert center_shown(window) == pytest.approx((ball_x(5), 0.8, 0.0), abs=1e-3)
+
+    done = controller.previews_done
+    qtbot.waitUntil(lambda: controller.previews_done > done and controller.preview is None
+                    and controller._pending is None, timeout=SLOW)
+    shown = controller.last_preview.pixels
+    assert shown.shape[:2] == (48, 64)  # the preview of a 64x48 scene is full size
+    truth = whitted.render(preview_scene(expected, 64 * 48)).pixels
+    assert np.array_equal(shown, truth)
+    frame0 = whitted.render(preview_scene(whitted.load_scene(rolling).at_frame(0), 64 * 48))
+    assert not np.array_equal(shown, frame0.pixels)  # the ball moved
+
+    # keys move the slider too: Home goes to frame 0, Right steps one frame
+    qtbot.keyClick(timeline.slider, Qt.Key.Key_Home)
+    qtbot.keyClick(timeline.slider, Qt.Key.Key_Right)
+    assert timeline.frame == 1
+    assert window.doc.scene.objects[1].center == pytest.approx((ball_x(1), 0.8, 0.0))
+
+
+def test_i_keys_the_selection_at_the_frame_and_undo_removes_the_key(open_rolling, qtbot):
+    window = open_rolling(preview=False, warm_up=False)
+    timeline = window.timeline
+    click_frame(qtbot, timeline, 3)
+    click_tree(qtbot, window.tree, BALL)
+    assert window.tree.hasFocus()
+    qtbot.keyClick(window.tree, Qt.Key.Key_I)
+
+    tracks = window.doc.scene.animation.tracks
+    assert [t.path for t in tracks] == ["objects[ball].center", "objects[ball].transform"]
+    assert [k[0] for k in tracks[0].keys] == [0, 3, 7]
+    assert tracks[0].keys[1][1] == pytest.approx([ball_x(3), 0.8, 0.0])
+    assert tracks[1].keys == [(3, {"scale": 1.0, "rotate": [0.0, 0.0, 0.0],
+                                   "translate": [0.0, 0.0, 0.0]})]
+    assert timeline.slider.keys == [0.0, 3.0, 7.0]
+
+    # the camera, with the focus on the picture
+    window.select(CAMERA)
+    click_frame(qtbot, timeline, 6)
+    window.viewport.setFocus()
+    qtbot.keyClick(window.viewport, Qt.Key.Key_I)
+    paths = [t.path for t in window.doc.scene.animation.tracks]
+    assert paths[2:] == ["camera.position", "camera.look_at"]
+    assert window.doc.scene.animation.tracks[2].keys == [(6, [0.0, 1.5, 6.0])]
+
+    # Ctrl+Z takes the keys back, one key press at a time; the frame stays
+    qtbot.keyClick(window.viewport, Qt.Key.Key_Z, CTRL)
+    assert len(window.doc.scene.animation.tracks) == 2
+    qtbot.keyClick(window.viewport, Qt.Key.Key_Z, CTRL)
+    tracks = window.doc.scene.animation.tracks
+    assert len(tracks) == 1 and [k[0] for k in tracks[0].keys] == [0, 7]
+    assert timeline.frame == 6 and timeline.slider.keys == [0.0, 7.0]
+    # the scene is shown posed at frame 6 by the original track
+    assert window.doc.scene.objects[1].center == pytest.approx((ball_x(6), 0.8, 0.0))
+    qtbot.keyClick(window.viewport, Qt.Key.Key_Z, CTRL | SHIFT)
+    assert [k[0] for k in window.doc.scene.animation.tracks[0].keys] == [0, 3, 7]
+
+    # typing an "i" in a text field types it: no key
+    window.select(BALL)
+    before = window.doc.scene.animation
+    line = window.properties.row("name").editor.line
+    type_into(qtbot, line, "big", finish=False)
+    qtbot.keyClick(line, Qt.Key.Key_I)
+    assert line.text() == "bigi" and window.doc.scene.animation == before
+
+
+def test_the_first_key_of_a_still_scene_makes_the_animation(make_window, qtbot):  # noqa: F811
+    window = make_window(preview=False, warm_up=False)
+    timeline = window.timeline
+    assert window.doc.scene.animation is None and not timeline.isVisible()
+    window.viewport.setFocus()
+    qtbot.keyClick(window.viewport, Qt.Key.Key_I)  # the camera is selected
+    anim = window.doc.scene.animation
+    assert anim is not None and anim.frames == 48 and anim.fps == 24
+    assert [t.path for t in anim.tracks] == ["camera.position", "camera.look_at"]
+    assert timeline.isVisible()
+    qtbot.keyClick(window.viewport, Qt.Key.Key_Z, CTRL)
+    assert window.doc.scene.animation is None
+    # the render settings have nothing to key: a message, no edit
+    window.select(("render",))
+    qtbot.keyClick(window.viewport, Qt.Key.Key_I)
+    assert window.doc.scene.animation is None
+    assert "select an object" in window.statusBar().currentMessage()
+
+
+def test_a_key_on_an_edit_lands_in_the_saved_file(open_rolling, rolling, qtbot):
+    window = open_rolling(preview=False, warm_up=False)
+    timeline = window.timeline
+    timeline.slider.setFocus()
+    qtbot.keyClick(timeline.slider, Qt.Key.Key_End)
+    assert timeline.frame == 7
+    click_tree(qtbot, window.tree, BALL)
+    assert center_shown(window) == pytest.approx((1.5, 0.8, 0.0))
+    type_into(qtbot, window.properties.row("center").editor.lines[1], "2")  # y: up
+    # not keyed yet: the picture shows the edit, the track does not undo it
+    assert timeline.still(window.doc.scene).objects[1].center == (1.5, 2.0, 0.0)
+    click_tree(qtbot, window.tree, BALL)
+    qtbot.keyClick(window.tree, Qt.Key.Key_I)
+    qtbot.keyClick(window.tree, Qt.Key.Key_S, CTRL)
+    assert not window.errors and not window.doc.dirty
+
+    text = rolling.read_text(encoding="utf-8")
+    assert "# A small animated scene: the ball rolls" in text
+    assert 'path = "objects[ball].center"   # left to right' in text
+    assert "  [0, [-1, 0.8, 0]],\n  [7, [1.5, 2.0, 0.0]],\n]" in text
+    saved = whitted.load_scene(rolling)
+    assert saved.at_frame(7).objects[1].center == (1.5, 2.0, 0.0)
+    assert saved.at_frame(0).objects[1].center == (-1.0, 0.8, 0.0)
+    assert saved.at_frame(4).objects[1].center == pytest.approx((ball_x(4), 0.8 + 1.2 * 4 / 7,
+                                                                 0.0))
+
+
+def test_play_advances_frames_and_stop_stops(open_rolling, qtbot):
+    window = open_rolling(preview=False, warm_up=False)
+    timeline = window.timeline
+    seen = []
+    timeline.frame_changed.connect(seen.append)
+    qtbot.mouseClick(timeline.play_button, LEFT)
+    assert timeline.playing and timeline.play_button.text().endswith("Stop")
+    qtbot.waitUntil(lambda: len(seen) >= 10, timeout=5000)  # 24 fps, eight frames: loops
+    qtbot.mouseClick(timeline.play_button, LEFT)
+    assert not timeline.playing and timeline.play_button.text().endswith("Play")
+    assert seen[:10] == [1, 2, 3, 4, 5, 6, 7, 0, 1, 2]
+    stopped = timeline.frame
+    qtbot.wait(200)
+    assert timeline.frame == stopped and len(seen) in (10, 11)
+    assert window.doc.scene.objects[1].center == pytest.approx((ball_x(stopped), 0.8, 0.0))
+    assert not window.doc.dirty  # showing frames is not an edit
+
+
+FAKE_ANIMATE = ("import sys, pathlib; print('frame 0 (1/1): 0.01 s', flush=True); "
+                "pathlib.Path(sys.argv[1]).write_bytes(b'film'); sys.exit(int(sys.argv[2]))")
+
+
+def test_render_animation_saves_then_runs_the_film_command(open_rolling, rolling, qtbot,
+                                                           tmp_path):
+    window = open_rolling(preview=False, warm_up=False)
+    timeline = window.timeline
+    calls = []
+
+    def command(scene_path, output, status="0"):
+        calls.append((scene_path, output, scene_path.read_text(encoding="utf-8")))
+        return [sys.executable, "-c", FAKE_ANIMATE, str(output), status]
+
+    timeline.animate_command = command
+    film = tmp_path / "rolling.mp4"
+    timeline.ask_film_path = lambda: film
+    click_tree(qtbot, window.tree, BALL)
+    qtbot.keyClick(window.tree, Qt.Key.Key_I)  # unsaved: saved before the film
+    qtbot.mouseClick(timeline.film_button, LEFT)
+    assert calls and calls[0][0] == rolling and "[[animation.tracks]]" in calls[0][2]
+    assert not window.doc.dirty and timeline.film_running
+    qtbot.waitUntil(lambda: not timeline.film_running, timeout=30_000)
+    assert film.read_bytes() == b"film" and not window.errors
+    assert str(film) in timeline.film_status.text()
+
+    timeline.animate_command = lambda s, o: command(s, o, "2")  # a failing run says so
+    qtbot.mouseClick(timeline.film_button, LEFT)
+    qtbot.waitUntil(lambda: not timeline.film_running, timeout=30_000)
+    assert window.errors and "frame 0 (1/1)" in window.errors[-1][1]
+
+
+@pytest.mark.skipif(importlib.util.find_spec("whitted.cli.animate") is None,
+                    reason="whitted animate is not on this branch yet")
+def test_render_animation_makes_the_film(open_rolling, qtbot, tmp_path):
+    window = open_rolling(preview=False, warm_up=False)
+    film = tmp_path / "rolling.gif"
+    assert window.timeline.render_animation(film)
+    qtbot.waitUntil(lambda: not window.timeline.film_running, timeout=SLOW)
+    assert not window.errors and film.stat().st_size > 0
+    assert len(list((tmp_path / "rolling_frames").glob("*.png"))) == 8
