@@ -280,3 +280,70 @@ def test_render_animation_makes_the_film(open_rolling, qtbot, tmp_path):
     qtbot.waitUntil(lambda: not window.timeline.film_running, timeout=SLOW)
     assert not window.errors and film.stat().st_size > 0
     assert len(list((tmp_path / "rolling_frames").glob("*.png"))) == 8
+
+
+def test_frames_box_edits_the_animation_and_refuses_to_cut_keys(open_rolling, qtbot):
+    window = open_rolling(preview=False, warm_up=False)
+    box = window.timeline.frames_box
+    qtbot.mouseClick(box, LEFT)
+    for text, frames in (("12", 12), ("4", 12)):  # 4 would leave the key at frame 7 out
+        qtbot.keyClick(box, Qt.Key.Key_A, CTRL)
+        qtbot.keyClicks(box, text)
+        qtbot.keyClick(box, Qt.Key.Key_Return)
+        assert window.doc.scene.animation.frames == frames
+    assert "outside 0..3" in window.statusBar().currentMessage()
+    assert window.timeline.slider.maximum() == 11
+    qtbot.keyClick(box, Qt.Key.Key_Z, CTRL)
+    assert window.doc.scene.animation.frames == 8 and window.timeline.slider.maximum() == 7
+
+
+# ---------------------------------------------------------------------- keys and poses, no Qt
+
+
+def test_posing_is_what_at_frame_shows_and_leaves_shared_materials_shared(rolling):
+    from whitted.animation import Track
+    from whitted.gui.keyframes import frame_still, posed
+
+    scene = whitted.load_scene(rolling)
+    kt = Track("objects[ball].material.kr", {0: 0.0, 7: 0.7})
+    scene = scene.with_animation(8, 24, [*scene.animation.tracks, kt])
+    for frame in (0, 3, 7):
+        pose = posed(scene, frame)
+        assert pose.objects[1].center == pytest.approx((ball_x(frame), 0.8, 0.0))
+        assert pose.objects[1].material == "plastic"  # not given its own copy
+        assert posed(pose, frame) == pose
+        assert frame_still(pose, frame) == scene.at_frame(frame)
+        assert frame_still(pose, frame).objects[1].material.kr == pytest.approx(0.1 * frame)
+    assert scene.objects[1].center == (-1.0, 0.8, 0.0)  # the scene posed is unchanged
+
+
+def test_insert_keys_names_items_readably_and_replaces_a_key_at_the_frame(rolling):
+    from whitted.gui.keyframes import insert_keys, key_targets
+
+    scene = whitted.load_scene(rolling)
+    lamp = key_targets(scene, ("lights", 1))
+    assert lamp == [("lights[lamp].position", [-4.0, 6.0, 5.0])]
+    assert key_targets(scene, ("lights", 0)) == []  # an ambient light has no place
+    assert key_targets(scene, ("render",)) == [] and key_targets(scene, None) == []
+    twin = scene.model_copy(update={"objects": [*scene.objects, scene.objects[1]]})
+    assert key_targets(twin, ("objects", 2))[0][0] == "objects[2].center"  # name not unique
+    keyed = insert_keys(scene, [("objects[1].center", [0.0, 3.0, 0.0])], 7)
+    track = keyed.animation.tracks[0]  # the same value, spelt another way: the same track
+    assert len(keyed.animation.tracks) == 1 and track.path == "objects[ball].center"
+    assert track.keys == [(0, [-1, 0.8, 0]), (7, [0.0, 3.0, 0.0])]
+    with pytest.raises(ValueError, match="outside 0..7"):
+        insert_keys(scene, lamp, 9)
+
+
+def test_saving_writes_the_animation_table_compactly_and_reads_it_back(rolling):
+    from whitted.scene.toml_document import compact_toml, scene_toml
+
+    scene = whitted.load_scene(rolling)
+    text = compact_toml(scene)
+    assert "[animation]\nframes = 8\n\n[[animation.tracks]]\npath = \"objects[ball].center\"\n" \
+           "keys = [\n    [0, [-1, 0.8, 0]],\n    [7, [1.5, 0.8, 0]],\n]\n" in text
+    assert whitted.scene.io.scene_from_dict(whitted.scene.io.parse_scene_text(
+        text, ".toml")) == scene
+    still = scene.model_copy(update={"animation": None})
+    assert "animation" not in scene_toml(still, text=ROLLING_BALL, loaded=scene)
+    assert scene_toml(scene, text=ROLLING_BALL, loaded=scene) == ROLLING_BALL

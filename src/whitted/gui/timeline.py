@@ -26,8 +26,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from pydantic import ValidationError
-from PySide6.QtCore import QProcess, QRect, Qt, QTimer, Signal
-from PySide6.QtGui import QAction, QColor, QKeySequence, QPainter, QPolygon
+from PySide6.QtCore import QEvent, QProcess, QRect, Qt, QTimer, Signal
+from PySide6.QtGui import QAction, QColor, QKeyEvent, QKeySequence, QPainter, QPolygon
 from PySide6.QtWidgets import (
     QComboBox,
     QDockWidget,
@@ -134,6 +134,28 @@ class KeySlider(QSlider):
         painter.end()
 
 
+def _scene_keys_event(box: QSpinBox | QDoubleSpinBox, event: QEvent) -> bool:
+    """Ctrl+Z / Ctrl+Shift+Z in a box holding no typed value: the window's (the scene's)
+    undo and redo, as in the editor's other fields. True when handled here."""
+    if event.type() == QEvent.Type.ShortcutOverride and isinstance(event, QKeyEvent) \
+            and not box.lineEdit().isModified() \
+            and any(event.matches(k) for k in (QKeySequence.StandardKey.Undo,
+                                               QKeySequence.StandardKey.Redo)):
+        event.ignore()
+        return True
+    return False
+
+
+class SceneSpinBox(QSpinBox):
+    def event(self, event: QEvent) -> bool:  # noqa: D102 - Qt's name
+        return _scene_keys_event(self, event) or super().event(event)
+
+
+class SceneDoubleSpinBox(QDoubleSpinBox):
+    def event(self, event: QEvent) -> bool:  # noqa: D102 - Qt's name
+        return _scene_keys_event(self, event) or super().event(event)
+
+
 class TimelinePanel(QWidget):
     """The timeline of ``window``'s document (see the module's text). ``frame`` is the
     current frame; ``still(scene)`` is what the picture shows of ``scene`` there."""
@@ -169,11 +191,11 @@ class TimelinePanel(QWidget):
         self.interpolation.addItems(INTERPOLATIONS)
         self.interpolation.setToolTip("how a new track goes from key to key")
 
-        self.frames_box = QSpinBox(self)
+        self.frames_box = SceneSpinBox(self)
         self.frames_box.setRange(1, 100_000)
         self.frames_box.setToolTip("how many frames the animation has")
         self.frames_box.editingFinished.connect(self._frames_edited)
-        self.fps_box = QDoubleSpinBox(self)
+        self.fps_box = SceneDoubleSpinBox(self)
         self.fps_box.setRange(1.0, 240.0)
         self.fps_box.setDecimals(2)
         self.fps_box.setToolTip("frames per second of the film")
@@ -308,7 +330,7 @@ class TimelinePanel(QWidget):
             return
         self._pose()
 
-    def _update_controls(self) -> None:
+    def _update_controls(self, *, boxes: bool = False) -> None:
         scene = self.doc.scene
         anim = scene.animation
         n = self.frame_count
@@ -322,7 +344,7 @@ class TimelinePanel(QWidget):
         self.slider.set_keys(key_frames(scene))
         for box, value in ((self.frames_box, n),
                            (self.fps_box, anim.fps if anim is not None else NEW_FPS)):
-            if not box.hasFocus():
+            if boxes or not box.hasFocus():
                 box.blockSignals(True)
                 box.setValue(value)
                 box.blockSignals(False)
@@ -375,7 +397,7 @@ class TimelinePanel(QWidget):
         except (EditRefused, ValidationError, ValueError) as exc:
             message = friendly_message(exc) if isinstance(exc, ValidationError) else str(exc)
             self._status(f"{text}: {message}")
-            self._update_controls()
+            self._update_controls(boxes=True)  # the box shows the scene's value again
             return
         self.doc.apply(new, text, merge_key=("timeline", merge))
 
@@ -383,6 +405,7 @@ class TimelinePanel(QWidget):
         if self.frames_box.value() != self.frame_count or self.doc.scene.animation is None:
             self._edit_animation(f"Frames {self.frames_box.value()}", "frames",
                                  frames=self.frames_box.value())
+        _forget_typing(self.frames_box)
 
     def _fps_edited(self) -> None:
         anim = self.doc.scene.animation
@@ -391,6 +414,7 @@ class TimelinePanel(QWidget):
                                  fps=self.fps_box.value())
             if self.playing:
                 self.play()
+        _forget_typing(self.fps_box)
 
     # ------------------------------------------------------------------ playing
 
@@ -523,6 +547,12 @@ class TimelinePanel(QWidget):
         if error == QProcess.ProcessError.FailedToStart and self.film is not None:
             self.film_log.append(f"cannot start {self.film.program()}")
             self._film_done(-1, QProcess.ExitStatus.CrashExit)
+
+
+def _forget_typing(box: QSpinBox | QDoubleSpinBox) -> None:
+    """After a value is committed, Ctrl+Z in the box is the scene's undo, as in the editor's
+    other fields (see :func:`_scene_keys_event`)."""
+    box.lineEdit().setModified(False)
 
 
 def attach_timeline(window: MainWindow) -> TimelinePanel:
