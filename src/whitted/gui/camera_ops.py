@@ -170,17 +170,16 @@ def zoom_to(camera: Camera, factor: float, width: int, height: int, u: float,
 
 def look_from(camera: Camera, direction, target, distance: float) -> Camera:
     """The camera looking at ``target`` from ``distance`` along ``direction`` (a view from
-    the front, the side, the top...)."""
+    the front, the side, the top...), with the world's up (+y) as its up: a view from
+    straight above is tilted by a hair toward the front so that up stays +y (and a later
+    orbit still turns about the vertical)."""
     d = np.asarray(direction, np.float64)
-    d /= np.linalg.norm(d)
+    d = d / np.linalg.norm(d)
+    up = np.array([0.0, 1.0, 0.0])
+    if abs(float(d @ up)) > 0.9999:
+        d = d + np.array([0.0, 0.0, 1e-3])
+        d /= np.linalg.norm(d)
     target = np.asarray(target, np.float64)
-    up = np.asarray(camera.up, np.float64)
-    if abs(float(d @ up)) > 0.999 * np.linalg.norm(up):  # looking along up: tilt it
-        up = np.array([0.0, 0.0, -1.0]) if d[1] > 0 else np.array([0.0, 0.0, 1.0])
-        data = camera.model_dump()
-        data.update(position=_rounded(target + distance * d), look_at=_rounded(target),
-                    up=_rounded(up), rotate=None, axis_angle=None)
-        return Camera.model_validate(data)
     return with_view(camera, target + distance * d, target, up)
 
 

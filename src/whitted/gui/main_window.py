@@ -5,10 +5,12 @@ tests can answer them)."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
-from PySide6.QtCore import QSettings, Qt, QTimer
-from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
+import numpy as np
+from PySide6.QtCore import QPointF, QSettings, Qt, QTimer
+from PySide6.QtGui import QAction, QCloseEvent, QColor, QKeySequence, QPainter, QPen
 from PySide6.QtWidgets import (
     QApplication,
     QDockWidget,
@@ -43,6 +45,7 @@ from .properties import PropertyPanel
 from .recent import RecentFiles
 from .render_controller import RenderController
 from .timeline import attach_timeline
+from .transform_tool import TransformTool, light_position, object_bounds, object_centre
 from .tree import SceneTree
 from .viewport import Viewport
 
@@ -121,6 +124,10 @@ class MainWindow(QMainWindow):
         self.ids.ready.connect(self._update_outline)
         self.doc.selection_changed.connect(lambda *_: self._update_outline())
         self.viewport.clicked.connect(self.pick)
+        self.viewport.key_handler = self._viewport_key
+        self.viewport.overlay = self._draw_overlay
+        self.viewport.drag_started.connect(lambda: self.controller.set_interacting(True))
+        self.viewport.drag_finished.connect(lambda: self.controller.set_interacting(False))
         self.viewport.orbit.connect(self._orbit)
         self.viewport.pan.connect(self._pan)
         self.viewport.zoom.connect(self._zoom)
@@ -129,6 +136,7 @@ class MainWindow(QMainWindow):
         self._update_title()
         self._update_render_actions()
         self.viewport.set_aspect(scene.render.width, scene.render.height)
+        self._update_preview_target()
         if warm_up:
             self.viewport.caption = "Loading the render kernels (the first run compiles them)…"
             self.controller.warm_up()
@@ -560,10 +568,79 @@ class MainWindow(QMainWindow):
         except WhittedError as exc:
             self.statusBar().showMessage(f"Cannot pick: {exc}", 4000)
             return None
+        light = self.light_at(u, v)
         index = id_at(ids, u, v)
-        key = ("objects", index) if index >= 0 else None
+        key = light if light is not None else ("objects", index) if index >= 0 else None
         self.select(key)
         return key
+
+    LIGHT_PICK_PX = 12
+
+    def _light_marks(self):
+        """(key, picture point (u, v)) of every light with a place in the scene."""
+        scene = self.doc.scene
+        s = scene.render
+        for i, light in enumerate(scene.lights):
+            p = light_position(light)
+            uv = camera_ops.project(scene.camera, s.width, s.height, p) if p else None
+            if uv is not None:
+                yield ("lights", i), uv
+
+    def light_at(self, u: float, v: float):
+        """The light whose mark is within a few pixels of (u, v), if any."""
+        here = self.viewport.to_widget(u, v)
+        best, best_d = None, float(self.LIGHT_PICK_PX)
+        for key, (lu, lv) in self._light_marks():
+            p = self.viewport.to_widget(lu, lv)
+            d = math.hypot(p.x() - here.x(), p.y() - here.y())
+            if d <= best_d:
+                best, best_d = key, d
+        return best
+
+    def _draw_overlay(self, p: QPainter, to_widget) -> None:
+        """Over the picture: lights (a sun mark, named), the camera's target (a cross), and
+        the selected object's bounding box."""
+        scene = self.doc.scene
+        s = scene.render
+        cam = scene.camera
+        selected = self.doc.selection
+        if selected is not None and selected[0] == "objects":
+            bounds = object_bounds(scene, selected[1])
+            if bounds is not None:
+                lo, hi = bounds
+                corners = [(x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                           for z in (lo[2], hi[2])]
+                uvs = [camera_ops.project(cam, s.width, s.height, c) for c in corners]
+                pen = QPen(QColor(255, 150, 20, 170), 1, Qt.PenStyle.DashLine)
+                p.setPen(pen)
+                for a in range(8):
+                    for b in range(a + 1, 8):
+                        if bin(a ^ b).count("1") == 1 and uvs[a] and uvs[b]:
+                            p.drawLine(to_widget(*uvs[a]), to_widget(*uvs[b]))
+        target = camera_ops.project(cam, s.width, s.height, camera_ops.target_of(cam))
+        if target is not None:
+            c = to_widget(*target)
+            p.setPen(QPen(QColor(255, 255, 255, 150), 1))
+            p.drawLine(c + QPointF(-7, 0), c + QPointF(7, 0))
+            p.drawLine(c + QPointF(0, -7), c + QPointF(0, 7))
+        for key, uv in self._light_marks():
+            c = to_widget(*uv)
+            light = scene.lights[key[1]]
+            colour = QColor(255, 150, 20) if key == selected else QColor(255, 230, 90)
+            p.setPen(QPen(QColor(0, 0, 0, 160), 3))
+            p.drawEllipse(c, 5, 5)
+            p.setPen(QPen(colour, 1.5))
+            p.setBrush(colour)
+            p.drawEllipse(c, 4, 4)
+            p.setBrush(Qt.BrushStyle.NoBrush)
+            for k in range(8):
+                a = k * math.pi / 4
+                d = QPointF(math.cos(a), math.sin(a))
+                p.drawLine(c + d * 6.5, c + d * 10)
+            p.setPen(QColor(0, 0, 0))
+            p.drawText(c + QPointF(13, 5), label_of(light))
+            p.setPen(colour)
+            p.drawText(c + QPointF(12, 4), label_of(light))
 
     def _update_outline(self) -> None:
         """The selected object's outline over the picture (from the current id image)."""
@@ -579,6 +656,121 @@ class MainWindow(QMainWindow):
         if outline is not self.viewport.outline:
             self.viewport.outline = outline
             self.viewport.update()
+
+    def _viewport_key(self, event) -> bool:
+        """The picture's keys: G/R/S move, rotate, scale the selection; F frames it, Home
+        frames everything; numpad 1/3/7 (or 1/3/7) look from the front, the right, the top
+        (with Ctrl: the back, the left, the bottom)."""
+        key = event.key()
+        mods = event.modifiers()
+        ctrl = bool(mods & Qt.KeyboardModifier.ControlModifier)
+        tools = {Qt.Key.Key_G: "move", Qt.Key.Key_R: "rotate", Qt.Key.Key_S: "scale"}
+        if key in tools and not ctrl:
+            return self.start_tool(tools[key])
+        if key == Qt.Key.Key_F and not ctrl:
+            return self.frame_selection()
+        if key == Qt.Key.Key_Home:
+            return self.frame_all()
+        views = {Qt.Key.Key_1: (0.0, 0.0, 1.0), Qt.Key.Key_3: (1.0, 0.0, 0.0),
+                 Qt.Key.Key_7: (0.0, 1.0, 0.0)}
+        if key in views and (not ctrl or mods & Qt.KeyboardModifier.KeypadModifier):
+            d = np.asarray(views[key]) * (-1.0 if ctrl else 1.0)
+            return self.view_from(d, {Qt.Key.Key_1: "front", Qt.Key.Key_3: "side",
+                                      Qt.Key.Key_7: "top"}[key])
+        return False
+
+    def start_tool(self, mode: str) -> bool:
+        key = self.doc.selection
+        if key is None or len(key) != 2 or self.viewport.tool is not None:
+            return False
+        if key[0] == "lights" and (mode != "move" or light_position(
+                self.doc.item(key)) is None):
+            return False
+        start = self.viewport.hover
+        if self.viewport.to_picture(start) is None:
+            start = self.viewport.picture_rect().center()
+        tool = TransformTool(mode, self.doc.scene, key[1], start,
+                             (self.viewport.width(), self.viewport.height()),
+                             apply=lambda t, merge: self._tool_edit(key, t, merge, mode),
+                             finish=self._tool_finished,
+                             status=lambda text: self.statusBar().showMessage(text),
+                             kind=key[0])
+        tool.start_uv = tool.uv = self.viewport.to_picture(start)
+        self.viewport.tool = tool
+        self._tool_edits = 0
+        self.controller.set_interacting(True)
+        return True
+
+    def _tool_edit(self, key, transform, merge, mode: str) -> None:
+        item = self.doc.item(key)
+        data = item.model_dump()
+        if key[0] == "lights":  # a light moves by the vector: from where it was at the start
+            tool = self.viewport.tool
+            field = "position" if "position" in data else "center"
+            start = tool.centre if tool is not None else np.asarray(data[field])
+            data[field] = tuple(round(float(v), 6) + 0.0 for v in start + transform)
+        else:
+            data["transform"] = transform.model_dump()
+        try:
+            before = self.doc.undo_stack.index()
+            self.doc.edit_item(key, data, f"{TransformTool.NAMES[mode]} {label_of(item)}",
+                               merge_key=merge)
+            self._tool_edits += self.doc.undo_stack.index() != before or self._tool_edits > 0
+        except EditRefused as exc:
+            self.statusBar().showMessage(str(exc), 3000)
+
+    def _tool_finished(self, confirmed: bool, tool) -> None:
+        self.viewport.tool = None
+        self.controller.set_interacting(False)
+        if not confirmed and self._tool_edits:
+            stack = self.doc.undo_stack
+            command = stack.command(stack.index() - 1)
+            if command is not None and getattr(command, "merge_key", None) == tool.merge_key:
+                command.forget_on_undo = True  # no redo of a cancelled move
+                stack.undo()
+        self.statusBar().showMessage("" if confirmed else "Cancelled", 2000)
+        self.viewport.update()
+
+    def frame_selection(self) -> bool:
+        key = self.doc.selection
+        if key is None or key[0] != "objects":
+            return self.frame_all()
+        bounds = object_bounds(self.doc.scene, key[1])
+        if bounds is None:
+            c = object_centre(self.doc.scene, key[1])
+            bounds = (c - 1.0, c + 1.0)
+        self._frame(*bounds, "Frame selection")
+        return True
+
+    def frame_all(self) -> bool:
+        scene = self.doc.scene
+        boxes = [b for i in range(len(scene.objects))
+                 if (b := object_bounds(scene, i)) is not None]
+        if not boxes:
+            return False
+        lo = np.min([b[0] for b in boxes], axis=0)
+        hi = np.max([b[1] for b in boxes], axis=0)
+        self._frame(lo, hi, "Frame all")
+        return True
+
+    def _frame(self, lo, hi, text: str) -> None:
+        s = self.doc.scene.render
+        try:
+            camera = camera_ops.frame_bounds(self.doc.scene.camera, s.width, s.height, lo, hi)
+        except ValueError:
+            return
+        self._camera_edit(camera, text, None)
+
+    def view_from(self, direction, name: str) -> bool:
+        camera = self.doc.scene.camera
+        target = camera_ops.target_of(camera)
+        distance = float(np.linalg.norm(np.subtract(camera.position, target)))
+        try:
+            camera = camera_ops.look_from(camera, direction, target, distance)
+        except ValueError:
+            return False
+        self._camera_edit(camera, f"View from the {name}", None)
+        return True
 
     def _camera_edit(self, camera, text: str, merge) -> None:
         try:
@@ -621,7 +813,14 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ rendering
 
+    def _update_preview_target(self) -> None:
+        """Previews refine, when the input stops, up to the picture's size on screen."""
+        r = self.viewport.fit_rect()
+        ratio = self.viewport.devicePixelRatioF()
+        self.controller.target_pixels = max(1, int(r.width() * r.height() * ratio * ratio))
+
     def _scene_changed(self, key=None) -> None:
+        self._update_preview_target()
         scene = self.timeline.still(self.doc.scene)
         if self.doc.selection is not None and self.doc.selection[0] == "objects":
             self.ids.request(scene)  # the outline follows
@@ -640,8 +839,10 @@ class MainWindow(QMainWindow):
         self._update_render_actions()
 
     def escape(self) -> None:
-        """Esc: stop a running render; with none running, deselect."""
-        if self.controller.rendering:
+        """Esc: cancel a G/R/S move; else stop a running render; else deselect."""
+        if self.viewport.tool is not None:
+            self.viewport.tool.cancel()
+        elif self.controller.rendering:
             self.stop_render()
         else:
             self.select(None)

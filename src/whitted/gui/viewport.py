@@ -56,6 +56,7 @@ class Viewport(QWidget):
         self.key_handler = None
         #: a running modal tool (a G/R/S move): gets the pointer, a click confirms it
         self.tool = None
+        self.hover = QPointF(-1, -1)  # where the pointer last was (a G/R/S move starts there)
         self._press: QPointF | None = None
         self._last: QPointF | None = None
         self._mode = ""
@@ -209,6 +210,7 @@ class Viewport(QWidget):
         event.accept()
 
     def mouseMoveEvent(self, event: QMouseEvent) -> None:  # noqa: N802
+        self.hover = event.position()
         if self.tool is not None:
             uv = self.to_picture(event.position())
             self.tool.move(event.position(), uv)

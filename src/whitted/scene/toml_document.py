@@ -123,9 +123,24 @@ def compact_toml(scene: Scene) -> str:
             for it in items:
                 aot.append(_table(compact_data(it)))
             doc[name] = aot
+    for name in _OTHER_FIELDS:  # e.g. the animation table
+        value = getattr(scene, name, None)
+        if value is not None and value != _scene_default(name):
+            doc[name] = _table(compact_data(value)) if isinstance(value, BaseModel) else \
+                _item(_plain(value))
     if scene.animation is not None:
         doc["animation"] = _animation_table(scene.animation)
     return tomlkit.dumps(doc)
+
+
+_KNOWN_FIELDS = ("render", "camera", "background", "materials", "lights", "objects",
+                 "animation")  # the [animation] table: see below
+_OTHER_FIELDS = tuple(n for n in Scene.model_fields if n not in _KNOWN_FIELDS)
+
+
+def _scene_default(name: str) -> Any:
+    field = Scene.model_fields[name]
+    return field.default_factory() if field.default_factory is not None else field.default
 
 
 # ---------------------------------------------------------------------- editing a file
@@ -247,6 +262,19 @@ def edit_toml(text: str, old: Scene, new: Scene) -> str:
         o, n = getattr(old, name), getattr(new, name)
         if o != n:
             _update_list(doc, name, list(o), list(n))
+    for name in _OTHER_FIELDS:
+        o, n = getattr(old, name, None), getattr(new, name, None)
+        if o == n:
+            continue
+        node = doc.get(name)
+        if isinstance(n, BaseModel) and isinstance(o, BaseModel) and _is_table(node):
+            _update_table(node, o, n)
+        elif n is None or n == _scene_default(name):
+            if name in doc:
+                del doc[name]
+        else:
+            doc[name] = _table(compact_data(n)) if isinstance(n, BaseModel) else \
+                _item(_plain(n))
     if old.animation != new.animation:
         _update_animation(doc, old.animation, new.animation)
     return tomlkit.dumps(doc)
