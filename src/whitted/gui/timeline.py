@@ -220,6 +220,7 @@ class TimelinePanel(QWidget):
         top.addWidget(self.slider, 1)
         top.addWidget(self.frame_box)
         top.addWidget(self.key_button)
+        top.addWidget(QLabel("new tracks", self))
         top.addWidget(self.interpolation)
         bottom = QHBoxLayout()
         bottom.addWidget(QLabel("Frames", self))
