@@ -145,3 +145,30 @@ def test_a_light_is_drawn_picked_and_moved_with_g(make_window, qtbot):  # noqa: 
     qtbot.keyClicks(vp, "gy1")
     qtbot.keyClick(vp, Qt.Key.Key_Return)
     assert window.doc.item(("lights", 2)).position == pytest.approx((1.0, 3.0, 0.0))
+
+
+def test_new_objects_rest_on_the_floor_clear_of_the_others(window, tmp_path):
+    from whitted.gui.transform_tool import object_bounds
+
+    for kind in ("sphere", "box", "cylinder", "cone", "sphere"):
+        window.object_actions[kind].trigger()
+    scene = window.doc.scene
+    boxes = [object_bounds(scene, i) for i in range(1, len(scene.objects))]
+    for i, (lo, hi) in enumerate(boxes):
+        if i > 0:  # the new ones (the ball is the first)
+            assert lo[1] == pytest.approx(0.0, abs=1e-6)  # on the floor
+        for j, (lo2, hi2) in enumerate(boxes[:i]):
+            assert not (np.all(lo < hi2 - 1e-6) and np.all(lo2 < hi - 1e-6)), (i, j)
+    # a huge model is scaled to a sensible size, and says so
+    obj = tmp_path / "huge.obj"
+    obj.write_text("v 0 0 0\nv 900 0 0\nv 0 900 0\nv 0 0 900\nf 1 3 2\nf 1 2 4\nf 1 4 3\n"
+                   "f 2 3 4\n")
+    key = window.add_model(obj)
+    lo, hi = object_bounds(window.doc.scene, key[1])
+    assert np.max(hi - lo) == pytest.approx(1.5, rel=1e-2) and lo[1] == pytest.approx(0.0)
+    assert "scaled by" in window.statusBar().currentMessage()
+    # lights are named by type and number
+    window.light_actions["point"].trigger()
+    assert window.doc.item().name == "point 2"  # the starter scene's lamp is the first
+    window.light_actions["disk"].trigger()
+    assert window.doc.item().name == "disk 1"

@@ -27,7 +27,6 @@ from ..kernels.layout import (
 )
 from ..scene.scene import Scene
 from ..scene.shapes import Mesh
-from .bvh import build_bvh
 from .geometry import box_corners, corners_bounds
 from .light_buffers import build_light_buffers
 from .lights import light_rows
@@ -35,6 +34,7 @@ from .materials import MaterialTable
 from .mesh_objects import FLATTEN_LIMIT, add_flat_mesh, mesh_key, mesh_source
 from .meshes import MeshSource, MeshTable
 from .primitives import PrimitiveRows
+from .reuse import cached_build_bvh
 from .shapes import add_shape
 from .textures import compile_textures
 
@@ -119,8 +119,8 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT) -> CompiledS
     bounded = np.flatnonzero(finite & ~is_instance).astype(np.int32)
     instances = np.flatnonzero(is_instance).astype(np.int32)
     unbounded = np.flatnonzero(~finite)
-    bvh = build_bvh(lo[bounded], hi[bounded])
-    inst_bvh = build_bvh(lo[instances], hi[instances])
+    bvh = cached_build_bvh(lo[bounded], hi[bounded])
+    inst_bvh = cached_build_bvh(lo[instances], hi[instances])
     prim_info = np.empty((len(prim_type), N_PRIM_INFO), np.int32)
     prim_info[:, PRIM_TYPE] = prim_type
     prim_info[:, PRIM_XFORM] = prim_xform

@@ -542,6 +542,11 @@ class MainWindow(QMainWindow):
         except (ValueError, EditRefused) as exc:
             self.show_error("Cannot add the model", str(exc))
             return None
+        scale = obj.transform.scale if obj.transform is not None else 1.0
+        if scale != 1.0:
+            self.statusBar().showMessage(
+                f"{Path(path).name} was scaled by {scale:g} to a sensible size "
+                "(Placement > Scale)", 8000)
         return self.doc.add("objects", obj, f"Add model {Path(path).name}")
 
     def delete_selected(self) -> bool:

@@ -57,7 +57,11 @@ def _local_points(obj) -> np.ndarray | None:
 
 def object_bounds(scene: Scene, index: int) -> tuple[np.ndarray, np.ndarray] | None:
     """World-space box (lo, hi) around object ``index``; None for an unbounded plane."""
-    obj = scene.objects[index]
+    return item_bounds(scene.objects[index], scene)
+
+
+def item_bounds(obj, scene: Scene) -> tuple[np.ndarray, np.ndarray] | None:
+    """World-space box (lo, hi) around ``obj`` (its files found from ``scene``'s folder)."""
     pts = _local_points(obj)
     if pts is None and obj.type == "mesh":
         try:
