@@ -3,9 +3,6 @@ slider and the Play button, the I key wherever the focus is, Ctrl+Z, Ctrl+S; off
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-
 import numpy as np
 import pytest
 
@@ -239,47 +236,60 @@ def test_play_advances_frames_and_stop_stops(open_rolling, qtbot):
     assert not window.doc.dirty  # showing frames is not an edit
 
 
-FAKE_ANIMATE = ("import sys, pathlib; print('frame 0 (1/1): 0.01 s', flush=True); "
-                "pathlib.Path(sys.argv[1]).write_bytes(b'film'); sys.exit(int(sys.argv[2]))")
+def test_render_animation_saves_then_makes_the_film_that_whitted_animate_makes(
+        open_rolling, rolling, qtbot, tmp_path):
+    import imageio.v3 as iio
 
+    from whitted.animation.frames import frame_digest, frame_is_current
 
-def test_render_animation_saves_then_runs_the_film_command(open_rolling, rolling, qtbot,
-                                                           tmp_path):
     window = open_rolling(preview=False, warm_up=False)
     timeline = window.timeline
-    calls = []
-
-    def command(scene_path, output, status="0"):
-        calls.append((scene_path, output, scene_path.read_text(encoding="utf-8")))
-        return [sys.executable, "-c", FAKE_ANIMATE, str(output), status]
-
-    timeline.animate_command = command
-    film = tmp_path / "rolling.mp4"
+    film = tmp_path / "rolling.gif"
     timeline.ask_film_path = lambda: film
     click_tree(qtbot, window.tree, BALL)
+    click_frame(qtbot, timeline, 4)
     qtbot.keyClick(window.tree, Qt.Key.Key_I)  # unsaved: saved before the film
-    qtbot.mouseClick(timeline.film_button, LEFT)
-    assert calls and calls[0][0] == rolling and "[[animation.tracks]]" in calls[0][2]
-    assert not window.doc.dirty and timeline.film_running
-    qtbot.waitUntil(lambda: not timeline.film_running, timeout=30_000)
-    assert film.read_bytes() == b"film" and not window.errors
-    assert str(film) in timeline.film_status.text()
+    with qtbot.waitSignal(timeline.film_done, timeout=SLOW) as done:
+        qtbot.mouseClick(timeline.film_button, LEFT)
+        assert not window.doc.dirty and timeline.film_running
+    job = done.args[0]
+    assert job.error is None and not job.stopped and job.rendered == 8
+    assert "Wrote" in timeline.film_status.text() and timeline.film_progress.value() == 1000
+    frames = iio.imread(film, index=None)
+    assert frames.shape[:3] == (8, 48, 64)
+    saved = whitted.load_scene(rolling)
+    assert len(saved.animation.tracks) == 2  # the key made in the editor is in the film
+    for k in range(8):  # the frames whitted animate (and render --frame K) would write
+        assert frame_is_current(tmp_path / "rolling_frames" / f"{k:04d}.png",
+                                frame_digest(saved.at_frame(k), k))
 
-    timeline.animate_command = lambda s, o: command(s, o, "2")  # a failing run says so
-    qtbot.mouseClick(timeline.film_button, LEFT)
-    qtbot.waitUntil(lambda: not timeline.film_running, timeout=30_000)
-    assert window.errors and "frame 0 (1/1)" in window.errors[-1][1]
 
+def test_a_stopped_film_keeps_its_frames_and_the_next_run_continues(make_window, qtbot,  # noqa: F811
+                                                                    tmp_path):
+    path = tmp_path / "rolling.toml"  # frames of a few tenths of a second: time to stop
+    path.write_text(ROLLING_BALL.replace("width = 64\nheight = 48",
+                                         "width = 400\nheight = 300\nsamples = 4"))
+    window = make_window(whitted.load_scene(path), path, preview=False, warm_up=False)
+    timeline = window.timeline
+    film = tmp_path / "rolling.mp4"
+    timeline.ask_film_path = lambda: film
+    with qtbot.waitSignal(timeline.film_done, timeout=SLOW) as done:
+        timeline.render_animation()
+        qtbot.waitUntil(lambda: timeline.film.done >= 2, timeout=SLOW)
+        qtbot.waitUntil(lambda: timeline.film_status.text().startswith("frame 3/8"))
+        assert 200 <= timeline.film_progress.value() < 1000
+        qtbot.mouseClick(timeline.film_stop, LEFT)
+    first = done.args[0]
+    assert first.stopped and 2 <= first.done < 8 and not film.exists()
+    assert "Stopped" in timeline.film_status.text()
+    on_disk = sorted(p.name for p in (tmp_path / "rolling_frames").glob("*.png"))
+    assert on_disk == [f"{k:04d}.png" for k in range(first.done)]
 
-@pytest.mark.skipif(importlib.util.find_spec("whitted.cli.animate") is None,
-                    reason="whitted animate is not on this branch yet")
-def test_render_animation_makes_the_film(open_rolling, qtbot, tmp_path):
-    window = open_rolling(preview=False, warm_up=False)
-    film = tmp_path / "rolling.gif"
-    assert window.timeline.render_animation(film)
-    qtbot.waitUntil(lambda: not window.timeline.film_running, timeout=SLOW)
-    assert not window.errors and film.stat().st_size > 0
-    assert len(list((tmp_path / "rolling_frames").glob("*.png"))) == 8
+    with qtbot.waitSignal(timeline.film_done, timeout=SLOW) as done:
+        qtbot.mouseClick(timeline.film_button, LEFT)
+    second = done.args[0]
+    assert second.kept == first.done and second.rendered == 8 - first.done
+    assert film.stat().st_size > 0 and not window.errors
 
 
 def test_frames_box_edits_the_animation_and_refuses_to_cut_keys(open_rolling, qtbot):

@@ -10,23 +10,20 @@ of a still one).
   transform (and centre), a light's position or the camera's position and look_at at the
   current frame, creating the ``[animation]`` table and its tracks as needed; one undo step
 - frames and frames per second of the animation (undoable edits)
-- Render animation…: saves the scene, then runs ``whitted animate`` on it in a separate
-  process (QProcess); the panel shows a busy bar and the command's last line of output as it
-  is written, and Stop interrupts it (Ctrl-C: the finished frames are kept, the next run
-  continues). Only its exit status is read.
+- Render animation…: saves the scene, then renders its film on a background thread
+  (:mod:`whitted.gui.film_job`: the frames and the film ``whitted animate`` makes, resumable
+  by either), with a progress bar over frames and tiles and the time left; Stop keeps the
+  finished frames.
 
 :func:`attach_timeline` puts it into a :class:`~whitted.gui.main_window.MainWindow`."""
 
 from __future__ import annotations
 
-import os
-import signal
-import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from pydantic import ValidationError
-from PySide6.QtCore import QEvent, QProcess, QRect, Qt, QTimer, Signal
+from PySide6.QtCore import QEvent, QRect, Qt, QTimer, Signal
 from PySide6.QtGui import QAction, QColor, QKeyEvent, QKeySequence, QPainter, QPolygon
 from PySide6.QtWidgets import (
     QComboBox,
@@ -47,8 +44,9 @@ from PySide6.QtWidgets import (
 
 from ..animation.model import Animation
 from ..errors import WhittedError
-from ..scene import Scene
+from ..scene import Scene, load_scene
 from .document import EditRefused, label_of, rebuild_scene
+from .film_job import FilmJob
 from .keyframes import (
     NEW_FPS,
     NEW_FRAMES,
@@ -161,6 +159,7 @@ class TimelinePanel(QWidget):
     current frame; ``still(scene)`` is what the picture shows of ``scene`` there."""
 
     frame_changed = Signal(int)
+    film_done = Signal(object)  # the FilmJob, finished, stopped or failed
 
     def __init__(self, window: MainWindow) -> None:
         super().__init__(window)
@@ -169,9 +168,7 @@ class TimelinePanel(QWidget):
         self.frame = 0
         self._still_cache: tuple[Scene, int, Scene] | None = None
         self._stack_index = self.doc.undo_stack.index()
-        self.film: QProcess | None = None
-        self.film_path: Path | None = None
-        self.film_log: list[str] = []
+        self.film: FilmJob | None = None
 
         self.play_button = QPushButton("▶ Play", self)
         self.play_button.setToolTip("play the preview at the scene's frames per second")
@@ -202,16 +199,16 @@ class TimelinePanel(QWidget):
         self.fps_box.editingFinished.connect(self._fps_edited)
         self.film_button = QPushButton("Render animation…", self)
         self.film_button.setToolTip("save the scene, then render every frame and encode the "
-                                    "film (whitted animate)")
+                                    "film, as whitted animate does")
         self.film_button.clicked.connect(lambda: self.render_animation())
         self.film_stop = QPushButton("Stop", self)
         self.film_stop.setToolTip("stop the film render; finished frames are kept")
         self.film_stop.clicked.connect(self.stop_film)
         self.film_stop.setEnabled(False)
         self.film_progress = QProgressBar(self)
-        self.film_progress.setRange(0, 1)
+        self.film_progress.setRange(0, 1000)
         self.film_progress.setValue(0)
-        self.film_progress.setTextVisible(False)
+        self.film_progress.setFormat("%p%")
         self.film_progress.setMaximumWidth(160)
         self.film_status = QLabel("", self)
 
@@ -239,6 +236,10 @@ class TimelinePanel(QWidget):
 
         self.play_timer = QTimer(self)
         self.play_timer.timeout.connect(self._play_tick)
+        self.film_timer = QTimer(self)
+        self.film_timer.setInterval(100)
+        self.film_timer.timeout.connect(self._film_tick)
+        window.installEventFilter(self)
 
         self.doc.changed.connect(self._scene_changed)
         self.doc.reset.connect(self._scene_reset)
@@ -460,13 +461,10 @@ class TimelinePanel(QWidget):
             path = path.with_suffix(".gif" if "gif" in chosen.lower() else ".mp4")
         return path
 
-    def animate_command(self, scene_path: Path, output: Path) -> list[str]:
-        """The command that renders the film (``whitted animate SCENE -o OUTPUT``)."""
-        return [sys.executable, "-m", "whitted", "animate", str(scene_path), "-o", str(output)]
-
     def render_animation(self, output: Path | None = None) -> bool:
-        """Save the scene (asking where, if it has no file), then render its film in a
-        separate process; False when cancelled or already running."""
+        """Save the scene (asking where, if it has no file), then render its film on a
+        background thread (:class:`~whitted.gui.film_job.FilmJob`: the frames and the film
+        ``whitted animate`` makes); False when cancelled or already running."""
         if self.film is not None:
             return False
         window = self.window_
@@ -481,23 +479,22 @@ class TimelinePanel(QWidget):
         if output is None:
             return False
         output = Path(output)
-        if output.resolve() == Path(self.doc.path).resolve():
-            window.show_error("Cannot render the animation", "the film would write over the "
-                              "scene file")
+        try:
+            scene = load_scene(self.doc.path)  # what the file holds, as the command reads it
+            if output.resolve() == Path(self.doc.path).resolve():
+                raise ValueError("the film would write over the scene file")
+            job = FilmJob(scene, output)
+            job.start()
+        except (WhittedError, ValueError, OSError) as exc:
+            window.show_error("Cannot render the animation", str(exc))
             return False
-        command = self.animate_command(Path(self.doc.path), output)
-        process = QProcess(self)
-        process.setProcessChannelMode(QProcess.ProcessChannelMode.MergedChannels)
-        process.setWorkingDirectory(str(Path(self.doc.path).parent))
-        process.readyRead.connect(self._film_output)
-        process.finished.connect(self._film_done)
-        process.errorOccurred.connect(self._film_error)
-        self.film, self.film_path, self.film_log = process, output, []
-        self.film_progress.setRange(0, 0)  # busy: only the exit status is read
+        self.film = job
+        self.film_progress.setRange(0, 1000)
+        self.film_progress.setValue(0)
         self.film_status.setText(f"Rendering {output.name}…")
         self.film_button.setEnabled(False)
         self.film_stop.setEnabled(True)
-        process.start(command[0], command[1:])
+        self.film_timer.start()
         return True
 
     @property
@@ -505,49 +502,60 @@ class TimelinePanel(QWidget):
         return self.film is not None
 
     def stop_film(self) -> None:
-        """Interrupt the film render as Ctrl-C does: finished frames stay on disk."""
-        process = self.film
-        if process is None:
-            return
-        pid = process.processId()
-        if pid and hasattr(signal, "SIGINT") and os.name == "posix":
-            os.kill(pid, signal.SIGINT)
-        else:
-            process.terminate()
-        self.film_status.setText("Stopping…")
-        self.film_stop.setEnabled(False)
+        """Stop the film render after the tiles in flight: finished frames stay on disk, and
+        the next run (or ``whitted animate``) continues from them."""
+        if self.film is not None:
+            self.film.stop()
+            self.film_status.setText("Stopping…")
+            self.film_stop.setEnabled(False)
 
-    def _film_output(self) -> None:
-        if self.film is None:
+    def _film_tick(self) -> None:
+        job = self.film
+        if job is None:
+            self.film_timer.stop()
             return
-        text = bytes(self.film.readAll().data()).decode("utf-8", "replace")
-        lines = [line.strip() for line in text.replace("\r", "\n").splitlines()
-                 if line.strip()]
-        if lines:
-            self.film_log = (self.film_log + lines)[-20:]
-            self.film_status.setText(lines[-1][:120])
-
-    def _film_done(self, code: int, status) -> None:
-        self._film_output()
-        path = self.film_path
+        self.film_progress.setValue(round(job.fraction * 1000))
+        if not job.finished:
+            if job.encoding:
+                self.film_status.setText(f"Encoding {job.output.name}…")
+            elif job.frame is not None and not job.cancel.cancelled:
+                eta = job.eta
+                left = "" if eta is None else f", {_duration(eta)} left"
+                self.film_status.setText(f"frame {job.frame + 1}/{job.total} "
+                                         f"({job.fraction:.0%}{left})")
+            return
+        self.film_timer.stop()
         self.film = None
-        self.film_progress.setRange(0, 1)
         self.film_stop.setEnabled(False)
         self._update_controls()
-        ok = code == 0 and status == QProcess.ExitStatus.NormalExit
-        self.film_progress.setValue(1 if ok else 0)
-        if ok:
-            self.film_status.setText(f"Wrote {path}")
-            self._status(f"Rendered the animation to {path}", 8000)
+        kept = f", {job.kept} already done" if job.kept else ""
+        if job.error is not None:
+            self.film_status.setText("Failed")
+            self.window_.show_error("The animation did not finish", job.error)
+        elif job.stopped:
+            self.film_status.setText(f"Stopped: {job.done} of {job.total} frames kept in "
+                                     f"{job.frames_dir}")
         else:
-            tail = "\n".join(self.film_log[-6:]) or f"exit status {code}"
-            self.film_status.setText(f"Stopped or failed (exit status {code})")
-            self.window_.show_error("The animation did not finish", tail)
+            self.film_progress.setValue(1000)
+            self.film_status.setText(f"Wrote {job.output} ({job.total} frames{kept}, "
+                                     f"{_duration(job.seconds)})")
+            self._status(f"Rendered the animation to {job.output}", 8000)
+        self.film_done.emit(job)
 
-    def _film_error(self, error) -> None:
-        if error == QProcess.ProcessError.FailedToStart and self.film is not None:
-            self.film_log.append(f"cannot start {self.film.program()}")
-            self._film_done(-1, QProcess.ExitStatus.CrashExit)
+    def _window_closing(self) -> None:
+        if self.film is not None and not self.window_.isVisible():
+            self.film.stop()  # the window is gone: finish nothing more
+
+    def eventFilter(self, watched, event) -> bool:  # noqa: N802 - Qt's name
+        if watched is self.window_ and event.type() == QEvent.Type.Close:
+            QTimer.singleShot(0, self._window_closing)  # after the close was accepted
+        return False
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 60:
+        return f"{seconds:.0f} s"
+    return f"{int(seconds // 60)} min {int(seconds % 60):02d} s"
 
 
 def _forget_typing(box: QSpinBox | QDoubleSpinBox) -> None:
