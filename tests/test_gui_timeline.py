@@ -163,6 +163,15 @@ def test_i_keys_the_selection_at_the_frame_and_undo_removes_the_key(open_rolling
     qtbot.keyClick(window.viewport, Qt.Key.Key_Z, CTRL | SHIFT)
     assert [k[0] for k in window.doc.scene.animation.tracks[0].keys] == [0, 3, 7]
 
+    # an edit not keyed gives way to the track when the frame changes, and says so
+    click_tree(qtbot, window.tree, BALL)
+    type_into(qtbot, window.properties.row("center").editor.lines[2], "-1")
+    # (the panel shows 6 digits and commits x as shown)
+    assert window.doc.scene.objects[1].center == pytest.approx((ball_x(6), 0.8, -1.0), abs=1e-5)
+    click_frame(qtbot, timeline, 5)
+    assert window.doc.scene.objects[1].center == pytest.approx((ball_x(5), 0.8, 0.0))
+    assert "objects[ball].center was not keyed" in window.statusBar().currentMessage()
+
     # typing an "i" in a text field types it: no key
     window.select(BALL)
     before = window.doc.scene.animation

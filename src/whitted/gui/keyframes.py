@@ -148,6 +148,24 @@ def posed(scene: Scene, frame: int) -> Scene:
     return out
 
 
+def unkeyed_edits(scene: Scene, frame: int) -> list[str]:
+    """The tracks (their paths) whose value in ``scene``, posed at ``frame``, was edited
+    since and not keyed: the frame's pose would replace those edits."""
+    if scene.animation is None:
+        return []
+    out = []
+    for i, track in enumerate(scene.animation.tracks):
+        steps = _posable(scene, track)
+        if steps is None:
+            continue
+        current = get_value(scene, steps)
+        value = track_value(scene, i, frame)
+        if _plain(current) != _plain(value) and not (
+                current is None and _is_default(scene, steps, value)):
+            out.append(track.path)
+    return out
+
+
 def _is_default(scene: Scene, steps: tuple, value: Any) -> bool:
     """Whether ``value`` is what an unset field (None) at ``steps`` reads as."""
     try:
@@ -187,4 +205,4 @@ def key_frames(scene: Scene) -> list[float]:
 
 
 __all__ = ["NEW_FPS", "NEW_FRAMES", "frame_still", "insert_keys", "key_frames", "key_targets",
-           "posed", "track_paths"]
+           "posed", "track_paths", "unkeyed_edits"]

@@ -55,6 +55,7 @@ from .keyframes import (
     key_frames,
     key_targets,
     posed,
+    unkeyed_edits,
 )
 from .messages import friendly_message
 
@@ -275,6 +276,10 @@ class TimelinePanel(QWidget):
         frame = max(0, min(int(frame), self.frame_count - 1))
         if frame == self.frame:
             return
+        lost = self._unkeyed()
+        if lost:
+            self._status(f"The edit of {', '.join(lost)} was not keyed: frame {frame} shows "
+                         "the track's value (I keys an edit at its frame)", 10_000)
         self.frame = frame
         self._sync_frame_widgets()
         self._pose()
@@ -286,6 +291,15 @@ class TimelinePanel(QWidget):
                 widget.blockSignals(True)
                 widget.setValue(self.frame)
                 widget.blockSignals(False)
+
+    def _unkeyed(self) -> list[str]:
+        scene = self.doc.scene
+        if scene.animation is None or self.playing:
+            return []
+        try:
+            return unkeyed_edits(scene, min(self.frame, scene.frame_count - 1))
+        except (ValueError, WhittedError):
+            return []
 
     def _pose(self) -> None:
         """Set the values the tracks drive to this frame's (no undo step), and show it."""
