@@ -535,8 +535,7 @@ class TimelinePanel(QWidget):
             elif job.frame is not None and not job.cancel.cancelled:
                 eta = job.eta
                 left = "" if eta is None else f", {_duration(eta)} left"
-                self.film_status.setText(f"frame {job.frame + 1}/{job.total} "
-                                         f"({job.fraction:.0%}{left})")
+                self.film_status.setText(f"frame {job.frame + 1}/{job.total}{left}")
             return
         self.film_timer.stop()
         self.film = None
