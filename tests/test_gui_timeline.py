@@ -234,9 +234,11 @@ def test_play_advances_frames_and_stop_stops(open_rolling, qtbot):
     timeline.frame_changed.connect(seen.append)
     qtbot.mouseClick(timeline.play_button, LEFT)
     assert timeline.playing and timeline.play_button.text().endswith("Stop")
+    assert window.controller.interacting  # coarse previews while playing
     qtbot.waitUntil(lambda: len(seen) >= 10, timeout=5000)  # 24 fps, eight frames: loops
     qtbot.mouseClick(timeline.play_button, LEFT)
     assert not timeline.playing and timeline.play_button.text().endswith("Play")
+    assert not window.controller.interacting  # the frame stopped at refines
     assert seen[:10] == [1, 2, 3, 4, 5, 6, 7, 0, 1, 2]
     stopped = timeline.frame
     qtbot.wait(200)

@@ -177,6 +177,8 @@ class TimelinePanel(QWidget):
         self.slider = KeySlider(self)
         self.slider.setToolTip("the frame the picture shows (keys are marked)")
         self.slider.valueChanged.connect(self.set_frame)
+        self.slider.sliderPressed.connect(lambda: self._interacting(True))  # scrubbing
+        self.slider.sliderReleased.connect(lambda: self._interacting(self.playing))
         self.frame_box = QSpinBox(self)
         self.frame_box.setPrefix("frame ")
         self.frame_box.setToolTip("the current frame")
@@ -444,10 +446,19 @@ class TimelinePanel(QWidget):
             return
         self.play_timer.start(max(1, round(1000 / anim.fps)))
         self.play_button.setText("■ Stop")
+        self._interacting(True)  # coarse, fast previews while playing
 
     def stop(self) -> None:
+        was_playing = self.playing
         self.play_timer.stop()
         self.play_button.setText("▶ Play")
+        if was_playing:
+            self._interacting(False)  # the frame stopped at refines to full size
+
+    def _interacting(self, on: bool) -> None:
+        set_interacting = getattr(self.window_.controller, "set_interacting", None)
+        if set_interacting is not None:
+            set_interacting(on)
 
     def toggle_play(self) -> None:
         if self.playing:
