@@ -163,6 +163,17 @@ def test_i_keys_the_selection_at_the_frame_and_undo_removes_the_key(open_rolling
     qtbot.keyClick(window.viewport, Qt.Key.Key_Z, CTRL | SHIFT)
     assert [k[0] for k in window.doc.scene.animation.tracks[0].keys] == [0, 3, 7]
 
+    # Alt+I deletes the ball's keys at frame 3 (its transform track, left empty, goes)
+    click_frame(qtbot, timeline, 3)
+    click_tree(qtbot, window.tree, BALL)
+    qtbot.keyClick(window.tree, Qt.Key.Key_I, Qt.KeyboardModifier.AltModifier)
+    tracks = window.doc.scene.animation.tracks
+    assert [t.path for t in tracks] == ["objects[ball].center"]
+    assert [k[0] for k in tracks[0].keys] == [0, 7]
+    qtbot.keyClick(window.tree, Qt.Key.Key_Z, CTRL)
+    assert [k[0] for k in window.doc.scene.animation.tracks[0].keys] == [0, 3, 7]
+    click_frame(qtbot, timeline, 6)
+
     # an edit not keyed gives way to the track when the frame changes, and says so
     click_tree(qtbot, window.tree, BALL)
     type_into(qtbot, window.properties.row("center").editor.lines[2], "-1")

@@ -114,6 +114,29 @@ def insert_keys(scene: Scene, targets: list[tuple[str, Any]], frame: int,
     return Scene(**fields).with_base_dir(getattr(scene, "_base_dir", None))
 
 
+def delete_keys(scene: Scene, targets: list[tuple[str, Any]], frame: int) -> Scene:
+    """``scene`` without the keys at ``frame`` of the tracks that drive ``targets``' values;
+    a track left without keys goes (the value keeps what the frame showed). The same scene
+    when there is no such key."""
+    if scene.animation is None:
+        return scene
+    tracks = []
+    for track in scene.animation.tracks:
+        if any(_same_target(scene, track.path, path) for path, _ in targets):
+            keys = [[f, v] for f, v in track.keys if float(f) != float(frame)]
+            if len(keys) == len(track.keys):
+                tracks.append(track)
+            elif keys:
+                tracks.append(Track(track.path, keys, interpolation=track.interpolation))
+        else:
+            tracks.append(track)
+    if tracks == scene.animation.tracks:
+        return scene
+    fields = {name: getattr(scene, name) for name in Scene.model_fields}
+    fields["animation"] = scene.animation.model_copy(update={"tracks": tracks})
+    return Scene(**fields).with_base_dir(getattr(scene, "_base_dir", None))
+
+
 def _posable(scene: Scene, track: Track) -> tuple | None:
     """The resolved path of a track that posing may write into the scene's own values, or
     None: a path through an object's ``material`` is left to ``at_frame`` (setting it would
@@ -204,5 +227,5 @@ def key_frames(scene: Scene) -> list[float]:
     return sorted({float(f) for t in scene.animation.tracks for f, _ in t.keys})
 
 
-__all__ = ["NEW_FPS", "NEW_FRAMES", "frame_still", "insert_keys", "key_frames", "key_targets",
-           "posed", "track_paths", "unkeyed_edits"]
+__all__ = ["NEW_FPS", "NEW_FRAMES", "delete_keys", "frame_still", "insert_keys", "key_frames",
+           "key_targets", "posed", "track_paths", "unkeyed_edits"]

@@ -50,6 +50,7 @@ from .film_job import FilmJob
 from .keyframes import (
     NEW_FPS,
     NEW_FRAMES,
+    delete_keys,
     frame_still,
     insert_keys,
     key_frames,
@@ -406,6 +407,23 @@ class TimelinePanel(QWidget):
         self._status(f"Keyed {name} ({paths}) at frame {self.frame}")
         return True
 
+    def delete_key(self) -> bool:
+        """Remove the selection's keys at the current frame (one undo step)."""
+        scene = self.doc.scene
+        targets = key_targets(scene, self.doc.selection)
+        try:
+            new = delete_keys(scene, targets, self.frame)
+        except (ValidationError, ValueError, WhittedError) as exc:
+            self._status(f"Cannot delete the key: {exc}")
+            return False
+        name = label_of(self.doc.item()) if targets else "the selection"
+        if new is scene or not self.doc.apply(new, f"Delete key: {name} at frame "
+                                                   f"{self.frame}"):
+            self._status(f"{name} has no key at frame {self.frame}")
+            return False
+        self._status(f"Deleted the key of {name} at frame {self.frame}")
+        return True
+
     def _edit_animation(self, text: str, merge: str, **update) -> None:
         scene = self.doc.scene
         anim = scene.animation or Animation(frames=NEW_FRAMES, fps=NEW_FPS)
@@ -613,6 +631,8 @@ def attach_timeline(window: MainWindow) -> TimelinePanel:
 
     panel.act_key = action("&Insert key", panel.insert_key, "I",
                            "key the selected item's placement (or the camera) at this frame")
+    panel.act_delete_key = action("&Delete key", panel.delete_key, "Alt+I",
+                                  "remove the selection's keys at this frame")
     panel.act_play = action("&Play / Stop", panel.toggle_play, None,
                             "play the preview of the animation")
     panel.act_film = action("&Render animation…", lambda: panel.render_animation(), None,
@@ -622,7 +642,7 @@ def attach_timeline(window: MainWindow) -> TimelinePanel:
     if help_menu is not None:  # before Help, where menus usually end
         window.menuBar().removeAction(menu.menuAction())
         window.menuBar().insertMenu(help_menu, menu)
-    menu.addActions([panel.act_key, panel.act_play])
+    menu.addActions([panel.act_key, panel.act_delete_key, panel.act_play])
     menu.addSeparator()
     menu.addAction(panel.act_film)
     menu.addSeparator()
