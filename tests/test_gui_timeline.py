@@ -183,6 +183,13 @@ def test_i_keys_the_selection_at_the_frame_and_undo_removes_the_key(open_rolling
     assert window.doc.scene.objects[1].center == pytest.approx((ball_x(5), 0.8, 0.0))
     assert "objects[ball].center was not keyed" in window.statusBar().currentMessage()
 
+    # with the focus on a slider of the properties panel, I keys (one more key at frame 5)
+    slider = window.properties.row("material", "kr").editor.slider
+    qtbot.mouseClick(slider, LEFT, NO_MOD, QPoint(2, slider.height() // 2))
+    assert slider.hasFocus()
+    qtbot.keyClick(slider, Qt.Key.Key_I)
+    assert 5 in [k[0] for k in window.doc.scene.animation.tracks[0].keys]
+
     # typing an "i" in a text field types it: no key
     window.select(BALL)
     before = window.doc.scene.animation
@@ -379,3 +386,19 @@ def test_saving_writes_the_animation_table_compactly_and_reads_it_back(rolling):
     still = scene.model_copy(update={"animation": None})
     assert "animation" not in scene_toml(still, text=ROLLING_BALL, loaded=scene)
     assert scene_toml(scene, text=ROLLING_BALL, loaded=scene) == ROLLING_BALL
+
+
+def test_saving_edits_frames_and_keys_of_the_animation_table_in_place(rolling):
+    from whitted.gui.keyframes import insert_keys
+    from whitted.scene.toml_document import scene_toml
+
+    scene = whitted.load_scene(rolling)
+    longer = scene.with_animation(12, 30, scene.animation.tracks)
+    keyed = insert_keys(longer, [("objects[ball].center", [0, 2, 0])], 10)
+    text = scene_toml(keyed, text=ROLLING_BALL, loaded=scene)
+    expected = ROLLING_BALL.replace("frames = 8\nfps = 24", "frames = 12\nfps = 30.0").replace(
+        "  [7, [1.5, 0.8, 0]],\n", "  [7, [1.5, 0.8, 0]],\n  [10, [0, 2, 0]],\n")
+    assert text == expected
+    unkeyed = scene.with_animation(8, 24, [])
+    text = scene_toml(unkeyed, text=ROLLING_BALL, loaded=scene)
+    assert "[[animation.tracks]]" not in text and "frames = 8" in text
