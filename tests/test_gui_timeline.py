@@ -402,3 +402,38 @@ def test_saving_edits_frames_and_keys_of_the_animation_table_in_place(rolling):
     unkeyed = scene.with_animation(8, 24, [])
     text = scene_toml(unkeyed, text=ROLLING_BALL, loaded=scene)
     assert "[[animation.tracks]]" not in text and "frames = 8" in text
+
+
+def test_tracks_follow_their_object_through_rename_duplicate_and_delete(open_rolling, qtbot):
+    window = open_rolling(preview=False, warm_up=False)
+    tree = window.tree
+    click_tree(qtbot, tree, BALL)
+    type_into(qtbot, window.properties.row("name").editor.line, "bowl")
+    assert window.doc.scene.objects[1].name == "bowl"
+    assert window.doc.scene.animation.tracks[0].path == "objects[bowl].center"
+
+    click_tree(qtbot, tree, ("objects", 0))
+    qtbot.keyClick(tree, Qt.Key.Key_D, CTRL)  # the floor's copy goes before the bowl
+    assert [o.name for o in window.doc.scene.objects] == ["floor", "floor copy", "bowl"]
+    assert window.doc.scene.at_frame(7).objects[2].center == (1.5, 0.8, 0.0)
+
+    click_tree(qtbot, tree, ("objects", 2))
+    qtbot.keyClick(tree, Qt.Key.Key_Delete)  # its track goes with it
+    assert len(window.doc.scene.objects) == 2 and window.doc.scene.animation.tracks == []
+    qtbot.keyClick(tree, Qt.Key.Key_Z, CTRL)
+    assert window.doc.scene.animation.tracks[0].path == "objects[bowl].center"
+
+
+def test_a_track_by_index_follows_its_item_when_the_list_moves(rolling):
+    from whitted.animation import Track
+    from whitted.gui.keyframes import tracks_following_items
+
+    scene = whitted.load_scene(rolling)
+    scene = scene.with_animation(8, 24, [Track("objects[1].center", {0: [0, 1, 0]}),
+                                         Track("lights[lamp].intensity", {0: 0.5})])
+    floor, ball = scene.objects
+    anim = tracks_following_items(scene, {"objects": [floor.model_copy(), floor, ball]})
+    assert [t.path for t in anim.tracks] == ["objects[2].center", "lights[lamp].intensity"]
+    assert tracks_following_items(scene, {"objects": [floor, ball]}) is None
+    anim = tracks_following_items(scene, {"lights": [scene.lights[0]]})  # the lamp deleted
+    assert [t.path for t in anim.tracks] == ["objects[1].center"]

@@ -19,7 +19,14 @@ from typing import Any
 from pydantic import BaseModel
 
 from ..animation.model import Animation, Interpolation, Track
-from ..animation.paths import PathError, format_path, get_value, resolve_path, set_value
+from ..animation.paths import (
+    PathError,
+    format_path,
+    get_value,
+    parse_path,
+    resolve_path,
+    set_value,
+)
 from ..animation.timeline import scene_at_frame, track_value
 from ..scene import Scene
 from ..scene.types import Transform
@@ -137,6 +144,53 @@ def delete_keys(scene: Scene, targets: list[tuple[str, Any]], frame: int) -> Sce
     return Scene(**fields).with_base_dir(getattr(scene, "_base_dir", None))
 
 
+def tracks_following_items(scene: Scene, update: dict[str, Any]) -> Animation | None:
+    """The animation of ``scene`` for the scene that ``update`` (new ``objects`` or
+    ``lights`` lists) makes of it: a track keeps driving the same item when items are
+    renamed, duplicated, added or moved (its path says the item's new name or index), and
+    goes with an item that is deleted. None when nothing changes."""
+    anim = scene.animation
+    if anim is None or not any(kind in update for kind in ("objects", "lights")):
+        return None
+    tracks, changed = [], False
+    for track in anim.tracks:
+        steps = _item_steps(track.path)
+        if steps is None or steps[0].key not in update:
+            tracks.append(track)
+            continue
+        kind = str(steps[0].key)
+        old_items, new_items = getattr(scene, kind), list(update[kind])
+        try:
+            index = resolve_path(scene, steps[:2])[1].key
+        except PathError:
+            tracks.append(track)
+            continue
+        item = old_items[index]
+        moved = next((j for j, it in enumerate(new_items) if it is item), None)
+        if moved is None and len(new_items) == len(old_items):
+            moved = index  # edited in place (a rename, a new value)
+        if moved is None:
+            changed = True  # the item was deleted: its tracks go with it
+            continue
+        ref = _item_ref(new_items, moved) if isinstance(steps[1].key, str) else f"[{moved}]"
+        path = str(steps[0].key) + ref + "".join(str(step) for step in steps[2:])
+        changed = changed or path != track.path
+        tracks.append(track if path == track.path else track.model_copy(update={"path": path}))
+    if not changed:
+        return None
+    return anim.model_copy(update={"tracks": tracks})
+
+
+def _item_steps(path: str) -> tuple | None:
+    try:
+        steps = parse_path(path)
+    except PathError:
+        return None
+    if len(steps) < 2 or steps[0].key not in ("objects", "lights") or not steps[1].item:
+        return None
+    return steps
+
+
 def _posable(scene: Scene, track: Track) -> tuple | None:
     """The resolved path of a track that posing may write into the scene's own values, or
     None: a path through an object's ``material`` is left to ``at_frame`` (setting it would
@@ -228,4 +282,4 @@ def key_frames(scene: Scene) -> list[float]:
 
 
 __all__ = ["NEW_FPS", "NEW_FRAMES", "delete_keys", "frame_still", "insert_keys", "key_frames",
-           "key_targets", "posed", "track_paths", "unkeyed_edits"]
+           "key_targets", "posed", "track_paths", "tracks_following_items", "unkeyed_edits"]

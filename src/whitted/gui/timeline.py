@@ -339,13 +339,15 @@ class TimelinePanel(QWidget):
         stack = self.doc.undo_stack
         previous, self._stack_index = self._stack_index, index
         try:
-            if index == previous or stack.count() == 0:
+            if stack.count() == 0:  # cleared: a new scene, which the reset poses
                 return
+            command = stack.command(index - 1) if index > 0 else None
         except RuntimeError:  # the window is going away
             return
-        command = stack.command(index - 1) if index > 0 else None
-        if index > previous and command is not None and not getattr(command, "_seen", False):
-            command._seen = True  # a new edit (push)
+        fresh = command is not None and not getattr(command, "_seen", False)
+        if fresh:
+            command._seen = True  # a new edit (a push; at the undo limit the index stays)
+        if index == previous or (index > previous and fresh):
             return
         self._pose()
 
