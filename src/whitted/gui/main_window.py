@@ -44,6 +44,7 @@ from .picking import IdBuffer, id_at, outline_image
 from .properties import PropertyPanel
 from .recent import RecentFiles
 from .render_controller import RenderController
+from .timeline import attach_timeline
 from .transform_tool import TransformTool, light_position, object_bounds, object_centre
 from .tree import SceneTree
 from .viewport import Viewport
@@ -107,6 +108,7 @@ class MainWindow(QMainWindow):
         self._make_actions()
         self._make_menus()
         self._make_toolbar()
+        self.timeline = attach_timeline(self)  # frames of an animated scene, keys, films
 
         self.doc.changed.connect(self._scene_changed)
         self.doc.path_changed.connect(self._update_title)
@@ -138,7 +140,7 @@ class MainWindow(QMainWindow):
         if warm_up:
             self.viewport.caption = "Loading the render kernels (the first run compiles them)…"
             self.controller.warm_up()
-        self.controller.request_preview(self.doc.scene)
+        self.controller.request_preview(self.timeline.still(self.doc.scene))
 
     # ------------------------------------------------------------------ layout
 
@@ -567,7 +569,7 @@ class MainWindow(QMainWindow):
         if not (0 <= u <= 1 and 0 <= v <= 1):
             return None
         try:
-            ids = self.ids.ids_for(self.doc.scene)
+            ids = self.ids.ids_for(self.timeline.still(self.doc.scene))
         except WhittedError as exc:
             self.statusBar().showMessage(f"Cannot pick: {exc}", 4000)
             return None
@@ -648,11 +650,11 @@ class MainWindow(QMainWindow):
     def _update_outline(self) -> None:
         """The selected object's outline over the picture (from the current id image)."""
         key = self.doc.selection
-        ids = self.ids.ids if self.ids.scene is self.doc.scene else None
+        ids = self.ids.ids if self.ids.scene is self.timeline.still(self.doc.scene) else None
         if key is None or key[0] != "objects":
             outline = None
         elif ids is None:
-            self.ids.request(self.doc.scene)
+            self.ids.request(self.timeline.still(self.doc.scene))
             return
         else:
             outline = outline_image(ids, key[1])
@@ -824,7 +826,7 @@ class MainWindow(QMainWindow):
 
     def _scene_changed(self, key=None) -> None:
         self._update_preview_target()
-        scene = self.doc.scene
+        scene = self.timeline.still(self.doc.scene)
         if self.doc.selection is not None and self.doc.selection[0] == "objects":
             self.ids.request(scene)  # the outline follows
         self.viewport.set_aspect(scene.render.width, scene.render.height)
@@ -836,7 +838,7 @@ class MainWindow(QMainWindow):
 
     def start_render(self) -> None:
         self.commit_pending_edit()
-        self.controller.render(self.doc.scene)
+        self.controller.render(self.timeline.still(self.doc.scene))
         self.progress.setValue(0)
         self.eta.setText("starting…")
         self._update_render_actions()
@@ -897,7 +899,7 @@ class MainWindow(QMainWindow):
     def _toggle_preview(self, on: bool) -> None:
         self.controller.preview_enabled = on
         if on:
-            self.controller.request_preview(self.doc.scene)
+            self.controller.request_preview(self.timeline.still(self.doc.scene))
 
 
 def catalog_model_filter() -> str:
