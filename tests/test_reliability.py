@@ -701,7 +701,11 @@ def test_d8_bit_depth_16_png_from_the_command_line(tmp_path: Path):
     lambda: whitted.Box(min=[0, 0, 0], max=[0, 1, 1]),
     lambda: whitted.Scene.model_validate({"objects": [{"type": "cube"}]}),
     lambda: whitted.load_scene("/nonexistent/scene.toml"),
-], ids=["radius", "unknown-key", "width", "preset", "box", "model-validate", "load"])
+    lambda: whitted.DirectionalLight(direction=[1e200, 0, 0]),
+    lambda: whitted.Sphere(radius=1e300),
+    lambda: whitted.Material(preset=["glass"]),
+], ids=["radius", "unknown-key", "width", "preset", "box", "model-validate", "load",
+        "direction-1e200", "radius-1e300", "preset-list"])
 def test_e_bad_values_raise_whitted_errors(make):
     with pytest.raises(WhittedError) as info:
         make()

@@ -19,6 +19,7 @@ from pydantic import BaseModel, ValidationError
 from ..errors import SceneError, shorten
 from .materials import Material
 from .scene import Scene
+from .types import MAX_MAGNITUDE
 
 SCENE_SUFFIXES = (".toml", ".json")
 
@@ -35,8 +36,6 @@ _SHAPE_AND_LIGHT_TAGS = {
 MAX_SCENE_BYTES = 256 << 20
 #: Deepest nesting of tables and lists a scene file may use (the schema needs about 8).
 MAX_NESTING = 64
-#: Largest magnitude of a number in a scene file: beyond it squares and products overflow.
-MAX_MAGNITUDE = 1e15
 
 
 def load_scene(path: str | Path) -> Scene:

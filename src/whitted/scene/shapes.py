@@ -10,7 +10,7 @@ import numpy as np
 from pydantic import BeforeValidator, Field, PlainSerializer, model_validator
 
 from .materials import Material
-from .types import Direction, Finite, Strict, Transform, Vec3
+from .types import MAX_MAGNITUDE, Direction, Finite, Strict, Transform, Vec3
 
 
 class _Shape(Strict):
@@ -205,6 +205,9 @@ def _array_of(columns: int, kind: str):
             raise ValueError(f"expected rows of {columns} numbers, got shape {a.shape}")
         if kind == "f" and not np.isfinite(a).all():
             raise ValueError("values must be finite")
+        if kind == "f" and a.size and np.abs(a).max() > MAX_MAGNITUDE:
+            raise ValueError(f"a value is too large (scene values are limited to "
+                             f"{MAX_MAGNITUDE:.0e} in magnitude)")
         return ArrayData(a.astype(np.float64 if kind == "f" else np.int64))
 
     return Annotated[

@@ -78,13 +78,41 @@ class Strict(BaseModel):
     @model_validator(mode="before")
     @classmethod
     def _lists_as_tuples(cls, data: Any) -> Any:
-        """Files hold lists where the model holds tuples (vectors, triangles): take them."""
+        """Files hold lists where the model holds tuples (vectors, triangles): take them.
+        Numbers beyond :data:`MAX_MAGNITUDE` are refused here, for every model (their squares
+        and products would overflow in the compiler)."""
         if not isinstance(data, dict):
             return data
+        for key, value in data.items():
+            big = _too_large(value)
+            if big is not None:
+                raise ValueError(f"{key}: number {big!r} is too large (scene values are limited "
+                                 f"to {MAX_MAGNITUDE:.0e} in magnitude)")
         names = _tuple_fields(cls)
         if not names or not any(isinstance(data.get(n), list) for n in names):
             return data
         return {k: (_as_tuple(v) if k in names else v) for k, v in data.items()}
+
+
+#: Largest magnitude of a number in a scene: beyond it squares and products overflow.
+MAX_MAGNITUDE = 1e15
+
+
+def _too_large(value: Any, depth: int = 0) -> float | int | None:
+    """The first number in ``value`` (a number or a short list of them, nested twice at most)
+    whose magnitude exceeds :data:`MAX_MAGNITUDE`; None if there is none. Non-finite numbers
+    are left to the fields' own checks."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, int | float | np.integer | np.floating):
+        magnitude = abs(float(value)) if not isinstance(value, int) else abs(value)
+        return value if math.isfinite(magnitude) and magnitude > MAX_MAGNITUDE else None
+    if isinstance(value, list | tuple) and depth < 2 and len(value) <= 64:
+        for item in value:
+            big = _too_large(item, depth + 1)
+            if big is not None:
+                return big
+    return None
 
 
 def _as_tuple(value: Any) -> Any:
