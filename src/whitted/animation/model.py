@@ -40,7 +40,9 @@ class Track(Strict):
     @classmethod
     def _keys_from_dict(cls, value: Any) -> Any:
         if isinstance(value, dict):
-            return [[float(k) if isinstance(k, str) else k, v] for k, v in value.items()]
+            return [(float(k) if isinstance(k, str) else k, v) for k, v in value.items()]
+        if isinstance(value, list | tuple):  # files hold [frame, value] lists: pairs
+            return [tuple(pair) if isinstance(pair, list) else pair for pair in value]
         return value
 
     @field_validator("keys")
