@@ -332,6 +332,7 @@ def test_tracks_from_python(scene_file):
         scene.with_animation(3, tracks=[Track("camera.fob", {0: 30})])
     saved = animated.save(scene_file.with_name("saved.toml"))
     assert whitted.load_scene(saved).animation == animated.animation
+    assert "    [4, [0, 90, 0]],\n" in saved.read_text()  # one key per line
 
 
 def test_mesh_sequence_names_each_frames_file(tmp_path):
