@@ -75,6 +75,13 @@ def test_each_level_of_reuse_renders_what_a_fresh_compile_renders(tmp_path):
     moved, level = cache.compile(camera_only)
     assert level in ("bvh", "none")
     assert np.array_equal(_pixels(camera_only, moved), _pixels(camera_only))
+    dimmer = camera_only.model_copy(update={"lights": [
+        camera_only.lights[0].model_copy(update={"intensity": 0.4, "color": (1, 0.5, 0.2)})]})
+    kept, level = cache.compile(dimmer)
+    assert level == "light buffers"
+    assert kept.lights.buffer_cells is moved.lights.buffer_cells
+    assert np.array_equal(_pixels(dimmer, kept), _pixels(dimmer))
+    assert not np.array_equal(_pixels(dimmer), _pixels(camera_only))
 
 
 def test_a_mesh_keeps_its_bvh_when_another_object_moves(tmp_path):
