@@ -12,6 +12,7 @@ from ._cache import configure_kernel_cache
 
 configure_kernel_cache()  # before any kernel module imports numba
 
+from .animation import Animation, Track
 from .errors import SceneError, WhittedError
 from .output import Image
 from .render import CancelToken, Progress, RenderJob, RenderStats, render, render_aovs
@@ -52,6 +53,7 @@ except PackageNotFoundError:  # running from a source tree without installing
     __version__ = "0+unknown"
 
 __all__ = [
+    "Animation", "Track",
     "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera", "CancelToken",
     "CheckerTexture", "Cone", "Cylinder", "DirectionalLight", "Disk", "DiskLight", "Gradient",
     "GradientTexture", "Image", "ImageTexture", "Material", "Mesh", "Plane",

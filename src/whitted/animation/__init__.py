@@ -6,6 +6,7 @@ renders like any other scene. :func:`render_frame` (in :mod:`whitted.animation.f
 renders one frame to a PNG that records what it is a picture of, so a film can resume.
 """
 
+from .. import scene as _scene  # noqa: F401 - the scene model first: it holds an Animation
 from .model import Animation, Track
 from .overrides import apply_overrides, parse_assignment, parse_value, parse_values
 from .paths import PathError, get_value, parse_path, resolve_path, set_value
