@@ -41,8 +41,8 @@ class Track(Strict):
     def _keys_from_dict(cls, value: Any) -> Any:
         if isinstance(value, dict):
             return [(float(k) if isinstance(k, str) else k, v) for k, v in value.items()]
-        if isinstance(value, list | tuple):  # files hold [frame, value] lists: pairs
-            return [tuple(pair) if isinstance(pair, list) else pair for pair in value]
+        if isinstance(value, list):  # [frame, value] pairs as a file writes them: tuples
+            return [tuple(k) if isinstance(k, list) else k for k in value]
         return value
 
     @field_validator("keys")
