@@ -381,3 +381,25 @@ def test_a_current_frame_is_not_rendered_again(scene_file, tmp_path):
     assert read_frame_digest(tmp_path / "f.png") == first.digest
     changed = render_frame(scene, 2, tmp_path / "f.png", samples=2)  # other settings
     assert changed.rendered and changed.digest != first.digest
+
+
+def test_cyclic_animation_runs_from_the_last_key_back_to_the_first(scene_file):
+    scene = whitted.load_scene(scene_file).model_copy(update={"animation": None})
+    tracks = [Track("lights[0].intensity", {0: 0.0, 6: 0.6})]
+    plain = scene.with_animation(12, tracks=tracks)
+    loop = plain.model_copy(update={"animation": plain.animation.model_copy(
+        update={"cyclic": True})})
+    assert plain.at_frame(9).lights[0].intensity == 0.6  # held after the last key
+    assert loop.at_frame(9).lights[0].intensity == pytest.approx(0.3)  # on its way back
+    assert loop.at_frame(3).lights[0].intensity == pytest.approx(0.3)
+
+
+def test_cyclic_spline_orbit_is_symmetric_round_the_loop():
+    scene = whitted.load_scene(Path(__file__).parents[1] / "examples" / "camera_orbit.toml")
+    assert scene.animation.cyclic
+    radius = [math.hypot(p[0], p[2]) for p in
+              (scene.at_frame(k).camera.position for k in range(48))]
+    assert max(abs(r - 9) for r in radius) < 0.02  # keys every 30 degrees: nearly a circle
+    a, b = scene.at_frame(3).camera.position, scene.at_frame(45).camera.position
+    assert a[0] == pytest.approx(-b[0]) and a[2] == pytest.approx(b[2])  # mirror images
+    assert radius[2] == pytest.approx(radius[46]) == pytest.approx(radius[14])

@@ -67,12 +67,16 @@ class Animation(Strict):
 
     frames: int = Field(ge=1, le=MAX_FRAMES)
     fps: float = Field(default=24.0, gt=0.0, le=1000.0)
+    #: the film loops: frame ``frames`` would be frame 0 again, so every track runs from its
+    #: last key back to its first (a camera orbit that plays seamlessly in a loop)
+    cyclic: bool = False
     tracks: list[Track] = Field(default_factory=list)
 
     def track(self, path: str, keys: Any, interpolation: Interpolation = "linear") -> Animation:
         """A copy with one more track (``keys``: ``{frame: value}`` or ``[(frame, value)]``)."""
         new = Track(path, keys, interpolation=interpolation)
-        return Animation(frames=self.frames, fps=self.fps, tracks=[*self.tracks, new])
+        return Animation(frames=self.frames, fps=self.fps, cyclic=self.cyclic,
+                         tracks=[*self.tracks, new])
 
 
 def animation_toml(data: dict[str, Any]) -> str:

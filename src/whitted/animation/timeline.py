@@ -10,6 +10,7 @@ rendered. The scene it came from is not changed.
 from __future__ import annotations
 
 import hashlib
+import math
 import re
 import string
 from dataclasses import dataclass
@@ -18,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 from pydantic import BaseModel
 
 from ..errors import SceneError
-from .interpolate import interpolate_tree
+from .interpolate import interpolate_tree, wrap_keys
 from .model import Track
 from .paths import PathError, Step, format_path, get_value, parse_path, resolve_path, set_value
 
@@ -123,7 +124,13 @@ def _prepare(scene: Scene, index: int, track: Track) -> _Ready:
         times.append(float(frame))
         values.append(_tree(get_value(keyed, steps)))
     name = steps[-1].key if isinstance(steps[-1].key, str) else None
+    if scene.animation is not None and scene.animation.cyclic:
+        times, values = wrap_keys(times, values, float(frames))
     return _Ready(steps, written, times, values, track.interpolation, name)
+
+
+def _value_at(ready: _Ready, frame: float) -> Any:
+    return interpolate_tree(ready.times, ready.values, frame, ready.interpolation, ready.name)
 
 
 def track_value(scene: Scene, track: Track | int, frame: float) -> Any:
@@ -131,7 +138,7 @@ def track_value(scene: Scene, track: Track | int, frame: float) -> Any:
     assert scene.animation is not None
     index = track if isinstance(track, int) else scene.animation.tracks.index(track)
     ready = _prepare(scene, index, scene.animation.tracks[index])
-    return interpolate_tree(ready.times, ready.values, frame, ready.interpolation, ready.name)
+    return _value_at(ready, frame)
 
 
 def check_animation(scene: Scene) -> None:
@@ -150,10 +157,10 @@ def check_animation(scene: Scene) -> None:
         ready = _prepare(scene, i, track)
         if ready.interpolation == "step" or len(ready.times) < 2:
             continue
-        first, last = int(ready.times[0]), int(ready.times[-1])
+        first = max(0, math.ceil(ready.times[0]))
+        last = min(scene.animation.frames - 1, math.floor(ready.times[-1]))
         for frame in range(first, last + 1):
-            value = interpolate_tree(ready.times, ready.values, frame, ready.interpolation,
-                                     ready.name)
+            value = _value_at(ready, frame)
             try:
                 set_value(scene, ready.written, value)
             except PathError as exc:
@@ -176,8 +183,7 @@ def scene_at_frame(scene: Scene, frame: int) -> Scene:
         for i, track in enumerate(scene.animation.tracks):
             try:
                 ready = _prepare(scene, i, track)
-                value = interpolate_tree(ready.times, ready.values, frame, ready.interpolation,
-                                         ready.name)
+                value = _value_at(ready, frame)
                 still = set_value(still, ready.steps, value)
             except (PathError, ValueError) as exc:
                 raise SceneError(f"frame {frame}: {exc}",
