@@ -13,6 +13,8 @@ import hashlib
 import math
 import re
 import string
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -129,6 +131,34 @@ def _prepare(scene: Scene, index: int, track: Track) -> _Ready:
     return _Ready(steps, written, times, values, track.interpolation, name)
 
 
+_PREPARED: OrderedDict[tuple, tuple[Scene, list[_Ready]]] = OrderedDict()
+_PREPARED_LOCK = threading.Lock()
+_KEEP = 4
+
+
+def _prepared(scene: Scene) -> list[_Ready]:
+    """Every track of ``scene`` checked and its keys normalised, remembered for the last few
+    scenes (a film asks for the same scene's tracks at every frame; normalising a key
+    validates it in the scene, so a track keyed at every frame would otherwise cost the
+    square of its length)."""
+    assert scene.animation is not None
+    key = (id(scene), id(scene.animation), id(scene.objects), id(scene.lights),
+           id(scene.materials), len(scene.objects), len(scene.lights),
+           tuple((id(t), id(t.keys), len(t.keys), t.path, t.interpolation)
+                 for t in scene.animation.tracks))
+    with _PREPARED_LOCK:
+        hit = _PREPARED.get(key)
+        if hit is not None and hit[0] is scene:
+            _PREPARED.move_to_end(key)
+            return hit[1]
+    ready = [_prepare(scene, i, t) for i, t in enumerate(scene.animation.tracks)]
+    with _PREPARED_LOCK:
+        _PREPARED[key] = (scene, ready)  # holding the scene keeps its id from being reused
+        while len(_PREPARED) > _KEEP:
+            _PREPARED.popitem(last=False)
+    return ready
+
+
 def _value_at(ready: _Ready, frame: float) -> Any:
     return interpolate_tree(ready.times, ready.values, frame, ready.interpolation, ready.name)
 
@@ -180,9 +210,12 @@ def scene_at_frame(scene: Scene, frame: int) -> Scene:
                          f"frame{'s' if n != 1 else ''})")
     still = scene
     if scene.animation is not None:
-        for i, track in enumerate(scene.animation.tracks):
+        try:
+            prepared = _prepared(scene)
+        except ValueError as exc:
+            raise SceneError(f"frame {frame}: {exc}") from None
+        for i, ready in enumerate(prepared):
             try:
-                ready = _prepare(scene, i, track)
                 value = _value_at(ready, frame)
                 still = set_value(still, ready.steps, value)
             except (PathError, ValueError) as exc:
