@@ -403,3 +403,57 @@ def test_cyclic_spline_orbit_is_symmetric_round_the_loop():
     a, b = scene.at_frame(3).camera.position, scene.at_frame(45).camera.position
     assert a[0] == pytest.approx(-b[0]) and a[2] == pytest.approx(b[2])  # mirror images
     assert radius[2] == pytest.approx(radius[46]) == pytest.approx(radius[14])
+
+
+# ------------------------------------------------------------------------------ properties
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+_keys = st.lists(st.tuples(st.integers(0, 60), st.floats(-100, 100)), min_size=1, max_size=8,
+                 unique_by=lambda k: k[0]).map(sorted)
+
+
+@settings(max_examples=60, deadline=None)
+@given(_keys, st.floats(0, 60))
+def test_every_mode_passes_through_its_keys_and_linear_smooth_stay_between(keys, t):
+    times = [float(k[0]) for k in keys]
+    values = [k[1] for k in keys]
+    for mode in ("step", "linear", "smooth", "spline"):
+        for k, v in zip(times, values, strict=True):
+            assert interpolate_scalar(times, values, k, mode) == pytest.approx(v, abs=1e-9)
+    for mode in ("linear", "smooth"):
+        x = interpolate_scalar(times, values, t, mode)
+        assert min(values) - 1e-9 <= x <= max(values) + 1e-9
+
+
+def _angle_between(a, b) -> float:
+    r = _matrix(a).T @ _matrix(b)
+    return math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(r) - 1) / 2))))
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.floats(-179, 179), min_size=3, max_size=3),
+       st.lists(st.floats(-179, 179), min_size=3, max_size=3),
+       st.sampled_from(["linear", "smooth"]))
+def test_rotations_turn_steadily_the_short_way(a, b, mode):
+    total = _angle_between(a, b)  # the short way, 0..180 degrees
+    steps = 8
+    frames = [interpolate_rotation([0, steps], [a, b], k, mode) for k in range(steps + 1)]
+    np.testing.assert_allclose(_matrix(frames[-1]), _matrix(b), atol=1e-9)
+    turned = sum(_angle_between(frames[k], frames[k + 1]) for k in range(steps))
+    assert turned == pytest.approx(total, abs=1e-5)  # no detour, no flip
+
+
+_names = st.text(st.characters(whitelist_categories=("L", "N"), whitelist_characters=" _-"),
+                 min_size=1, max_size=12).filter(lambda s: s.strip() == s and not s.isdigit())
+
+
+@settings(max_examples=60, deadline=None)
+@given(_names, st.integers(0, 999), st.sampled_from(["kt", "color", "rotate"]))
+def test_paths_read_back_as_written(name, index, leaf):
+    from whitted.animation.paths import format_path
+
+    for text in (f"objects[{name}].material.{leaf}", f"lights[{index}].{leaf}"):
+        steps = parse_path(text)
+        assert format_path(steps) == text and parse_path(format_path(steps)) == steps
