@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import whitted
 from whitted.animation import (
@@ -406,9 +408,6 @@ def test_cyclic_spline_orbit_is_symmetric_round_the_loop():
 
 
 # ------------------------------------------------------------------------------ properties
-
-from hypothesis import given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
 
 _keys = st.lists(st.tuples(st.integers(0, 60), st.floats(-100, 100)), min_size=1, max_size=8,
                  unique_by=lambda k: k[0]).map(sorted)
