@@ -223,7 +223,13 @@ def render(
         err.print(Text(f"warning: {warning}"))
     written = [str(output)]
     try:
-        image.save(output, bit_depth=bit_depth)
+        if frame is not None and not interrupted.is_set() and bit_depth == 8 \
+                and image_format(output) == "png":  # the very file the film's frame K is
+            from ..animation.frames import frame_digest, write_frame_png
+
+            write_frame_png(output, image, frame_digest(scene, frame), frame)
+        else:
+            image.save(output, bit_depth=bit_depth)
         if aovs and not interrupted.is_set():
             planes = render_aovs(scene)
             for path, aov_name in zip(outputs[1:], aovs, strict=True):
