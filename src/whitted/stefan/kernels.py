@@ -76,9 +76,10 @@ def _face(kc, kn, tn, tc):
 
 
 @njit(cache=True, inline="always")
-def _conduct_row(H, T, K, Hn, g, i, j):
+def _conduct_row(H, kind, T, K, Hn, Tn, Kn, p, g, i, j):
     """Hn = H + dt/dx² * sum over the six faces of k_face (T_nb - T): harmonic-mean face
-    conductivity; air and ghost neighbours (k = 0) add exactly zero."""
+    conductivity; air and ghost neighbours (k = 0) add exactly zero. Also the temperature
+    and conductivity of Hn (Tn, Kn), so a step needs no separate pass for them."""
     for k in range(1, H.shape[2] - 1):
         kc = K[i, j, k]
         tc = T[i, j, k]
@@ -89,6 +90,13 @@ def _conduct_row(H, T, K, Hn, g, i, j):
         s += _face(kc, K[i, j, k - 1], T[i, j, k - 1], tc)
         s += _face(kc, K[i, j, k + 1], T[i, j, k + 1], tc)
         Hn[i, j, k] = H[i, j, k] + g * s
+        if kind[i, j, k] == BODY:  # the next step's temperature and conductivity
+            h = Hn[i, j, k]
+            Tn[i, j, k] = _temperature(h, p)
+            Kn[i, j, k] = _conductivity(h, p)
+        else:
+            Tn[i, j, k] = 0.0
+            Kn[i, j, k] = 0.0
 
 
 @njit(cache=True, inline="always")
@@ -161,13 +169,10 @@ def _neighbour(i, j, k, face):
 
 
 @njit(cache=True, inline="always")
-def _surface_cell(H, kind, T, K, Hn, p, dt, dx, face_h, face_t, face_drain, air_h, air_t,
-                  cell, scale, out, m, rescale):
+def _surface_cell(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, face_drain, air_h,
+                  air_t, i, j, k, scale, out, m, rescale):
     """The boundary heat of one surface cell, added to Hn; drain if it is all liquid and a
     face drains. ``out[m]``: heat in (J/m² of face), drained (J/m³), breach signal, drains."""
-    i = cell[0]
-    j = cell[1]
-    k = cell[2]
     out[m, 0] = 0.0
     out[m, 1] = 0.0
     out[m, 2] = 0.0
@@ -199,6 +204,8 @@ def _surface_cell(H, kind, T, K, Hn, p, dt, dx, face_h, face_t, face_drain, air_
         outer += scale[m] * air_faces
     hn = Hn[i, j, k] + dt / dx * outer
     Hn[i, j, k] = hn
+    Tn[i, j, k] = _temperature(hn, p)
+    Kn[i, j, k] = _conductivity(hn, p)
     out[m, 0] = outer * dt
     if wet and hn >= hl:
         out[m, 1] = hn
@@ -210,7 +217,7 @@ def _surface_cell(H, kind, T, K, Hn, p, dt, dx, face_h, face_t, face_drain, air_
 
 
 @njit(cache=True)
-def _apply_drains(Hn, kind, surface, scale, out, n_surface, is_surface):
+def _apply_drains(Hn, Tn, Kn, kind, surface, scale, out, n_surface, is_surface):
     """Drained cells become air; their body neighbours join the surface list. Serial, in list
     order (deterministic). Returns the new list length."""
     n = n_surface
@@ -222,6 +229,8 @@ def _apply_drains(Hn, kind, surface, scale, out, n_surface, is_surface):
         k = surface[m, 2]
         kind[i, j, k] = AIR
         Hn[i, j, k] = 0.0
+        Tn[i, j, k] = 0.0
+        Kn[i, j, k] = 0.0
         for face in range(6):
             ii, jj, kk = _neighbour(i, j, k, face)
             if kind[ii, jj, kk] == BODY and is_surface[ii, jj, kk] == 0:
@@ -262,7 +271,7 @@ def find_surface(kind, face_h, air_h, surface, is_surface):
 
 
 @njit(cache=True, parallel=True)
-def run_steps_parallel(H, kind, T, K, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
+def run_steps_parallel(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, face_drain, air_h,
                        air_t, surface, scale, n_surface, is_surface, n_steps, totals,
                        stop_on_breach, rescale_every, first_step):
     """Up to ``n_steps`` explicit steps (H holds the result), parallel over grid rows and
@@ -276,18 +285,19 @@ def run_steps_parallel(H, kind, T, K, Hn, p, dt, dx, face_h, face_t, face_drain,
     done = 0
     src = H
     dst = Hn
+    for q in prange(nx * ny):
+        i = q // ny
+        _state_row(src, kind, p, T, K, i + 1, q - i * ny + 1)
     for step in range(n_steps):
         for q in prange(nx * ny):
             i = q // ny
-            _state_row(src, kind, p, T, K, i + 1, q - i * ny + 1)
-        for q in prange(nx * ny):
-            i = q // ny
-            _conduct_row(src, T, K, dst, g, i + 1, q - i * ny + 1)
+            _conduct_row(src, kind, T, K, dst, Tn, Kn, p, g, i + 1, q - i * ny + 1)
         ns = n_surface[0]
         rescale = (first_step + step) % rescale_every == 0
         for m in prange(ns):
-            _surface_cell(src, kind, T, K, dst, p, dt, dx, face_h, face_t, face_drain, air_h,
-                          air_t, surface[m], scale, out, m, rescale)
+            _surface_cell(src, kind, T, K, dst, Tn, Kn, p, dt, dx, face_h, face_t,
+                          face_drain, air_h, air_t, surface[m, 0], surface[m, 1],
+                          surface[m, 2], scale, out, m, rescale)
         breach = 0.0
         drains = 0.0
         for m in range(ns):  # in list order: no dependence on the thread count
@@ -298,8 +308,11 @@ def run_steps_parallel(H, kind, T, K, Hn, p, dt, dx, face_h, face_t, face_drain,
         totals[2] += breach
         totals[3] += drains
         if drains > 0.0:
-            n_surface[0] = _apply_drains(dst, kind, surface, scale, out, ns, is_surface)
+            n_surface[0] = _apply_drains(dst, Tn, Kn, kind, surface, scale, out, ns,
+                                         is_surface)
         src, dst = dst, src
+        T, Tn = Tn, T
+        K, Kn = Kn, K
         done += 1
         if breach > 0.0 and stop_on_breach:
             break
@@ -309,7 +322,7 @@ def run_steps_parallel(H, kind, T, K, Hn, p, dt, dx, face_h, face_t, face_drain,
 
 
 @njit(cache=True)
-def run_steps_serial(H, kind, T, K, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
+def run_steps_serial(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, face_drain, air_h,
                      air_t, surface, scale, n_surface, is_surface, n_steps, totals,
                      stop_on_breach, rescale_every, first_step):
     """``run_steps_parallel`` in one thread: for small grids and 1-D runs, where starting the
@@ -321,18 +334,19 @@ def run_steps_serial(H, kind, T, K, Hn, p, dt, dx, face_h, face_t, face_drain, a
     done = 0
     src = H
     dst = Hn
+    for q in range(nx * ny):
+        i = q // ny
+        _state_row(src, kind, p, T, K, i + 1, q - i * ny + 1)
     for step in range(n_steps):
         for q in range(nx * ny):
             i = q // ny
-            _state_row(src, kind, p, T, K, i + 1, q - i * ny + 1)
-        for q in range(nx * ny):
-            i = q // ny
-            _conduct_row(src, T, K, dst, g, i + 1, q - i * ny + 1)
+            _conduct_row(src, kind, T, K, dst, Tn, Kn, p, g, i + 1, q - i * ny + 1)
         ns = n_surface[0]
         rescale = (first_step + step) % rescale_every == 0
         for m in range(ns):
-            _surface_cell(src, kind, T, K, dst, p, dt, dx, face_h, face_t, face_drain, air_h,
-                          air_t, surface[m], scale, out, m, rescale)
+            _surface_cell(src, kind, T, K, dst, Tn, Kn, p, dt, dx, face_h, face_t,
+                          face_drain, air_h, air_t, surface[m, 0], surface[m, 1],
+                          surface[m, 2], scale, out, m, rescale)
         breach = 0.0
         drains = 0.0
         for m in range(ns):
@@ -343,8 +357,11 @@ def run_steps_serial(H, kind, T, K, Hn, p, dt, dx, face_h, face_t, face_drain, a
         totals[2] += breach
         totals[3] += drains
         if drains > 0.0:
-            n_surface[0] = _apply_drains(dst, kind, surface, scale, out, ns, is_surface)
+            n_surface[0] = _apply_drains(dst, Tn, Kn, kind, surface, scale, out, ns,
+                                         is_surface)
         src, dst = dst, src
+        T, Tn = Tn, T
+        K, Kn = Kn, K
         done += 1
         if breach > 0.0 and stop_on_breach:
             break

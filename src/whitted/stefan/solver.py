@@ -112,6 +112,8 @@ class EnthalpySolver:
         self._T = np.zeros(shape)
         self._K = np.zeros(shape)
         self._Hn = np.zeros(shape)
+        self._Tn = np.zeros(shape)
+        self._Kn = np.zeros(shape)
         # rows of the grid are the parallel unit; small grids run in one thread
         self.parallel = H.shape[0] * H.shape[1] >= PARALLEL_MIN_ROWS and H.size >= 32768
         # totals: heat in (J/m² per face), drained (J/m³ per cell), breach signals, drained
@@ -154,7 +156,8 @@ class EnthalpySolver:
         true one sets ``breach_time``; in drain mode the cavity then drains through the hole
         layer by layer, one cell per step, and the next call goes on)."""
         runner = kernels.run_steps_parallel if self.parallel else kernels.run_steps_serial
-        done = runner(self._Hp, self._kindp, self._T, self._K, self._Hn, self._p, self.dt,
+        done = runner(self._Hp, self._kindp, self._T, self._K, self._Hn, self._Tn, self._Kn,
+                      self._p, self.dt,
                       self.dx, self._face_h, self._face_t, self._face_drain,
                       float(self.air.h), float(self.air.temperature), self._surface,
                       self._scale, self._n_surface, self._is_surface, int(n), self.totals,
