@@ -395,6 +395,11 @@ def bench(
         raise fail(str(exc)) from None
 
 
+from .stefan import register as _register_stefan  # noqa: E402 - after the commands above
+
+_register_stefan(app)
+
+
 def main() -> None:
     """Console entry point: usage mistakes end as one ``error:`` line and status 2."""
     try:

@@ -169,9 +169,13 @@ class EnthalpySolver:
             self.breach_time = self.time
         return done
 
-    def advance(self, t_end: float, chunk: int = 2000) -> None:
-        """Step until ``t_end`` (the last step shortened to land on it) or a breach stop."""
+    def advance(self, t_end: float, chunk: int = 2000, should_stop=None, on_chunk=None) -> bool:
+        """Step until ``t_end`` (the last step shortened to land on it) or a breach stop.
+        ``should_stop()`` is asked between chunks of steps (False: go on); returns False when
+        it stopped the run before ``t_end``. The chunking never changes the result."""
         while self.time < t_end - 1e-9 * max(1.0, t_end):
+            if should_stop is not None and should_stop():
+                return False
             n = int(math.floor((t_end - self.time) / self.dt + 1e-9))
             if n == 0:  # land exactly on t_end with one short step (still stable)
                 full = self.dt
@@ -181,8 +185,11 @@ class EnthalpySolver:
                 self.time = t_end
                 break
             self.run_steps(min(n, chunk))
+            if on_chunk is not None:
+                on_chunk()
             if self.breached and self.stop_on_breach:
-                return
+                return True
+        return True
 
     def _confirm_breach(self) -> bool:
         """A liquid body region touching air (the kernel's signal, checked on the field)."""

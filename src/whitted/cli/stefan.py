@@ -1,0 +1,186 @@
+"""``whitted stefan``: solve, validate and film the melting of a hollow piece of ice.
+
+A thin client: the physics is :mod:`whitted.stefan`, the rendering the render API.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.markup import escape
+from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeRemainingColumn
+from rich.table import Table
+
+from ..errors import WhittedError
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
+                  help="The Stefan problem: a hollow piece of ice with water inside, melting.")
+err = Console(stderr=True, highlight=False, soft_wrap=True)
+# tables keep their columns when the output is a file or a pipe
+out = Console(highlight=False, soft_wrap=True, width=None if sys.stdout.isatty() else 120)
+EXIT_USER_ERROR = 2
+EXIT_INTERRUPTED = 130
+
+
+def _fail(message: str) -> typer.Exit:
+    err.print(f"[bold red]error:[/] {escape(message)}", soft_wrap=True)
+    return typer.Exit(EXIT_USER_ERROR)
+
+
+class _Interrupt:
+    """Ctrl-C sets a flag the solver checks between chunks of steps."""
+
+    def __init__(self) -> None:
+        self.flag = threading.Event()
+        self.previous = None
+
+    def __enter__(self) -> _Interrupt:
+        self.previous = signal.getsignal(signal.SIGINT)
+        signal.signal(signal.SIGINT, lambda *_: self.flag.set())
+        return self
+
+    def __exit__(self, *exc) -> None:
+        signal.signal(signal.SIGINT, self.previous)
+
+
+def _load(case_path: Path):
+    from ..stefan.case import load_case
+
+    try:
+        case = load_case(case_path)
+    except WhittedError as exc:
+        raise _fail(str(exc)) from None
+    return case, case_path.read_text(encoding="utf-8")
+
+
+def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, size=(480, 360)):
+    from ..stefan.case import CaseError
+    from ..stefan.run import run_case
+
+    case, text = _load(case_path)
+    if output.exists() and not output.is_dir():
+        raise _fail(f"{output}: exists and is not a folder")
+    if output.resolve() == case_path.resolve().parent and fresh:
+        raise _fail(f"{output}: --fresh would clear the case file's own folder")
+    if fresh and output.exists():
+        for sub in ("fields", "surfaces", "scenes"):
+            for f in (output / sub).glob("*"):
+                f.unlink()
+    columns = (TextColumn("[bold]{task.description}"), BarColumn(), TaskProgressColumn(),
+               TextColumn("t = {task.fields[t]}"), TimeRemainingColumn())
+    with _Interrupt() as stop, Progress(*columns, console=err, transient=True,
+                                        disable=quiet or not err.is_terminal) as bar:
+        task = bar.add_task("melting", total=1.0, t="0 s")
+
+        def progress(fraction: float, t: float, what: str) -> None:
+            bar.update(task, completed=fraction, t=f"{t:.0f} s")
+
+        try:
+            result = run_case(case, text, output, resume=not fresh, progress=progress,
+                              should_stop=stop.flag.is_set, scene_size=size)
+        except CaseError as exc:
+            raise _fail(str(exc)) from None
+    return case, result
+
+
+@app.command()
+def run(
+    case_path: Annotated[Path, typer.Argument(metavar="CASE", help="Case file (TOML)")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Output folder")] = Path(
+        "stefan-out"),
+    fresh: Annotated[bool, typer.Option("--fresh", help="Start over, do not resume")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
+) -> None:
+    """Compute the melt of CASE: fields (.npz), surfaces (.ply) per saved time, a time series
+    (CSV and plots) and a scene per saved time. Ctrl-C keeps what was saved; run again to
+    resume from the last saved time."""
+    case, result = _solve(case_path, output, fresh, quiet)
+    _report(result)
+    if result.interrupted:
+        err.print(f"interrupted at t = {result.end_time:.0f} s: kept every saved time in "
+                  f"{output}; run the same command again to resume")
+        raise typer.Exit(EXIT_INTERRUPTED)
+
+
+def _report(result) -> None:
+    cells = "x".join(str(n) for n in result.cells)
+    head = (f"resumed at t = {result.resumed_from:.0f} s, " if result.resumed_from is not None
+            else "")
+    out.print(f"{head}t = {result.end_time:.0f} s after {result.steps} steps on {cells} cells "
+              f"({result.solve_seconds:.1f} s solving); saved {len(result.saved)} time(s) -> "
+              f"{result.out_dir}")
+    if result.breach_time is not None:
+        out.print(f"breach: the shell opened at t = {result.breach_time:.0f} s "
+                  f"({result.breach_time / 60:.1f} min)")
+
+
+@app.command()
+def validate(
+    full: Annotated[bool, typer.Option("--full", help="The docs' table: 1 h, finer cells "
+                                       "(minutes)")] = False,
+    plot: Annotated[Path | None, typer.Option("--plot", help="Front against time (PNG)")] = None,
+) -> None:
+    """Check the solver against exact answers and print the tables: Neumann's lambda, front
+    error against cell size, the axes, the convective slab, the sphere, the energy balance."""
+    from ..stefan import validate as v
+
+    t0 = time.perf_counter()
+    table = Table(title="Similarity constants (root-found) against the issue's numbers")
+    for col in ("case", "computed", "quoted", "difference"):
+        table.add_column(col)
+    for r in v.lambda_rows():
+        table.add_row(r["case"], f"{r['lambda']:.6f}", f"{r['quoted']:g}",
+                      f"{r['difference']:+.2e}")
+    out.print(table)
+
+    t_end = 3600.0 if full else 600.0
+    cells = (1.0, 0.5, 0.25, 0.125)
+    table = Table(title=f"Two-phase front (+10 °C wall, -10 °C ice) after {t_end:.0f} s, 1-D")
+    for col in ("dx (mm)", "cells", "steps", "front (mm)", "exact (mm)", "error", "order",
+                "far end moved (°C)", "energy (rel.)"):
+        table.add_column(col, justify="right")
+    for r in v.convergence_rows(t_end=t_end, cells_mm=cells):
+        table.add_row(f"{r['dx_mm']:g}", str(r["cells"]), str(r["steps"]),
+                      f"{r['front_mm']:.4f}", f"{r['exact_mm']:.4f}", f"{r['error_pct']:+.2f} %",
+                      "" if r["order"] is None else f"{r['order']:.2f}",
+                      f"{r['far_change']:.1e}", f"{r['energy_rel']:.1e}")
+    out.print(table)
+
+    table = Table(title="The 1-D case along each axis and in 3-D (0.5 mm, 600 s, same dt)")
+    for col in ("run", "front (mm)", "error", "vs first (m)"):
+        table.add_column(col, justify="right")
+    for r in v.axis_rows():
+        table.add_row(r["run"], f"{r['front_mm']:.6f}", f"{r['error_pct']:+.2f} %",
+                      f"{r['vs_first']:.1e}")
+    out.print(table)
+
+    slab = v.convective_slab()
+    out.print(f"convective slab (h = 20 W/m²K, air 20 °C, 3000 s): receded "
+              f"{slab['receded_mm']:.4f} mm, h dT t / (rho_i L) = {slab['expected_mm']:.4f} mm, "
+              f"error {slab['error_pct']:+.3f} %")
+    sphere = v.sphere_roundness()
+    out.print(f"sphere of ice (radius 9 cells, 2400 s): radius spread "
+              f"{sphere['spread_start_cells']:.2f} -> {sphere['spread_end_cells']:.2f} cells; "
+              f"receded {sphere['receded_mm']:.3f} mm by volume, exact "
+              f"{sphere['receded_exact_mm']:.3f} mm")
+    energy = v.energy_balance()
+    out.print(f"energy (default case, 16 cells, 600 s): enthalpy change "
+              f"{energy['enthalpy_change_J']:.6f} J = heat in {energy['heat_in_J']:.6f} J - "
+              f"drained {energy['drained_J']:.6f} J; imbalance {energy['imbalance_J']:.1e} J "
+              f"({energy['relative']:.1e} relative)")
+    if plot is not None:
+        v.plot_front(plot)
+        out.print(f"plot -> {plot}")
+    out.print(f"({time.perf_counter() - t0:.1f} s)")
+
+
+def register(parent: typer.Typer) -> None:
+    """Add ``whitted stefan ...`` to the main command."""
+    parent.add_typer(app, name="stefan")
