@@ -552,11 +552,6 @@ def bench(
         raise fail(str(exc)) from None
 
 
-from .stefan import register as _register_stefan  # noqa: E402 - after the commands above
-
-_register_stefan(app)
-
-
 def main() -> None:
     """Console entry point: usage mistakes end as one ``error:`` line and status 2; nothing
     ends in a traceback (set WHITTED_DEBUG=1 to see one for an internal error)."""
@@ -594,4 +589,5 @@ def main() -> None:
 
 # Commands in their own modules register themselves on `app` when imported.
 from . import animate as _animate  # noqa: E402, F401
+from . import stefan as _stefan  # noqa: E402, F401
 from . import sweep as _sweep  # noqa: E402, F401

@@ -13,25 +13,22 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
-from rich.markup import escape
-from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeRemainingColumn
-from rich.table import Table
 
 from ..errors import WhittedError
+from .console import LazyConsole
+from .main import EXIT_INTERRUPTED, err, fail
+from .main import app as main_app
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="The Stefan problem: a hollow piece of ice with water inside, melting.")
-err = Console(stderr=True, highlight=False, soft_wrap=True)
+main_app.add_typer(app, name="stefan")
 # tables keep their columns when the output is a file or a pipe
-out = Console(highlight=False, soft_wrap=True, width=None if sys.stdout.isatty() else 120)
-EXIT_USER_ERROR = 2
-EXIT_INTERRUPTED = 130
+out = LazyConsole(highlight=False, soft_wrap=True, emoji=False,
+                  width=None if sys.stdout.isatty() else 120)
 
 
 def _fail(message: str) -> typer.Exit:
-    err.print(f"[bold red]error:[/] {escape(message)}", soft_wrap=True)
-    return typer.Exit(EXIT_USER_ERROR)
+    return fail(message)
 
 
 class _Interrupt:
@@ -73,6 +70,14 @@ def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, size=(480, 3
         for sub in ("fields", "surfaces", "scenes"):
             for f in (output / sub).glob("*"):
                 f.unlink()
+    from rich.progress import (
+        BarColumn,
+        Progress,
+        TaskProgressColumn,
+        TextColumn,
+        TimeRemainingColumn,
+    )
+
     columns = (TextColumn("[bold]{task.description}"), BarColumn(), TaskProgressColumn(),
                TextColumn("t = {task.fields[t]}"), TimeRemainingColumn())
     with _Interrupt() as stop, Progress(*columns, console=err, transient=True,
@@ -129,6 +134,8 @@ def validate(
 ) -> None:
     """Check the solver against exact answers and print the tables: Neumann's lambda, front
     error against cell size, the axes, the convective slab, the sphere, the energy balance."""
+    from rich.table import Table
+
     from ..stefan import validate as v
 
     t0 = time.perf_counter()
@@ -179,8 +186,3 @@ def validate(
         v.plot_front(plot)
         out.print(f"plot -> {plot}")
     out.print(f"({time.perf_counter() - t0:.1f} s)")
-
-
-def register(parent: typer.Typer) -> None:
-    """Add ``whitted stefan ...`` to the main command."""
-    parent.add_typer(app, name="stefan")
