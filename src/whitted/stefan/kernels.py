@@ -24,9 +24,16 @@ order, from both sides; the totals are summed in a fixed order, whatever the thr
 
 from __future__ import annotations
 
+import os
+
 from .._cache import configure_kernel_cache
 
 configure_kernel_cache()  # before numba reads its settings
+# Threads that wait at the end of a parallel loop sleep instead of spinning (OpenMP layer). A
+# step is three short parallel loops; on a machine shared with other work a spinning thread
+# keeps a core from the thread everyone waits for. Measured on the 2-core VM under load:
+# 2 threads 4.0 -> 94.5 M cell updates/s (1 thread: 56-69).
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import numpy as np  # noqa: E402
 from numba import njit, prange  # noqa: E402
