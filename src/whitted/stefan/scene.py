@@ -12,15 +12,19 @@ from __future__ import annotations
 
 from pathlib import Path
 
-ABSORPTION_BOOST = 8.0  # times the presets' per-unit absorption, for visibility (said so)
+ABSORPTION_BOOST = 3.0  # times the presets' per-unit absorption, for visibility (said so)
 
 
-def still_life_scene(outer: str | None, inner: str | None, time_s: float, *, width: int = 480,
-                     height: int = 360, samples: int = 1, size_cm: float = 4.0) -> str:
-    """The scene file's text; ``outer``/``inner`` are PLY paths relative to the scene file."""
-    top = 1.15 * size_cm
+def still_life_scene(outer: str | None, inner: str | None, time_s: float | None, *,
+                     width: int = 480, height: int = 360, samples: int = 1,
+                     size_cm: float = 4.0, frames: int | None = None, fps: float = 8.0) -> str:
+    """The scene file's text; ``outer``/``inner`` are PLY paths relative to the scene file.
+    With ``frames``, an animated scene whose meshes are sequences (``{frame:04d}`` in the
+    names): frame k shows saved time k."""
+    when = ("one frame per saved time (series.csv has the times)" if time_s is None
+            else f"t = {time_s:.0f} s ({time_s / 60:.1f} min)")
     lines = [
-        f"# whitted stefan: the melting piece at t = {time_s:.0f} s ({time_s / 60:.1f} min).",
+        f"# whitted stefan: the melting piece, {when}.",
         f"# Absorption of ice and water exaggerated x{ABSORPTION_BOOST:g} for visibility.",
         "",
         "[render]",
@@ -30,9 +34,9 @@ def still_life_scene(outer: str | None, inner: str | None, time_s: float, *, wid
         "max_depth = 12",
         "",
         "[camera]",
-        f"position = [{0.9 * size_cm:.3f}, {1.35 * size_cm:.3f}, {3.4 * size_cm:.3f}]",
+        f"position = [{0.7 * size_cm:.3f}, {1.2 * size_cm:.3f}, {2.9 * size_cm:.3f}]",
         f"look_at = [0.0, {0.45 * size_cm:.3f}, 0.0]",
-        "fov = 38.0",
+        "fov = 36.0",
         "",
         "[background]",
         "gradient = { top = [0.05, 0.05, 0.07], bottom = [0.55, 0.57, 0.62] }",
@@ -51,31 +55,42 @@ def still_life_scene(outer: str | None, inner: str | None, time_s: float, *, wid
         "",
         "[[lights]]",
         'type = "ambient"',
-        "intensity = 0.15",
+        "intensity = 0.25",
         "",
         "[[lights]]  # the backlight",
         'type = "point"',
-        f"position = [{-0.5 * size_cm:.3f}, {2.5 * size_cm:.3f}, {-4.0 * size_cm:.3f}]",
-        "intensity = 0.9",
+        f"position = [{-0.5 * size_cm:.3f}, {2.0 * size_cm:.3f}, {-2.0 * size_cm:.3f}]",
+        "intensity = 0.8",
         "",
         "[[lights]]",
         'type = "point"',
-        f"position = [{3.0 * size_cm:.3f}, {3.0 * size_cm:.3f}, {3.0 * size_cm:.3f}]",
-        "intensity = 0.35",
+        f"position = [{-3.0 * size_cm:.3f}, {4.0 * size_cm:.3f}, {4.0 * size_cm:.3f}]",
+        "intensity = 0.6",
         "",
         "[[objects]]",
         'name = "table"',
         'type = "plane"',
-        "material = { color = [0.42, 0.3, 0.22], ka = 0.2, kd = 0.7, ks = 0.25, "
+        "material = { color = [0.62, 0.45, 0.3], ka = 0.2, kd = 0.7, ks = 0.25, "
         "shininess = 40.0, kr = 0.12 }",
         "",
         "[[objects]]",
-        'name = "back wall stripes"',
+        'name = "back wall"',
         'type = "box"',
-        f"min = [{-3 * size_cm:.3f}, 0.0, {-3 * size_cm:.3f}]",
-        f"max = [{3 * size_cm:.3f}, {top * 2:.3f}, {-2.9 * size_cm:.3f}]",
-        'material = { color = "#2e86c1", ka = 0.2, kd = 0.8 }',
+        f"min = [{-4 * size_cm:.3f}, 0.0, {-3 * size_cm:.3f}]",
+        f"max = [{4 * size_cm:.3f}, {4 * size_cm:.3f}, {-2.9 * size_cm:.3f}]",
+        "material = { color = [0.85, 0.85, 0.82], ka = 0.25, kd = 0.75 }",
     ]
+    for n, colour in enumerate(("#c03a2b", "#f1c40f", "#2e86c1")):
+        x0 = (-1.1 + 0.8 * n) * size_cm
+        lines += [
+            "",
+            "[[objects]]",
+            f'name = "stripe {n + 1}"',
+            'type = "box"',
+            f"min = [{x0:.3f}, 0.0, {-2.9 * size_cm:.3f}]",
+            f"max = [{x0 + 0.35 * size_cm:.3f}, {4 * size_cm:.3f}, {-2.85 * size_cm:.3f}]",
+            f'material = {{ color = "{colour}", ka = 0.25, kd = 0.75 }}',
+        ]
     for name, path, material in (("ice", outer, "ice"), ("water", inner, "water")):
         if path is None:
             continue
@@ -90,6 +105,8 @@ def still_life_scene(outer: str | None, inner: str | None, time_s: float, *, wid
             # lifted a hair so the piece's base does not coincide with the table plane
             "transform = { scale = 100.0, translate = [0.0, 0.005, 0.0] }",
         ]
+    if frames is not None:
+        lines += ["", "[animation]", f"frames = {frames}", f"fps = {fps:g}"]
     return "\n".join(lines) + "\n"
 
 
