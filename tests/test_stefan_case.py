@@ -133,3 +133,21 @@ def test_breach_stops_or_drains(tmp_path, action):
         with np.load(sorted((tmp_path / action / "fields").glob("*.npz"))[-1]) as z:
             f, kind = z["liquid_fraction"], z["kind"]
             assert not ((kind == 1) & (f >= 1.0)).any()  # the cavity water has drained
+
+
+def test_film_renders_one_frame_per_saved_time_with_the_time_in_it(tmp_path):
+    import imageio.v3 as iio
+
+    case_path = tmp_path / "tiny.toml"
+    case_path.write_text("[grid]\ncells = 12\n[time]\nend = 600.0\nsave_every = 300.0\n")
+    film = tmp_path / "melt.gif"
+    result = CliRunner().invoke(app, ["stefan", "film", str(case_path), "-o", str(film),
+                                      "-W", "96", "-H", "72", "-q"])
+    assert result.exit_code == 0, result.output
+    frames = iio.imread(film, index=None)
+    assert frames.shape[:3] == (3, 72, 96)
+    raw = iio.imread(tmp_path / "melt_stefan" / "frames" / "0000.png")
+    # the stamped time differs from the raw render in the top-left corner only
+    diff = np.abs(frames[0][..., :3].astype(int) - raw[..., :3].astype(int)).sum(axis=2)
+    assert diff[:20, :].sum() > 0
+    assert diff[40:, 60:].max() <= 24  # GIF palette quantisation, no stamp there

@@ -234,7 +234,10 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
                "dx_m": solver.dx, "breach_time_s": solver.breach_time,
                "breach_action": case.breach.action, "finished": result.finished,
                "heat_in_J": solver.heat_in, "drained_J": solver.drained,
-               "energy_imbalance_J": solver.energy_error(), "saved_times": len(rows)}
+               "energy_imbalance_J": solver.energy_error(), "saved_times": len(rows),
+               "solve_seconds": result.solve_seconds,
+               "surface_seconds_per_save": (float(np.mean(result.surface_seconds))
+                                            if result.surface_seconds else None)}
     _atomic_bytes(out / "summary.json", json.dumps(summary, indent=2).encode())
     return result
 
