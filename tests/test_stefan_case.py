@@ -149,5 +149,5 @@ def test_film_renders_one_frame_per_saved_time_with_the_time_in_it(tmp_path):
     raw = iio.imread(tmp_path / "melt_stefan" / "frames" / "0000.png")
     # the stamped time differs from the raw render in the top-left corner only
     diff = np.abs(frames[0][..., :3].astype(int) - raw[..., :3].astype(int)).sum(axis=2)
-    assert diff[:20, :].sum() > 0
-    assert diff[40:, 60:].max() <= 24  # GIF palette quantisation, no stamp there
+    assert diff[:16, :60].max() > 150  # white text
+    assert diff[40:, 60:].mean() < 10  # only GIF palette quantisation there
