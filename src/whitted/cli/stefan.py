@@ -109,8 +109,9 @@ def run(
     case, result = _solve(case_path, output, fresh, quiet)
     _report(result)
     if result.interrupted:
-        err.print(f"interrupted at t = {result.end_time:.0f} s: kept every saved time in "
-                  f"{output}; run the same command again to resume")
+        err.print(f"interrupted at t = {result.end_time:.1f} s: kept the saved times up to "
+                  f"t = {result.last_saved:.0f} s in {output}; run the same command again to "
+                  "resume from there")
         raise typer.Exit(EXIT_INTERRUPTED)
 
 

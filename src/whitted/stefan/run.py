@@ -44,6 +44,7 @@ SERIES_COLUMNS = ("time_s", "ice_volume_cm3", "cavity_volume_cm3", "water_volume
 class RunResult:
     out_dir: Path
     saved: list[float] = field(default_factory=list)  # times saved in this call
+    last_saved: float | None = None  # the latest saved time (a resume starts there)
     resumed_from: float | None = None
     end_time: float = 0.0
     breach_time: float | None = None
@@ -226,6 +227,7 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
     if solver.breached and case.breach.action == "stop":
         result.finished = True
     result.end_time = solver.time
+    result.last_saved = rows[-1]["time_s"] if rows else None
     result.breach_time = solver.breach_time
     result.steps = solver.steps
     plot_series(rows, out / "series.png", solver.breach_time)
