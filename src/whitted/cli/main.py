@@ -598,4 +598,5 @@ def main() -> None:
 
 # Commands in their own modules register themselves on `app` when imported.
 from . import animate as _animate  # noqa: E402, F401
+from . import stefan as _stefan  # noqa: E402, F401
 from . import sweep as _sweep  # noqa: E402, F401
