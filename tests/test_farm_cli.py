@@ -66,3 +66,62 @@ def test_without_dask_the_farm_says_what_to_install(tmp_path):
     assert len(lines) == 1 and "Traceback" not in result.stderr
     assert lines[0].startswith("error: the render farm needs dask.distributed: "
                                "pip install 'whitted[farm]'")
+
+
+FILM = """
+[render]
+width = 48
+height = 32
+
+[camera]
+position = [0, 1.5, 5]
+look_at = [0, 0.5, 0]
+
+[[lights]]
+type = "point"
+position = [3, 5, 4]
+
+[[objects]]
+type = "plane"
+material = { kd = 0.8, texture = { type = "checker", checks = 2.0 } }
+
+[[objects]]
+name = "ball"
+type = "sphere"
+center = [0, 0.5, 0]
+radius = 0.5
+material = "glass"
+
+[animation]
+frames = 6
+fps = 12
+
+[[animation.tracks]]
+path = "camera.position"
+keys = [[0, [0, 1.5, 5]], [5, [3, 1.5, 4]]]
+"""
+
+
+def test_animate_on_a_local_cluster_writes_the_local_frames_and_film(tmp_path):
+    import imageio_ffmpeg
+
+    scene = tmp_path / "turn.toml"
+    scene.write_text(FILM)
+    local = CliRunner().invoke(app, ["animate", str(scene), "-o", str(tmp_path / "local"),
+                                     "-q"])
+    assert local.exit_code == 0, local.stderr
+    result = whitted("animate", scene, "-o", tmp_path / "farm.mp4", "--cluster", "local:2",
+                     cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "6 frames (6 rendered" in result.stdout
+    names = [f"{k:04d}.png" for k in range(6)]
+    assert sorted(p.name for p in (tmp_path / "farm_frames").iterdir()) == names
+    for name in names:  # the same PNG bytes: pixels and the frame hash that resumes
+        assert (tmp_path / "farm_frames" / name).read_bytes() == (
+            tmp_path / "local" / name).read_bytes()
+    frames, _ = imageio_ffmpeg.count_frames_and_secs(str(tmp_path / "farm.mp4"))
+    meta = next(imageio_ffmpeg.read_frames(str(tmp_path / "farm.mp4")))
+    assert frames == 6 and tuple(meta["size"]) == (48, 32)
+    again = whitted("animate", scene, "-o", tmp_path / "farm.mp4", "--cluster", "local:2",
+                    cwd=tmp_path)  # resume: every frame is current
+    assert again.returncode == 0 and "6 already done" in again.stdout
