@@ -75,6 +75,18 @@ def local_pixels(scene) -> np.ndarray:
     return RenderJob(scene, threads=1).run().pixels
 
 
+def test_the_plugin_readied_every_worker_before_any_task(client):
+    def state() -> tuple:
+        import numba
+
+        from whitted.farm import worker
+
+        return (numba.get_num_threads(), os.environ.get("NUMBA_NUM_THREADS"),
+                worker._threads, worker.warm_seconds() is not None)
+
+    assert list(client.run(state).values()) == [(1, "1", 1, True)] * 2
+
+
 def test_band_ranges_cover_the_image_in_whole_tile_rows():
     assert band_ranges(90, 4) == [(0, 16), (16, 48), (48, 64), (64, 90)]
     assert band_ranges(90, 100) == [(0, 16), (16, 32), (32, 48), (48, 64), (64, 80), (80, 90)]

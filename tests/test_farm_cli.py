@@ -125,3 +125,29 @@ def test_animate_on_a_local_cluster_writes_the_local_frames_and_film(tmp_path):
     again = whitted("animate", scene, "-o", tmp_path / "farm.mp4", "--cluster", "local:2",
                     cwd=tmp_path)  # resume: every frame is current
     assert again.returncode == 0 and "6 already done" in again.stdout
+
+
+@pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="Numba's default pool is 1 thread")
+def test_worker_threads_agree_with_numba_when_numba_came_first(tmp_path):
+    # A spawned Dask worker re-imports the client's main module (whitted's CLI, and Numba with
+    # it) before the Nanny sets NUMBA_NUM_THREADS: Numba's config then says one pool size and
+    # the environment another, and the next compile (a cold cache) raised RuntimeError.
+    code = """
+import os
+os.environ.pop("NUMBA_NUM_THREADS", None)
+import numba                                  # config: one thread per core
+os.environ["NUMBA_NUM_THREADS"] = "1"        # what the Nanny sets afterwards
+from whitted.farm.worker import set_worker_threads
+set_worker_threads(1)
+
+@numba.njit
+def twice(x):
+    return 2 * x
+
+assert twice(21) == 42                       # a compile re-reads the environment
+print(numba.get_num_threads(), numba.config.NUMBA_NUM_THREADS)
+"""
+    result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                            text=True, timeout=120, env=dict(os.environ))
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.split() == ["1", "1"]
