@@ -11,7 +11,16 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from whitted.bench.models import CONE_SEGMENTS, height_field_mesh, rounded_box_mesh
+from whitted.bench.models import (
+    CONE_SEGMENTS,
+    bumpy_torus_mesh,
+    bunny_source,
+    displaced_sphere_mesh,
+    height_field_mesh,
+    rounded_box_mesh,
+    subdivide,
+    vase_mesh,
+)
 from whitted.bench.povray import parse_povray_statistics, povray_rays
 from whitted.bench.runner import TABLE_COLUMNS, BenchOptions, run_bench
 from whitted.bench.scenes import SCENES, benchmarks_dir, has_meshes, load_bench_scene
@@ -29,8 +38,10 @@ def test_quick_bench_table_and_json(tmp_path):
     for column in TABLE_COLUMNS:
         assert column in result.output, column
     rows = json.loads(out.read_text())
-    quick_scenes = [name for name, spec in SCENES.items() if spec.quick]
+    quick_scenes = [name for name, spec in SCENES.items() if spec.quick
+                    and (name != "bunny1m" or bunny_source() is not None)]
     assert [r["scene"] for r in rows] == quick_scenes  # meshes render: none skipped
+    assert {"sphere1m", "vase1m", "instances100", "mesh1m"} <= set(quick_scenes)
     for row in rows:
         assert row.keys() >= JSON_KEYS
         assert row["width"] <= 64 and row["runs"] == 1
@@ -129,3 +140,70 @@ def test_benchmark_scenes_and_models():
     assert len(directed) == len(edges) and all((b, a) in directed for a, b in directed)  # closed
     _, field = height_field_mesh(quads=(10, 5))
     assert len(field) == 100
+
+
+def _directed_edges(faces: np.ndarray) -> set[tuple[int, int]]:
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]).tolist()
+    directed = set(map(tuple, edges))
+    assert len(directed) == len(edges)  # no edge used twice the same way: consistent winding
+    return directed
+
+
+def _signed_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
+    a, b, c = (vertices[faces[:, k]] for k in range(3))
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+def test_mesh_benchmark_models_closed_outward_and_counted():
+    vertices, faces = displaced_sphere_mesh((40, 21), bumps=0.0)
+    assert len(faces) == 2 * 40 * 20  # fans at the poles + quads: 2·n_lon·(n_lat − 1)
+    directed = _directed_edges(faces)
+    assert all((b, a) in directed for a, b in directed)  # closed
+    # outward, and with no bumps close to the unit sphere's volume (inscribed polyhedron)
+    assert 0.97 * 4 / 3 * np.pi < _signed_volume(vertices, faces) < 4 / 3 * np.pi
+
+    vertices, faces = bumpy_torus_mesh((30, 16))
+    assert len(faces) == 2 * 30 * 16
+    directed = _directed_edges(faces)
+    assert all((b, a) in directed for a, b in directed)
+    assert _signed_volume(vertices, faces) > 0  # outward (about 2π²·R·r²)
+
+    vertices, faces = vase_mesh((400, 6))
+    assert len(faces) == 2 * 400 * 6 + 400
+    directed = _directed_edges(faces)
+    open_edges = [e for e in directed if (e[1], e[0]) not in directed]
+    assert len(open_edges) == 400  # only the rim at the top is open
+    p = vertices[faces]
+    longest = np.max(np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2), axis=1)
+    area = np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1) / 2
+    assert np.median(longest ** 2 / (2 * area)) > 20  # long and thin
+    assert np.all(np.cross(p[-400:, 1] - p[-400:, 0], p[-400:, 2] - p[-400:, 0])[:, 1] < 0)
+
+
+def test_subdivide_keeps_the_surface_and_closedness():
+    vertices, faces = rounded_box_mesh((1.0, 0.5, 0.8), 0.2, 3)
+    fine_v, fine_f = subdivide(vertices, faces, levels=2)
+    assert len(fine_f) == 16 * len(faces)
+    directed = _directed_edges(fine_f)
+    assert all((b, a) in directed for a, b in directed)
+    # midpoint subdivision only splits flat triangles: same volume, same area
+    assert _signed_volume(fine_v, fine_f) == pytest.approx(_signed_volume(vertices, faces))
+    rough_v, rough_f = subdivide(vertices, faces, levels=1, roughness=0.3)
+    assert np.array_equal(rough_v[:len(vertices)], vertices)  # old points stay
+    assert not np.allclose(rough_v[len(vertices):], subdivide(vertices, faces, 1)[0][
+        len(vertices):])
+
+
+def test_compare_embree_traces_the_same_rays():
+    pytest.importorskip("embreex")
+    from whitted.bench.embree import compare_embree
+
+    scene = load_bench_scene("sphere1m", quick=True).with_settings(width=32, height=18)
+    row = compare_embree(scene, repeats=1)
+    assert row["embree_rays"] == 32 * 18 + row["whitted_hits"]  # camera + one shadow per hit
+    assert row["embree_triangles"] == 2 * 100 * 50 + 2  # the sphere and the ground's two
+    # the same world: the same camera rays hit the sphere or the ground (the top row is sky)
+    assert row["whitted_hits"] == row["embree_hits"] == 32 * 17
+    assert abs(row["whitted_occluded"] - row["embree_occluded"]) <= 2
+    assert row["ratio_embree"] == pytest.approx(
+        row["whitted_trace_mrays_per_s"] / row["embree_mrays_per_s"])

@@ -4,52 +4,35 @@
 >>> scene = whitted.load_scene("examples/transparent_sphere.toml")   # doctest: +SKIP
 >>> image = whitted.render(scene, width=320, height=240)             # doctest: +SKIP
 >>> image.save("out.png")                                            # doctest: +SKIP
+
+The public names are imported on first use (a module-level ``__getattr__``), so
+``import whitted`` costs a few milliseconds and a command that never renders never imports
+Numba, and one that never reads a scene never imports pydantic.
 """
 
-from importlib.metadata import PackageNotFoundError, version
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
 
 from ._cache import configure_kernel_cache
 
 configure_kernel_cache()  # before any kernel module imports numba
 
-from .errors import SceneError, WhittedError
-from .output import Image
-from .render import CancelToken, Progress, RenderJob, RenderStats, render, render_aovs
-from .scene import (
-    PRESETS,
-    AmbientLight,
-    AxisAngle,
-    Background,
-    Box,
-    Camera,
-    CheckerTexture,
-    Cone,
-    Cylinder,
-    DirectionalLight,
-    Disk,
-    DiskLight,
-    Gradient,
-    GradientTexture,
-    ImageTexture,
-    Material,
-    Mesh,
-    Plane,
-    PointLight,
-    Rectangle,
-    RenderSettings,
-    Scene,
-    Sphere,
-    Transform,
-    Triangle,
-    load_scene,
-    save_scene,
-)
-from .scene.default import default_scene
-
-try:
-    __version__ = version("whitted")
-except PackageNotFoundError:  # running from a source tree without installing
-    __version__ = "0+unknown"
+#: public name -> the module that defines it
+_LAZY = {
+    "SceneError": ".errors", "WhittedError": ".errors",
+    "Image": ".output",
+    "CancelToken": ".render", "Progress": ".render", "RenderJob": ".render",
+    "RenderStats": ".render", "render": ".render", "render_aovs": ".render",
+    "default_scene": ".scene.default",
+    **dict.fromkeys((
+        "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera",
+        "CheckerTexture", "Cone", "Cylinder", "DirectionalLight", "Disk", "DiskLight",
+        "Gradient", "GradientTexture", "ImageTexture", "Material", "Mesh", "Plane",
+        "PointLight", "Rectangle", "RenderSettings", "Scene", "Sphere", "Transform",
+        "Triangle", "load_scene", "save_scene"), ".scene"),
+}
 
 __all__ = [
     "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera", "CancelToken",
@@ -59,3 +42,63 @@ __all__ = [
     "SceneError", "Sphere", "Transform", "Triangle", "WhittedError", "__version__",
     "default_scene", "load_scene", "render", "render_aovs", "save_scene",
 ]
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("whitted")
+    except PackageNotFoundError:  # running from a source tree without installing
+        return "0+unknown"
+
+
+def __getattr__(name: str):
+    if name == "__version__":
+        value = _version()
+    elif name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name], __name__), name)
+    else:
+        raise AttributeError(f"module 'whitted' has no attribute {name!r}")
+    globals()[name] = value  # the next look-up is a plain attribute
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})
+
+
+if TYPE_CHECKING:  # for type checkers and IDEs: the same names, imported eagerly
+    from .errors import SceneError, WhittedError
+    from .output import Image
+    from .render import CancelToken, Progress, RenderJob, RenderStats, render, render_aovs
+    from .scene import (
+        PRESETS,
+        AmbientLight,
+        AxisAngle,
+        Background,
+        Box,
+        Camera,
+        CheckerTexture,
+        Cone,
+        Cylinder,
+        DirectionalLight,
+        Disk,
+        DiskLight,
+        Gradient,
+        GradientTexture,
+        ImageTexture,
+        Material,
+        Mesh,
+        Plane,
+        PointLight,
+        Rectangle,
+        RenderSettings,
+        Scene,
+        Sphere,
+        Transform,
+        Triangle,
+        load_scene,
+        save_scene,
+    )
+    from .scene.default import default_scene

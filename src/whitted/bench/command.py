@@ -52,8 +52,13 @@ def bench_main(
     markdown_path: Path | None, size: str | None, in_process: bool,
     out: Console, err: Console,
 ) -> None:
-    if compare not in (None, "povray"):
-        raise BenchUsageError(f"--compare: unknown renderer {compare!r} (known: povray)")
+    if compare not in (None, "povray", "embree"):
+        raise BenchUsageError(f"--compare: unknown renderer {compare!r} (known: povray, embree)")
+    if compare == "embree":
+        from .embree import embree_available
+
+        if not embree_available():
+            raise BenchUsageError("--compare embree needs embreex: pip install 'whitted[bench]'")
     if study not in (None, "threads", "size"):
         raise BenchUsageError(f"--study: unknown study {study!r} (threads or size)")
     if runs < 1:
@@ -64,6 +69,12 @@ def bench_main(
         if povray_executable() is None:
             raise BenchUsageError("--compare povray: povray is not installed "
                                   "(Debian: apt-get install povray)")
+    if study:
+        import importlib.util
+
+        if importlib.util.find_spec("matplotlib") is None:  # checked before the long study
+            raise BenchUsageError(f"--study {study}: the plot needs matplotlib: "
+                                  "pip install 'whitted[plots]'")
     options = BenchOptions(scenes=scenes or None, runs=runs, threads=parse_threads(threads),
                            quick=quick, compare=compare, in_process=in_process,
                            size=parse_size(size))

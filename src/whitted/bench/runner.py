@@ -34,6 +34,7 @@ from typing import Any
 
 from ..render.api import RAY_KIND_NAMES, RenderJob, available_threads
 from ..scene.scene import Scene
+from .models import MissingSourceModel
 from .scenes import BenchScene, has_meshes, load_bench_scene, pick_scenes
 from .timing import timed_process
 
@@ -52,7 +53,7 @@ class BenchOptions:
     runs: int = 5
     threads: list[int] | None = None  # None: every core
     quick: bool = False  # tiny images, one run, in this process, no 1M-triangle mesh
-    compare: str | None = None  # "povray"
+    compare: str | None = None  # "povray" or "embree" (the mesh scenes' rays, one thread)
     in_process: bool = False
     size: tuple[int, int] | None = None  # override every scene's image size
     warmup: bool = True
@@ -88,7 +89,12 @@ def run_bench(options: BenchOptions, log: Callable[[str], None] = print) -> Benc
     threads_list = options.threads or [available_threads()]
     result = BenchResult()
     for spec in pick_scenes(options.scenes, options.quick):
-        scene = load_bench_scene(spec.name)
+        try:
+            scene = load_bench_scene(spec.name, quick=options.quick)
+        except MissingSourceModel as exc:
+            result.skipped.append((spec.name, str(exc)))
+            log(f"  skipped {spec.name}: {exc}")
+            continue
         width, height = image_size(scene, options)
         scene = scene.with_settings(width=width, height=height)
         with tempfile.TemporaryDirectory(prefix=f"whitted-bench-{spec.name}-") as tmp:
@@ -107,7 +113,23 @@ def run_bench(options: BenchOptions, log: Callable[[str], None] = print) -> Benc
                 if options.compare == "povray":
                     row.update(_bench_povray(spec, scene, threads, options, folder, row))
                 result.rows.append(row)
+        if options.compare == "embree" and spec.meshes and result.rows \
+                and result.rows[-1]["scene"] == spec.name:
+            log(f"{spec.name}: the same camera and shadow rays, whitted and Embree, 1 thread")
+            embree = _bench_embree(scene)
+            for row in result.rows:
+                if row["scene"] == spec.name:
+                    row.update(embree)
     return result
+
+
+def _bench_embree(scene: Scene) -> dict[str, Any]:
+    from .embree import compare_embree
+
+    try:
+        return compare_embree(scene)
+    except (ImportError, ValueError) as exc:
+        raise BenchError(str(exc)) from None
 
 
 def _median(values: list[float]) -> float:
@@ -223,12 +245,15 @@ TABLE_COLUMNS = ("scene", "size", "threads", "primary", "shadow", "reflection", 
                  "peak MiB")
 POVRAY_COLUMNS = ("POV trace s", "POV wall s", "render ratio", "wall ratio",
                   "POV rays p/s/rl/rr")
+EMBREE_COLUMNS = ("trace Mrays/s", "Embree Mrays/s", "of Embree")
 
 
 def table_rows(rows: list[dict[str, Any]]) -> tuple[list[str], list[list[str]]]:
     """Column headings and text cells of the results table."""
     compare = any("povray_trace_s" in r for r in rows)
-    columns = list(TABLE_COLUMNS) + (list(POVRAY_COLUMNS) if compare else [])
+    embree = any("embree_mrays_per_s" in r for r in rows)
+    columns = (list(TABLE_COLUMNS) + (list(POVRAY_COLUMNS) if compare else [])
+               + (list(EMBREE_COLUMNS) if embree else []))
     cells = []
     for r in rows:
         line = [r["scene"], f"{r['width']}x{r['height']}", str(r["threads"]),
@@ -243,6 +268,12 @@ def table_rows(rows: list[dict[str, Any]]) -> tuple[list[str], list[list[str]]]:
                          "/".join(compact(pov[k]) for k in RAY_KINDS)]
             else:
                 line += [""] * len(POVRAY_COLUMNS)
+        if embree:
+            if "embree_mrays_per_s" in r:
+                line += [f"{r['whitted_trace_mrays_per_s']:.2f}",
+                         f"{r['embree_mrays_per_s']:.2f}", f"{r['ratio_embree']:.2f}"]
+            else:
+                line += [""] * len(EMBREE_COLUMNS)
         cells.append(line)
     return columns, cells
 

@@ -25,7 +25,13 @@ class BenchScene:
     name: str
     file: str
     description: str
-    quick: bool = True  # part of `whitted bench --quick`
+    quick: bool = True  # part of `whitted bench --quick` (with small versions of big models)
+    mesh_bench: bool = False  # one of the mesh benchmarks (issue 18); mesh1m is one too
+
+    @property
+    def meshes(self) -> bool:
+        """A scene of the mesh benchmark: what ``--compare embree`` traces."""
+        return self.mesh_bench or self.name == "mesh1m"
 
 
 SCENES: dict[str, BenchScene] = {
@@ -39,9 +45,19 @@ SCENES: dict[str, BenchScene] = {
         BenchScene("ice", "ice.toml",
                    "001's hollow ice block with water and an air bubble, all meshes"),
         BenchScene("mesh1m", "mesh1m.toml",
-                   "a generated 1,000,000-triangle height field, one light with shadows",
-                   quick=False),
+                   "a generated 1,000,000-triangle height field, one light with shadows"),
         BenchScene("lecture", "lecture.toml", "002's two rectangles"),
+        BenchScene("sphere1m", "sphere1m.toml",
+                   "a closed bumpy UV sphere of 1,000,000 triangles seen whole, shadows",
+                   mesh_bench=True),
+        BenchScene("bunny1m", "bunny1m.toml",
+                   "the Stanford bunny subdivided to 1,111,216 triangles, shadows",
+                   mesh_bench=True),
+        BenchScene("vase1m", "vase1m.toml",
+                   "a finely revolved vase: 980,000 long thin triangles, shadows",
+                   mesh_bench=True),
+        BenchScene("instances100", "instances100.toml",
+                   "100 instances of a 100,000-triangle torus, shadows", mesh_bench=True),
     )
 }
 
@@ -66,8 +82,10 @@ def pick_scenes(names: list[str] | None, quick: bool = False) -> list[BenchScene
     return [SCENES[n] for n in names]
 
 
-def load_bench_scene(name: str, folder: Path | None = None) -> Scene:
-    """Benchmark scene ``name`` with every file name absolute and generated models written."""
+def load_bench_scene(name: str, folder: Path | None = None, quick: bool = False) -> Scene:
+    """Benchmark scene ``name`` with every file name absolute and generated models written
+    (their small versions with ``quick``). Raises ``models.MissingSourceModel`` when a model
+    needs a file this machine does not have (the bunny)."""
     spec = SCENES[name]
     path = (folder or benchmarks_dir()) / spec.file
     if not path.is_file():
@@ -76,16 +94,16 @@ def load_bench_scene(name: str, folder: Path | None = None) -> Scene:
     text = path.read_text(encoding="utf-8")
     scene = scene_from_dict(parse_scene_text(text, ".toml", str(path)), file=str(path),
                             text=text).with_base_dir(path.parent)
-    return with_absolute_files(scene)
+    return with_absolute_files(scene, quick)
 
 
-def with_absolute_files(scene: Scene) -> Scene:
+def with_absolute_files(scene: Scene, quick: bool = False) -> Scene:
     """The scene with model and texture file names absolute (generated ones written), so it
     can be saved anywhere and still find them."""
     for obj in scene.objects:
         if isinstance(obj, Mesh) and obj.file is not None:
             if obj.file.startswith(GENERATED_PREFIX):
-                obj.file = str(generated_model(obj.file[len(GENERATED_PREFIX):]))
+                obj.file = str(generated_model(obj.file[len(GENERATED_PREFIX):], quick=quick))
             else:
                 obj.file = str(scene.resolve_path(obj.file))
         material = obj.material

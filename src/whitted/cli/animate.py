@@ -6,18 +6,9 @@ import signal
 import threading
 import time
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
-from pydantic import ValidationError
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TaskProgressColumn,
-    TextColumn,
-    TimeRemainingColumn,
-)
 
 from ..errors import SceneError, WhittedError
 from .farm import ClusterOption, SchedulerOption, animate_on_farm
@@ -31,6 +22,9 @@ from .main import (
     fail,
     out,
 )
+
+if TYPE_CHECKING:
+    from rich.progress import Progress
 
 FRAME_DIGITS = 4
 
@@ -109,6 +103,8 @@ def animate(
     """Render every frame of SCENE to numbered PNGs (FILM_frames/0000.png ...), then encode
     the film (H.264 MP4 or GIF). Frames already rendered from the same scene and settings are
     kept, so an interrupted run continues where it stopped (Ctrl-C keeps finished frames)."""
+    from pydantic import ValidationError
+
     from ..animation.frames import FrameRenderer
     from ..output.video import encode_film, even_size
     from ..render.api import CancelToken
@@ -220,6 +216,15 @@ class _FilmProgress:
 
     def __enter__(self) -> _FilmProgress:
         if self.live:
+            from rich.progress import (
+                BarColumn,
+                MofNCompleteColumn,
+                Progress,
+                TaskProgressColumn,
+                TextColumn,
+                TimeRemainingColumn,
+            )
+
             self._progress = Progress(
                 TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
                 TaskProgressColumn(), TimeRemainingColumn(), console=err, transient=True)

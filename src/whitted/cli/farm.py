@@ -6,13 +6,16 @@ from __future__ import annotations
 import time
 from contextlib import nullcontext
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from ..errors import WhittedError
-from ..scene.scene import Scene
+
+if TYPE_CHECKING:
+    from rich.progress import Progress
+
+    from ..scene.scene import Scene
 
 ClusterOption = Annotated[
     str | None, typer.Option("--cluster", help="Render on a new local Dask cluster: local:N "
@@ -38,6 +41,14 @@ def bar(label: str, quiet: bool) -> Progress | None:
 
     if quiet or not err.is_terminal:
         return None
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeRemainingColumn,
+    )
+
     return Progress(TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn(),
                     TimeRemainingColumn(), console=err, transient=True)
 

@@ -7,25 +7,28 @@ import sys
 import threading
 import time
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
-import numpy as np
 import typer
-from pydantic import ValidationError
-from rich.console import Console
-from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeRemainingColumn
-from rich.text import Text
 
 try:  # typer vendors click from 0.2x on; older releases depend on click itself
     from typer._click.exceptions import UsageError
 except ImportError:  # pragma: no cover - depends on the installed typer
     from click.exceptions import UsageError
 
-from .. import __version__
 from ..errors import WhittedError, shorten
-from ..scene import Scene, load_scene
-from ..scene.default import default_scene
+from .console import Text, err, out
 from .farm import ClusterOption, SchedulerOption, render_still_on_farm
+
+if TYPE_CHECKING:
+    import numpy as np
+    from pydantic import ValidationError
+
+    from ..scene import Scene
+
+# NumPy, pydantic, rich, the scene models and the renderer are imported inside the commands
+# that use them: `whitted --help` and the import of this module stay far under 0.2 s
+# (tests/test_startup.py).
 
 app = typer.Typer(
     add_completion=False,
@@ -33,9 +36,6 @@ app = typer.Typer(
     help="whitted: a fast Whitted ray tracer. Render scene files (TOML/JSON) to images.",
     pretty_exceptions_enable=False,
 )
-# emoji=False: a user's ":100:" (a line number, a name) is printed as it is, never as an emoji
-err = Console(stderr=True, highlight=False, soft_wrap=True, emoji=False)
-out = Console(highlight=False, soft_wrap=True, emoji=False)
 
 AOV_NAMES = ("depth", "normal", "id")
 EXIT_USER_ERROR = 2
@@ -63,6 +63,8 @@ def _note(message: str) -> None:
 
 def _version(value: bool) -> None:
     if value:
+        from .. import __version__
+
         out.print(f"whitted {__version__}")
         raise typer.Exit()
 
@@ -77,6 +79,9 @@ def main_options(
 
 
 def _load(scene_path: Path | None) -> tuple[Scene, str]:
+    from ..scene import load_scene
+    from ..scene.default import default_scene
+
     if scene_path is None:
         return default_scene(), "<default scene>"
     return load_scene(scene_path), str(scene_path)
@@ -139,6 +144,8 @@ def render(
 ) -> None:
     """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG).
     An animated scene renders frame 0, or the frame --frame names."""
+    from pydantic import ValidationError
+
     from ..output.encode import check_bit_depth, image_format
     from ..render.api import RenderJob, render_aovs
 
@@ -257,6 +264,8 @@ def _with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
 
 
 def _save_npy(path: Path, array: np.ndarray) -> None:
+    import numpy as np
+
     from ..output.encode import atomic_write
 
     atomic_write(path, lambda tmp: np.save(tmp, array))
@@ -289,6 +298,14 @@ def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
         job.start()
         _wait(job, interrupted)
         return
+    from rich.progress import (
+        BarColumn,
+        Progress,
+        TaskProgressColumn,
+        TextColumn,
+        TimeRemainingColumn,
+    )
+
     columns = (
         TextColumn("[bold]rendering"),
         BarColumn(),
@@ -309,6 +326,8 @@ def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
 
 def _model_info(path: Path) -> None:
     """``whitted info MODEL``: what the loader reads from a model file."""
+    import numpy as np
+
     from ..assets import load_mesh
 
     try:
@@ -352,6 +371,8 @@ def info(
 ) -> None:
     """Print a scene's objects, lights, bounds and an estimate of the work; or what a model
     file (OBJ, PLY, STL, OFF, glTF) holds: vertices, triangles, bounds, materials, textures."""
+    import numpy as np
+
     from ..assets.mesh import SUPPORTED_SUFFIXES
     from ..compile.scene import compile_scene
 
@@ -423,6 +444,8 @@ def gui(
     ] = None,
 ) -> None:
     """Open the scene editor (a desktop window) on SCENE, or on the built-in default scene."""
+    from ..scene import load_scene
+
     scene = None
     try:
         exists = scene_path is not None and scene_path.exists()
@@ -436,9 +459,11 @@ def gui(
     elif scene_path is not None and scene_path.suffix.lower() not in (".toml", ".json"):
         raise fail(f"{scene_path}: unknown scene format {scene_path.suffix!r} (use .toml or .json)")
     try:  # Qt is imported here only, so the other commands start without it
+        import PySide6.QtWidgets  # noqa: F401  (gui.app imports it only when it runs)
+
         from ..gui.app import run_editor
     except ImportError as exc:
-        raise fail(f"the editor needs PySide6 (pip install PySide6-Essentials): {exc}") from None
+        raise fail(f"the editor needs PySide6 ({exc}): pip install 'whitted[gui]'") from None
     raise typer.Exit(run_editor(scene, scene_path))
 
 
@@ -455,6 +480,8 @@ def export(
     height: Annotated[int | None, typer.Option("--height", "-H", help="Image height")] = None,
 ) -> None:
     """Write SCENE for another renderer: POV-Ray 3.7 scene language (--format pov)."""
+    from pydantic import ValidationError
+
     from ..export.pov import export_pov
 
     if export_format != "pov":

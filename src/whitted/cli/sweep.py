@@ -10,7 +10,6 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from pydantic import ValidationError
 
 from ..errors import SceneError, WhittedError
 from .main import (
@@ -52,6 +51,8 @@ def sweep(
     the columns, a second one the rows), keep each image in SHEET_cells/, and write a
     contact sheet with the values under the images. Example: --set
     "objects[glass sphere].material.kt=1:0:-0.2" (1, 0.8, ... 0)."""
+    from pydantic import ValidationError
+
     from ..animation.frames import FrameRenderer
     from ..animation.overrides import apply_overrides, parse_assignment, parse_values
     from ..animation.sweep import contact_sheet, sweep_cells

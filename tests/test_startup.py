@@ -1,0 +1,128 @@
+"""Start-up: what ``import whitted``, the CLI and a plain render import, and kernels loaded
+from the on-disk cache without Numba's compiler registries.
+
+Each check runs in a fresh interpreter (``sys.modules`` of this test process holds whatever
+the other tests imported). Times are not asserted here: they live in ``whitted bench`` and
+docs/performance.md.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+import whitted
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+HEAVY_EXTRAS = ("PySide6", "matplotlib", "dask", "distributed", "embreex")
+
+
+def _modules_after(code: str, tmp_path: Path) -> set[str]:
+    """The top-level packages imported once ``code`` has run in a fresh interpreter."""
+    script = textwrap.dedent(code) + textwrap.dedent("""
+        import json, sys
+        print("MODULES=" + json.dumps(sorted({m.split(".")[0] for m in sys.modules})))
+    """)
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(
+        [str(REPO_ROOT / "src"), *filter(None, [env.get("PYTHONPATH")])])
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                            cwd=tmp_path, env=env, timeout=600)
+    assert result.returncode == 0, result.stderr
+    line = next(x for x in result.stdout.splitlines() if x.startswith("MODULES="))
+    return set(json.loads(line.removeprefix("MODULES=")))
+
+
+def test_import_whitted_imports_no_numba_no_pydantic(tmp_path):
+    loaded = _modules_after("import whitted", tmp_path)
+    assert "whitted" in loaded
+    for heavy in ("numba", "numpy", "pydantic", "rich", "typer", *HEAVY_EXTRAS):
+        assert heavy not in loaded, f"import whitted imported {heavy}"
+
+
+def test_cli_module_imports_no_numba_pydantic_or_rich(tmp_path):
+    loaded = _modules_after("import whitted.cli.main", tmp_path)
+    assert "typer" in loaded
+    for heavy in ("numba", "numpy", "pydantic", "rich", "PIL", "trimesh", *HEAVY_EXTRAS):
+        assert heavy not in loaded, f"import whitted.cli.main imported {heavy}"
+
+
+def test_plain_render_imports_no_gui_plots_or_farm(tmp_path):
+    out = tmp_path / "x.png"
+    loaded = _modules_after(f"""
+        from whitted.cli.main import app
+        app(["render", {str(REPO_ROOT / "examples" / "glass_cube.toml")!r}, "-W", "24",
+             "-H", "16", "-q", "-o", {str(out)!r}], standalone_mode=False)
+    """, tmp_path)
+    assert out.stat().st_size > 0
+    assert "numba" in loaded  # it did render
+    for heavy in HEAVY_EXTRAS:
+        assert heavy not in loaded, f"whitted render imported {heavy}"
+
+
+def test_public_api_resolves_every_name():
+    for name in whitted.__all__:
+        assert getattr(whitted, name) is not None, name
+    assert set(whitted.__all__) <= set(dir(whitted))
+    from whitted.scene.shapes import Sphere
+
+    assert whitted.Sphere is Sphere
+    with pytest.raises(AttributeError, match="no attribute 'Spheer'"):
+        _ = whitted.Spheer
+
+
+def test_kernels_loaded_from_cache_then_a_new_kernel_compiles(tmp_path):
+    """A render loads its kernels without Numba's compiler registries (kernels/jit.py
+    ``KernelCache``); a kernel compiled afterwards in the same process, using NumPy and math
+    functions and calling a loaded kernel, must still compile and give the right value."""
+    loaded = _modules_after("""
+        import math
+        import numpy as np
+        import whitted
+        from whitted.kernels.jit import kernel
+        from whitted.kernels.vec import dot
+
+        whitted.render(whitted.Scene(), width=8, height=8, threads=1)
+
+        @kernel(cache=False)
+        def fresh(a):
+            s = 0.0
+            for i in range(a.shape[0]):
+                s += math.sqrt(a[i]) + np.sin(0.0)
+            return s + dot((1.0, 2.0, 3.0), (4.0, 5.0, 6.0))
+
+        assert fresh(np.array([4.0, 9.0])) == 5.0 + 32.0
+    """, tmp_path)
+    assert "numba" in loaded
+
+
+@pytest.mark.parametrize(("blocked", "args", "extra"), [
+    ("PySide6", ["gui"], "gui"),
+    ("matplotlib", ["bench", "--study", "threads", "--quick"], "plots"),
+])
+def test_a_missing_extra_is_one_line_naming_it(tmp_path, blocked, args, extra):
+    """Without an optional dependency the command says which extra to install (one line,
+    status 2), instead of a traceback."""
+    script = textwrap.dedent(f"""
+        import sys
+        sys.modules[{blocked!r}] = None  # as if it were not installed
+        import importlib.util
+        real_find_spec = importlib.util.find_spec
+        importlib.util.find_spec = lambda name, *a: (
+            None if name.split(".")[0] == {blocked!r} else real_find_spec(name, *a))
+        sys.argv = ["whitted", *{args!r}]
+        from whitted.cli.main import main
+        main()
+    """)
+    env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"))
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                            cwd=tmp_path, env=env, timeout=120)
+    assert result.returncode == 2, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and f"pip install 'whitted[{extra}]'" in lines[0], result.stderr
