@@ -30,3 +30,17 @@ def test_package_imports_first(package):
     result = subprocess.run([sys.executable, "-c", f"import {package}"], capture_output=True,
                             text=True, env=env, timeout=300)
     assert result.returncode == 0, result.stderr.strip().splitlines()[-1:]
+
+
+def test_render_stays_the_function_after_the_render_package_is_imported():
+    """``whitted.render`` is the function, even once ``whitted.render`` the subpackage has been
+    imported (Python would otherwise set the module's attribute to the subpackage)."""
+    code = ("import whitted.render.api, whitted.animation, whitted\n"
+            "import inspect\n"
+            "assert inspect.isfunction(whitted.render), whitted.render\n"
+            "assert whitted.render is whitted.render.__globals__['render']\n")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [str(SRC), *filter(None, [os.environ.get("PYTHONPATH")])]))
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            env=env, timeout=300)
+    assert result.returncode == 0, result.stderr.strip().splitlines()[-1:]
