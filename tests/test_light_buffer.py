@@ -14,8 +14,9 @@ from numba import njit
 
 import whitted
 from meshgen import uv_sphere
-from whitted.compile.flatten import compile_scene, render_params
 from whitted.compile.light_buffers import buffer_side
+from whitted.compile.params import render_params
+from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import hit_analytic
 from whitted.kernels.intersect import INF
 from whitted.kernels.layout import (

@@ -368,7 +368,7 @@ def test_missing_file_and_unknown_format(tmp_path):
     with pytest.raises(SceneError, match=r"unsupported model format '\.xyz' \(supported: \.obj, "
                                          r"\.ply, \.stl, \.off, \.gltf, \.glb\)"):
         load_mesh(tmp_path / "model.xyz")
-    with pytest.raises(SceneError, match="not a file"):
+    with pytest.raises(SceneError, match="is a directory, not a regular file"):
         load_mesh(tmp_path)
 
 
@@ -479,13 +479,15 @@ def test_cache_returns_the_same_object_and_reads_once(tmp_path, monkeypatch):
     path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     clear_mesh_cache()
     reads = []
-    original = Path.read_bytes
+    from whitted.assets import files
 
-    def counting_read_bytes(self: Path) -> bytes:
-        reads.append(self)
-        return original(self)
+    original = files.map_limited
 
-    monkeypatch.setattr(Path, "read_bytes", counting_read_bytes)
+    def counting_read(file_path, *args, **kwargs):
+        reads.append(file_path)
+        return original(file_path, *args, **kwargs)
+
+    monkeypatch.setattr(files, "map_limited", counting_read)
     first = load_mesh(path)
     assert load_mesh(str(path)) is first
     assert load_mesh(tmp_path / "." / "cached.obj") is first

@@ -11,7 +11,7 @@ from numba import njit
 
 import whitted
 from meshgen import cube, uv_sphere
-from whitted.compile.flatten import compile_scene
+from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import closest_hit, surface_normals
 from whitted.kernels.layout import PRIM_MATERIAL
 from whitted.kernels.uv import surface_uv
@@ -240,10 +240,10 @@ def test_per_triangle_materials_and_override():
     blue = whitted.Material(color=(0, 0, 1), ka=1, kd=0)
     src = MeshSource("two.obj", v, np.array(faces), None, None, np.array([0, 0, 1, 1]),
                      [red, blue])
-    from whitted.compile import flatten
+    from whitted.compile import scene as compile_module
 
-    original = flatten._mesh_source
-    flatten._mesh_source = lambda *a: src
+    original = compile_module.mesh_source
+    compile_module.mesh_source = lambda *a: src
     try:
         compiled = compile_scene(scene, flatten_limit=0)  # instanced: the triangles' materials
         mats = compiled.materials[compiled.geometry.tri_material]
@@ -259,7 +259,7 @@ def test_per_triangle_materials_and_override():
         green = flat.materials[flat.geometry.prim_info[:, PRIM_MATERIAL]]
         assert (green[:, 1] == 1).all() and (green[:, 0] == 0).all()
     finally:
-        flatten._mesh_source = original
+        compile_module.mesh_source = original
 
 
 def test_closed_mesh_rendered_from_inside_and_outside():

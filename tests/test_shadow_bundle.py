@@ -13,7 +13,7 @@ from numba import njit
 
 import whitted
 from meshgen import uv_sphere
-from whitted.compile.flatten import compile_scene
+from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import hit_analytic
 from whitted.kernels.intersect import INF
 from whitted.kernels.lighting import SHADOW_LIST_CAP, list_bundle_occluders

@@ -1,4 +1,4 @@
-"""Exact ray/shape intersection for every shape, through the real compiled scene (flatten ->
+"""Exact ray/shape intersection for every shape, through the real compiled scene (compile_scene ->
 BVH -> ``closest_hit`` -> ``world_normal``), checked against hand-computed values.
 
 Every hand-computed expected value is worked out in the comment next to it. ``t`` is the ray
@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from whitted.compile.flatten import compile_scene
+from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import closest_hit, surface_normals
 from whitted.kernels.layout import PRIM_OBJECT
 from whitted.scene import (

@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 
 import whitted
 from whitted.cli.main import app
-from whitted.compile.flatten import compile_scene
+from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import closest_hit
 from whitted.kernels.uv import surface_uv
 

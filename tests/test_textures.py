@@ -166,7 +166,7 @@ def test_bad_files_are_one_line_scene_errors(tmp_path: Path, quad_png: Path, con
 
 
 def test_folder_is_a_scene_error(tmp_path: Path):
-    with pytest.raises(SceneError, match="not a file"):
+    with pytest.raises(SceneError, match="is a directory, not an image file"):
         load_image(tmp_path)
 
 

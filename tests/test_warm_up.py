@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 
-from whitted.compile.flatten import render_params
+from whitted.compile.params import render_params
 from whitted.kernels import tiles
 from whitted.kernels.callees import render_callees
 from whitted.kernels.jit import kernel

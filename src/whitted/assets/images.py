@@ -16,6 +16,7 @@ from __future__ import annotations
 import io
 import os
 import threading
+import warnings
 from collections import OrderedDict
 from pathlib import Path
 
@@ -26,6 +27,11 @@ from PIL import Image, ImageOps, UnidentifiedImageError
 from ..errors import SceneError
 
 COLORSPACES = ("srgb", "linear")
+#: Largest texture image decoded (8192 x 8192): checked from the file's header, before the
+#: pixels are decoded, whatever the bit depth (a decoded pixel costs up to 20 bytes).
+MAX_TEXTURE_PIXELS = 1 << 26
+#: Largest image file read.
+MAX_IMAGE_BYTES = 1 << 30
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 _CACHE_ENTRIES = 32
 
@@ -74,8 +80,11 @@ def load_image(path: str | os.PathLike[str], colorspace: str = "srgb") -> np.nda
         raise SceneError("image file not found", file=name) from None
     except OSError as exc:
         raise SceneError(f"cannot read image file: {_one_line(exc)}", file=name) from None
-    if not resolved.is_file():
-        raise SceneError("image path is not a file", file=name)
+    from .files import kind_of
+
+    kind = kind_of(status.st_mode)
+    if kind is not None:
+        raise SceneError(f"is {kind}, not an image file", file=name)
 
     key = (str(resolved), status.st_mtime_ns, status.st_size, colorspace)
     with _cache_lock:
@@ -84,10 +93,9 @@ def load_image(path: str | os.PathLike[str], colorspace: str = "srgb") -> np.nda
             _cache.move_to_end(key)
             return pixels
 
-    try:
-        data = resolved.read_bytes()
-    except OSError as exc:
-        raise SceneError(f"cannot read image file: {_one_line(exc)}", file=name) from None
+    from .files import read_limited
+
+    data = read_limited(resolved, MAX_IMAGE_BYTES, "image file", name)
     pixels = _decode(data, colorspace, name)
     pixels.setflags(write=False)
 
@@ -108,10 +116,16 @@ def _one_line(exc: BaseException) -> str:
 def _decode(data: bytes, colorspace: str, name: str) -> np.ndarray:
     """Decode file bytes into (H, W, 3) float32 linear RGB."""
     try:
+        if data[:8] == _PNG_SIGNATURE and len(data) > 24:
+            # IHDR is the first chunk: width and height before any pixel is decoded
+            _check_size(int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big"),
+                        name)
         if data[:8] == _PNG_SIGNATURE and len(data) > 24 and data[24] == 16:
             codes, levels = _read_png16(data)
         else:
-            codes, levels = _read_with_pillow(data)
+            codes, levels = _read_with_pillow(data, name)
+    except SceneError:
+        raise
     except UnidentifiedImageError:
         raise SceneError("not an image, or a format that cannot be read", file=name) from None
     except Image.DecompressionBombError as exc:
@@ -151,9 +165,20 @@ def _read_png16(data: bytes) -> tuple[np.ndarray, int]:
     return codes[:, :, :colour_planes], 65536
 
 
-def _read_with_pillow(data: bytes) -> tuple[np.ndarray, int]:
+def _check_size(width: int, height: int, name: str) -> None:
+    if width * height > MAX_TEXTURE_PIXELS:
+        raise SceneError(f"image too large: {width}x{height} pixels (the limit is "
+                         f"{MAX_TEXTURE_PIXELS:,} pixels, 8192x8192)", file=name)
+
+
+def _read_with_pillow(data: bytes, name: str = "image") -> tuple[np.ndarray, int]:
     """Integer codes and their number of levels (256 or 65536), or float data with levels 0."""
-    with Image.open(io.BytesIO(data)) as opened:
+    with warnings.catch_warnings():
+        # the size is checked below, against a limit under Pillow's own warning threshold
+        warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+        opened = Image.open(io.BytesIO(data))
+    with opened:
+        _check_size(opened.size[0], opened.size[1], name)
         opened.load()
         image = ImageOps.exif_transpose(opened)  # photos stored sideways, shown upright
         mode = image.mode

@@ -78,16 +78,17 @@ def load_mesh(path: str | Path) -> MeshData:
     Raises :class:`~whitted.errors.SceneError` (``path:line: problem``) for a missing,
     unreadable, unsupported or malformed file.
     """
+    from .files import path_problem
+
     name = os.fspath(path)
     file_path = Path(name)
+    problem = path_problem(file_path)
+    if problem is not None:
+        raise SceneError(problem, file=name)
     try:
         status = file_path.stat()
-    except FileNotFoundError:
-        raise SceneError("no such file", file=name) from None
     except OSError as error:
         raise SceneError(f"cannot read the file ({error.strerror or error})", file=name) from None
-    if not file_path.is_file():
-        raise SceneError("not a file (a folder?)", file=name)
     suffix = file_path.suffix.lower()
     if suffix not in SUPPORTED_SUFFIXES:
         raise SceneError(
@@ -121,13 +122,27 @@ def load_mesh(path: str | Path) -> MeshData:
     return mesh
 
 
+#: Largest OBJ file read. Large files are memory-mapped, not read whole.
+MAX_OBJ_BYTES = 8 << 30
+
+
+def _check_obj_head(head: bytes, name: str) -> None:
+    """Refuse binary data from the first bytes, before the rest of the file is touched."""
+    if head.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        return
+    for k, byte in enumerate(head):
+        if byte < 32 and byte not in (9, 10, 11, 12, 13):
+            line = head.count(b"\n", 0, k) + 1
+            raise SceneError(f"binary data (byte 0x{byte:02x}): not an OBJ text file",
+                             file=name, line=line)
+
+
 def _read_model(file_path: Path, name: str, suffix: str) -> MeshData:
     if suffix in OBJ_SUFFIXES:
-        try:
-            data = file_path.read_bytes()
-        except OSError as error:
-            raise SceneError(f"cannot read the file ({error.strerror or error})",
-                             file=name) from None
+        from .files import head_bytes, map_limited
+
+        _check_obj_head(head_bytes(file_path, 65536, MAX_OBJ_BYTES, "OBJ file", name), name)
+        data = map_limited(file_path, MAX_OBJ_BYTES, "OBJ file", name)
         return load_obj_bytes(data, name, file_path.parent)
     from .trimesh_formats import load_with_trimesh
 
@@ -155,16 +170,18 @@ _RECORD_NAMES = {
 }
 
 
-def obj_text_bytes(data: bytes, name: str) -> bytes:
+def obj_text_bytes(data, name: str):
     """The OBJ text as 8-bit bytes: UTF-16 (by its BOM) is re-encoded as UTF-8, a UTF-8 BOM is
-    dropped; other bytes pass unchanged (names may be Latin-1)."""
-    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+    dropped; other bytes pass unchanged (names may be Latin-1). ``data`` is bytes or a memory
+    map (large files); the result is bytes or a view of it."""
+    head = bytes(data[:3])
+    if head.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
         try:
-            return data.decode("utf-16").encode("utf-8")
+            return bytes(data).decode("utf-16").encode("utf-8")
         except UnicodeDecodeError as error:
             raise SceneError(f"invalid UTF-16 text ({error.reason})", file=name) from None
-    if data.startswith(codecs.BOM_UTF8):
-        return data[3:]
+    if head == codecs.BOM_UTF8:
+        return memoryview(data)[3:]
     return data
 
 

@@ -323,8 +323,16 @@ def to_material(
 
 def read_mtl_file(path: Path, warnings: list[str]) -> dict[str, MtlRecord] | None:
     """The records of an MTL file, or None when it cannot be read."""
+    from ..errors import SceneError
+    from .files import read_limited
+
     try:
-        data = path.read_bytes()
-    except OSError:
+        data = read_limited(path, MAX_MTL_BYTES, "material library")
+    except SceneError as error:
+        warnings.append(str(error))
         return None
     return parse_mtl(decode_text(data), os.fspath(path), warnings)
+
+
+#: Largest MTL file read (material libraries are small text files).
+MAX_MTL_BYTES = 64 << 20

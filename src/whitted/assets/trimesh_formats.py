@@ -17,7 +17,9 @@ import json
 import logging
 import os
 import tempfile
+import warnings as python_warnings
 from pathlib import Path
+from struct import error as struct_error
 
 import numpy as np
 
@@ -116,17 +118,67 @@ def _material_of(geometry: object, images: dict[str, Path], name: str, warnings:
     return Material.model_validate(fields)
 
 
+#: Largest PLY/STL/OFF/glTF file read (trimesh holds the whole file and more in memory).
+MAX_TRIMESH_BYTES = 2 << 30
+
+
+def check_header(path: Path, name: str) -> None:
+    """Refuse at once, from its first bytes, a file that is not of the format its extension
+    says (before trimesh reads all of it)."""
+    from .files import head_bytes
+
+    suffix = path.suffix.lower()
+    kind = suffix[1:].upper()
+    head = head_bytes(path, 4096, MAX_TRIMESH_BYTES, f"{kind} file", name)
+    size = path.stat().st_size
+    text = head.lstrip(b"\xef\xbb\xbf").lstrip()
+    ok = True
+    if suffix == ".ply":
+        ok = head.startswith(b"ply") and head[3:4] in (b"\n", b"\r")
+    elif suffix == ".stl":
+        binary = size >= 84 and 84 + 50 * int.from_bytes(head[80:84], "little") == size
+        ok = binary or text[:5].lower() == b"solid"
+    elif suffix == ".off":
+        first = text.split(None, 1)[0] if text.split(None, 1) else b""
+        ok = first.upper().endswith(b"OFF") and len(first) <= 8
+    elif suffix == ".glb":
+        ok = head[:4] == b"glTF"
+    elif suffix == ".gltf":
+        ok = text[:1] == b"{"
+    if not ok:
+        raise SceneError(f"not a {kind} file (its first bytes are not a {kind} header)",
+                         file=name)
+
+
+def _detail(error: BaseException) -> str:
+    """A bad file's problem in words, not the reader library's internals."""
+    if isinstance(error, ImportError | UnicodeDecodeError):
+        return "the text is not UTF-8"
+    if isinstance(error, KeyError):
+        return f"missing element or property {error.args[0]!r}" if error.args else "incomplete"
+    if isinstance(error, IndexError | ValueError | TypeError | AttributeError | struct_error):
+        text = " ".join(str(error).split())
+        return f"malformed or truncated data ({text[:80]})" if text else "malformed data"
+    if isinstance(error, MemoryError):
+        return "too large to load"
+    text = " ".join(str(error).split())
+    return text[:120] if text else type(error).__name__
+
+
 def load_with_trimesh(path: Path, name: str) -> MeshData:
     """A MeshData for a PLY, STL, OFF or glTF/GLB file."""
     import trimesh
 
+    check_header(path, name)
     logging.getLogger("trimesh").setLevel(logging.ERROR)
     try:
-        scene = trimesh.load_scene(os.fspath(path), process=False)
-    except Exception as error:  # trimesh raises many kinds for a bad file
-        detail = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
-        raise SceneError(f"cannot read the {path.suffix.lower()[1:].upper()} file: {detail}",
-                         file=name) from None
+        with python_warnings.catch_warnings():
+            python_warnings.simplefilter("ignore")
+            with np.errstate(all="ignore"):
+                scene = trimesh.load_scene(os.fspath(path), process=False)
+    except Exception as error:  # noqa: BLE001 - trimesh raises many kinds for a bad file
+        raise SceneError(f"cannot read the {path.suffix.lower()[1:].upper()} file: "
+                         f"{_detail(error)}", file=name) from None
     images = _external_base_colour_images(path)
     warnings: list[str] = []
     texture_files: list[str] = []

@@ -16,10 +16,13 @@ try:  # typer vendors click from 0.2x on; older releases depend on click itself
 except ImportError:  # pragma: no cover - depends on the installed typer
     from click.exceptions import UsageError
 
-from ..errors import WhittedError
+from ..errors import WhittedError, shorten
+from .console import Text, err, out
+from .farm import ClusterOption, SchedulerOption, render_still_on_farm
 
 if TYPE_CHECKING:
     import numpy as np
+    from pydantic import ValidationError
 
     from ..scene import Scene
 
@@ -27,49 +30,35 @@ if TYPE_CHECKING:
 # that use them: `whitted --help` and the import of this module stay far under 0.2 s
 # (tests/test_startup.py).
 
-
-class _LazyConsole:
-    """A rich ``Console`` made on first use (importing rich costs about 40 ms)."""
-
-    def __init__(self, **options) -> None:
-        self._options = options
-        self._made = None
-
-    @property
-    def console(self):
-        if self._made is None:
-            from rich.console import Console
-
-            self._made = Console(**self._options)
-        return self._made
-
-    def __getattr__(self, name: str):
-        return getattr(self.console, name)
-
-
-def escape(text: str) -> str:
-    from rich.markup import escape as rich_escape
-
-    return rich_escape(text)
-
 app = typer.Typer(
     add_completion=False,
     no_args_is_help=False,
     help="whitted: a fast Whitted ray tracer. Render scene files (TOML/JSON) to images.",
     pretty_exceptions_enable=False,
 )
-err = _LazyConsole(stderr=True, highlight=False, soft_wrap=True)
-out = _LazyConsole(highlight=False, soft_wrap=True)
 
 AOV_NAMES = ("depth", "normal", "id")
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 130
+EXIT_TERMINATED = 143  # 128 + SIGTERM
+#: The longest error line printed (a file may hold a huge key or value: it is cut, not echoed).
+MESSAGE_LIMIT = 400
+
+
+def one_line(message: str) -> str:
+    """``message`` as one line of at most :data:`MESSAGE_LIMIT` characters."""
+    return shorten(" ".join(str(message).split()), MESSAGE_LIMIT)
 
 
 def fail(message: str) -> typer.Exit:
-    """One line on stderr, exit status 2: the way every user mistake ends."""
-    err.print(f"[bold red]error:[/] {escape(message)}", soft_wrap=True)
+    """One line on stderr, exit status 2: the way every user mistake ends. The message is
+    printed literally (no rich markup, no emoji codes)."""
+    err.print(Text.assemble(("error:", "bold red"), " ", one_line(message)), soft_wrap=True)
     return typer.Exit(EXIT_USER_ERROR)
+
+
+def _note(message: str) -> None:
+    err.print(Text(one_line(message)), soft_wrap=True)
 
 
 def _version(value: bool) -> None:
@@ -96,6 +85,22 @@ def _load(scene_path: Path | None) -> tuple[Scene, str]:
     if scene_path is None:
         return default_scene(), "<default scene>"
     return load_scene(scene_path), str(scene_path)
+
+
+def apply_set_options(scene: Scene, set_values: list[str] | None) -> Scene:
+    """The scene with every ``--set PATH=VALUE`` applied (SceneError on a bad one)."""
+    if not set_values:
+        return scene
+    from ..animation.overrides import apply_overrides, parse_assignment
+
+    return apply_overrides(scene, [parse_assignment(text) for text in set_values])
+
+
+def _is_dir(path: Path) -> bool:
+    try:
+        return path.is_dir()
+    except (OSError, ValueError):  # a name too long, a NUL byte: reported by the checks later
+        return False
 
 
 def _parse_aovs(text: str | None) -> list[str]:
@@ -128,8 +133,17 @@ def render(
         str | None, typer.Option("--transfer", help="srgb or linear (default: the scene's)")
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
+    frame: Annotated[
+        int | None, typer.Option("--frame", "-f", help="Frame of an animated scene (from 0)")
+    ] = None,
+    set_values: Annotated[
+        list[str] | None, typer.Option("--set", help="PATH=VALUE: change a scene value")
+    ] = None,
+    cluster: ClusterOption = None,
+    scheduler: SchedulerOption = None,
 ) -> None:
-    """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG)."""
+    """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG).
+    An animated scene renders frame 0, or the frame --frame names."""
     from pydantic import ValidationError
 
     from ..output.encode import check_bit_depth, image_format
@@ -137,59 +151,116 @@ def render(
 
     process_start = time.perf_counter()
     aovs = _parse_aovs(aov)
+    if _is_dir(output):
+        raise fail(f"{output}: is a directory (give a file name such as {output / 'render.png'})")
     try:
-        image_format(output)
-        check_bit_depth(bit_depth, output)
+        check_bit_depth(bit_depth, image_format(output))
     except ValueError as exc:
         raise fail(f"{output}: {exc}") from None
     if transfer not in (None, "srgb", "linear"):
-        raise fail(f"--transfer: unknown transfer {transfer!r} (use srgb or linear)")
+        raise fail(f"--transfer: unknown transfer {shorten(transfer)!r} (use srgb or linear)")
     try:
         scene, name = _load(scene_path)
+        scene = apply_set_options(scene, set_values)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    try:
         scene = scene.with_settings(width=width, height=height, samples=samples,
                                     max_depth=max_depth, threads=threads, seed=seed,
                                     transfer=transfer)
-    except WhittedError as exc:
-        raise fail(str(exc)) from None
+        if frame is not None or scene.is_animated:
+            scene = scene.at_frame(frame or 0)
     except ValidationError as exc:  # a command-line override out of range
         raise fail(_override_error(exc)) from None
-    if not output.parent.exists():
-        raise fail(f"{output}: the folder {output.parent} does not exist")
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    outputs = [output] + [output.with_name(f"{output.stem}.{a}.npy") for a in aovs]
+    try:
+        from ..output.safety import check_memory, check_outputs
 
-    job = RenderJob(scene)
+        check_outputs(outputs, scene, scene_path)
+        check_memory(scene.render.width, scene.render.height, image_format(output), bit_depth)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    if cluster is not None or scheduler is not None:  # bands on a Dask cluster (cli/farm.py)
+        render_still_on_farm(scene, output, cluster=cluster, scheduler=scheduler,
+                             threads=threads, quiet=quiet, bit_depth=bit_depth, aovs=aovs)
+
+    try:
+        job = RenderJob(scene)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
     interrupted = threading.Event()
-    previous = signal.getsignal(signal.SIGINT)
+    signals: list[int] = []
+    handled = [signal.SIGINT, signal.SIGTERM]
+    previous = {sig: signal.getsignal(sig) for sig in handled}
 
-    def on_interrupt(signum, frame) -> None:  # Ctrl-C: stop after the tiles in flight
+    def on_interrupt(signum, frame) -> None:  # Ctrl-C, SIGTERM: stop after the tiles in flight
+        signals.append(signum)
         interrupted.set()
         job.cancel()
 
-    signal.signal(signal.SIGINT, on_interrupt)
+    for sig in handled:
+        signal.signal(sig, on_interrupt)
     try:
-        _run_with_progress(job, quiet)
+        _run_with_progress(job, quiet, interrupted)
     except WhittedError as exc:  # a model or texture file the scene names is unusable
-        raise fail(str(exc)) from None
+        raise fail(_with_scene_key(exc, scene, name)) from None
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for sig in handled:
+            signal.signal(sig, previous[sig])
+    exit_code = EXIT_TERMINATED if signal.SIGTERM in signals else EXIT_INTERRUPTED
+    stats = job.stats
+    if interrupted.is_set() and (job.running or stats.tiles_done == 0):
+        # stopped while compiling, or before any tile was finished: there is nothing to keep,
+        # and an existing file at the output path is left as it was
+        what = "terminated" if signal.SIGTERM in signals else "interrupted"
+        _note(f"{what} before any tile was finished: nothing written ({output} is unchanged)")
+        raise typer.Exit(exit_code)
     image = job.image
     assert image is not None
-    stats = job.stats
     for warning in stats.warnings:
-        err.print(f"warning: {warning}", markup=False, highlight=False)
-    image.save(output, bit_depth=bit_depth)
+        err.print(Text(f"warning: {warning}"))
     written = [str(output)]
-    if aovs and not interrupted.is_set():
-        planes = render_aovs(scene)
-        for aov_name in aovs:
-            path = output.with_name(f"{output.stem}.{aov_name}.npy")
-            _save_npy(path, planes[aov_name])
-            written.append(str(path))
+    try:
+        image.save(output, bit_depth=bit_depth)
+        if aovs and not interrupted.is_set():
+            planes = render_aovs(scene)
+            for path, aov_name in zip(outputs[1:], aovs, strict=True):
+                _save_npy(path, planes[aov_name])
+                written.append(str(path))
+    except OSError as exc:
+        raise fail(f"{getattr(exc, 'filename', None) or output}: cannot write: "
+                   f"{exc.strerror or exc}") from None
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
     stats.wall_seconds = time.perf_counter() - process_start
     if not quiet or interrupted.is_set():
-        out.print(f"{stats.summary()} -> {', '.join(written)}")
+        out.print(Text(f"{stats.summary()} -> {', '.join(written)}"))
     if interrupted.is_set():
-        err.print(f"interrupted: kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")
-        raise typer.Exit(EXIT_INTERRUPTED)
+        what = "terminated" if signal.SIGTERM in signals else "interrupted"
+        _note(f"{what}: kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")
+        raise typer.Exit(exit_code)
+
+
+def _with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
+    """A model or texture error from the render, with the scene file and key that name it."""
+    from ..scene.io import named_files
+
+    file = getattr(exc, "file", None)
+    if not file:
+        return str(exc)
+    for keys, named in named_files(scene):
+        try:
+            target = scene.resolve_path(named)
+        except (OSError, RuntimeError, ValueError):
+            continue
+        from ..assets.files import same_file
+
+        if same_file(target, file) or str(target) == file:
+            where = "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in keys).lstrip(".")
+            return f"{name}: {where}: {exc}"
+    return f"{name}: {exc}"
 
 
 def _save_npy(path: Path, array: np.ndarray) -> None:
@@ -200,7 +271,7 @@ def _save_npy(path: Path, array: np.ndarray) -> None:
     atomic_write(path, lambda tmp: np.save(tmp, array))
 
 
-def _override_error(exc) -> str:
+def _override_error(exc: ValidationError) -> str:
     """One line for a command-line value the render settings reject."""
     from ..scene.io import _clean_message
 
@@ -212,12 +283,20 @@ def _override_error(exc) -> str:
     return f"{option}: {_clean_message(e)}"
 
 
-def _run_with_progress(job, quiet: bool) -> None:
+def _wait(job, interrupted: threading.Event) -> None:
+    """Wait for the job; after an interrupt, stop waiting at once if no tile is being rendered
+    yet (the first compile of the kernels takes many seconds and cannot be cut short)."""
+    while job.running:
+        job.join(0.1)
+        if interrupted.is_set() and not job.rendering:
+            return
+    job.wait()
+
+
+def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
     if quiet or not err.is_terminal:
         job.start()
-        while job.wait(0.1) is None and job.running:
-            pass
-        job.wait()
+        _wait(job, interrupted)
         return
     from rich.progress import (
         BarColumn,
@@ -234,7 +313,7 @@ def _run_with_progress(job, quiet: bool) -> None:
         TextColumn("{task.fields[rays]} rays"),
         TimeRemainingColumn(),
     )
-    with Progress(*columns, console=err.console, transient=True) as bar:
+    with Progress(*columns, console=err, transient=True) as bar:
         task = bar.add_task("render", total=1.0, rays="0")
 
         def update(p) -> None:
@@ -242,9 +321,7 @@ def _run_with_progress(job, quiet: bool) -> None:
 
         job.progress = update
         job.start()
-        while job.wait(0.1) is None and job.running:
-            pass
-        job.wait()
+        _wait(job, interrupted)
 
 
 def _model_info(path: Path) -> None:
@@ -257,7 +334,7 @@ def _model_info(path: Path) -> None:
         mesh = load_mesh(path)
     except WhittedError as exc:
         raise fail(str(exc)) from None
-    out.print(f"[bold]{path}[/]", highlight=False)
+    out.print(Text(str(path), style="bold"))
     out.print(f"vertices: {mesh.vertex_records}")
     out.print(f"triangles: {mesh.triangle_records}")
     if len(mesh.vertices) != mesh.vertex_records:
@@ -277,13 +354,13 @@ def _model_info(path: Path) -> None:
         colour = ", ".join(f"{c:.3g}" for c in mat.color)
         tex = f" texture={mat.texture.file}" if getattr(mat.texture, "file", None) else ""
         out.print(f"  [{k}] color=({colour}) kt={mat.kt:.3g} triangles={counts[k]}{tex}",
-                  highlight=False)
+                  highlight=False, markup=False)
     out.print(f"textures: {len(mesh.texture_files)}")
     for file in mesh.texture_files:
-        out.print(f"  {file}", highlight=False)
+        out.print(f"  {file}", highlight=False, markup=False)
     out.print(f"warnings: {len(mesh.warnings)}")
     for warning in mesh.warnings:
-        out.print(f"  {warning}", markup=False, highlight=False)
+        out.print(Text(f"  {warning}"))
 
 
 @app.command()
@@ -297,18 +374,24 @@ def info(
     import numpy as np
 
     from ..assets.mesh import SUPPORTED_SUFFIXES
-    from ..compile.flatten import compile_scene
+    from ..compile.scene import compile_scene
 
     if scene_path is not None and scene_path.suffix.lower() in SUPPORTED_SUFFIXES:
         _model_info(scene_path)
         return
     try:
         scene, name = _load(scene_path)
-        compiled = compile_scene(scene)
+        compiled = compile_scene(scene.at_frame(0) if scene.is_animated else scene)
     except WhittedError as exc:
         raise fail(str(exc)) from None
     r = scene.render
-    out.print(f"[bold]{name}[/]")
+    out.print(Text(name, style="bold"))
+    if scene.animation is not None:
+        a = scene.animation
+        out.print(f"animation: {a.frames} frames at {a.fps:g} fps ({a.frames / a.fps:.2f} s), "
+                  f"{len(a.tracks)} track(s): "
+                  + ", ".join(f"{t.path} ({t.interpolation})" for t in a.tracks),
+                  markup=False, highlight=False)
     out.print(f"image: {r.width}x{r.height}, {r.samples} sample(s)/pixel, max depth "
               f"{r.max_depth}, min weight {r.min_weight}")
     out.print(f"objects: {len(scene.objects)}")
@@ -318,10 +401,10 @@ def info(
             else "from the file" if obj.type == "mesh" and getattr(obj, "file", None)
             else "default")
         label = f" '{obj.name}'" if obj.name else ""
-        out.print(f"  [{i}] {obj.type}{label} material={mat}")
+        out.print(f"  [{i}] {obj.type}{label} material={mat}", markup=False)
     out.print(f"lights: {len(scene.lights)}")
     for i, light in enumerate(scene.lights):
-        out.print(f"  [{i}] {light.type} intensity={light.intensity}")
+        out.print(f"  [{i}] {light.type} intensity={light.intensity}", markup=False)
     out.print(f"materials: {len(compiled.materials)} distinct")
     if np.all(np.isfinite(compiled.bounds_min)):
         lo = ", ".join(f"{v:.3g}" for v in compiled.bounds_min)
@@ -344,7 +427,7 @@ def info(
                          f"{len(geo.mesh_nodes):,} mesh BVH nodes)")
         out.print("meshes: " + "; ".join(parts))
     for warning in compiled.warnings:
-        out.print(f"warning: {warning}", markup=False, highlight=False)
+        out.print(Text(f"warning: {warning}"))
     shadow = sum(
         (light.samples or r.shadow_samples) if light.type == "disk" else 1
         for light in scene.lights if light.type != "ambient"
@@ -361,11 +444,15 @@ def gui(
     ] = None,
 ) -> None:
     """Open the scene editor (a desktop window) on SCENE, or on the built-in default scene."""
-    scene = None
-    if scene_path is not None and scene_path.exists():
-        try:
-            from ..scene import load_scene
+    from ..scene import load_scene
 
+    scene = None
+    try:
+        exists = scene_path is not None and scene_path.exists()
+    except (OSError, ValueError) as exc:
+        raise fail(f"{scene_path}: {getattr(exc, 'strerror', None) or exc}") from None
+    if exists:
+        try:
             scene = load_scene(scene_path)
         except WhittedError as exc:
             raise fail(str(exc)) from None
@@ -401,36 +488,37 @@ def export(
         raise fail(f"--format: unknown format {export_format!r} (known: pov)")
     try:
         scene, name = _load(scene_path)
-        scene = scene.with_settings(width=width, height=height)
-        if output is None:
-            output = Path(scene_path.stem if scene_path else "default").with_suffix(".pov")
-        if not output.parent.exists():
-            raise fail(f"{output}: the folder {output.parent} does not exist")
-        export_pov(scene, output, source=name)
     except WhittedError as exc:
         raise fail(str(exc)) from None
+    try:
+        scene = scene.with_settings(width=width, height=height)
     except ValidationError as exc:
         raise fail(_override_error(exc)) from None
+    if output is None:  # the whole stem: scene.v1.toml -> scene.v1.pov
+        output = Path((scene_path.stem if scene_path else "default") + ".pov")
+    try:
+        export_pov(scene, output, source=str(scene_path) if scene_path else name)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    except OSError as exc:
+        raise fail(f"{output}: cannot write: {exc.strerror or exc}") from None
     r = scene.render
-    out.print(f"{name} -> {output} (POV-Ray 3.7; render with: povray +I{output} "
-              f"+W{r.width} +H{r.height} -A)")
+    out.print(Text(f"{name} -> {output} (POV-Ray 3.7; render with: povray +I{output} "
+                   f"+W{r.width} +H{r.height} -A)"))
 
 
 @app.command()
 def bench(
     scene: Annotated[
         list[str] | None, typer.Option("--scene", help="Scene(s): seed000, softshadow, ice, "
-                                       "mesh1m, lecture, sphere1m, bunny1m, vase1m, "
-                                       "instances100 (default: all)")
+                                       "mesh1m, lecture (default: all)")
     ] = None,
     runs: Annotated[int, typer.Option("--runs", "-n", help="Timed runs; the median")] = 5,
     threads: Annotated[
         str | None, typer.Option("--threads", "-t", help="Thread counts, e.g. 1,2 (all cores)")
     ] = None,
     quick: Annotated[bool, typer.Option("--quick", help="Tiny images, one run (CI)")] = False,
-    compare: Annotated[
-        str | None, typer.Option("--compare", help="Also time: povray, embree")
-    ] = None,
+    compare: Annotated[str | None, typer.Option("--compare", help="Also time: povray")] = None,
     study: Annotated[str | None, typer.Option("--study", help="threads or size")] = None,
     json_path: Annotated[Path | None, typer.Option("--json", help="Write results")] = None,
     plot: Annotated[Path | None, typer.Option("--plot", help="Study plot (PNG)")] = None,
@@ -442,7 +530,20 @@ def bench(
 ) -> None:
     """Render the benchmark scenes (benchmarks/) and print times, rays and memory."""
     from ..bench.command import bench_main
+    from ..bench.scenes import SCENES
 
+    for name in scene or []:  # checked before the header line: a mistake is one line
+        if name not in SCENES and not name.startswith("generated/"):
+            raise fail(f"--scene: unknown benchmark scene {shorten(name)!r} "
+                       f"(known: {', '.join(SCENES)})")
+    from ..output.safety import check_output_place
+
+    for option, path in (("--json", json_path), ("--plot", plot), ("--markdown", markdown)):
+        try:
+            if path is not None:
+                check_output_place(path)
+        except WhittedError as exc:
+            raise fail(f"{option}: {exc}") from None
     try:
         bench_main(scenes=scene, runs=runs, threads=threads, quick=quick, compare=compare,
                    study=study, json_path=json_path, plot_path=plot, markdown_path=markdown,
@@ -452,7 +553,10 @@ def bench(
 
 
 def main() -> None:
-    """Console entry point: usage mistakes end as one ``error:`` line and status 2."""
+    """Console entry point: usage mistakes end as one ``error:`` line and status 2; nothing
+    ends in a traceback (set WHITTED_DEBUG=1 to see one for an internal error)."""
+    import os
+
     try:
         code = app(standalone_mode=False)
     except UsageError as exc:
@@ -460,10 +564,29 @@ def main() -> None:
             f"whitted {exc.ctx.info_name}"
         )
         hint = f" (see '{command} --help')"
-        err.print(f"[bold red]error:[/] {escape(exc.format_message())}{hint}", soft_wrap=True)
+        err.print(Text.assemble(("error:", "bold red"), " ",
+                                one_line(exc.format_message()) + hint), soft_wrap=True)
         sys.exit(EXIT_USER_ERROR)
     except typer.Abort:
         sys.exit(EXIT_INTERRUPTED)
     except KeyboardInterrupt:
         sys.exit(EXIT_INTERRUPTED)
+    except WhittedError as exc:  # a user mistake a command did not catch itself
+        err.print(Text.assemble(("error:", "bold red"), " ", one_line(str(exc))), soft_wrap=True)
+        sys.exit(EXIT_USER_ERROR)
+    except MemoryError:
+        err.print(Text.assemble(("error:", "bold red"), " ", "out of memory"), soft_wrap=True)
+        sys.exit(EXIT_USER_ERROR)
+    except Exception as exc:  # noqa: BLE001 - a bug: one line, the traceback on request
+        if os.environ.get("WHITTED_DEBUG"):
+            raise
+        err.print(Text.assemble(("internal error:", "bold red"), " ", one_line(
+            f"{type(exc).__name__}: {exc} (please report it; WHITTED_DEBUG=1 shows the "
+            "traceback)")), soft_wrap=True)
+        sys.exit(1)
     sys.exit(code if isinstance(code, int) else 0)
+
+
+# Commands in their own modules register themselves on `app` when imported.
+from . import animate as _animate  # noqa: E402, F401
+from . import sweep as _sweep  # noqa: E402, F401

@@ -479,10 +479,15 @@ def export_pov(
     scene: Scene, path: str | os.PathLike[str], *, width: int | None = None,
     height: int | None = None, source: str | None = None,
 ) -> Path:
-    """Write the scene as a POV-Ray 3.7 file at ``path`` (atomically). Returns the path."""
+    """Write the scene as a POV-Ray 3.7 file at ``path`` (atomically). Returns the path.
+    :class:`~whitted.errors.OutputError` when ``path`` is the scene file (``source``) or a
+    file the scene reads, or cannot be written."""
     from ..output.encode import atomic_write
+    from ..output.safety import check_outputs
 
     path = Path(path)
+    source_file = source if source and Path(source).suffix.lower() in (".toml", ".json") else None
+    check_outputs([path], scene, source_file)
     text = scene_to_pov(scene, width=width, height=height, source=source)
     atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
     return path

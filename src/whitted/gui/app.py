@@ -10,7 +10,15 @@ from ..scene import Scene
 
 def run_editor(scene: Scene | None = None, path: Path | None = None) -> int:
     """Open the editor on ``scene`` (loaded from ``path``; None: the default scene, or a new
-    scene to be saved at ``path``) and return the exit status when the window closes."""
+    scene to be saved at ``path``) and return the exit status when the window closes.
+    Returns 2 with one line on stderr when Qt could not open a window here (missing system
+    libraries), before Qt starts."""
+    from .system_check import display_problem
+
+    problem = display_problem()
+    if problem is not None:
+        print(f"whitted gui: {problem}", file=sys.stderr)
+        return 2
     from PySide6.QtWidgets import QApplication
 
     from .main_window import MainWindow, starter_scene

@@ -112,3 +112,93 @@ def move_to(camera: Camera, position: tuple[float, float, float]) -> Camera:
     """The camera at ``position``, still looking at its target."""
     target = target_of(camera)
     return with_view(camera, np.asarray(position, np.float64), target, np.asarray(camera.up))
+
+
+def ray_direction(camera: Camera, width: int, height: int, u: float, v: float) -> np.ndarray:
+    """The unit direction of the view ray through the picture point (u, v) (0..1 from the
+    top-left corner) of a ``width`` x ``height`` render (perspective cameras; orthographic
+    ones look straight ahead)."""
+    right, up, forward = (np.asarray(a, np.float64) for a in camera.basis())
+    if camera.projection == "orthographic":
+        return forward
+    hx, hy = camera.half_extents(width, height)
+    d = forward + (2 * u - 1) * hx * right + (1 - 2 * v) * hy * up
+    return d / np.linalg.norm(d)
+
+
+def ray_origin(camera: Camera, width: int, height: int, u: float, v: float) -> np.ndarray:
+    pos = np.asarray(camera.position, np.float64)
+    if camera.projection != "orthographic":
+        return pos
+    right, up, _ = (np.asarray(a, np.float64) for a in camera.basis())
+    hx, hy = camera.half_extents(width, height)
+    return pos + (2 * u - 1) * hx * right + (1 - 2 * v) * hy * up
+
+
+def project(camera: Camera, width: int, height: int,
+            point) -> tuple[float, float] | None:
+    """The picture point (u, v) where ``point`` appears; None behind the camera."""
+    right, up, forward = (np.asarray(a, np.float64) for a in camera.basis())
+    d = np.asarray(point, np.float64) - np.asarray(camera.position, np.float64)
+    z = float(d @ forward)
+    hx, hy = camera.half_extents(width, height)
+    if camera.projection == "orthographic":
+        x, y = float(d @ right) / hx, float(d @ up) / hy
+    else:
+        if z <= 1e-6:
+            return None
+        x, y = float(d @ right) / (z * hx), float(d @ up) / (z * hy)
+    return (x + 1) / 2, (1 - y) / 2
+
+
+def zoom_to(camera: Camera, factor: float, width: int, height: int, u: float,
+            v: float) -> Camera:
+    """Zoom toward the picture point (u, v): the scene point under it, at the target's
+    depth, stays under the pointer (eye and target move toward it by ``factor``)."""
+    if camera.projection == "orthographic" or not (0 <= u <= 1 and 0 <= v <= 1):
+        return zoom(camera, factor)
+    pos, target, _, _ = _frame(camera)
+    _, _, forward = camera.basis()
+    depth = float((target - pos) @ np.asarray(forward))
+    d = ray_direction(camera, width, height, u, v)
+    p = pos + d * depth / max(float(d @ np.asarray(forward)), 1e-6)
+    new_pos = p + (pos - p) * factor
+    if np.linalg.norm(new_pos - (p + (target - p) * factor)) < MIN_DISTANCE:
+        return camera
+    return with_view(camera, new_pos, p + (target - p) * factor, np.asarray(camera.up))
+
+
+def look_from(camera: Camera, direction, target, distance: float) -> Camera:
+    """The camera looking at ``target`` from ``distance`` along ``direction`` (a view from
+    the front, the side, the top...), with the world's up (+y) as its up: a view from
+    straight above is tilted by a hair toward the front so that up stays +y (and a later
+    orbit still turns about the vertical)."""
+    d = np.asarray(direction, np.float64)
+    d = d / np.linalg.norm(d)
+    up = np.array([0.0, 1.0, 0.0])
+    if abs(float(d @ up)) > 0.9999:
+        d = d + np.array([0.0, 0.0, 1e-3])
+        d /= np.linalg.norm(d)
+    target = np.asarray(target, np.float64)
+    return with_view(camera, target + distance * d, target, up)
+
+
+def frame_bounds(camera: Camera, width: int, height: int, lo, hi,
+                 margin: float = 1.15) -> Camera:
+    """The camera moved along its view direction so that the box lo..hi fills the view."""
+    lo, hi = np.asarray(lo, np.float64), np.asarray(hi, np.float64)
+    centre = (lo + hi) / 2
+    radius = max(float(np.linalg.norm(hi - lo)) / 2, 1e-3) * margin
+    pos, target, _, _ = _frame(camera)
+    view = pos - target
+    n = float(np.linalg.norm(view))
+    direction = view / n if n > MIN_DISTANCE else np.array([0.0, 0.0, 1.0])
+    if camera.projection == "orthographic":
+        data = camera.model_dump()
+        data["ortho_height"] = 2 * radius
+        camera = Camera.model_validate(data)
+        return with_view(camera, centre + direction * max(n, 4 * radius), centre,
+                         np.asarray(camera.up))
+    hx, hy = camera.half_extents(width, height)
+    distance = radius / math.sin(math.atan(min(hx, hy)))
+    return with_view(camera, centre + direction * distance, centre, np.asarray(camera.up))

@@ -22,6 +22,8 @@ LIGHT_KINDS = {
     "disk": "Disk light (soft shadows)",
 }
 HAS_MESH = hasattr(S, "Mesh")
+#: a model larger or smaller than this (its longest side) is scaled to MODEL_SIZE
+MODEL_LARGEST, MODEL_SMALLEST, MODEL_SIZE = 20.0, 0.05, 1.5
 #: model formats the mesh loader reads (file dialog filter)
 MODEL_SUFFIXES = ("obj", "ply", "stl", "off", "glb", "gltf")
 
@@ -30,9 +32,62 @@ def _v(a: np.ndarray) -> tuple[float, float, float]:
     return (round(float(a[0]), 4), round(float(a[1]), 4), round(float(a[2]), 4))
 
 
+def ground_height(scene: Scene) -> float | None:
+    """The height of the scene's floor: a plane facing up (None when there is none)."""
+    for obj in scene.objects:
+        if obj.type == "plane" and obj.transform is None:
+            n = np.asarray(obj.normal, np.float64)
+            if n[1] > 0.99 * np.linalg.norm(n):
+                return float(obj.point[1])
+    return None
+
+
 def spot(scene: Scene) -> np.ndarray:
-    """Where a new object goes: the point the camera looks at, or 5 units ahead."""
-    return np.asarray(target_of(scene.camera), dtype=np.float64)
+    """Where a new object goes: on the floor where the camera looks (the centre of the view
+    meeting the floor, or under the point it looks at), else the point it looks at."""
+    target = np.asarray(target_of(scene.camera), dtype=np.float64)
+    floor = ground_height(scene)
+    if floor is None:
+        return target
+    pos = np.asarray(scene.camera.position, np.float64)
+    d = target - pos
+    if d[1] < -1e-6:
+        t = (floor - pos[1]) / d[1]
+        hit = pos + t * d
+        if np.linalg.norm(hit - target) < 2 * np.linalg.norm(d):
+            return np.array([hit[0], floor, hit[2]])
+    return np.array([target[0], floor, target[2]])
+
+
+def _overlaps(lo, hi, boxes) -> bool:
+    return any(bool(np.all(lo < b_hi) and np.all(b_lo < hi)) for b_lo, b_hi in boxes)
+
+
+def place_clear(scene: Scene, make: Callable[[np.ndarray], BaseModel]) -> BaseModel:
+    """``make(point)`` built at the spot, resting on the floor, moved sideways (along the
+    camera's right) until it intersects no other object's bounds."""
+    from .transform_tool import item_bounds
+
+    base = spot(scene)
+    floor = ground_height(scene)
+    boxes = [b for o in scene.objects if (b := item_bounds(o, scene)) is not None]
+    right = np.asarray(scene.camera.basis()[0], np.float64)
+    right = np.array([right[0], 0.0, right[2]])
+    right = right / np.linalg.norm(right) if np.linalg.norm(right) > 1e-9 else np.array(
+        [1.0, 0, 0])
+    obj = make(base)
+    bounds = item_bounds(obj, scene)
+    if bounds is None:
+        return obj
+    lift = np.array([0.0, (floor - bounds[0][1]) if floor is not None else 0.0, 0.0])
+    size = float(np.max(bounds[1] - bounds[0])) + 0.1
+    for k in range(41):
+        step = (k + 1) // 2 * (1 if k % 2 else -1) * size  # 0, +1, -1, +2, -2, ...
+        candidate = make(base + lift + step * right)
+        lo, hi = item_bounds(candidate, scene)
+        if not _overlaps(lo + 1e-6, hi - 1e-6, boxes):
+            return candidate
+    return make(base + lift)
 
 
 def unique_name(scene: Scene, base: str) -> str:
@@ -60,13 +115,27 @@ def _objects(t: np.ndarray) -> dict[str, Callable[[], BaseModel]]:
 
 
 def new_object(scene: Scene, kind: str) -> BaseModel:
-    obj = _objects(spot(scene))[kind]()
+    """A new object of ``kind``: on the floor in front of the camera, clear of the others
+    (a plane stays the plane y = 0)."""
+    if kind == "plane":
+        obj = _objects(spot(scene))[kind]()
+    else:
+        obj = place_clear(scene, lambda t: _objects(t)[kind]())
     return obj.model_copy(update={"name": unique_name(scene, kind)})
 
 
+def light_name(scene: Scene, kind: str) -> str:
+    """Lights are named by their type and number: "point 2" is the second point light."""
+    n = sum(1 for li in scene.lights if li.type == kind) + 1
+    names = {getattr(li, "name", None) for li in scene.lights}
+    while f"{kind} {n}" in names:
+        n += 1
+    return f"{kind} {n}"
+
+
 def new_light(scene: Scene, kind: str) -> BaseModel:
-    t = spot(scene)
-    name = unique_name(scene, f"{kind} light")
+    t = np.asarray(target_of(scene.camera), dtype=np.float64)
+    name = light_name(scene, kind)
     if kind == "ambient":
         return S.AmbientLight(name=name, intensity=0.2)
     if kind == "point":
@@ -108,6 +177,22 @@ def new_model(scene: Scene, path: Path) -> BaseModel:
         name = str(path.relative_to(scene.base_dir.resolve()))
     except ValueError:
         name = str(path)
-    t = spot(scene)
-    return S.Mesh(file=name, name=unique_name(scene, path.stem),
-                  transform=S.Transform(translate=_v(t)))
+    mesh = S.Mesh(file=name, name=unique_name(scene, path.stem))
+    from .transform_tool import item_bounds
+
+    bounds = item_bounds(mesh.model_copy(update={"file": str(path)}), scene)
+    scale = 1.0
+    if bounds is not None:
+        extent = float(np.max(bounds[1] - bounds[0]))
+        if extent > MODEL_LARGEST or extent < MODEL_SMALLEST:  # a sensible size: 1.5 units
+            scale = float(f"{MODEL_SIZE / extent:.3g}")
+    centre = (bounds[0] + bounds[1]) / 2 * scale if bounds is not None else np.zeros(3)
+    bottom = bounds[0][1] * scale if bounds is not None else 0.0
+
+    def make(t: np.ndarray) -> BaseModel:
+        shift = np.array([t[0] - centre[0], t[1] - bottom, t[2] - centre[2]])
+        return mesh.model_copy(update={"transform": S.Transform(
+            scale=scale, translate=_v(shift))})
+
+    obj = place_clear(scene, lambda t: make(t).model_copy(update={"file": str(path)}))
+    return obj.model_copy(update={"file": name})

@@ -36,12 +36,16 @@ class SceneEdit(QUndoCommand):
         self.select_before = select_before
         self.select_after = select_after
         self.merge_key = merge_key
+        #: undone for good (a cancelled G/R/S move): the stack forgets it, nothing to redo
+        self.forget_on_undo = False
 
     def redo(self) -> None:
         self.doc._replace(self.after, self.select_after)
 
     def undo(self) -> None:
         self.doc._replace(self.before, self.select_before)
+        if self.forget_on_undo:
+            self.setObsolete(True)
 
     def id(self) -> int:
         return MERGE_ID if self.merge_key is not None else -1

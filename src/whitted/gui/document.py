@@ -12,8 +12,8 @@ from PySide6.QtCore import QObject, Signal
 from PySide6.QtGui import QUndoStack
 
 from ..scene import Scene
-from ..scene.io import validation_message
 from .commands import SceneEdit
+from .messages import friendly_message
 
 #: what is selected: ("camera",), ("render",), ("background",), ("lights", i), ("objects", i)
 SelectionKey = tuple
@@ -24,7 +24,12 @@ SINGLETONS = (CAMERA, RENDER, BACKGROUND)
 
 
 class EditRefused(ValueError):
-    """An edit the scene model rejects; the message is one short line for the field."""
+    """An edit the scene model rejects; the message is one short line for the field.
+    ``validation`` keeps the model's error, so the panel can name the field its way."""
+
+    def __init__(self, message: str, validation: ValidationError | None = None) -> None:
+        super().__init__(message)
+        self.validation = validation
 
 
 def scene_fields(scene: Scene) -> dict[str, Any]:
@@ -38,11 +43,13 @@ def rebuild_scene(scene: Scene, **update: Any) -> Scene:
     try:
         new = Scene(**fields)
     except ValidationError as exc:
-        raise EditRefused(validation_message(exc)) from None
+        raise EditRefused(friendly_message(exc), exc) from None
     return new.with_base_dir(getattr(scene, "_base_dir", None))
 
 
-def item_of(scene: Scene, key: SelectionKey) -> BaseModel | None:
+def item_of(scene: Scene, key: SelectionKey | None) -> BaseModel | None:
+    if key is None:
+        return None
     if key in SINGLETONS:
         return getattr(scene, key[0])
     if len(key) == 2 and key[0] in ("lights", "objects"):
@@ -66,7 +73,7 @@ def validate_like(model: BaseModel, data: dict[str, Any]) -> BaseModel:
     try:
         return type(model).model_validate(data)
     except ValidationError as exc:
-        raise EditRefused(validation_message(exc)) from None
+        raise EditRefused(friendly_message(exc), exc) from None
 
 
 def set_path(data: Any, path: tuple, value: Any) -> Any:
@@ -107,6 +114,8 @@ class SceneDocument(QObject):
     open) with the key to select; ``reset`` after New/Open."""
 
     changed = Signal(object)  # selection key
+    #: the one selection of the tree, the properties panel and the picture changed
+    selection_changed = Signal(object)
     reset = Signal()
     path_changed = Signal()
 
@@ -137,6 +146,7 @@ class SceneDocument(QObject):
         self.path_changed.emit()
         self.reset.emit()
         self.changed.emit(self.selection)
+        self.selection_changed.emit(self.selection)
 
     def mark_saved(self, path: Path, scene: Scene) -> None:
         self.scene = scene
@@ -147,8 +157,13 @@ class SceneDocument(QObject):
     def item(self, key: SelectionKey | None = None) -> BaseModel | None:
         return item_of(self.scene, self.selection if key is None else key)
 
-    def select(self, key: SelectionKey) -> None:
-        self.selection = key
+    def select(self, key: SelectionKey | None) -> None:
+        """Select ``key`` (None: nothing); every view follows through ``selection_changed``."""
+        if key is not None and item_of(self.scene, key) is None:
+            key = None
+        if key != self.selection:
+            self.selection = key
+            self.selection_changed.emit(key)
 
     # ------------------------------------------------------------------ edits
 
@@ -229,11 +244,14 @@ class SceneDocument(QObject):
         """Called by the undo commands only."""
         self.scene = scene
         self.revision += 1
+        before = self.selection
         if select is not None and item_of(scene, select) is not None:
             self.selection = select
-        elif item_of(scene, self.selection) is None:
-            self.selection = CAMERA
+        elif self.selection is not None and item_of(scene, self.selection) is None:
+            self.selection = None
         self.changed.emit(self.selection)
+        if self.selection != before:
+            self.selection_changed.emit(self.selection)
 
 
 def label_of(item: Any) -> str:

@@ -5,11 +5,14 @@ tests can answer them)."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
-from PySide6.QtCore import QSettings, Qt, QTimer
-from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
+import numpy as np
+from PySide6.QtCore import QPointF, QSettings, Qt, QTimer
+from PySide6.QtGui import QAction, QCloseEvent, QColor, QKeySequence, QPainter, QPen
 from PySide6.QtWidgets import (
+    QApplication,
     QDockWidget,
     QFileDialog,
     QLabel,
@@ -24,6 +27,7 @@ from ..errors import WhittedError
 from ..scene import Scene, load_scene, save_scene
 from ..scene.default import default_scene
 from ..scene.io import rebase_files
+from ..scene.toml_document import save_scene_toml
 from . import camera_ops, catalog
 from .autosave import Autosave, recovery_for
 from .document import (
@@ -36,9 +40,11 @@ from .document import (
     rebuild_scene,
     set_path,
 )
+from .picking import IdBuffer, id_at, outline_image
 from .properties import PropertyPanel
 from .recent import RecentFiles
 from .render_controller import RenderController
+from .transform_tool import TransformTool, light_position, object_bounds, object_centre
 from .tree import SceneTree
 from .viewport import Viewport
 
@@ -75,6 +81,7 @@ class MainWindow(QMainWindow):
         if path is not None:
             scene = scene.with_base_dir(Path(path).parent)
         self.doc = SceneDocument(scene, Path(path) if path is not None else None, self)
+        self._remember_source(scene, path)
         self.controller = RenderController(self)
         self.controller.preview_enabled = preview
         self.autosave = Autosave(self.doc, interval_ms=autosave_interval_ms,
@@ -111,6 +118,14 @@ class MainWindow(QMainWindow):
         self.controller.failed.connect(self._render_failed)
         self.controller.kernels_ready.connect(self._kernels_ready)
         self.autosave.saved.connect(self._status)
+        self.ids = IdBuffer(self)
+        self.ids.ready.connect(self._update_outline)
+        self.doc.selection_changed.connect(lambda *_: self._update_outline())
+        self.viewport.clicked.connect(self.pick)
+        self.viewport.key_handler = self._viewport_key
+        self.viewport.overlay = self._draw_overlay
+        self.viewport.drag_started.connect(lambda: self.controller.set_interacting(True))
+        self.viewport.drag_finished.connect(lambda: self.controller.set_interacting(False))
         self.viewport.orbit.connect(self._orbit)
         self.viewport.pan.connect(self._pan)
         self.viewport.zoom.connect(self._zoom)
@@ -119,6 +134,7 @@ class MainWindow(QMainWindow):
         self._update_title()
         self._update_render_actions()
         self.viewport.set_aspect(scene.render.width, scene.render.height)
+        self._update_preview_target()
         if warm_up:
             self.viewport.caption = "Loading the render kernels (the first run compiles them)…"
             self.controller.warm_up()
@@ -178,10 +194,23 @@ class MainWindow(QMainWindow):
         self.act_rename.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
         for a in (self.act_duplicate, self.act_rename, self.act_delete):
             self.tree.addAction(a)
+            self.viewport.addAction(a)  # also with the focus on the picture
         self.act_render = self._action("&Render", self.start_render, K("Ctrl+R"),
                                        "render the full picture, tile by tile")
-        self.act_stop = self._action("&Stop", self.stop_render, K("Esc"),
-                                     "stop the render and keep the picture so far")
+        self.act_stop = self._action("&Stop", self.stop_render, None,
+                                     "stop the render and keep the picture so far (Esc)")
+        self.act_escape = self._action("Stop the render, or &deselect", self.escape, K("Esc"),
+                                       "Esc: stops a running render, else deselects")
+        self.act_fit = self._action("&Fit the picture", lambda: self.viewport.set_picture_scale(
+            None), K("Ctrl+0"), "show the whole picture, as large as fits")
+        self.act_one_to_one = self._action(
+            "&Actual pixels (1:1)", lambda: self.viewport.set_picture_scale(1.0), K("Ctrl+1"),
+            "one render pixel per screen pixel")
+        self.act_zoom_in = self._action(
+            "Zoom the picture &in", lambda: self.viewport.zoom_picture(1.25),
+            [K("Ctrl+="), K("Ctrl++")], "also Ctrl+wheel; Ctrl+drag moves the zoomed picture")
+        self.act_zoom_out = self._action(
+            "Zoom the picture &out", lambda: self.viewport.zoom_picture(0.8), K("Ctrl+-"))
         self.act_preview = QAction("Interactive &preview", self, checkable=True, checked=True)
         self.act_preview.toggled.connect(self._toggle_preview)
         self.act_settings = self._action("Render &settings…",
@@ -211,6 +240,8 @@ class MainWindow(QMainWindow):
         edit.addActions([self.act_undo, self.act_redo])
         edit.addSeparator()
         edit.addActions([self.act_duplicate, self.act_rename, self.act_delete])
+        edit.addSeparator()
+        edit.addAction(self.act_escape)
         add = bar.addMenu("&Add")
         self.add_object_menu = add.addMenu("&Object")
         self.add_object_menu.addActions(list(self.object_actions.values()))
@@ -218,6 +249,9 @@ class MainWindow(QMainWindow):
         self.add_object_menu.addAction(self.act_model)
         self.add_light_menu = add.addMenu("&Light")
         self.add_light_menu.addActions(list(self.light_actions.values()))
+        view = bar.addMenu("&View")
+        self.view_menu = view
+        view.addActions([self.act_fit, self.act_one_to_one, self.act_zoom_in, self.act_zoom_out])
         render = bar.addMenu("&Render")
         render.addActions([self.act_render, self.act_stop])
         render.addSeparator()
@@ -337,6 +371,7 @@ class MainWindow(QMainWindow):
             return False
         self.controller.stop()
         self.doc.set_scene(starter_scene(), None)
+        self._remember_source(None, None)
         return True
 
     def open_dialog(self) -> bool:
@@ -359,9 +394,22 @@ class MainWindow(QMainWindow):
             return False
         self.controller.stop()
         self.doc.set_scene(scene, path)
+        self._remember_source(scene, path)
         self.recent.add(path)
         self.offer_recovery()
         return True
+
+    def _remember_source(self, scene: Scene | None, path: Path | None,
+                         text: str | None = None) -> None:
+        """Keep the TOML file's text as read (or written) and the scene it holds: saving
+        writes only the edits into it (comments and layout stay)."""
+        self.source_text: str | None = text
+        self.source_scene: Scene | None = scene
+        if text is None and path is not None and Path(path).suffix.lower() == ".toml":
+            try:
+                self.source_text = Path(path).read_text(encoding="utf-8")
+            except OSError:
+                self.source_text = None
 
     def offer_recovery(self) -> bool:
         """If an autosave of the current scene is newer than the file, offer it back."""
@@ -380,25 +428,44 @@ class MainWindow(QMainWindow):
         self.statusBar().showMessage(f"Recovered the unsaved changes from {auto.name}", 5000)
         return True
 
+    def commit_pending_edit(self) -> None:
+        """A value typed in a field but not yet committed (no Enter, no focus change) is
+        committed before the scene is saved or rendered."""
+        focus = QApplication.focusWidget()
+        finish = getattr(focus, "finish", None)
+        if focus is not None and self.isAncestorOf(focus) and callable(finish):
+            finish()
+
     def save(self) -> bool:
+        self.commit_pending_edit()
         if self.doc.path is None:
             return self.save_as()
         return self.save_to(self.doc.path)
 
     def save_as(self, path: Path | None = None) -> bool:
+        self.commit_pending_edit()
         path = path if path is not None else self.ask_save_path()
         return self.save_to(Path(path)) if path is not None else False
 
     def save_to(self, path: Path) -> bool:
         old_path = self.doc.path
         scene = self.doc.scene
+        text = None
         try:
             if path.parent.resolve() != scene.base_dir.resolve():
                 scene = rebase_files(scene, path.parent)
-            save_scene(scene, path)
+            if path.suffix.lower() == ".toml":
+                same_folder = old_path is not None and old_path.parent.resolve() == \
+                    path.parent.resolve()
+                text = save_scene_toml(
+                    scene, path, text=self.source_text if same_folder else None,
+                    loaded=self.source_scene if same_folder else None)
+            else:
+                save_scene(scene, path)
         except (WhittedError, OSError, ValueError) as exc:
             self.show_error("Cannot save the scene", str(exc))
             return False
+        self._remember_source(scene, path, text)
         if old_path is not None and old_path != path:
             self.autosave.discard(old_path)
         self.doc.mark_saved(path, scene.with_base_dir(path.parent))
@@ -437,6 +504,7 @@ class MainWindow(QMainWindow):
             self.recent_menu.addAction("(none)").setEnabled(False)
 
     def closeEvent(self, event: QCloseEvent) -> None:  # noqa: N802
+        self.commit_pending_edit()
         if not self.maybe_save():
             event.ignore()
             return
@@ -449,9 +517,9 @@ class MainWindow(QMainWindow):
     # ------------------------------------------------------------------ edits
 
     def select(self, key) -> None:
+        """Select ``key`` (None: nothing): the tree, the properties panel and the picture's
+        outline all follow the document's one selection."""
         self.doc.select(key)
-        self.tree.select_key(key)
-        self.properties.refresh()
 
     def add_object(self, kind: str) -> tuple:
         obj = catalog.new_object(self.doc.scene, kind)
@@ -472,6 +540,11 @@ class MainWindow(QMainWindow):
         except (ValueError, EditRefused) as exc:
             self.show_error("Cannot add the model", str(exc))
             return None
+        scale = obj.transform.scale if obj.transform is not None else 1.0
+        if scale != 1.0:
+            self.statusBar().showMessage(
+                f"{Path(path).name} was scaled by {scale:g} to a sensible size "
+                "(Placement > Scale)", 8000)
         return self.doc.add("objects", obj, f"Add model {Path(path).name}")
 
     def delete_selected(self) -> bool:
@@ -481,9 +554,226 @@ class MainWindow(QMainWindow):
         return self.doc.duplicate(self.doc.selection)
 
     def rename_selected(self) -> None:
-        item = self.tree.item_for(self.doc.selection)
-        if item is not None and len(self.doc.selection) == 2:
+        key = self.doc.selection
+        item = self.tree.item_for(key) if key is not None else None
+        if item is not None and len(key) == 2:
             self.tree.editItem(item, 0)
+
+    # ------------------------------------------------------------------ pointing
+
+    def pick(self, u: float, v: float, modifiers=None) -> tuple | None:
+        """A click on the picture at (u, v): select the object seen there (through the
+        renderer's object-id image); a click on the background deselects."""
+        if not (0 <= u <= 1 and 0 <= v <= 1):
+            return None
+        try:
+            ids = self.ids.ids_for(self.doc.scene)
+        except WhittedError as exc:
+            self.statusBar().showMessage(f"Cannot pick: {exc}", 4000)
+            return None
+        light = self.light_at(u, v)
+        index = id_at(ids, u, v)
+        key = light if light is not None else ("objects", index) if index >= 0 else None
+        self.select(key)
+        return key
+
+    LIGHT_PICK_PX = 12
+
+    def _light_marks(self):
+        """(key, picture point (u, v)) of every light with a place in the scene."""
+        scene = self.doc.scene
+        s = scene.render
+        for i, light in enumerate(scene.lights):
+            p = light_position(light)
+            uv = camera_ops.project(scene.camera, s.width, s.height, p) if p else None
+            if uv is not None:
+                yield ("lights", i), uv
+
+    def light_at(self, u: float, v: float):
+        """The light whose mark is within a few pixels of (u, v), if any."""
+        here = self.viewport.to_widget(u, v)
+        best, best_d = None, float(self.LIGHT_PICK_PX)
+        for key, (lu, lv) in self._light_marks():
+            p = self.viewport.to_widget(lu, lv)
+            d = math.hypot(p.x() - here.x(), p.y() - here.y())
+            if d <= best_d:
+                best, best_d = key, d
+        return best
+
+    def _draw_overlay(self, p: QPainter, to_widget) -> None:
+        """Over the picture: lights (a sun mark, named), the camera's target (a cross), and
+        the selected object's bounding box."""
+        scene = self.doc.scene
+        s = scene.render
+        cam = scene.camera
+        selected = self.doc.selection
+        if selected is not None and selected[0] == "objects":
+            bounds = object_bounds(scene, selected[1])
+            if bounds is not None:
+                lo, hi = bounds
+                corners = [(x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                           for z in (lo[2], hi[2])]
+                uvs = [camera_ops.project(cam, s.width, s.height, c) for c in corners]
+                pen = QPen(QColor(255, 150, 20, 170), 1, Qt.PenStyle.DashLine)
+                p.setPen(pen)
+                for a in range(8):
+                    for b in range(a + 1, 8):
+                        if bin(a ^ b).count("1") == 1 and uvs[a] and uvs[b]:
+                            p.drawLine(to_widget(*uvs[a]), to_widget(*uvs[b]))
+        target = camera_ops.project(cam, s.width, s.height, camera_ops.target_of(cam))
+        if target is not None:
+            c = to_widget(*target)
+            p.setPen(QPen(QColor(255, 255, 255, 150), 1))
+            p.drawLine(c + QPointF(-7, 0), c + QPointF(7, 0))
+            p.drawLine(c + QPointF(0, -7), c + QPointF(0, 7))
+        for key, uv in self._light_marks():
+            c = to_widget(*uv)
+            light = scene.lights[key[1]]
+            colour = QColor(255, 150, 20) if key == selected else QColor(255, 230, 90)
+            p.setPen(QPen(QColor(0, 0, 0, 160), 3))
+            p.drawEllipse(c, 5, 5)
+            p.setPen(QPen(colour, 1.5))
+            p.setBrush(colour)
+            p.drawEllipse(c, 4, 4)
+            p.setBrush(Qt.BrushStyle.NoBrush)
+            for k in range(8):
+                a = k * math.pi / 4
+                d = QPointF(math.cos(a), math.sin(a))
+                p.drawLine(c + d * 6.5, c + d * 10)
+            p.setPen(QColor(0, 0, 0))
+            p.drawText(c + QPointF(13, 5), label_of(light))
+            p.setPen(colour)
+            p.drawText(c + QPointF(12, 4), label_of(light))
+
+    def _update_outline(self) -> None:
+        """The selected object's outline over the picture (from the current id image)."""
+        key = self.doc.selection
+        ids = self.ids.ids if self.ids.scene is self.doc.scene else None
+        if key is None or key[0] != "objects":
+            outline = None
+        elif ids is None:
+            self.ids.request(self.doc.scene)
+            return
+        else:
+            outline = outline_image(ids, key[1])
+        if outline is not self.viewport.outline:
+            self.viewport.outline = outline
+            self.viewport.update()
+
+    def _viewport_key(self, event) -> bool:
+        """The picture's keys: G/R/S move, rotate, scale the selection; F frames it, Home
+        frames everything; numpad 1/3/7 (or 1/3/7) look from the front, the right, the top
+        (with Ctrl: the back, the left, the bottom)."""
+        key = event.key()
+        mods = event.modifiers()
+        ctrl = bool(mods & Qt.KeyboardModifier.ControlModifier)
+        tools = {Qt.Key.Key_G: "move", Qt.Key.Key_R: "rotate", Qt.Key.Key_S: "scale"}
+        if key in tools and not ctrl:
+            return self.start_tool(tools[key])
+        if key == Qt.Key.Key_F and not ctrl:
+            return self.frame_selection()
+        if key == Qt.Key.Key_Home:
+            return self.frame_all()
+        views = {Qt.Key.Key_1: (0.0, 0.0, 1.0), Qt.Key.Key_3: (1.0, 0.0, 0.0),
+                 Qt.Key.Key_7: (0.0, 1.0, 0.0)}
+        if key in views and (not ctrl or mods & Qt.KeyboardModifier.KeypadModifier):
+            d = np.asarray(views[key]) * (-1.0 if ctrl else 1.0)
+            return self.view_from(d, {Qt.Key.Key_1: "front", Qt.Key.Key_3: "side",
+                                      Qt.Key.Key_7: "top"}[key])
+        return False
+
+    def start_tool(self, mode: str) -> bool:
+        key = self.doc.selection
+        if key is None or len(key) != 2 or self.viewport.tool is not None:
+            return False
+        if key[0] == "lights" and (mode != "move" or light_position(
+                self.doc.item(key)) is None):
+            return False
+        start = self.viewport.hover
+        if self.viewport.to_picture(start) is None:
+            start = self.viewport.picture_rect().center()
+        tool = TransformTool(mode, self.doc.scene, key[1], start,
+                             (self.viewport.width(), self.viewport.height()),
+                             apply=lambda t, merge: self._tool_edit(key, t, merge, mode),
+                             finish=self._tool_finished,
+                             status=lambda text: self.statusBar().showMessage(text),
+                             kind=key[0])
+        tool.start_uv = tool.uv = self.viewport.to_picture(start)
+        self.viewport.tool = tool
+        self._tool_edits = 0
+        self.controller.set_interacting(True)
+        return True
+
+    def _tool_edit(self, key, transform, merge, mode: str) -> None:
+        item = self.doc.item(key)
+        data = item.model_dump()
+        if key[0] == "lights":  # a light moves by the vector: from where it was at the start
+            tool = self.viewport.tool
+            field = "position" if "position" in data else "center"
+            start = tool.centre if tool is not None else np.asarray(data[field])
+            data[field] = tuple(round(float(v), 6) + 0.0 for v in start + transform)
+        else:
+            data["transform"] = transform.model_dump()
+        try:
+            before = self.doc.undo_stack.index()
+            self.doc.edit_item(key, data, f"{TransformTool.NAMES[mode]} {label_of(item)}",
+                               merge_key=merge)
+            self._tool_edits += self.doc.undo_stack.index() != before or self._tool_edits > 0
+        except EditRefused as exc:
+            self.statusBar().showMessage(str(exc), 3000)
+
+    def _tool_finished(self, confirmed: bool, tool) -> None:
+        self.viewport.tool = None
+        self.controller.set_interacting(False)
+        if not confirmed and self._tool_edits:
+            stack = self.doc.undo_stack
+            command = stack.command(stack.index() - 1)
+            if command is not None and getattr(command, "merge_key", None) == tool.merge_key:
+                command.forget_on_undo = True  # no redo of a cancelled move
+                stack.undo()
+        self.statusBar().showMessage("" if confirmed else "Cancelled", 2000)
+        self.viewport.update()
+
+    def frame_selection(self) -> bool:
+        key = self.doc.selection
+        if key is None or key[0] != "objects":
+            return self.frame_all()
+        bounds = object_bounds(self.doc.scene, key[1])
+        if bounds is None:
+            c = object_centre(self.doc.scene, key[1])
+            bounds = (c - 1.0, c + 1.0)
+        self._frame(*bounds, "Frame selection")
+        return True
+
+    def frame_all(self) -> bool:
+        scene = self.doc.scene
+        boxes = [b for i in range(len(scene.objects))
+                 if (b := object_bounds(scene, i)) is not None]
+        if not boxes:
+            return False
+        lo = np.min([b[0] for b in boxes], axis=0)
+        hi = np.max([b[1] for b in boxes], axis=0)
+        self._frame(lo, hi, "Frame all")
+        return True
+
+    def _frame(self, lo, hi, text: str) -> None:
+        s = self.doc.scene.render
+        try:
+            camera = camera_ops.frame_bounds(self.doc.scene.camera, s.width, s.height, lo, hi)
+        except ValueError:
+            return
+        self._camera_edit(camera, text, None)
+
+    def view_from(self, direction, name: str) -> bool:
+        camera = self.doc.scene.camera
+        target = camera_ops.target_of(camera)
+        distance = float(np.linalg.norm(np.subtract(camera.position, target)))
+        try:
+            camera = camera_ops.look_from(camera, direction, target, distance)
+        except ValueError:
+            return False
+        self._camera_edit(camera, f"View from the {name}", None)
+        return True
 
     def _camera_edit(self, camera, text: str, merge) -> None:
         try:
@@ -505,9 +795,10 @@ class MainWindow(QMainWindow):
             return
         self._camera_edit(camera, "Pan camera", ("pan", drag))
 
-    def _zoom(self, factor: float) -> None:
+    def _zoom(self, factor: float, u: float = -1.0, v: float = -1.0) -> None:
+        s = self.doc.scene.render
         try:
-            camera = camera_ops.zoom(self.doc.scene.camera, factor)
+            camera = camera_ops.zoom_to(self.doc.scene.camera, factor, s.width, s.height, u, v)
         except ValueError:
             return
         # wheel notches in a row zoom as one step
@@ -525,8 +816,17 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ rendering
 
+    def _update_preview_target(self) -> None:
+        """Previews refine, when the input stops, up to the picture's size on screen."""
+        r = self.viewport.fit_rect()
+        ratio = self.viewport.devicePixelRatioF()
+        self.controller.target_pixels = max(1, int(r.width() * r.height() * ratio * ratio))
+
     def _scene_changed(self, key=None) -> None:
+        self._update_preview_target()
         scene = self.doc.scene
+        if self.doc.selection is not None and self.doc.selection[0] == "objects":
+            self.ids.request(scene)  # the outline follows
         self.viewport.set_aspect(scene.render.width, scene.render.height)
         self._update_title()
         if self.controller.rendering:
@@ -535,15 +835,29 @@ class MainWindow(QMainWindow):
         self.controller.request_preview(scene)
 
     def start_render(self) -> None:
+        self.commit_pending_edit()
         self.controller.render(self.doc.scene)
         self.progress.setValue(0)
         self.eta.setText("starting…")
         self._update_render_actions()
 
+    def escape(self) -> None:
+        """Esc: cancel a G/R/S move; else stop a running render; else deselect."""
+        if self.viewport.tool is not None:
+            self.viewport.tool.cancel()
+        elif self.controller.rendering:
+            self.stop_render()
+        else:
+            self.select(None)
+
     def stop_render(self) -> None:
         if self.controller.rendering:
             self.controller.stop()
             self.eta.setText("stopping…")
+            self.statusBar().showMessage("Stopping…")
+            self.viewport.caption = "Stopping…"
+            self.viewport.update()
+            self.act_stop.setEnabled(False)  # until it has stopped
 
     def _update_render_actions(self) -> None:
         running = self.controller.rendering
@@ -558,6 +872,9 @@ class MainWindow(QMainWindow):
         self.viewport.caption = "preview" if kind == "preview" else ""
 
     def _render_finished(self, kind: str, text: str) -> None:
+        if self.viewport.caption == "Stopping…":
+            self.viewport.caption = ""
+            self.viewport.update()
         self.statusBar().showMessage(text, 8000)
         self._update_render_actions()
 

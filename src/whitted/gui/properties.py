@@ -5,11 +5,13 @@ marked red, with the model's message under it, and never reaches the scene."""
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from pydantic import BaseModel
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (
+    QApplication,
     QComboBox,
     QFormLayout,
     QGroupBox,
@@ -35,6 +37,7 @@ from .document import (
     label_of,
     set_path,
 )
+from .messages import friendly_message
 from .widgets import (
     BoolEditor,
     ChoiceEditor,
@@ -46,6 +49,7 @@ from .widgets import (
     NumberEditor,
     TextEditor,
     VectorEditor,
+    guard_wheel,
 )
 
 SMOOTH = {None: "auto", True: "on", False: "off"}
@@ -87,6 +91,8 @@ class PropertyPanel(QWidget):
         self.material_combo: QComboBox | None = None
         self.material_row: FieldRow | None = None
         self._signature: object = None
+        #: the item this panel shows, and the only one its edits go to
+        self.key: tuple | None = None
         self.title = QLabel(self)
         self.title.setStyleSheet("font-weight: bold; font-size: 11pt;")
         self.scroll = QScrollArea(self)
@@ -98,6 +104,7 @@ class PropertyPanel(QWidget):
         box.addWidget(self.scroll, 1)
         self.form: QWidget | None = None
         doc.changed.connect(self.refresh)
+        doc.selection_changed.connect(self.refresh)
         self.refresh()
 
     # ------------------------------------------------------------------ building
@@ -114,13 +121,37 @@ class PropertyPanel(QWidget):
         specs = F.object_specs(item)
         geometry = [s for s in specs if s.group != F.TRANSFORM]
         placement = [s for s in specs if s.group == F.TRANSFORM]
-        return geometry + F.material_specs(self.doc.scene.material_of(key[1])) + placement
+        return geometry + F.material_specs(self.shown_material(key)) + placement
+
+    def file_materials(self, key: tuple) -> list[Material] | None:
+        """The materials of a model file (its MTL...) when the object uses them (no
+        ``material`` of its own); None otherwise or when the file cannot be read."""
+        if key is None or key[0] != "objects":
+            return None
+        obj = self.doc.item(key)
+        if getattr(obj, "type", None) != "mesh" or obj.file is None or obj.material is not None:
+            return None
+        try:
+            from ..assets import load_mesh
+
+            return list(load_mesh(self.doc.scene.resolve_path(obj.file)).materials)
+        except Exception:  # noqa: BLE001 - an unreadable file shows the default instead
+            return None
+
+    def shown_material(self, key: tuple) -> Material:
+        """The material the panel shows for an object: its own, or its model file's first."""
+        from_file = self.file_materials(key)
+        if from_file:
+            return from_file[0]
+        return self.doc.scene.material_of(key[1])
 
     def refresh(self, *_: object) -> None:
         key = self.doc.selection
         item = self.doc.item(key)
+        self.key = key if item is not None else None
         if item is None:
             self.title.setText("Nothing selected")
+            self._signature = None
             self._rebuild(key, [])
             return
         specs = self.specs_for(key, item)
@@ -143,6 +174,12 @@ class PropertyPanel(QWidget):
         return f"{kind}: {label_of(item)} ({item.type})"
 
     def _rebuild(self, key: tuple, specs: list[F.Spec]) -> None:
+        # the focus must not stay in the old form (a window of its own once taken out of
+        # the scroll area, where the window's shortcuts would no longer reach)
+        focus = QApplication.focusWidget()
+        had_focus = self.form is not None and focus is not None and self.form.isAncestorOf(focus)
+        focused_path = next((p for p, r in self.rows.items()
+                             if had_focus and r.isAncestorOf(focus)), None)
         if self.form is not None:  # deleted later: its editor may be emitting right now
             old = self.scroll.takeWidget()
             if old is not None:
@@ -180,7 +217,13 @@ class PropertyPanel(QWidget):
         if key == CAMERA:
             outer.addWidget(self._camera_tools())
         outer.addStretch(1)
+        guard_wheel(self.form)
         self.scroll.setWidget(self.form)
+        if had_focus:
+            row = self.rows.get(focused_path) if focused_path is not None else None
+            inputs = [w for w in row.editor.findChildren(QWidget)
+                      if w.focusPolicy() != Qt.FocusPolicy.NoFocus] if row is not None else []
+            (inputs[0] if inputs else self.scroll).setFocus()
 
     def _add_material_source(self, form: QFormLayout) -> None:
         combo = QComboBox()
@@ -227,7 +270,7 @@ class PropertyPanel(QWidget):
     def value_of(self, key: tuple, item: BaseModel, spec: F.Spec) -> Any:
         path = spec.path
         if path[0] == "material" and key[0] == "objects":
-            material = self.doc.scene.material_of(key[1])
+            material = self.shown_material(key)
             if path[1:] == ("texture", "type"):
                 return getattr(material.texture, "type", "none")
             if path[1] == "specular_color" and material.specular_color is None:
@@ -255,6 +298,15 @@ class PropertyPanel(QWidget):
         combo = self.material_combo
         assert combo is not None
         combo.clear()
+        obj_file = getattr(item, "file", None) if getattr(item, "type", None) == "mesh" else None
+        if obj_file:
+            count = len(self.file_materials(key) or []) if item.material is None else 0
+            name = Path(obj_file).name
+            combo.addItem(f"From the model file ({name})" if not count or count == 1 else
+                          f"From the model file ({name}, {count} materials)", "file:")
+            combo.setItemData(0, "the materials the model's own file gives (its MTL, glTF...);"
+                                 " editing a value overrides them all with this one",
+                              Qt.ItemDataRole.ToolTipRole)
         combo.addItem("Default (grey)", "default:")
         for name in self.doc.scene.materials:
             combo.addItem(f"{name} (scene material)", f"named:{name}")
@@ -262,10 +314,14 @@ class PropertyPanel(QWidget):
             combo.addItem(f"{name} (preset)", f"preset:{name}")
         combo.addItem("Custom", "custom:")
         ref = item.material
-        if ref is None:
+        if ref is None and obj_file:
+            current = "file:"
+        elif ref is None:
             current = "default:"
         elif isinstance(ref, str):
             current = f"named:{ref}" if ref in self.doc.scene.materials else f"preset:{ref}"
+        elif not isinstance(ref, str) and ref == Material() and obj_file:
+            current = "default:"
         elif ref.preset is not None and ref == Material(preset=ref.preset):
             current = f"preset:{ref.preset}"
         else:
@@ -276,9 +332,10 @@ class PropertyPanel(QWidget):
     # ------------------------------------------------------------------ edits
 
     def commit(self, spec: F.Spec, value: Any, continuous: bool = False) -> bool:
-        """Apply one field's new value; False (and a message at the field) if refused."""
-        key = self.doc.selection
-        item = self.doc.item(key)
+        """Apply one field's new value to the item this panel shows; False (and a message at
+        the field) if refused."""
+        key = self.key
+        item = self.doc.item(key) if key is not None else None
         row = self.rows.get(spec.path)
         if item is None:
             return False
@@ -289,18 +346,27 @@ class PropertyPanel(QWidget):
             self.doc.edit_item(key, data, f"Change {spec.label.lower()}", merge_key=merge)
         except EditRefused as exc:
             if row is not None:
-                row.show_error(str(exc))
+                row.show_error(self._message(exc, spec))
             return False
         row = self.rows.get(spec.path)  # the form may have been rebuilt by the edit
         if row is not None:
             row.clear_error()
         return True
 
+    @staticmethod
+    def _message(exc: EditRefused, spec: F.Spec) -> str:
+        """The refusal in the user's words, naming the field as its label does."""
+        if exc.validation is None:
+            return str(exc)
+        label = spec.label.split(" (")[0].lower()
+        field = next((p for p in reversed(spec.path) if isinstance(p, str)), None)
+        return friendly_message(exc.validation, label, field)
+
     def _data_with(self, key: tuple, item: BaseModel, spec: F.Spec, value: Any) -> dict:
         path = spec.path
         data = item.model_dump()
         if path[0] == "material" and key[0] == "objects":
-            material = self.doc.scene.material_of(key[1]).model_dump()
+            material = self.shown_material(key).model_dump()
             if path[1:] == ("texture", "type"):
                 material["texture"] = self._new_texture(value, material.get("texture"))
             else:
@@ -335,19 +401,21 @@ class PropertyPanel(QWidget):
     def choose_material(self, choice: str) -> None:
         """``default:``, ``named:NAME``, ``preset:NAME`` or ``custom:`` (the drop-down)."""
         kind, _, name = choice.partition(":")
-        key = self.doc.selection
-        item = self.doc.item(key)
+        key = self.key
+        item = self.doc.item(key) if key is not None else None
         if item is None or key[0] != "objects":
             return
         data = item.model_dump()
-        if kind == "default":
+        if kind == "file":  # a model without a material of its own: its file's materials
             data["material"] = None
+        elif kind == "default":  # (a model's "none" is its file's: grey is an override)
+            data["material"] = {} if getattr(item, "file", None) else None
         elif kind == "named":
             data["material"] = name
         elif kind == "preset":
             data["material"] = {"preset": name}
         else:  # custom: this object's own copy of what it shows now
-            data["material"] = self.doc.scene.material_of(key[1]).model_dump()
+            data["material"] = self.shown_material(key).model_dump()
         try:
             self.doc.edit_item(key, data, "Change material")
         except EditRefused as exc:

@@ -15,17 +15,21 @@ import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
 from PySide6.QtGui import QImage
 
+from ..compile.scene import compile_scene  # built here once, reused by the previews of a drag
 from ..output.encode import encode_ldr
 from ..output.image import Image
 from ..render.api import Progress, RenderJob, available_threads, warm_up_kernels
 from ..scene import Scene
 
-POLL_MS = 25
+POLL_MS = 15
 BACKDROP_DIM = 0.6  # the preview under unrendered tiles, dimmed so the finished ones stand out
 #: preview pixel budget: starts here, adapts so that a preview takes about PREVIEW_TARGET_S
 PREVIEW_PIXELS = 160 * 120
 PREVIEW_MIN_PIXELS, PREVIEW_MAX_PIXELS = 64 * 48, 480 * 360
 PREVIEW_TARGET_S = 0.15
+#: while the user drags (orbit, slider, G/R/S) a preview aims at this, for >= 10 updates/s
+INTERACTIVE_TARGET_S = 0.04
+REFINE_FACTOR = 4  # each idle refinement step has this many times the pixels
 PREVIEW_DEPTH = 2
 PREVIEW_SHADOW_SAMPLES = 4
 
@@ -61,6 +65,16 @@ class _Active:
     kind: str  # "preview" or "render"
     started: float
     scene: Scene
+    pixels: int = 0  # a preview's pixel budget
+    refining: bool = False  # an idle refinement step (not a first look at an edit)
+    reused: bool = False  # the compiled geometry of an earlier preview was reused
+    thread: threading.Thread | None = None  # a preview's own thread
+
+    @property
+    def running(self) -> bool:
+        if self.thread is not None:
+            return self.thread.is_alive()
+        return self.job.running
     latest: Progress | None = None
     shown_tiles: int = -1
     first_pixels: float | None = None
@@ -111,6 +125,15 @@ class RenderController(QObject):
         self.last_preview: Image | None = None
         self.previews_done = 0
         self.last_preview_seconds: float | None = None
+        #: the user is dragging: coarse previews, no refinement until it stops
+        self.interacting = False
+        #: pixels of a preview at full viewport size (the refinement's goal)
+        self.target_pixels = PREVIEW_MAX_PIXELS
+        self.interactive_pixels = PREVIEW_PIXELS // 2
+        self._requested_at: float | None = None
+        #: measurements: edit -> first picture, last edit -> full-size picture (seconds)
+        self.edit_to_frame: list[float] = []
+        self.edit_to_full: list[float] = []
         self.first_pixels_seconds: float | None = None
         self._pending: Scene | None = None
         self._poll = QTimer(self)
@@ -120,6 +143,8 @@ class RenderController(QObject):
         self._throttle.setSingleShot(True)
         self._throttle.setInterval(preview_delay_ms)
         self._throttle.timeout.connect(self._start_preview)
+        self._shown: _Active | None = None  # the preview on screen
+        self._compiled: tuple | None = None  # (geometry key, CompiledScene) of a preview
         self._warm = threading.Event()
         self._warm_seconds = 0.0
 
@@ -182,6 +207,9 @@ class RenderController(QObject):
         """Preview ``scene`` soon (edits in quick succession coalesce into one preview)."""
         if not self.preview_enabled:
             return
+        if self._pending is None and self._requested_at is None:
+            self._requested_at = time.perf_counter()
+        self._last_edit = time.perf_counter()
         self._pending = scene
         if not self._throttle.isActive():
             self._throttle.start()
@@ -195,12 +223,63 @@ class RenderController(QObject):
                 self._pending = scene
                 self._throttle.start()
             return
+        if self.preview is not None and not self.preview.refining \
+                and self.preview.running:
+            # a preview of an earlier edit is nearly there: show it, then this one (cancelling
+            # it would show nothing at all while edits come faster than previews)
+            self._pending = scene
+            return
         self._cancel_preview()
-        small = preview_scene(scene, self.preview_pixels)
-        active = _Active(RenderJob(small), "preview", time.perf_counter(), scene)
+        pixels = self.interactive_pixels if self.interacting else self.preview_pixels
+        self._start_preview_job(scene, pixels, refining=False)
+
+    def _start_preview_job(self, scene: Scene, pixels: int, *, refining: bool) -> None:
+        """A preview on its own thread. The compiled geometry is reused while only the
+        camera or the resolution changes (an orbit, a refinement): building it is most of a
+        small preview's time."""
+        small = preview_scene(scene, pixels)
+        job = RenderJob(small)
+        active = _Active(job, "preview", time.perf_counter(), scene, pixels=pixels,
+                         refining=refining)
+        key = _geometry_key(small)
+        cached = self._compiled[1] if self._compiled is not None and \
+            self._compiled[0] == key else None
+        active.reused = cached is not None
+
+        def work() -> None:
+            try:
+                compiled = cached
+                if compiled is None:
+                    compiled = compile_scene(small)
+                    self._compiled = (key, compiled)  # one store: read on the UI thread
+                job.compiled = compiled
+                job.run()
+            except BaseException as exc:  # noqa: BLE001 - reported by _preview_done
+                job.error = exc
+
+        active.thread = threading.Thread(target=work, name="whitted-preview", daemon=True)
         self.preview = active
-        active.job.start()
+        active.thread.start()
         self._poll.start()
+
+    def set_interacting(self, on: bool) -> None:
+        """A drag started (coarse, fast previews) or ended (refine to full size)."""
+        self.interacting = on
+        if not on and self.preview is None and self._pending is None \
+                and self._shown is not None:
+            self._refine(self._shown)
+
+    def _refine(self, done: _Active) -> None:
+        """The next, larger preview of the same scene, while nothing else is asked for."""
+        if self.interacting or self._pending is not None or self.full is not None \
+                or not self.preview_enabled:
+            return
+        s = done.scene.render
+        goal = min(self.target_pixels, s.width * s.height)
+        if done.job.settings.width * done.job.settings.height >= goal * 0.98:
+            return
+        self._start_preview_job(done.scene, min(goal, done.pixels * REFINE_FACTOR),
+                                refining=True)
 
     def _cancel_preview(self) -> None:
         if self.preview is not None:
@@ -213,8 +292,10 @@ class RenderController(QObject):
         if self._warm.is_set() and self._warm_seconds >= 0:
             self.kernels_ready.emit(self._warm_seconds)
             self._warm_seconds = -1.0
-        if self.preview is not None and not self.preview.job.running:
+        if self.preview is not None and not self.preview.running:
             self._preview_done(self.preview)
+            if self._pending is not None and self.preview is None:
+                self._start_preview()  # the edits that came in meanwhile, at once
         if self.full is not None:
             self._full_tick(self.full)
         if self.full is None and self.preview is None and self._warm_seconds < 0:
@@ -228,17 +309,35 @@ class RenderController(QObject):
             return
         if job.cancel_token.cancelled or job.image is None:
             return
-        seconds = time.perf_counter() - active.started
-        render_seconds = job.stats.render_seconds + job.stats.build_seconds
-        if job.stats.compile_seconds == 0:  # adapt the resolution to the time it took
-            ratio = PREVIEW_TARGET_S / max(render_seconds, 1e-3)
-            self.preview_pixels = int(np.clip(self.preview_pixels * min(max(ratio, 0.5), 2.0),
-                                              PREVIEW_MIN_PIXELS, PREVIEW_MAX_PIXELS))
+        now = time.perf_counter()
+        seconds = now - active.started
+        render_seconds = job.stats.render_seconds + (0.0 if active.reused else
+                                                     job.stats.build_seconds)
+        if job.stats.compile_seconds == 0 and not active.refining:
+            # adapt the resolution to the time it took (the dragging budget separately)
+            target = INTERACTIVE_TARGET_S if self.interacting else PREVIEW_TARGET_S
+            ratio = min(max(target / max(render_seconds, 1e-3), 0.5), 2.0)
+            if self.interacting:
+                self.interactive_pixels = int(np.clip(self.interactive_pixels * ratio,
+                                                      PREVIEW_MIN_PIXELS, PREVIEW_MAX_PIXELS))
+            else:
+                self.preview_pixels = int(np.clip(self.preview_pixels * ratio,
+                                                  PREVIEW_MIN_PIXELS, PREVIEW_MAX_PIXELS))
+        if self._requested_at is not None:
+            self.edit_to_frame.append(now - self._requested_at)
+            self._requested_at = None
+        s0 = active.scene.render
+        full = job.settings.width * job.settings.height >= 0.98 * min(
+            self.target_pixels, s0.width * s0.height)
+        if full and active.refining and getattr(self, "_last_edit", None) is not None:
+            self.edit_to_full.append(now - self._last_edit)
         self.last_preview = job.image
         self.last_preview_seconds = seconds
         self.previews_done += 1
         s = job.settings
+        self._shown = active
         self.frame.emit(to_qimage(job.framebuffer, s.transfer, s.tonemap), "preview")
+        self._refine(active)
 
     def _full_tick(self, active: _Active) -> None:
         job = active.job
@@ -273,12 +372,20 @@ class RenderController(QObject):
         """Cancel everything and wait for the render threads (closing the window)."""
         self._throttle.stop()
         self._poll.stop()
-        jobs = [a.job for a in (self.full, self.preview) if a is not None]
-        for job in jobs:
-            job.cancel()
-        for job in jobs:
-            job.join(timeout)
+        active = [a for a in (self.full, self.preview) if a is not None]
+        for a in active:
+            a.job.cancel()
+        for a in active:
+            if a.thread is not None:
+                a.thread.join(timeout)
+            a.job.join(timeout)
         self.full = self.preview = None
+
+
+def _geometry_key(scene: Scene) -> tuple:
+    """What the compiled geometry depends on (not the camera, nor the image size)."""
+    return (scene.objects, scene.materials, scene.lights, scene.render.shadow_samples,
+            scene.base_dir)
 
 
 def _progress_text(p: Progress) -> str:

@@ -27,6 +27,7 @@ class SceneTree(QTreeWidget):
         self.itemSelectionChanged.connect(self._selection_changed)
         self.itemChanged.connect(self._renamed)
         doc.changed.connect(self.fill)
+        doc.selection_changed.connect(self.select_key)
         self.fill()
 
     def fill(self, *_: object) -> None:
@@ -100,8 +101,14 @@ class SceneTree(QTreeWidget):
         return None
 
     def select_key(self, key) -> None:
-        item = self.item_for(key)
-        if item is not None:
+        item = self.item_for(key) if key is not None else None
+        if item is None:
+            self._filling = True
+            try:
+                self.clearSelection()
+            finally:
+                self._filling = False
+        elif item is not self.currentItem() or not item.isSelected():
             self.setCurrentItem(item)
 
     def _selection_changed(self) -> None:
@@ -110,7 +117,7 @@ class SceneTree(QTreeWidget):
         items = self.selectedItems()
         key = items[0].data(0, KEY_ROLE) if items else None
         if key is not None and key != self.doc.selection:
-            self.doc.select(key)
+            self.doc.select(key)  # the properties panel follows through the document
             self.selected.emit(key)
 
     def _renamed(self, item: QTreeWidgetItem, column: int) -> None:

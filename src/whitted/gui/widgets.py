@@ -7,9 +7,12 @@ from __future__ import annotations
 import itertools
 import re
 
-from PySide6.QtCore import Qt, Signal
-from PySide6.QtGui import QColor
+from PySide6.QtCore import QEvent, QObject, QPoint, Qt, Signal
+from PySide6.QtGui import QColor, QKeyEvent, QKeySequence
 from PySide6.QtWidgets import (
+    QAbstractScrollArea,
+    QAbstractSlider,
+    QAbstractSpinBox,
     QCheckBox,
     QColorDialog,
     QComboBox,
@@ -73,6 +76,8 @@ class FieldEditor(QWidget):
 
     committed = Signal(object, bool)
     refused = Signal(str)
+    #: the field holds the scene's value again (typed back): its message goes away
+    restored = Signal()
 
     def set_value(self, value: object) -> None:
         raise NotImplementedError
@@ -82,14 +87,31 @@ class FieldEditor(QWidget):
             edit.setStyleSheet(ERROR_STYLE if bad else "")
 
 
+#: keys a field hands on to the window unless the user is typing a value in it
+_SCENE_KEYS = (QKeySequence.StandardKey.Undo, QKeySequence.StandardKey.Redo)
+
+
 class _Line(QLineEdit):
     """A line edit that remembers what it last showed, so leaving it unchanged commits
-    nothing."""
+    nothing. Its own undo/redo (Ctrl+Z, Ctrl+Shift+Z) works only while a value is being
+    typed; once committed (or untouched) those keys undo and redo the scene."""
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
         self.shown = ""
         self.setMinimumWidth(48)
+
+    def event(self, event) -> bool:  # noqa: D102 - Qt's name
+        if event.type() == QEvent.Type.ShortcutOverride and isinstance(event, QKeyEvent) \
+                and not self.changed and any(event.matches(k) for k in _SCENE_KEYS):
+            event.ignore()  # not ours: the window's shortcut runs
+            return True
+        return super().event(event)
+
+    def finish(self) -> None:
+        """Commit what is typed now (the window calls this before Save, Render...)."""
+        if self.changed:
+            self.editingFinished.emit()
 
     def show_text(self, text: str) -> None:
         self.shown = text
@@ -117,6 +139,8 @@ class TextEditor(FieldEditor):
     def _finish(self) -> None:
         if self.line.changed:
             self.committed.emit(self.line.text().strip() or None, False)
+        else:
+            self.restored.emit()
 
 
 class NumberEditor(FieldEditor):
@@ -135,6 +159,7 @@ class NumberEditor(FieldEditor):
 
     def _finish(self) -> None:
         if not self.line.changed:
+            self.restored.emit()
             return
         if self.optional and not self.line.text().strip():
             self.committed.emit(None, False)
@@ -178,6 +203,7 @@ class VectorEditor(FieldEditor):
 
     def _finish(self) -> None:
         if not any(line.changed for line in self.lines):
+            self.restored.emit()
             return
         out = []
         for axis, line in zip("xyz", self.lines, strict=True):
@@ -249,6 +275,7 @@ class CoefficientEditor(FieldEditor):
 
     def _finish(self) -> None:
         if not self.line.changed:
+            self.restored.emit()
             return
         text = self.line.text()
         parts = [p for p in re.split(r"[,;\s]+", text.strip()) if p]
@@ -298,6 +325,7 @@ class ColourEditor(FieldEditor):
 
     def _finish(self) -> None:
         if not self.line.changed:
+            self.restored.emit()
             return
         text = self.line.text().strip()
         if not text.startswith("#"):
@@ -357,39 +385,107 @@ class FileEditor(FieldEditor):
     def _finish(self) -> None:
         if self.line.changed:
             self.committed.emit(self.line.text().strip(), False)
+        else:
+            self.restored.emit()
 
 
 class FieldRow(QWidget):
-    """An editor with its error message under it (red, shown only while there is one)."""
+    """An editor with its error message. The message floats just under the field, over what
+    follows (never moving the form, so the next click lands where the user aimed), and goes
+    away when the field holds a valid value again."""
 
     def __init__(self, editor: FieldEditor, parent=None) -> None:
         super().__init__(parent)
         self.editor = editor
         self.message = QLabel(self)
         self.message.setWordWrap(True)
-        self.message.setStyleSheet("color: #c01010;")
+        self.message.setStyleSheet(
+            "QLabel { color: #a00000; background: #fff3f3; border: 1px solid #d88;"
+            " padding: 1px 4px; }")
         self.message.hide()
         box = QVBoxLayout(self)
         box.setContentsMargins(0, 0, 0, 0)
         box.setSpacing(1)
         box.addWidget(editor)
-        box.addWidget(self.message)
         editor.refused.connect(self.show_error)
+        editor.restored.connect(self.clear_error)
+
+    def _host(self) -> QWidget:
+        """The widget the message floats in: the scroll area's page (or the window)."""
+        host: QWidget = self
+        while host.parentWidget() is not None and not host.isWindow():
+            parent = host.parentWidget()
+            if parent.parentWidget() is not None and isinstance(
+                    parent.parentWidget(), QAbstractScrollArea):
+                return host
+            host = parent
+        return host
+
+    def _place(self) -> None:
+        host = self._host()
+        if self.message.parentWidget() is not host:
+            self.message.setParent(host)
+        width = max(self.width(), 120)
+        self.message.setFixedWidth(width)
+        self.message.adjustSize()
+        self.message.move(self.mapTo(host, QPoint(0, self.height())))
+        self.message.raise_()
 
     def show_error(self, message: str) -> None:
         self.message.setText(message)
+        self._place()
         self.message.show()
         self.editor.set_error(True)
 
     def clear_error(self) -> None:
-        if self.message.isVisible() or self.message.text():
+        if not self.message.isHidden() or self.message.text():
             self.message.clear()
             self.message.hide()
             self.editor.set_error(False)
 
+    def resizeEvent(self, event) -> None:  # noqa: N802
+        super().resizeEvent(event)
+        if not self.message.isHidden():
+            self._place()
+
+    def moveEvent(self, event) -> None:  # noqa: N802
+        super().moveEvent(event)
+        if not self.message.isHidden():
+            self._place()
+
     @property
     def error(self) -> str:
         return self.message.text()
+
+
+class WheelGuard(QObject):
+    """Lets the mouse wheel change a drop-down, slider or number box only while it has the
+    keyboard focus; otherwise the turn goes on to the scroll area under it (scrolling the
+    panel never changes a value that passes under the pointer)."""
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:  # noqa: N802 - Qt's name
+        if event.type() == QEvent.Type.Wheel and isinstance(watched, QWidget) \
+                and not watched.hasFocus():
+            event.ignore()  # not accepted: Qt hands it to the parents (the scroll area)
+            return True
+        return False
+
+
+_wheel_guard: WheelGuard | None = None
+WHEEL_GUARDED = (QComboBox, QAbstractSlider, QAbstractSpinBox)
+
+
+def guard_wheel(root: QWidget) -> None:
+    """Install the :class:`WheelGuard` on every drop-down, slider and number box in ``root``
+    (and take away their wheel focus: a wheel turn does not focus them either)."""
+    global _wheel_guard
+    if _wheel_guard is None:
+        _wheel_guard = WheelGuard()
+    widgets = [root, *root.findChildren(QWidget)]
+    for w in widgets:
+        if isinstance(w, WHEEL_GUARDED):
+            w.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+            w.installEventFilter(_wheel_guard)
 
 
 def _hbox(widget: QWidget, child: QWidget) -> QHBoxLayout:

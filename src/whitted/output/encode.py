@@ -270,6 +270,50 @@ def _fsync_dir(directory: pathlib.Path) -> None:
             os.close(fd)
 
 
+def _temp_prefix(target: pathlib.Path) -> str:
+    """Start of the names of ``target``'s temporary files (the name cut so that a temporary
+    name stays within the 255-byte limit of file names)."""
+    name = target.name
+    while len(os.fsencode(name)) > 160:
+        name = name[: len(name) * 3 // 4]
+    return f".{name}.tmp-"
+
+
+def _process_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError):
+        return True  # someone else's live process
+    return True
+
+
+def remove_stale_temporaries(path: PathLike) -> list[pathlib.Path]:
+    """Delete the temporary files that writes of ``path`` left behind when their process was
+    killed (their names carry the writer's process id; a live writer's file is kept).
+    Returns the files removed."""
+    target = pathlib.Path(path)
+    prefix = _temp_prefix(target)
+    removed = []
+    try:
+        entries = list(os.scandir(target.parent))
+    except OSError:
+        return removed
+    for entry in entries:
+        if not (entry.name.startswith(prefix) and entry.name.endswith(target.suffix)):
+            continue
+        pid_text = entry.name[len(prefix):].split(".", 1)[0]
+        if not pid_text.isdigit() or _process_alive(int(pid_text)):
+            continue
+        with contextlib.suppress(OSError):
+            os.unlink(entry.path)
+            removed.append(pathlib.Path(entry.path))
+    return removed
+
+
 def atomic_write(path: PathLike, write_fn: Callable[[str], object]) -> pathlib.Path:
     """Write a file atomically: ``path`` either keeps its old content or gets the complete new one.
 
@@ -278,11 +322,16 @@ def atomic_write(path: PathLike, write_fn: Callable[[str], object]) -> pathlib.P
     writer that picks its format from the extension still works. The temporary file is then
     fsynced, given the permissions of the file it replaces (or the umask default for a new
     file) and moved onto ``path`` with :func:`os.replace`. If anything raises, the temporary
-    file is removed and the exception propagates. Returns ``path`` as a :class:`pathlib.Path`.
+    file is removed and the exception propagates. The temporary file's name carries the process
+    id, so that temporary files of a writer that was killed (``kill -9``) are recognised and
+    removed by the next write of the same path. Returns ``path`` as a :class:`pathlib.Path`.
     """
     target = pathlib.Path(path)
     directory = target.parent
-    fd, tmp = tempfile.mkstemp(suffix=target.suffix, prefix=f".{target.name}.", dir=directory)
+    prefix = _temp_prefix(target)
+    remove_stale_temporaries(target)
+    fd, tmp = tempfile.mkstemp(suffix=target.suffix, prefix=f"{prefix}{os.getpid()}.",
+                               dir=directory)
     os.close(fd)
     try:
         write_fn(tmp)
@@ -310,25 +359,55 @@ def atomic_write(path: PathLike, write_fn: Callable[[str], object]) -> pathlib.P
 # writers (each takes the temporary path and already-encoded data)
 
 
-def _write_png8(tmp: str, data: np.ndarray) -> None:
+#: Rows encoded at a time: the tonemap/transfer/quantize steps work in float64, so they run
+#: on strips of rows and an 8-bit image costs a few bytes per pixel beyond its framebuffer.
+STRIP_PIXELS = 1 << 16
+
+
+def _strips(height: int, width: int):
+    rows = max(1, STRIP_PIXELS // max(1, width))
+    for y in range(0, height, rows):
+        yield y, min(height, y + rows)
+
+
+def _encoded_strips(pixels: np.ndarray, bits: int, transfer: str, tonemap: str):
+    """(first row, encoded uint8/uint16 rows) for consecutive strips of ``pixels``."""
+    for y0, y1 in _strips(pixels.shape[0], pixels.shape[1]):
+        yield y0, encode_ldr(pixels[y0:y1], bits=bits, transfer=transfer, tonemap=tonemap)
+
+
+def _pil_rgb(pixels: np.ndarray, transfer: str, tonemap: str):
+    """A Pillow RGB image filled strip by strip (no full-size float64 or uint8 copy)."""
     from PIL import Image as PILImage
 
-    PILImage.fromarray(data).save(tmp, format="PNG")
+    h, w, _ = pixels.shape
+    image = PILImage.new("RGB", (w, h))
+    for y0, strip in _encoded_strips(pixels, 8, transfer, tonemap):
+        image.paste(PILImage.fromarray(strip), (0, y0))
+    return image
 
 
-def _write_png16(tmp: str, data: np.ndarray) -> None:
+def _write_png8(tmp: str, pixels: np.ndarray, transfer: str, tonemap: str) -> None:
+    _pil_rgb(pixels, transfer, tonemap).save(tmp, format="PNG")
+
+
+def _write_png16(tmp: str, pixels: np.ndarray, transfer: str, tonemap: str) -> None:
     import png
 
-    h, w, _ = data.shape
+    h, w, _ = pixels.shape
     writer = png.Writer(width=w, height=h, greyscale=False, alpha=False, bitdepth=16)
+
+    def rows():
+        for _y0, strip in _encoded_strips(pixels, 16, transfer, tonemap):
+            yield from strip.reshape(len(strip), w * 3)
+
     with open(tmp, "wb") as f:
-        writer.write(f, data.reshape(h, w * 3))
+        writer.write(f, rows())
 
 
-def _write_jpeg(tmp: str, data: np.ndarray) -> None:
-    from PIL import Image as PILImage
-
-    PILImage.fromarray(data).save(tmp, format="JPEG", quality=JPEG_QUALITY, subsampling=0)
+def _write_jpeg(tmp: str, pixels: np.ndarray, transfer: str, tonemap: str) -> None:
+    _pil_rgb(pixels, transfer, tonemap).save(tmp, format="JPEG", quality=JPEG_QUALITY,
+                                             subsampling=0)
 
 
 def _write_exr(tmp: str, data: np.ndarray) -> None:
@@ -343,7 +422,8 @@ def _write_pfm(tmp: str, data: np.ndarray) -> None:
     with open(tmp, "wb") as f:
         f.write(f"PF\n{w} {h}\n-1.0\n".encode("ascii"))
         # PFM stores scanlines bottom-to-top; a negative scale means little-endian.
-        f.write(np.ascontiguousarray(data[::-1], dtype="<f4").tobytes())
+        for y0, y1 in _strips(h, w):  # bottom strip first, each flipped: no full-size copy
+            f.write(np.ascontiguousarray(data[h - y1:h - y0][::-1], dtype="<f4").tobytes())
 
 
 def _write_npy(tmp: str, data: np.ndarray) -> None:
@@ -375,13 +455,12 @@ def write_image(
 
     if fmt in HDR_FORMATS:
         writer = {"exr": _write_exr, "pfm": _write_pfm, "npy": _write_npy}[fmt]
+        return atomic_write(path, lambda tmp: writer(tmp, data))
+    if fmt == "jpeg":
+        ldr_writer = _write_jpeg
     else:
-        data = encode_ldr(data, bits=bit_depth, transfer=transfer, tonemap=tonemap)
-        if fmt == "jpeg":
-            writer = _write_jpeg
-        else:
-            writer = _write_png16 if bit_depth == 16 else _write_png8
-    return atomic_write(path, lambda tmp: writer(tmp, data))
+        ldr_writer = _write_png16 if bit_depth == 16 else _write_png8
+    return atomic_write(path, lambda tmp: ldr_writer(tmp, data, transfer, tonemap))
 
 
 # --------------------------------------------------------------------------------------------

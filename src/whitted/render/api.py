@@ -16,7 +16,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..compile.flatten import CompiledScene, compile_scene, render_params
+from ..compile.params import render_params
+from ..compile.scene import CompiledScene, compile_scene
+from ..errors import ArgumentError, JobStateError
 from ..kernels.layout import (
     N_RAY_KINDS,
     RAY_PRIMARY,
@@ -35,6 +37,29 @@ RAY_KIND_NAMES = {
     RAY_REFRACTION: "refraction",
 }
 DEFAULT_TILE = 16
+MAX_TILE = 4096
+MAX_THREADS = 1024  # as RenderSettings.threads
+
+
+def _whole_number(name: str, value: object, low: int, high: int) -> int:
+    """``value`` as an int in low..high, else :class:`ArgumentError` naming the argument."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise ArgumentError(f"{name} must be a whole number, got {value!r}")
+    if not low <= int(value) <= high:
+        raise ArgumentError(f"{name} must be between {low} and {high}, got {value!r}")
+    return int(value)
+
+
+def _as_scene(scene: object, what: str = "scene") -> Scene:
+    """A Scene; a path (str or os.PathLike) is loaded as a scene file."""
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, str | os.PathLike):
+        from ..scene.io import load_scene
+
+        return load_scene(scene)
+    raise ArgumentError(f"{what} must be a whitted.Scene or the path of a scene file, "
+                        f"got {type(scene).__name__}")
 
 
 class CancelToken:
@@ -123,11 +148,14 @@ def run_lanes(fn: Callable[[int, int], object], lanes: int, pool: ThreadPoolExec
         future.result()
 
 
-def tile_grid(width: int, height: int, tile: int = DEFAULT_TILE) -> np.ndarray:
-    """All tiles of the image in row-major order, rows of (x0, y0, x1, y1)."""
+def tile_grid(width: int, height: int, tile: int = DEFAULT_TILE,
+              rows: tuple[int, int] | None = None) -> np.ndarray:
+    """All tiles of the image in row-major order, rows of (x0, y0, x1, y1); only those of the
+    image rows ``rows = (start, stop)`` when given."""
+    y_start, y_stop = (0, height) if rows is None else rows
     xs = np.arange(0, width, tile)
-    ys = np.arange(0, height, tile)
-    grid = [(x, y, min(x + tile, width), min(y + tile, height)) for y in ys for x in xs]
+    ys = np.arange(y_start, y_stop, tile)
+    grid = [(x, y, min(x + tile, width), min(y + tile, y_stop)) for y in ys for x in xs]
     return np.array(grid, dtype=np.int32).reshape(-1, 4)
 
 
@@ -143,14 +171,34 @@ class RenderJob:
         cancel: CancelToken | None = None,
         threads: int | None = None,
         tile_size: int = DEFAULT_TILE,
+        compiled: CompiledScene | None = None,
+        rows: tuple[int, int] | None = None,
     ) -> None:
+        """``scene``: a Scene (or the path of a scene file); ``threads``: 1..1024, 0 or None
+        for the scene's setting (0 there: every core); ``tile_size``: pixels per tile side,
+        1..4096. Bad arguments raise :class:`~whitted.errors.ArgumentError`."""
+        scene = _as_scene(scene)
+        if scene.is_animated:  # an animated scene renders as its first frame
+            scene = scene.at_frame(0)
+        if progress is not None and not callable(progress):
+            raise ArgumentError(f"progress must be callable, got {type(progress).__name__}")
+        if cancel is not None and not isinstance(cancel, CancelToken):
+            raise ArgumentError(f"cancel must be a CancelToken, got {type(cancel).__name__}")
+        if threads is not None:
+            threads = _whole_number("threads", threads, 0, MAX_THREADS)
+        tile_size = _whole_number("tile_size", tile_size, 1, MAX_TILE)
         self.scene = scene
+        #: the compiled ``scene`` when the caller has it already (films reuse geometry)
+        self.compiled = compiled
         self.settings: RenderSettings = scene.render
         self.progress = progress
         self.cancel_token = cancel or CancelToken()
         n = threads if threads is not None else self.settings.threads
         self.threads = max(1, n or available_threads())
         self.tile_size = tile_size
+        self.rendering = False  # True while tiles are being rendered (after the compile)
+        #: render only the image rows [start, stop) (the farm's bands); the other rows stay 0
+        self.rows = None if rows is None else _checked_rows(rows, self.settings.height)
         self.framebuffer = np.zeros((self.settings.height, self.settings.width, 3), np.float32)
         self.stats = RenderStats(
             width=self.settings.width,
@@ -167,6 +215,11 @@ class RenderJob:
         self.cancel_token.cancel()
 
     def start(self) -> threading.Thread:
+        """Run the job on a background thread (once: :class:`JobStateError` when started
+        again)."""
+        if self._thread is not None:
+            raise JobStateError("this render job was already started (make a new RenderJob)")
+
         def target() -> None:
             try:
                 self.run()
@@ -186,10 +239,16 @@ class RenderJob:
         return True
 
     def wait(self, timeout: float | None = None) -> Image | None:
-        if self._thread is not None:
-            self._thread.join(timeout)
-            if self._thread.is_alive():
-                return None
+        """The image once the background render has ended (None while it still runs after
+        ``timeout`` seconds); re-raises its error. :class:`JobStateError` before
+        :meth:`start`."""
+        if self._thread is None:
+            if self.image is not None:  # finished by run()
+                return self.image
+            raise JobStateError("wait() before start(): start the job first (or call run())")
+        self._thread.join(timeout)
+        if self._thread.is_alive():
+            return None
         if self.error is not None:
             raise self.error
         return self.image
@@ -211,19 +270,21 @@ class RenderJob:
         wall_start = time.perf_counter()
         stats = self.stats
         stats.compile_seconds = warm_up_kernels()
-        compiled: CompiledScene = compile_scene(self.scene)
+        compiled: CompiledScene = (self.compiled if self.compiled is not None
+                                   else compile_scene(self.scene))
         stats.compile_seconds += warm_up_kernels(compiled)
         stats.build_seconds = compiled.build_seconds
         stats.warnings = list(compiled.warnings)
         stats.triangles = compiled.triangles
         params = render_params(self.scene, compiled, self.settings)
-        tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size)
+        tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size, self.rows)
         counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
         stats.tiles_total = len(tiles)
         lanes = self.threads
         render_start = time.perf_counter()
         done = 0
         lock = threading.Lock()
+        self.rendering = True
 
         next_tile = 0
         most_per_call = max(1, -(-len(tiles) // (64 * lanes)))  # ~64 progress updates a lane
@@ -265,6 +326,7 @@ class RenderJob:
         try:
             run_lanes(lane_work, lanes, pool)
         finally:
+            self.rendering = False
             if pool is not None:
                 pool.shutdown()
         stats.render_seconds = time.perf_counter() - render_start
@@ -278,17 +340,27 @@ class RenderJob:
         return self.image
 
 
+def _checked_rows(rows: tuple[int, int], height: int) -> tuple[int, int]:
+    start, stop = (int(r) for r in rows)
+    if not 0 <= start < stop <= height:
+        raise ArgumentError(f"rows {start}:{stop} are not a range of the image's {height} rows")
+    return start, stop
+
+
 def render(
-    scene: Scene,
+    scene: Scene | str | os.PathLike[str],
     *,
     progress: Callable[[Progress], None] | None = None,
     cancel: CancelToken | None = None,
     **overrides: object,
 ) -> Image:
-    """Render ``scene`` and return the :class:`~whitted.output.Image` (float32 linear HDR).
+    """Render ``scene`` (a Scene, or the path of a scene file) and return the
+    :class:`~whitted.output.Image` (float32 linear HDR).
 
     Keyword overrides replace render settings for this call (``width``, ``height``,
-    ``samples``, ``max_depth``, ``threads``, ``seed``, ...)."""
+    ``samples``, ``max_depth``, ``threads``, ``seed``, ...); an unknown or bad one raises
+    :class:`~whitted.errors.SceneValidationError`."""
+    scene = _as_scene(scene)
     if overrides:
         scene = scene.with_settings(**overrides)
     return RenderJob(scene, progress=progress, cancel=cancel).run()
@@ -299,6 +371,7 @@ def render_aovs(scene: Scene, **overrides: object) -> dict[str, np.ndarray]:
     from ..kernels.tiles import lane_workspace
     from ..kernels.tiles import render_aovs as aov_kernel
 
+    scene = _as_scene(scene)
     if overrides:
         scene = scene.with_settings(**overrides)
     warm_up_kernels()

@@ -32,7 +32,8 @@ import numpy as np
 
 from .._cache import configure_kernel_cache
 from ..assets.mesh import load_obj_bytes
-from ..compile.flatten import CompiledScene, compile_scene, render_params
+from ..compile.params import render_params
+from ..compile.scene import CompiledScene, compile_scene
 from ..kernels.layout import N_RAY_KINDS
 from ..scene.lights import PointLight
 from ..scene.scene import Scene

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import codecs
 import difflib
 import json
+import math
 import os
 import re
 import tomllib
@@ -14,7 +16,7 @@ from typing import Any
 import tomli_w
 from pydantic import BaseModel, ValidationError
 
-from ..errors import SceneError
+from ..errors import SceneError, shorten
 from .materials import Material
 from .scene import Scene
 
@@ -29,37 +31,43 @@ _SHAPE_AND_LIGHT_TAGS = {
 }
 
 
+#: The largest scene file read (scenes with inline meshes can be large, but not this).
+MAX_SCENE_BYTES = 256 << 20
+#: Deepest nesting of tables and lists a scene file may use (the schema needs about 8).
+MAX_NESTING = 64
+#: Largest magnitude of a number in a scene file: beyond it squares and products overflow.
+MAX_MAGNITUDE = 1e15
+
+
 def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene file. Raises :class:`SceneError` with file, key path and line."""
+    from ..assets.files import path_problem, read_limited
+
     path = Path(path)
     name = str(path)
     # Existence first: "no such file" is more useful than "unknown format" for a typo'd path.
-    if path.is_dir():
-        raise SceneError("is a directory, not a scene file", file=name)
-    if not path.exists():
-        raise SceneError("no such file", file=name)
+    problem = path_problem(path)
+    if problem is not None:
+        raise SceneError(problem, file=name)
     if path.suffix.lower() not in SCENE_SUFFIXES:
-        raise SceneError(f"unknown scene format {path.suffix!r} (use .toml or .json)", file=name)
+        raise SceneError(f"unknown scene format {shorten(path.suffix)!r} (use .toml or .json)",
+                         file=name)
+    raw = read_limited(path, MAX_SCENE_BYTES, "scene file")
+    if raw.startswith(codecs.BOM_UTF8):  # some editors write one; TOML and JSON do not want it
+        raw = raw[len(codecs.BOM_UTF8):]
     try:
-        raw = path.read_bytes()
         text = raw.decode("utf-8")
-    except FileNotFoundError:
-        raise SceneError("no such file", file=name) from None
-    except IsADirectoryError:
-        raise SceneError("is a directory, not a scene file", file=name) from None
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start) + 1
         raise SceneError(f"not UTF-8 text (byte {exc.start})", file=name, line=line) from None
-    except OSError as exc:
-        raise SceneError(f"cannot read: {exc.strerror}", file=name) from None
     data = parse_scene_text(text, path.suffix.lower(), name)
     scene = scene_from_dict(data, file=name, text=text).with_base_dir(path.parent)
     _check_files(scene, name, text, data)
     return scene
 
 
-def _check_files(scene: Scene, name: str | None, text: str | None, data: Any) -> None:
-    """Every model and texture file the scene names exists (read later, when compiled)."""
+def named_files(scene: Scene) -> list[tuple[list[str | int], str]]:
+    """(key path, file name) of every model and texture file the scene names."""
     named: list[tuple[list[str | int], str]] = []
     for i, obj in enumerate(scene.objects):
         if getattr(obj, "file", None):
@@ -70,40 +78,165 @@ def _check_files(scene: Scene, name: str | None, text: str | None, data: Any) ->
     for key, mat in scene.materials.items():
         if mat.texture is not None and getattr(mat.texture, "file", None):
             named.append((["materials", key, "texture", "file"], mat.texture.file))
+    from ..animation.timeline import is_sequence, sequence_file
+
+    expanded: list[tuple[list[str | int], str]] = []
+    for keys, pattern in named:
+        if len(keys) == 3 and is_sequence(pattern):  # a mesh sequence: every frame's file
+            expanded.extend((keys, sequence_file(pattern, k)) for k in range(scene.frame_count))
+        else:
+            expanded.append((keys, pattern))
+    return expanded
+
+
+def _check_files(scene: Scene, name: str | None, text: str | None, data: Any) -> None:
+    """Every model and texture file the scene names exists (read later, when compiled)."""
+    from ..assets.files import path_problem
+
+    named = named_files(scene)
     for keys, file in named:
-        target = scene.resolve_path(file)
-        if not target.is_file():
+        try:
+            target = scene.resolve_path(file)
+            problem = path_problem(target)
+        except (OSError, RuntimeError, ValueError) as exc:
+            target, problem = Path(file), f"unusable file name ({exc})"
+        if problem is not None:
             line = None
             if text is not None:
                 line = (_json_line(text, keys, data) if name and name.endswith(".json")
                         else _toml_line(text, keys))
-            problem = "is a directory" if target.is_dir() else "no such file"
-            raise SceneError(f"{problem}: {file!r} (looked in {target.parent})", file=name,
+            raise SceneError(f"{problem}: {shorten(file)!r} (looked in "
+                             f"{shorten(str(target.parent))})", file=name,
                              where=_format_path(keys), line=line)
 
 
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """JSON object hook: a key given twice is an error (TOML rejects it too)."""
+    out: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in out:
+            raise _DuplicateKey(key)
+        out[key] = value
+    return out
+
+
+class _DuplicateKey(ValueError):
+    def __init__(self, key: str) -> None:
+        super().__init__(key)
+        self.key = key
+
+
+def _json_big_int(text: str) -> int:
+    if len(text.lstrip("-")) > 30:  # far beyond any value a scene holds
+        raise ValueError(f"number {shorten(text, 24)} is too large")
+    return int(text)
+
+
+def _line_of_offset(text: str, offset: int) -> int:
+    return text.count("\n", 0, max(0, offset)) + 1
+
+
 def parse_scene_text(text: str, suffix: str, name: str | None = None) -> dict[str, Any]:
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    _check_nesting(text, name)
     if suffix == ".json":
         try:
-            data = json.loads(text)
+            data = json.loads(text, object_pairs_hook=_unique_keys, parse_int=_json_big_int)
         except json.JSONDecodeError as exc:
             raise SceneError(f"malformed JSON: {exc.msg}", file=name, line=exc.lineno) from None
+        except _DuplicateKey as exc:
+            line = _json_key_line(text, exc.key)
+            raise SceneError(f"duplicate key {shorten(exc.key)!r}", file=name,
+                             line=line) from None
+        except (ValueError, RecursionError) as exc:
+            raise SceneError(f"malformed JSON: {shorten(str(exc), 120)}", file=name) from None
         if not isinstance(data, dict):
             raise SceneError("the top level must be an object", file=name)
-        return data
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        msg = str(exc)
-        m = re.search(r"\(at line (\d+), column \d+\)", msg)
-        line = int(m.group(1)) if m else None
-        msg = re.sub(r"\s*\(at line \d+, column \d+\)", "", msg)
-        raise SceneError(f"malformed TOML: {msg}", file=name, line=line) from None
+    else:
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            msg = str(exc)
+            m = re.search(r"\(at line (\d+), column \d+\)", msg)
+            line = int(m.group(1)) if m else None
+            if line is None and "end of document" in msg:
+                line = max(1, text.count("\n") + (0 if text.endswith("\n") else 1))
+                msg = re.sub(r"\s*\(at end of document\)", "", msg)
+                msg += " (the file ends early: is it cut off?)"
+            msg = re.sub(r"\s*\(at line \d+, column \d+\)", "", msg)
+            raise SceneError(f"malformed TOML: {msg}", file=name, line=line) from None
+        except (ValueError, RecursionError) as exc:
+            raise SceneError(f"malformed TOML: {shorten(str(exc), 120)}", file=name) from None
+    _check_values(data, [], name, text, suffix)
+    return data
+
+
+def _check_nesting(text: str, name: str | None) -> None:
+    """Refuse brackets nested deeper than any scene needs before a parser recurses into them
+    (an upper bound: brackets inside strings count too, which only errs on the safe side for
+    texts far deeper than :data:`MAX_NESTING`)."""
+    depth = 0
+    deepest = 0
+    for m in re.finditer(r"[\[\]{}]", text):
+        depth += 1 if m.group() in "[{" else -1
+        if depth > deepest:
+            deepest = depth
+            if deepest > 4 * MAX_NESTING:
+                line = _line_of_offset(text, m.start())
+                raise SceneError(f"nested more than {MAX_NESTING} levels deep", file=name,
+                                 line=line)
+
+
+def _check_values(data: Any, keys: list[str | int], name: str | None, text: str,
+                  suffix: str, depth: int = 0) -> None:
+    """Nesting depth and number sizes: what would overflow later is an error now, at its key."""
+    def error(message: str) -> SceneError:
+        line = None
+        if suffix == ".json":
+            line = _json_line(text, keys, root)
+        elif keys:
+            line = _toml_line(text, keys)
+        return SceneError(message, file=name, where=_format_path(keys) or None, line=line)
+
+    root = data
+    stack: list[tuple[Any, list[str | int], int]] = [(data, keys, depth)]
+    while stack:
+        node, keys, depth = stack.pop()
+        if depth > MAX_NESTING:
+            raise error(f"nested more than {MAX_NESTING} levels deep")
+        if isinstance(node, dict):
+            stack.extend((v, [*keys, k], depth + 1) for k, v in node.items())
+        elif isinstance(node, list):
+            if node and all(type(v) in (int, float) for v in node):
+                big = [v for v in node if not abs(v) <= MAX_MAGNITUDE]
+                if big:
+                    k = next(i for i, v in enumerate(node) if not abs(v) <= MAX_MAGNITUDE)
+                    keys = [*keys, k]
+                    node = node[k]
+                else:
+                    continue
+            else:
+                stack.extend((v, [*keys, i], depth + 1) for i, v in enumerate(node))
+                continue
+        if isinstance(node, float | int) and not isinstance(node, bool):
+            if isinstance(node, float) and not math.isfinite(node):
+                continue  # the model says "expected a finite number" where it matters
+            if abs(node) > MAX_MAGNITUDE:
+                shown = shorten(repr(node), 24)
+                raise error(f"number {shown} is too large (scene values are limited to "
+                            f"{MAX_MAGNITUDE:.0e} in magnitude)")
+
+
+def _json_key_line(text: str, key: str) -> int | None:
+    pattern = re.compile(rf'"{re.escape(json.dumps(key)[1:-1])}"\s*:')
+    hits = [i for i, raw in enumerate(text.splitlines()) if pattern.search(raw)]
+    return hits[1] + 1 if len(hits) >= 2 else None
 
 
 def scene_from_dict(data: dict[str, Any], *, file: str | None = None, text: str | None = None):
     try:
-        return Scene.model_validate(data)
+        return Scene.model_validate(data, strict=True)
     except ValidationError as exc:
         raise _scene_error(exc, file, text, data) from None
 
@@ -147,8 +280,16 @@ def validation_message(exc: ValidationError) -> str:
     return _clean_message(best)
 
 
+def describe_validation_error(exc: ValidationError,
+                              root: type[BaseModel] | None = None) -> tuple[str, str]:
+    """(key path, message) of the most informative problem of ``exc``, as in scene files."""
+    e = _scene_error(exc, None, None, None, root=root)
+    return e.where or "", e.message
+
+
 def _scene_error(
-    exc: ValidationError, file: str | None, text: str | None, data: Any = None
+    exc: ValidationError, file: str | None, text: str | None, data: Any = None,
+    root: type[BaseModel] | None = None,
 ) -> SceneError:
     errors = exc.errors()
     # Unions report one error per member; the deepest location is the informative one.
@@ -163,11 +304,12 @@ def _scene_error(
         message = "expected " + " or ".join(dict.fromkeys(alternatives))
         message += _got(best, message)
     elif best["type"] == "extra_forbidden":
-        message = "unknown key" + _known_keys_hint(keys, data)
+        message = "unknown key" + _known_keys_hint(keys, data, root or Scene)
     else:
         message = _clean_message(best)
     where = _format_path(keys)
-    m = re.match(r"^((?:objects|lights)\[\d+\](?:\.\w+)*): (.*)$", message)
+    m = re.match(r"^((?:objects|lights)\[\d+\](?:\.\w+)*"
+                 r"|animation\.tracks\[\d+\](?:\.\w+)*(?:\[\d+\])?): (.*)$", message)
     if not keys and m:
         where, message = m.group(1), m.group(2)
         keys = _parse_path(where)
@@ -206,7 +348,8 @@ def _clean_message(error: dict[str, Any]) -> str:
     if kind == "union_tag_invalid":
         tag = error.get("input", {}).get("type") if isinstance(error.get("input"), dict) else None
         expected = error.get("ctx", {}).get("expected_tags", "")
-        return f"unknown type {tag!r} (expected one of {expected})"
+        shown = shorten(repr(tag), 40)
+        return f"unknown type {shown} (expected one of {expected})"
     if kind == "union_tag_not_found":
         return "missing 'type'"
     if kind in ("too_short", "too_long") and "ctx" in error:
@@ -233,14 +376,15 @@ def _short(value: Any) -> bool:
     return isinstance(value, int | float | str | bool) and len(repr(value)) <= 40
 
 
-def _known_keys_hint(keys: list[str | int], data: Any) -> str:
+def _known_keys_hint(keys: list[str | int], data: Any, root: type[BaseModel] = Scene) -> str:
     """`` (did you mean 'radius'?)`` for a misspelt key, else the keys that are allowed there."""
     if not keys or not isinstance(keys[-1], str):
         return ""
-    known = _allowed_keys(keys[:-1], data)
+    known = _allowed_keys(keys[:-1], data, root)
     if not known:
         return ""
-    close = difflib.get_close_matches(keys[-1], known, n=1, cutoff=0.6)
+    close = (difflib.get_close_matches(keys[-1], known, n=1, cutoff=0.6)
+             if len(keys[-1]) <= 100 else [])
     if close:
         return f" (did you mean {close[0]!r}?)"
     if len(known) <= 12:
@@ -248,9 +392,9 @@ def _known_keys_hint(keys: list[str | int], data: Any) -> str:
     return ""
 
 
-def _allowed_keys(parent: list[str | int], data: Any) -> list[str]:
+def _allowed_keys(parent: list[str | int], data: Any, root: type[BaseModel] = Scene) -> list[str]:
     """The keys the scene model accepts at ``parent`` (a cleaned location), or [] if unknown."""
-    models: list[type[BaseModel]] = [Scene]
+    models: list[type[BaseModel]] = [root]
     node = data
     container = False  # the next key indexes a list or names a dict entry
     for key in parent:
@@ -298,6 +442,7 @@ def _format_path(keys: list[str | int]) -> str:
         if isinstance(k, int):
             out += f"[{k}]"
             continue
+        k = shorten(k)
         name = k if re.fullmatch(r"[A-Za-z_][\w-]*", k) else json.dumps(k)  # "my glass"
         out += f".{name}" if out else name
     return out

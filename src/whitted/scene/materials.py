@@ -43,6 +43,8 @@ class Material(Strict):
     def _apply_preset(cls, data: object) -> object:
         if isinstance(data, dict) and data.get("preset") is not None:
             name = data["preset"]
+            if not isinstance(name, str):
+                raise ValueError(f"preset must be a preset's name (one of {', '.join(PRESETS)})")
             if name not in PRESETS:
                 raise ValueError(f"unknown material preset {name!r} (known: {', '.join(PRESETS)})")
             merged = dict(PRESETS[name])

@@ -7,6 +7,7 @@ from typing import Literal
 
 from pydantic import Field, PrivateAttr, model_validator
 
+from ..animation.model import Animation
 from .camera import Camera
 from .lights import Light
 from .materials import PRESETS, Material
@@ -52,6 +53,8 @@ class Scene(Strict):
     materials: dict[str, Material] = Field(default_factory=dict)
     lights: list[Light] = Field(default_factory=list)
     objects: list[Shape] = Field(default_factory=list)
+    #: the time axis (frames, fps, tracks): see :mod:`whitted.animation`; None for a still
+    animation: Animation | None = None
     # folder that relative file names (models, textures) are relative to: the scene file's
     # folder when loaded from a file, else the current directory
     _base_dir: Path | None = PrivateAttr(default=None)
@@ -91,6 +94,39 @@ class Scene(Strict):
                     f" (known: {', '.join(known)})"
                 )
         return self
+
+    @model_validator(mode="after")
+    def _animation_targets(self) -> Scene:
+        from ..animation.timeline import check_animation
+
+        check_animation(self)
+        return self
+
+    @property
+    def frame_count(self) -> int:
+        """Frames of the animation (1 for a still scene)."""
+        return self.animation.frames if self.animation is not None else 1
+
+    @property
+    def is_animated(self) -> bool:
+        """Whether frames differ: an animation, or a mesh file naming a numbered sequence."""
+        from ..animation.timeline import is_sequence
+
+        return self.animation is not None or any(
+            is_sequence(getattr(obj, "file", None)) for obj in self.objects)
+
+    def at_frame(self, frame: int) -> Scene:
+        """The plain still of frame ``frame`` (0 .. frame_count - 1): tracks applied, mesh
+        sequences named, the frame's seed derived; this scene is unchanged."""
+        from ..animation.timeline import scene_at_frame
+
+        return scene_at_frame(self, frame)
+
+    def with_animation(self, frames: int, fps: float = 24.0, tracks: list | None = None) -> Scene:
+        """A copy of this scene with an animation (validated against the scene)."""
+        scene = self.model_copy()
+        scene.animation = Animation(frames=frames, fps=fps, tracks=tracks or [])
+        return scene
 
     def material_of(self, index: int) -> Material:
         """The resolved material of object ``index`` (named, preset, inline or the default)."""

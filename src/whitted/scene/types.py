@@ -2,19 +2,113 @@
 
 from __future__ import annotations
 
+import functools
 import math
-from typing import Annotated
+import types
+import typing
+from contextvars import ContextVar
+from typing import Annotated, Any
 
 import numpy as np
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
+
+from ..errors import SceneValidationError
+
+_strict: ContextVar[bool] = ContextVar("whitted_strict_validation", default=False)
+_depth: ContextVar[int] = ContextVar("whitted_validation_depth", default=0)
 
 
 class Strict(BaseModel):
-    """Base of every scene model: unknown keys are errors, values are re-validated on assignment."""
+    """Base of every scene model: unknown keys are errors, values are re-validated on assignment.
+
+    Scene files are validated strictly (``model_validate(data, strict=True)``: numbers are
+    numbers, booleans booleans, no text for either); a list is taken wherever the model holds a
+    tuple. Errors are :class:`~whitted.errors.SceneValidationError` (a WhittedError that is also
+    pydantic's ValidationError)."""
 
     model_config = ConfigDict(
         extra="forbid", validate_assignment=True, frozen=False, allow_inf_nan=False
     )
+
+    def __init__(self, /, **data: Any) -> None:
+        # pydantic calls a custom __init__ for nested models too: the strictness of the
+        # outermost call travels in a context variable, and only the outermost call turns
+        # pydantic's error into the library's own
+        depth = _depth.set(_depth.get() + 1)
+        try:
+            self.__pydantic_validator__.validate_python(
+                data, self_instance=self, strict=_strict.get() or None)
+        except ValidationError as exc:
+            if _depth.get() > 1 or isinstance(exc, SceneValidationError):
+                raise
+            raise SceneValidationError.wrap(exc, type(self)) from None
+        finally:
+            _depth.reset(depth)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        try:
+            super().__setattr__(name, value)
+        except SceneValidationError:
+            raise
+        except ValidationError as exc:
+            raise SceneValidationError.wrap(exc, type(self)) from None
+
+    @classmethod
+    def model_validate(cls, obj: Any, *, strict: bool | None = None, **kwargs: Any) -> Any:
+        strictness = _strict.set(bool(strict))
+        depth = _depth.set(_depth.get() + 1)
+        try:
+            return super().model_validate(obj, strict=strict, **kwargs)
+        except ValidationError as exc:
+            if _depth.get() > 1 or isinstance(exc, SceneValidationError):
+                raise
+            raise SceneValidationError.wrap(exc, cls) from None
+        finally:
+            _depth.reset(depth)
+            _strict.reset(strictness)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _lists_as_tuples(cls, data: Any) -> Any:
+        """Files hold lists where the model holds tuples (vectors, triangles): take them."""
+        if not isinstance(data, dict):
+            return data
+        names = _tuple_fields(cls)
+        if not names or not any(isinstance(data.get(n), list) for n in names):
+            return data
+        return {k: (_as_tuple(v) if k in names else v) for k, v in data.items()}
+
+
+def _as_tuple(value: Any) -> Any:
+    if isinstance(value, list) and len(value) <= 64:
+        return tuple(_as_tuple(v) for v in value)
+    return value
+
+
+def _holds_tuple(annotation: Any, depth: int = 0) -> bool:
+    if depth > 8:
+        return False
+    origin = typing.get_origin(annotation)
+    if origin is tuple:
+        return True
+    if origin is Annotated:
+        return _holds_tuple(typing.get_args(annotation)[0], depth + 1)
+    if origin in (typing.Union, types.UnionType):
+        return any(_holds_tuple(a, depth + 1) for a in typing.get_args(annotation))
+    return False
+
+
+@functools.cache
+def _tuple_fields(cls: type[BaseModel]) -> frozenset[str]:
+    return frozenset(n for n, f in cls.model_fields.items() if _holds_tuple(f.annotation))
 
 
 def _finite_vector(value: object) -> tuple[float, float, float]:
@@ -34,7 +128,7 @@ def _finite_vector(value: object) -> tuple[float, float, float]:
 
 def _nonzero_vector(value: object) -> tuple[float, float, float]:
     v = _finite_vector(value)
-    if math.sqrt(v[0] ** 2 + v[1] ** 2 + v[2] ** 2) < 1e-12:
+    if math.hypot(*v) < 1e-12:  # hypot: no overflow for components above 1e154
         raise ValueError("must not be the zero vector")
     return v
 

@@ -1,0 +1,168 @@
+"""Scene description -> the compiled scene: flat NumPy arrays and BVHs that the kernels read.
+
+``compile_scene`` walks the scene's objects once: analytic shapes become primitive rows
+(``shapes.py``), mesh objects become flattened triangles or instances (``mesh_objects.py``),
+materials and lights become tables (``materials.py``, ``lights.py``); then it builds the scene
+BVH over the bounded primitives, the instances' own BVH, and the light buffers.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..kernels.features import NO_INSTANCES_DTYPE
+from ..kernels.layout import (
+    N_MAT_PARAMS,
+    N_PRIM_INFO,
+    PRIM_MATERIAL,
+    PRIM_OBJECT,
+    PRIM_SOLID,
+    PRIM_TYPE,
+    PRIM_XFORM,
+    SHAPE_MESH,
+    GeometryArrays,
+    LightArrays,
+)
+from ..scene.scene import Scene
+from ..scene.shapes import Mesh
+from .geometry import box_corners, corners_bounds
+from .light_buffers import build_light_buffers
+from .lights import light_rows
+from .materials import MaterialTable
+from .mesh_objects import FLATTEN_LIMIT, add_flat_mesh, mesh_key, mesh_source
+from .meshes import MeshSource, MeshTable
+from .primitives import PrimitiveRows
+from .reuse import cached_build_bvh
+from .shapes import add_shape
+from .textures import compile_textures
+
+
+@dataclass
+class CompiledScene:
+    """The scene as the kernels see it, plus what the Python side reports about it."""
+
+    geometry: GeometryArrays
+    materials: np.ndarray  # (M, N_MAT_PARAMS) float64
+    lights: LightArrays  # the light table (ambient lights excluded) and light buffers
+    ambient: tuple[float, float, float]
+    bounds_min: np.ndarray  # (3,) of all bounded primitives (inf when there are none)
+    bounds_max: np.ndarray
+    build_seconds: float
+    warnings: list[str]  # things the user should know (dropped triangles, missing textures)
+    triangles: int = 0  # distinct mesh triangles stored (instances not multiplied)
+    instanced_triangles: int = 0  # triangles in the scene counting every instance
+
+
+def packed_nodes(bvh, dtype) -> tuple[np.ndarray, np.ndarray]:
+    """A BVH's nodes in the kernel layout: boxes (M, 2, 3) and links (M, 2) (layout.py)."""
+    box = np.empty((len(bvh.node_count), 2, 3), dtype)
+    box[:, 0] = bvh.node_min
+    box[:, 1] = bvh.node_max
+    link = np.stack([bvh.node_offset, bvh.node_count], axis=1).astype(np.int32)
+    return box, link
+
+
+def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT) -> CompiledScene:
+    """Flatten ``scene`` into the kernel layout and build the BVHs over its bounded shapes.
+
+    A mesh whose copies (triangles x objects using it) come to at most ``flatten_limit``
+    triangles becomes triangle primitives of the scene BVH, one copy per object; a bigger one
+    is stored once and instanced."""
+    import time
+    from collections import Counter
+
+    start = time.perf_counter()
+    b = PrimitiveRows()
+    materials = MaterialTable()
+    meshes = MeshTable()
+    mesh_of: dict[tuple, object] = {}
+    sources: dict[tuple, tuple[MeshSource, np.ndarray]] = {}
+    warnings: list[str] = []
+    instanced = 0
+    flat = 0
+    uses = Counter(mesh_key(scene, s) for s in scene.objects if isinstance(s, Mesh))
+    for obj_index, shape in enumerate(scene.objects):
+        m = shape.transform.matrix() if shape.transform is not None else np.eye(4)
+        if isinstance(shape, Mesh):
+            key = mesh_key(scene, shape)
+            override = -1 if shape.material is None else materials.add(
+                scene.material_of(obj_index))
+            if key not in sources:
+                src = mesh_source(scene, obj_index, shape, warnings)
+                rows = np.array([materials.add(mat) for mat in src.materials], np.int32)
+                sources[key] = (src, rows)
+            src, rows = sources[key]
+            if uses[key] * len(src.faces) <= flatten_limit:
+                added = add_flat_mesh(b, meshes, src, rows, shape, m, override, obj_index)
+                flat += added
+                instanced += added
+                continue
+            if key not in mesh_of:
+                mesh_of[key] = meshes.add(src, rows, shape.smooth, shape.crease_angle)
+            stored = mesh_of[key]
+            if stored is None:
+                continue
+            identity = np.array_equal(m, np.eye(4))
+            lo, hi = corners_bounds(box_corners(stored.lo, stored.hi), None if identity else m)
+            b.add(SHAPE_MESH, [stored.index], lo, hi, material=override, obj=obj_index,
+                  solid=shape.solid, world_to_object=None if identity else np.linalg.inv(m))
+            instanced += stored.triangles
+            continue
+        add_shape(b, shape, m, materials.add(scene.material_of(obj_index)), obj_index)
+    warnings.extend(meshes.warnings)
+
+    prim_type, params, prim_xform, prim_material, prim_object, prim_solid, lo, hi = b.columns()
+    finite = np.all(np.isfinite(lo) & np.isfinite(hi), axis=1)
+    is_instance = prim_type == SHAPE_MESH
+    bounded = np.flatnonzero(finite & ~is_instance).astype(np.int32)
+    instances = np.flatnonzero(is_instance).astype(np.int32)
+    unbounded = np.flatnonzero(~finite)
+    bvh = cached_build_bvh(lo[bounded], hi[bounded])
+    inst_bvh = cached_build_bvh(lo[instances], hi[instances])
+    prim_info = np.empty((len(prim_type), N_PRIM_INFO), np.int32)
+    prim_info[:, PRIM_TYPE] = prim_type
+    prim_info[:, PRIM_XFORM] = prim_xform
+    prim_info[:, PRIM_MATERIAL] = prim_material
+    prim_info[:, PRIM_SOLID] = prim_solid
+    prim_info[:, PRIM_OBJECT] = prim_object
+    node_box, node_link = packed_nodes(bvh, np.float64)
+    # float32 marks a scene without instances: kernels specialised for it (features.py)
+    inst_box, inst_link = packed_nodes(
+        inst_bvh, np.float64 if len(instances) else NO_INSTANCES_DTYPE)
+    geometry = GeometryArrays(
+        prim_info=prim_info,
+        prim_params=params,
+        xforms=np.array(b.xforms, dtype=np.float64).reshape(len(b.xforms), 3, 4),
+        node_box=node_box,
+        node_link=node_link,
+        node_prims=np.ascontiguousarray(bounded[bvh.prim_order], dtype=np.int32),
+        unbounded=unbounded.astype(np.int32),
+        inst_box=inst_box,
+        inst_link=inst_link,
+        inst_prims=np.ascontiguousarray(instances[inst_bvh.prim_order], dtype=np.int32),
+        **meshes.arrays(),
+        **compile_textures(materials.textures, scene.resolve_path)._asdict(),
+    )
+    mat_table = np.array(materials.rows, dtype=np.float64).reshape(len(materials.rows),
+                                                                    N_MAT_PARAMS)
+    light_table, ambient = light_rows(scene)
+    lights = build_light_buffers(geometry, mat_table, light_table,
+                                 has_instances=len(instances) > 0)
+    if finite.any():
+        bmin, bmax = lo[finite].min(axis=0), hi[finite].max(axis=0)
+    else:
+        bmin, bmax = np.full(3, np.inf), np.full(3, -np.inf)
+    return CompiledScene(
+        geometry=geometry,
+        materials=mat_table,
+        lights=lights,
+        ambient=ambient,
+        bounds_min=bmin,
+        bounds_max=bmax,
+        build_seconds=time.perf_counter() - start,
+        warnings=warnings,
+        triangles=meshes.n_tris + flat,
+        instanced_triangles=instanced,
+    )

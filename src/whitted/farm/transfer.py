@@ -1,0 +1,86 @@
+"""Sending scenes and their files to the workers through Dask.
+
+Each file's bytes are scattered once under the key ``whitted-asset-<sha256>`` (the same file
+asked for twice, by two frames or two runs on one client, is one piece of data) and replicated
+on two workers, so losing one worker loses no file. A task that needs files takes their futures
+as arguments: Dask brings each blob to each worker once (from whichever worker has it, not
+from the client), and :func:`~whitted.farm.assets.materialise` writes it into that worker's
+disk cache.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+from ..scene.scene import Scene
+from ._dask import Client, Future
+from .assets import (
+    ASSET_KEY_PREFIX,
+    AssetManifest,
+    collect_assets,
+    file_stamps,
+    files_visible,
+)
+
+AssetMode = Literal["auto", "ship", "shared"]
+ASSET_MODES = ("auto", "ship", "shared")
+REPLICAS = 2
+
+
+@dataclass
+class Shipment:
+    """The files of some scenes on their way to the workers (``manifest`` None: the workers
+    read the client's files where they are)."""
+
+    manifest: AssetManifest | None = None
+    blobs: dict[str, Future] = field(default_factory=dict)  # by digest
+    needs: list[list[str]] = field(default_factory=list)  # tree paths, per scene
+
+    @property
+    def shipped(self) -> bool:
+        return self.manifest is not None
+
+    @property
+    def bytes(self) -> int:
+        return self.manifest.total_bytes if self.manifest is not None else 0
+
+    def for_scenes(self, indices: Sequence[int]) -> tuple[AssetManifest | None,
+                                                           dict[str, Future]]:
+        """The manifest and blob futures a task rendering these scenes takes."""
+        if self.manifest is None:
+            return None, {}
+        paths = {p for i in indices for p in self.needs[i]}
+        part = self.manifest.subset(paths)
+        return part, {digest: self.blobs[digest] for digest in set(part.files.values())}
+
+
+def workers_see(client: Client, stamps: dict[str, tuple[int, int]]) -> bool:
+    """Whether every worker (at least one) sees every file as the client does (``stamps``:
+    size and modification time by absolute path, from :func:`file_stamps`)."""
+    if not stamps:
+        return True
+    answers = client.run(files_visible, stamps)
+    return bool(answers) and all(answers.values())
+
+
+def ship_assets(client: Client, scenes: Sequence[Scene], mode: AssetMode = "auto") -> Shipment:
+    """Make the files of ``scenes`` (one base folder) reachable by every worker: "shared"
+    trusts a shared file system, "ship" always sends them, "auto" sends them unless every
+    worker already sees them."""
+    if mode not in ASSET_MODES:
+        raise ValueError(f"assets: unknown mode {mode!r} (use {', '.join(ASSET_MODES)})")
+    if mode == "shared":
+        return Shipment()
+    stamped = file_stamps(scenes)  # sizes and times only: no file is read yet
+    if not stamped[0] or (mode == "auto" and workers_see(client, stamped[0])):
+        return Shipment()
+    manifest, paths, needs = collect_assets(scenes, stamped)
+    data = {ASSET_KEY_PREFIX + digest: path.read_bytes() for digest, path in paths.items()}
+    scattered = client.scatter(data, hash=False)
+    n_workers = len(client.scheduler_info().get("workers", {}))
+    if n_workers > 1:
+        client.replicate(list(scattered.values()), n=min(REPLICAS, n_workers))
+    blobs = {key[len(ASSET_KEY_PREFIX):]: future for key, future in scattered.items()}
+    return Shipment(manifest, blobs, needs)

@@ -1,0 +1,167 @@
+"""What runs in a Dask worker: the plugin that readies each worker once, and the tasks.
+
+:class:`WhittedWorker` is a Dask ``WorkerPlugin``: when a worker joins (or when the plugin is
+registered with workers already running) it sets how many threads whitted renders with in that
+worker (Dask pins OpenMP and BLAS threads, not Numba's nor whitted's render lanes), and loads
+the render kernels from the worker's Numba cache, compiling them there on a cold cache
+(:func:`whitted.render.warm_up.warm_up_kernels`). That happens before the worker runs its first
+task, so no frame pays for it and no two frames on one worker compile twice.
+
+The tasks are plain functions of this module (workers import them from their own whitted):
+:func:`render_band` renders some rows of a still, :func:`render_frame_chunk` some frames of a
+film.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import tempfile
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..render.api import RenderStats
+from ..scene.scene import Scene
+from ._dask import WorkerPlugin
+from .assets import AssetManifest, materialise, worker_scene
+
+PLUGIN_NAME = "whitted-worker"
+_threads = 1  # render threads of this worker process (set by the plugin)
+_warm_seconds: float | None = None
+
+
+def set_worker_threads(threads: int) -> None:
+    """Render with ``threads`` lanes in this process, and cap Numba's own pool there too."""
+    global _threads
+    _threads = max(1, int(threads))
+    import numba
+    from numba.np.ufunc import parallel
+
+    # Numba re-reads its environment at each compile and refuses a NUMBA_NUM_THREADS that
+    # differs from the pool it launched; a worker may have imported Numba before Dask set
+    # its environment (a spawned worker re-imports the client's main module), so the two
+    # are made to agree here, before the pool starts.
+    if not getattr(parallel, "_is_initialized", False):
+        os.environ["NUMBA_NUM_THREADS"] = str(_threads)
+        numba.config.reload_config()
+    else:
+        os.environ["NUMBA_NUM_THREADS"] = str(numba.config.NUMBA_NUM_THREADS)
+    numba.set_num_threads(min(_threads, numba.config.NUMBA_NUM_THREADS))
+
+
+def warm_worker() -> float:
+    """Load (or compile) the kernels in this process; the seconds it took."""
+    global _warm_seconds
+    from ..render.warm_up import warm_up_kernels
+
+    start = time.perf_counter()
+    warm_up_kernels()
+    _warm_seconds = time.perf_counter() - start
+    return _warm_seconds
+
+
+def warm_seconds() -> float | None:
+    """How long this worker's warm-up took (None before it ran): for measurements."""
+    return _warm_seconds
+
+
+class WhittedWorker(WorkerPlugin):
+    """Readies each worker: ``threads`` render threads (default 1: one worker per core is the
+    usual layout), kernels loaded before the first task when ``warm``."""
+
+    name = PLUGIN_NAME
+
+    def __init__(self, threads: int = 1, warm: bool = True) -> None:
+        self.threads = threads
+        self.warm = warm
+
+    async def setup(self, worker) -> None:
+        set_worker_threads(self.threads)
+        if self.warm:  # off the event loop, so the worker keeps answering the scheduler
+            await asyncio.get_running_loop().run_in_executor(None, warm_worker)
+
+
+def _prepared(scene: Scene, manifest: AssetManifest | None,
+              blobs: dict[str, bytes]) -> tuple[Scene, Callable[[str], str]]:
+    """The scene re-pointed at this worker's copy of its files, and a function that turns
+    the worker's file names in a message back into the client's."""
+    if manifest is None:  # the workers see the client's files
+        return scene, str
+    tree = materialise(manifest, blobs)
+    return worker_scene(scene, manifest, tree), lambda text: text.replace(
+        str(tree), manifest.client_root)
+
+
+def render_band(scene: Scene, start: int, stop: int, manifest: AssetManifest | None = None,
+                blobs: dict[str, bytes] | None = None) -> tuple[int, np.ndarray, RenderStats]:
+    """Rows [start, stop) of the still: (start, the float32 rows, the band's statistics)."""
+    from ..render.api import RenderJob
+
+    prepared, client_names = _prepared(scene, manifest, blobs or {})
+    job = RenderJob(prepared, threads=_threads, rows=(start, stop))
+    job.run()
+    job.stats.warnings = [client_names(w) for w in job.stats.warnings]
+    return start, job.framebuffer[start:stop].copy(), job.stats
+
+
+@dataclass
+class FrameOutcome:
+    """One frame from a worker: its PNG's bytes, or why there are none."""
+
+    frame: int
+    png: bytes | None
+    error: str = ""
+    seconds: float = 0.0
+    warnings: list[str] = field(default_factory=list)
+
+
+def frame_png(image: Any, digest: str, frame: int) -> bytes:
+    """The bytes of the frame PNG the animation feature writes for ``image`` (its writer,
+    into a temporary file: the same bytes ``whitted animate`` writes)."""
+    from ..animation.frames import _write_frame_png
+
+    with tempfile.TemporaryDirectory(prefix="whitted-frame-") as tmp:
+        path = Path(tmp) / "frame.png"
+        _write_frame_png(path, image, digest, frame)
+        return path.read_bytes()
+
+
+_renderers = threading.local()  # a FrameRenderer per Dask thread: geometry reused between
+#                                 the consecutive frames one thread renders
+
+
+def render_frame_chunk(scene: Scene, frames: list[int], digests: list[str],
+                       settings: dict[str, Any], manifest: AssetManifest | None = None,
+                       blobs: dict[str, bytes] | None = None) -> list[FrameOutcome]:
+    """Frames ``frames`` of the animated ``scene`` (with render ``settings`` replaced), each
+    as the PNG bytes that carry the client's ``digests``. A frame that fails is returned with
+    its reason (the others still render); anything else raised fails the task (retried)."""
+    from ..animation.frames import FrameRenderer, still_for_frame
+    from ..render.api import RenderJob
+
+    renderer = getattr(_renderers, "renderer", None)
+    if renderer is None:
+        renderer = _renderers.renderer = FrameRenderer(_threads)
+    prepared, client_names = _prepared(scene, manifest, blobs or {})
+    outcomes = []
+    for frame, digest in zip(frames, digests, strict=True):
+        start = time.perf_counter()
+        try:
+            still = still_for_frame(prepared, frame, **settings)
+            compiled, _ = renderer.compile(still)
+            job = RenderJob(still, threads=_threads, compiled=compiled)
+            png = frame_png(job.run(), digest, frame)
+        except Exception as exc:  # noqa: BLE001 - this frame's own failure, told to the client
+            reason = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+            outcomes.append(FrameOutcome(frame, None,
+                                         client_names(reason) or type(exc).__name__))
+            continue
+        outcomes.append(FrameOutcome(frame, png, seconds=time.perf_counter() - start,
+                                     warnings=[client_names(w) for w in job.stats.warnings]))
+    return outcomes

@@ -1,0 +1,104 @@
+"""Checks made before a render starts, so that its result can be written when it ends: the
+output place is writable, no output is one of the job's inputs, and the memory the image and
+its encoder need is there."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Iterable
+from pathlib import Path
+
+from ..assets.files import kind_of, same_file
+from ..errors import OutputError
+
+#: Bytes per pixel held while rendering (the float32 RGB framebuffer).
+FRAMEBUFFER_BYTES = 12
+#: Bytes per pixel the encoders add on top of the framebuffer (see encode.write_image).
+ENCODER_BYTES = {"png": 4, "jpeg": 4, "exr": 12, "pfm": 0, "npy": 0}
+
+
+def check_output_place(path: str | os.PathLike[str]) -> None:
+    """:class:`OutputError` (one line) unless a file can be written at ``path``: its folder
+    exists and takes new files, and ``path`` is not a folder, a device or a pipe."""
+    target = Path(path)
+    name = os.fspath(path)
+    try:
+        status = os.stat(target)
+    except FileNotFoundError:
+        status = None
+    except OSError as exc:
+        raise OutputError(f"{name}: cannot write: {exc.strerror or exc}") from None
+    if status is not None:
+        kind = kind_of(status.st_mode)
+        if kind is not None:
+            raise OutputError(f"{name}: is {kind}, not a file that can be written")
+    folder = target.parent
+    if not folder.exists():
+        raise OutputError(f"{name}: the folder {folder} does not exist")
+    if not folder.is_dir():
+        raise OutputError(f"{name}: {folder} is not a folder")
+    try:  # the real test: the atomic writer makes a temporary file right there
+        fd, probe = tempfile.mkstemp(prefix=f".{target.name[:64]}.", suffix=".probe", dir=folder)
+    except OSError as exc:
+        raise OutputError(f"{name}: cannot write in {folder}: {exc.strerror or exc}") from None
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(probe)
+    if len(os.fsencode(target.name)) > 255:
+        raise OutputError(f"{name}: file name too long (over 255 bytes)")
+
+
+def input_files(scene: object, scene_path: str | os.PathLike[str] | None) -> list[Path]:
+    """Every file a render of ``scene`` reads that the scene names: the scene file, its models
+    and texture images."""
+    from ..scene.io import named_files
+
+    files: list[Path] = []
+    if scene_path is not None:
+        files.append(Path(scene_path))
+    for _keys, named in named_files(scene):
+        with contextlib.suppress(OSError, RuntimeError, ValueError):
+            files.append(scene.resolve_path(named))  # type: ignore[attr-defined]
+    return files
+
+
+def check_outputs(outputs: Iterable[str | os.PathLike[str]], scene: object = None,
+                  scene_path: str | os.PathLike[str] | None = None) -> None:
+    """Every output can be written and none is a file the job reads (:class:`OutputError`)."""
+    inputs = input_files(scene, scene_path) if scene is not None else (
+        [Path(scene_path)] if scene_path is not None else [])
+    for output in outputs:
+        for source in inputs:
+            if same_file(output, source):
+                raise OutputError(f"{output}: is an input of this job ({source}): "
+                                  "choose another output name")
+        check_output_place(output)
+
+
+def available_memory() -> int | None:
+    """Bytes of memory available to a new allocation (Linux's MemAvailable), or None."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
+
+
+def memory_need(width: int, height: int, fmt: str) -> int:
+    """Bytes a render of ``width`` x ``height`` written as ``fmt`` holds at its peak."""
+    return width * height * (FRAMEBUFFER_BYTES + ENCODER_BYTES.get(fmt, 12))
+
+
+def check_memory(width: int, height: int, fmt: str, bit_depth: int = 8) -> None:
+    """:class:`OutputError` before the work starts when the image cannot be held and written."""
+    need = memory_need(width, height, fmt)
+    have = available_memory()
+    if have is not None and need > have:
+        raise OutputError(
+            f"a {width}x{height} render to .{fmt} needs about {need / 2**30:.1f} GiB of memory; "
+            f"{have / 2**30:.1f} GiB is available")

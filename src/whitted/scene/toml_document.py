@@ -1,0 +1,318 @@
+"""Saving a scene into a user's TOML file without rewriting it (tomlkit keeps comments, layout,
+inline arrays and the order of keys): only what changed between the scene as loaded and the
+scene as edited is written, and new items are written compactly, with only the values that
+differ from their defaults.
+
+- :func:`compact_data`: an item (or a whole scene) as plain data with only non-default values
+- :func:`compact_toml`: a whole scene as compact TOML (a file that did not exist before)
+- :func:`edit_toml`: the text of a TOML scene file with the changes from ``old`` to ``new``
+- :func:`save_scene_toml`: write a scene, style-preserving when the file's text is known
+
+Every result is read back and compared with the scene before it is written; if a file's own
+style cannot carry an edit, the scene is written compactly instead (nothing is ever lost)."""
+
+from __future__ import annotations
+
+import difflib
+from pathlib import Path
+from typing import Any
+
+import tomlkit
+from pydantic import BaseModel
+from tomlkit.items import AoT, Array, InlineTable, Table
+
+from ..errors import SceneError
+from .io import parse_scene_text, rebase_files, scene_from_dict
+from .materials import Material
+from .scene import Scene
+
+# ---------------------------------------------------------------------- compact data
+
+
+def _defaults_for(model: BaseModel) -> dict[str, Any]:
+    """What a field of ``model`` is when left out: its class default, or, for a material
+    built on a preset, the preset's value."""
+    preset = getattr(model, "preset", None) if isinstance(model, Material) else None
+    if preset is not None:
+        base = Material(preset=preset)
+        return {name: getattr(base, name) for name in type(model).model_fields}
+    out = {}
+    for name, field in type(model).model_fields.items():
+        if field.default_factory is not None:
+            out[name] = field.default_factory()
+        else:
+            out[name] = field.default
+    return out
+
+
+def _plain(value: Any) -> Any:
+    """A value as TOML-ready plain data (tuples as lists, models compact)."""
+    if isinstance(value, BaseModel):
+        return compact_data(value)
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items() if v is not None}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    if isinstance(value, Path):
+        return str(value)
+    return value
+
+
+def compact_data(model: BaseModel) -> dict[str, Any]:
+    """``model`` as plain data with only the values that differ from their defaults (a
+    ``type`` tag is always kept: it says which kind of item this is)."""
+    defaults = _defaults_for(model)
+    out: dict[str, Any] = {}
+    names = list(type(model).model_fields)
+    if "type" in names:  # the kind of item first, then its name: how people write them
+        names.remove("type")
+        names.insert(0, "type")
+    for name in names:
+        value = getattr(model, name)
+        if name == "type" or (name == "preset" and value is not None):
+            out[name] = value
+            continue
+        if value is None or value == defaults.get(name, object()):
+            continue
+        plain = _plain(value)
+        if plain == {} and isinstance(value, BaseModel):
+            continue
+        out[name] = plain
+    return out
+
+
+def _item(value: Any, *, inline: bool = True) -> Any:
+    """A tomlkit item for plain data: tables inline (compact) unless ``inline`` is False."""
+    if isinstance(value, dict):
+        table = tomlkit.inline_table() if inline else tomlkit.table()
+        for k, v in value.items():
+            table[k] = _item(v)
+        return table
+    if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+        array = tomlkit.array()
+        for v in value:
+            array.append(_item(v))
+        return array
+    return tomlkit.item(value)
+
+
+def _table(data: dict[str, Any]) -> Table:
+    table = tomlkit.table()
+    for k, v in data.items():
+        table[k] = _item(v)
+    return table
+
+
+def compact_toml(scene: Scene) -> str:
+    """The whole scene as compact TOML: settings, camera and background as tables, named
+    materials, then ``[[lights]]`` and ``[[objects]]`` with only their non-default values."""
+    doc = tomlkit.document()
+    for name in ("render", "camera", "background"):
+        data = compact_data(getattr(scene, name))
+        if data:
+            doc[name] = _table(data)
+    if scene.materials:
+        mats = tomlkit.table()
+        for key, mat in scene.materials.items():
+            mats[key] = _table(compact_data(mat))
+        doc["materials"] = mats
+    for name in ("lights", "objects"):
+        items = getattr(scene, name)
+        if items:
+            aot = tomlkit.aot()
+            for it in items:
+                aot.append(_table(compact_data(it)))
+            doc[name] = aot
+    for name in _OTHER_FIELDS:  # e.g. the animation table
+        value = getattr(scene, name, None)
+        if value is not None and value != _scene_default(name):
+            doc[name] = _table(compact_data(value)) if isinstance(value, BaseModel) else \
+                _item(_plain(value))
+    return tomlkit.dumps(doc)
+
+
+_KNOWN_FIELDS = ("render", "camera", "background", "materials", "lights", "objects")
+_OTHER_FIELDS = tuple(n for n in Scene.model_fields if n not in _KNOWN_FIELDS)
+
+
+def _scene_default(name: str) -> Any:
+    field = Scene.model_fields[name]
+    return field.default_factory() if field.default_factory is not None else field.default
+
+
+# ---------------------------------------------------------------------- editing a file
+
+
+def _is_table(node: Any) -> bool:
+    return isinstance(node, Table | InlineTable)
+
+
+def _set_field(table: Any, name: str, old: BaseModel, new: BaseModel) -> None:
+    """Make ``table[name]`` say the new value of field ``name`` (or drop it: a default)."""
+    old_value, new_value = getattr(old, name), getattr(new, name)
+    if old_value == new_value:
+        return
+    node = table.get(name)
+    if (isinstance(new_value, BaseModel) and isinstance(old_value, BaseModel)
+            and type(new_value) is type(old_value) and _is_table(node)
+            and getattr(old_value, "type", None) == getattr(new_value, "type", None)
+            and getattr(old_value, "preset", None) == getattr(new_value, "preset", None)):
+        _update_table(node, old_value, new_value)
+        return
+    default = _defaults_for(new).get(name, object())
+    if new_value is None or (new_value == default and name not in ("type", "preset")):
+        if name in table:
+            del table[name]
+        return
+    plain = _plain(new_value)
+    table[name] = _item(plain, inline=not isinstance(table, Table) or not isinstance(
+        new_value, BaseModel) or isinstance(node, InlineTable) or node is None)
+
+
+def _update_table(table: Any, old: BaseModel, new: BaseModel) -> None:
+    for name in type(new).model_fields:
+        _set_field(table, name, old, new)
+
+
+def _key(item: BaseModel) -> str:
+    return item.model_dump_json()
+
+
+def _update_list(doc: Any, name: str, old: list, new: list) -> None:
+    if not new:
+        if name in doc:
+            del doc[name]
+        return
+    node = doc.get(name)
+    if not isinstance(node, AoT | Array):
+        doc[name] = _aot(new) if node is None or isinstance(node, AoT) else _array(new)
+        return
+    inline = isinstance(node, Array)
+    fresh = (lambda it: _item(compact_data(it))) if inline else (
+        lambda it: _table(compact_data(it)))
+    ops = difflib.SequenceMatcher(None, [_key(i) for i in old], [_key(i) for i in new],
+                                  autojunk=False).get_opcodes()
+    for tag, i1, i2, j1, j2 in reversed(ops):  # from the end: earlier indices stay valid
+        if tag == "equal":
+            continue
+        paired = min(i2 - i1, j2 - j1) if tag == "replace" else 0
+        for k in range(paired):
+            o, n = old[i1 + k], new[j1 + k]
+            if type(o) is type(n) and getattr(o, "type", None) == getattr(n, "type", None):
+                _update_table(node[i1 + k], o, n)
+            else:
+                node[i1 + k] = fresh(n)
+        for index in range(i2 - 1, i1 + paired - 1, -1):  # removed
+            del node[index]
+        for k in range(j2 - 1, j1 + paired - 1, -1):  # added, in order
+            node.insert(i1 + paired, fresh(new[k]))
+
+
+def _aot(items: list) -> AoT:
+    aot = tomlkit.aot()
+    for it in items:
+        aot.append(_table(compact_data(it)))
+    return aot
+
+
+def _array(items: list) -> Array:
+    array = tomlkit.array()
+    for it in items:
+        array.append(_item(compact_data(it)))
+    return array
+
+
+def edit_toml(text: str, old: Scene, new: Scene) -> str:
+    """``text`` (a TOML file that loads as ``old``) changed so that it loads as ``new``:
+    comments, layout and untouched values stay byte for byte."""
+    if old == new:
+        return text
+    doc = tomlkit.parse(text)
+    for name in ("render", "camera", "background"):
+        o, n = getattr(old, name), getattr(new, name)
+        if o == n:
+            continue
+        node = doc.get(name)
+        if _is_table(node):
+            _update_table(node, o, n)
+        else:
+            data = compact_data(n)
+            if data:
+                doc[name] = _table(data)
+            elif name in doc:
+                del doc[name]
+    if old.materials != new.materials:
+        node = doc.get("materials")
+        if not _is_table(node):
+            node = tomlkit.table()
+            doc["materials"] = node
+        for key in [k for k in old.materials if k not in new.materials]:
+            del node[key]
+        for key, mat in new.materials.items():
+            if key in old.materials and _is_table(node.get(key)):
+                _update_table(node[key], old.materials[key], mat)
+            elif old.materials.get(key) != mat:
+                node[key] = _table(compact_data(mat))
+        if not new.materials:
+            del doc["materials"]
+    for name in ("lights", "objects"):
+        o, n = getattr(old, name), getattr(new, name)
+        if o != n:
+            _update_list(doc, name, list(o), list(n))
+    for name in _OTHER_FIELDS:
+        o, n = getattr(old, name, None), getattr(new, name, None)
+        if o == n:
+            continue
+        node = doc.get(name)
+        if isinstance(n, BaseModel) and isinstance(o, BaseModel) and _is_table(node):
+            _update_table(node, o, n)
+        elif n is None or n == _scene_default(name):
+            if name in doc:
+                del doc[name]
+        else:
+            doc[name] = _table(compact_data(n)) if isinstance(n, BaseModel) else \
+                _item(_plain(n))
+    return tomlkit.dumps(doc)
+
+
+def _loads(text: str, scene: Scene) -> Scene | None:
+    try:
+        loaded = scene_from_dict(parse_scene_text(text, ".toml"))
+    except (SceneError, ValueError):
+        return None
+    return loaded
+
+
+def scene_toml(scene: Scene, *, text: str | None = None, loaded: Scene | None = None) -> str:
+    """The TOML to save ``scene`` as: ``text`` (the file as read, which loaded as ``loaded``)
+    with only the edits written into it, else the compact form. Checked by reading it back."""
+    if text is not None and loaded is not None:
+        try:
+            edited = edit_toml(text, loaded, scene)
+        except (KeyError, TypeError, ValueError, tomlkit.exceptions.TOMLKitError):
+            edited = None
+        if edited is not None and _loads(edited, scene) == scene:
+            return edited
+    compact = compact_toml(scene)
+    if _loads(compact, scene) == scene:
+        return compact
+    import tomli_w
+
+    from .io import scene_to_dict
+
+    return tomli_w.dumps(scene_to_dict(scene))  # every value spelt out: always loads back
+
+
+def save_scene_toml(scene: Scene, path: str | Path, *, text: str | None = None,
+                    loaded: Scene | None = None) -> str:
+    """Write ``scene`` to the TOML file ``path`` atomically (see :func:`scene_toml`); relative
+    model and texture names are rewritten when the folder changes. Returns the text written."""
+    from ..output.encode import atomic_write
+
+    path = Path(path)
+    if path.parent.resolve() != scene.base_dir.resolve():
+        scene = rebase_files(scene, path.parent)
+        text = loaded = None  # another folder: file names change, write it afresh
+    payload = scene_toml(scene, text=text, loaded=loaded)
+    atomic_write(path, lambda tmp: Path(tmp).write_text(payload, encoding="utf-8"))
+    return payload
