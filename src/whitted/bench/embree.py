@@ -89,7 +89,8 @@ def compare_embree(scene: Scene, repeats: int = 3) -> dict[str, Any]:
     except ImportError as exc:
         raise EmbreeMissing("--compare embree needs embreex: pip install 'whitted[bench]'") \
             from exc
-    from ..compile.flatten import compile_scene, render_params
+    from ..compile.params import render_params
+    from ..compile.scene import compile_scene
     from ..kernels.tiles import BVH_STACK
     from ..render.warm_up import warm_up_kernels
     from ..scene.lights import PointLight
