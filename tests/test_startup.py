@@ -109,6 +109,7 @@ def test_kernels_loaded_from_cache_then_a_new_kernel_compiles(tmp_path):
 @pytest.mark.parametrize(("blocked", "args", "extra"), [
     ("PySide6", ["gui"], "gui"),
     ("matplotlib", ["bench", "--study", "threads", "--quick"], "plots"),
+    ("embreex", ["bench", "--quick", "--scene", "sphere1m", "--compare", "embree"], "bench"),
 ])
 def test_a_missing_extra_is_one_line_naming_it(tmp_path, blocked, args, extra):
     """Without an optional dependency the command says which extra to install (one line,
