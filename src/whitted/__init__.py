@@ -89,6 +89,21 @@ def __dir__() -> list[str]:
     return sorted({*globals(), *__all__})
 
 
+class _Package(types.ModuleType):
+    """The ``whitted`` module itself. Importing the subpackage ``whitted.render`` makes Python
+    set the attribute ``render`` of this module to that subpackage, which would hide the
+    function ``whitted.render``; the function keeps the name (the subpackage stays reachable
+    through ``sys.modules`` and ``from whitted.render import ...``)."""
+
+    def __setattr__(self, name: str, value) -> None:
+        if name in _LAZY and isinstance(value, types.ModuleType):
+            return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
+
+
 if TYPE_CHECKING:  # for type checkers and IDEs: the same names, imported eagerly
     from .errors import SceneError, WhittedError
     from .output import Image

@@ -40,7 +40,9 @@ class Track(Strict):
     @classmethod
     def _keys_from_dict(cls, value: Any) -> Any:
         if isinstance(value, dict):
-            return [[float(k) if isinstance(k, str) else k, v] for k, v in value.items()]
+            value = [[float(k) if isinstance(k, str) else k, v] for k, v in value.items()]
+        if isinstance(value, list):  # scene files are validated strictly: a pair is a tuple
+            return [tuple(k) if isinstance(k, list) else k for k in value]
         return value
 
     @field_validator("keys")
