@@ -26,7 +26,7 @@ _LAZY = {
     "SceneError": ".errors", "WhittedError": ".errors",
     "Image": ".output",
     "CancelToken": ".render", "Progress": ".render", "RenderJob": ".render",
-    "RenderStats": ".render", "render_aovs": ".render",
+    "RenderStats": ".render", "render": ".render", "render_aovs": ".render",
     "default_scene": ".scene.default",
     **dict.fromkeys((
         "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera",
@@ -64,25 +64,6 @@ def __getattr__(name: str):
         raise AttributeError(f"module 'whitted' has no attribute {name!r}")
     globals()[name] = value  # the next look-up is a plain attribute
     return value
-
-
-class _Package(types.ModuleType):
-    """The type of this module: ``whitted.render`` is the render function, also once the
-    import system has bound the ``whitted.render`` subpackage to that name (it does when any
-    ``whitted.render.*`` module is imported; the eager imports of old ran after that)."""
-
-    @property
-    def render(self):
-        from .render.api import render
-
-        return render
-
-    @render.setter
-    def render(self, value) -> None:
-        pass  # the subpackage stays reachable as sys.modules["whitted.render"]
-
-
-sys.modules[__name__].__class__ = _Package
 
 
 def __dir__() -> list[str]:
