@@ -471,9 +471,11 @@ def gui(
             raise fail(str(exc)) from None
     elif scene_path is not None and scene_path.suffix.lower() not in (".toml", ".json"):
         raise fail(f"{scene_path}: unknown scene format {scene_path.suffix!r} (use .toml or .json)")
-    try:  # Qt is imported here only, so the other commands start without it
-        import PySide6.QtWidgets  # noqa: F401  (gui.app imports it only when it runs)
+    import importlib.util
 
+    if importlib.util.find_spec("PySide6") is None:  # looked up, not imported: Qt loads later
+        raise fail("the editor needs PySide6: pip install 'whitted[gui]'")
+    try:  # Qt is imported here only, so the other commands start without it
         from ..gui.app import run_editor
     except ImportError as exc:
         raise fail(f"the editor needs PySide6 ({exc}): pip install 'whitted[gui]'") from None
