@@ -326,7 +326,7 @@ def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
         TextColumn("{task.fields[rays]} rays"),
         TimeRemainingColumn(),
     )
-    with Progress(*columns, console=err, transient=True) as bar:
+    with Progress(*columns, console=err.console, transient=True) as bar:
         task = bar.add_task("rendering", total=1.0, rays="0")
 
         def update(p) -> None:
