@@ -209,3 +209,30 @@ def test_compile_helper_ends_when_its_parent_is_gone(tmp_path):
     alive = Path(f"/proc/{pid}").exists() and "State:\tZ" not in Path(
         f"/proc/{pid}/status").read_text()
     assert not alive, "the orphaned helper is still compiling"
+
+
+def test_render_in_a_terminal_draws_its_bar(tmp_path):
+    """``whitted render`` with a terminal on stderr draws the rich progress bar (the lazy
+    console must work inside rich's live display) and writes the image."""
+    import pty
+
+    out = tmp_path / "x.png"
+    env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"), COLUMNS="100", TERM="xterm")
+    pid, fd = pty.fork()
+    if pid == 0:  # the child: the CLI with the pseudo-terminal as its terminal
+        os.chdir(tmp_path)
+        os.execvpe(sys.executable, [sys.executable, "-m", "whitted", "render", "-W", "24",
+                                    "-H", "16", "-o", str(out)], env)
+    captured = b""
+    while True:
+        try:
+            chunk = os.read(fd, 4096)
+        except OSError:  # the child closed the terminal
+            break
+        if not chunk:
+            break
+        captured += chunk
+    _, status = os.waitpid(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 0, captured.decode(errors="replace")[-800:]
+    assert b"rendering" in captured and b"24x16" in captured
+    assert out.stat().st_size > 0
