@@ -473,9 +473,10 @@ def gui(
         raise fail(f"{scene_path}: unknown scene format {scene_path.suffix!r} (use .toml or .json)")
     import importlib.util
 
-    if importlib.util.find_spec("PySide6") is None:  # looked up, not imported: Qt loads later
-        raise fail("the editor needs PySide6: pip install 'whitted[gui]'")
-    try:  # Qt is imported here only, so the other commands start without it
+    # Qt is imported by the editor only, after its check of the system libraries Qt needs
+    if importlib.util.find_spec("PySide6") is None:
+        raise fail("the editor needs PySide6, which is not installed: pip install 'whitted[gui]'")
+    try:
         from ..gui.app import run_editor
     except ImportError as exc:
         raise fail(f"the editor needs PySide6 ({exc}): pip install 'whitted[gui]'") from None
