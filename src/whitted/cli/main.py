@@ -308,14 +308,27 @@ def _override_error(exc: ValidationError) -> str:
     return f"{option}: {_clean_message(e)}"
 
 
-def _wait(job, interrupted: threading.Event) -> None:
+def _wait(job, interrupted: threading.Event, tick=None) -> None:
     """Wait for the job; after an interrupt, stop waiting at once if no tile is being rendered
-    yet (the first compile of the kernels takes many seconds and cannot be cut short)."""
+    yet (the first compile of the kernels takes many seconds and cannot be cut short).
+    ``tick()`` is called every tenth of a second meanwhile."""
     while job.running:
         job.join(0.1)
+        if tick is not None:
+            tick()
         if interrupted.is_set() and not job.rendering:
             return
     job.wait()
+
+
+def _show_compile(bar, task) -> None:
+    """While the first run compiles the kernels, the bar says so and how far along it is."""
+    from ..render.warm_up import compile_progress
+
+    fraction = compile_progress()
+    if fraction is not None:
+        bar.update(task, description="compiling the kernels (first run only)",
+                   completed=fraction)
 
 
 def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
@@ -332,21 +345,21 @@ def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
     )
 
     columns = (
-        TextColumn("[bold]rendering"),
+        TextColumn("[bold]{task.description}"),
         BarColumn(),
         TaskProgressColumn(),
         TextColumn("{task.fields[rays]} rays"),
         TimeRemainingColumn(),
     )
-    with Progress(*columns, console=err, transient=True) as bar:
-        task = bar.add_task("render", total=1.0, rays="0")
+    with Progress(*columns, console=err.console, transient=True) as bar:
+        task = bar.add_task("rendering", total=1.0, rays="0")
 
         def update(p) -> None:
-            bar.update(task, completed=p.fraction, rays=f"{p.rays:,}")
+            bar.update(task, description="rendering", completed=p.fraction, rays=f"{p.rays:,}")
 
         job.progress = update
         job.start()
-        _wait(job, interrupted)
+        _wait(job, interrupted, lambda: _show_compile(bar, task))
 
 
 def _model_info(path: Path) -> None:
