@@ -40,6 +40,7 @@ from .document import (
     rebuild_scene,
     set_path,
 )
+from .icons import icon_for
 from .picking import IdBuffer, id_at, outline_image
 from .properties import PropertyPanel
 from .recent import RecentFiles
@@ -92,6 +93,7 @@ class MainWindow(QMainWindow):
         self.tree = SceneTree(self.doc)
         self.properties = PropertyPanel(self.doc)
         self.properties.choose_file = self.choose_file
+        self.properties.ask_keep_colour = self.ask_keep_colour
         self._dock(self.tree, "Scene", Qt.DockWidgetArea.LeftDockWidgetArea, 240)
         self._dock(self.properties, "Properties", Qt.DockWidgetArea.RightDockWidgetArea, 390)
 
@@ -103,6 +105,7 @@ class MainWindow(QMainWindow):
         self.eta = QLabel("", self)
         self.statusBar().addPermanentWidget(self.eta)
         self.statusBar().addPermanentWidget(self.progress)
+        self.progress.hide()  # only while a render runs
 
         self._make_actions()
         self._make_menus()
@@ -218,12 +221,15 @@ class MainWindow(QMainWindow):
         self.object_actions: dict[str, QAction] = {}
         for kind, text in catalog.OBJECT_KINDS.items():
             self.object_actions[kind] = self._action(text, lambda k=kind: self.add_object(k))
+            self.object_actions[kind].setIcon(icon_for(kind))
         self.act_model = self._action("Model from file…", self.add_model,
                                       tip="OBJ, PLY, STL, OFF, glTF")
         self.act_model.setEnabled(catalog.HAS_MESH)
+        self.act_model.setIcon(icon_for("mesh"))
         self.light_actions: dict[str, QAction] = {}
         for kind, text in catalog.LIGHT_KINDS.items():
             self.light_actions[kind] = self._action(text, lambda k=kind: self.add_light(k))
+            self.light_actions[kind].setIcon(icon_for(f"light:{kind}"))
 
     def _make_menus(self) -> None:
         bar = self.menuBar()
@@ -263,10 +269,13 @@ class MainWindow(QMainWindow):
         tools = self.addToolBar("Main")
         tools.setObjectName("main toolbar")
         tools.setMovable(False)
-        for menu, text in ((self.add_object_menu, "Add object"),
-                           (self.add_light_menu, "Add light")):
+        tools.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
+        for menu, text, icon in ((self.add_object_menu, "Add object", "sphere"),
+                                 (self.add_light_menu, "Add light", "light:point")):
             button = QToolButton(self)
             button.setText(text)
+            button.setIcon(icon_for(icon))
+            button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
             button.setMenu(menu)
             button.setPopupMode(QToolButton.ToolButtonPopupMode.InstantPopup)
             tools.addWidget(button)
@@ -301,6 +310,18 @@ class MainWindow(QMainWindow):
             f"{autosave.name} holds changes to {self.scene_name()} that were never saved "
             "(the editor closed unexpectedly). Recover them?")
         return answer == QMessageBox.StandardButton.Yes
+
+    def ask_keep_colour(self, preset: str) -> str:
+        """A preset chosen over the object's own colour: keep the colour, or take the
+        preset's? ('keep', 'replace' or 'cancel')."""
+        box = QMessageBox(QMessageBox.Icon.Question, "Keep your colour?",
+                          f"The {preset} preset has a colour of its own. Keep this object's "
+                          "colour with the preset's other values?", parent=self)
+        keep = box.addButton("Keep my colour", QMessageBox.ButtonRole.AcceptRole)
+        replace = box.addButton(f"Use the {preset} colour", QMessageBox.ButtonRole.DestructiveRole)
+        box.addButton(QMessageBox.StandardButton.Cancel)
+        box.exec()
+        return {keep: "keep", replace: "replace"}.get(box.clickedButton(), "cancel")
 
     def ask_open_path(self) -> Path | None:
         name, _ = QFileDialog.getOpenFileName(self, "Open scene", self._start_dir(), SCENE_FILTER)
@@ -838,6 +859,7 @@ class MainWindow(QMainWindow):
         self.commit_pending_edit()
         self.controller.render(self.doc.scene)
         self.progress.setValue(0)
+        self.progress.show()
         self.eta.setText("starting…")
         self._update_render_actions()
 
@@ -876,12 +898,15 @@ class MainWindow(QMainWindow):
             self.viewport.caption = ""
             self.viewport.update()
         self.statusBar().showMessage(text, 8000)
+        self.progress.hide()
         self._update_render_actions()
 
     def _render_failed(self, kind: str, message: str) -> None:
         self.viewport.caption = f"cannot render: {message}"
         self.viewport.update()
         self.statusBar().showMessage(f"Cannot {kind}: {message}", 8000)
+        if not self.controller.rendering:
+            self.progress.hide()
         self._update_render_actions()
 
     def _kernels_ready(self, seconds: float) -> None:
