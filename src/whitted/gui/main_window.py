@@ -94,6 +94,7 @@ class MainWindow(QMainWindow):
         self.properties = PropertyPanel(self.doc)
         self.properties.choose_file = self.choose_file
         self.properties.ask_keep_colour = self.ask_keep_colour
+        self.properties.interacting.connect(lambda on: self.controller.set_interacting(on))
         self._dock(self.tree, "Scene", Qt.DockWidgetArea.LeftDockWidgetArea, 240)
         self._dock(self.properties, "Properties", Qt.DockWidgetArea.RightDockWidgetArea, 390)
 
@@ -141,6 +142,7 @@ class MainWindow(QMainWindow):
         if warm_up:
             self.viewport.caption = "Loading the render kernels (the first run compiles them)…"
             self.controller.warm_up()
+            self.ids.warm_up(self.doc.scene)
         self.controller.request_preview(self.doc.scene)
 
     # ------------------------------------------------------------------ layout

@@ -81,6 +81,20 @@ class IdBuffer(QObject):
         self._poll.setInterval(30)
         self._poll.timeout.connect(self._collect)
 
+    def warm_up(self, scene: Scene) -> None:
+        """Load the id kernel now, on a background thread (loading it holds Python's lock
+        for a second or so: better while the editor starts than in a render's first second
+        after the first click)."""
+        small = scene.with_settings(width=4, height=3)
+
+        def work() -> None:
+            try:
+                object_ids(small, 4, 3)
+            except Exception:  # noqa: BLE001 - the preview reports a broken scene
+                pass
+
+        threading.Thread(target=work, name="whitted-ids-warm-up", daemon=True).start()
+
     def request(self, scene: Scene) -> None:
         """Compute the ids of ``scene`` soon (a burst of edits computes once)."""
         if scene is self.scene or scene is self._wanted:

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from pydantic import BaseModel
-from PySide6.QtCore import Qt, QTimer
+from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QApplication,
     QComboBox,
@@ -81,7 +81,10 @@ def make_editor(spec: F.Spec) -> FieldEditor:
 
 class PropertyPanel(QWidget):
     """Shows the document's selected item. ``choose_file(title, filters)`` (set by the window)
-    asks for a file and returns its path or None."""
+    asks for a file and returns its path or None. ``interacting(bool)``: a slider is held
+    (the preview goes coarse and fast) or let go."""
+
+    interacting = Signal(bool)
 
     def __init__(self, doc: SceneDocument, parent=None) -> None:
         super().__init__(parent)
@@ -215,6 +218,7 @@ class PropertyPanel(QWidget):
             self.specs[spec.path] = spec
             editor.committed.connect(
                 lambda value, continuous, s=spec: self.commit(s, value, continuous))
+            editor.dragging.connect(self.interacting)
             if isinstance(editor, FileEditor):
                 editor.browse.connect(lambda s=spec, e=editor: self._browse(s, e))
         if key == CAMERA:

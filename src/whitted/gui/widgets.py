@@ -78,6 +78,8 @@ class FieldEditor(QWidget):
     refused = Signal(str)
     #: the field holds the scene's value again (typed back): its message goes away
     restored = Signal()
+    #: a continuous change (a slider held) started (True) or ended (False)
+    dragging = Signal(bool)
 
     def set_value(self, value: object) -> None:
         raise NotImplementedError
@@ -240,6 +242,8 @@ class CoefficientEditor(FieldEditor):
         box.addWidget(self.slider, 1)
         box.addWidget(self.line)
         self.slider.sliderPressed.connect(self._new_session)
+        self.slider.sliderPressed.connect(lambda: self.dragging.emit(True))
+        self.slider.sliderReleased.connect(lambda: self.dragging.emit(False))
         self.slider.valueChanged.connect(self._slid)
         self.line.editingFinished.connect(self._finish)
 
