@@ -4,6 +4,7 @@ the current scene, computed on a background thread at about the picture's size, 
 
 from __future__ import annotations
 
+import contextlib
 import threading
 
 import numpy as np
@@ -88,10 +89,8 @@ class IdBuffer(QObject):
         small = scene.with_settings(width=4, height=3)
 
         def work() -> None:
-            try:
+            with contextlib.suppress(Exception):  # the preview reports a broken scene
                 object_ids(small, 4, 3)
-            except Exception:  # noqa: BLE001 - the preview reports a broken scene
-                pass
 
         threading.Thread(target=work, name="whitted-ids-warm-up", daemon=True).start()
 
