@@ -800,7 +800,9 @@ class MainWindow(QMainWindow):
 
     def _camera_edit(self, camera, text: str, merge) -> None:
         try:
-            self.doc.edit_item(CAMERA, camera.model_dump(), text, merge_key=merge)
+            # the view moves; the selection stays (the camera's panel, if shown, follows)
+            self.doc.edit_item(CAMERA, camera.model_dump(), text, merge_key=merge,
+                               select=False)
         except EditRefused as exc:
             self.statusBar().showMessage(str(exc), 3000)
 
