@@ -212,14 +212,15 @@ def render(
         signal.signal(sig, on_interrupt)
     try:
         _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
-                          interrupted, signals, process_start)
+                          interrupted, signals, process_start, frame)
     finally:
         for sig in handled:
             signal.signal(sig, previous[sig])
 
 
 def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet, interrupted,
-                      signals, process_start) -> None:
+                      signals, process_start, frame: int | None) -> None:
+    from ..output.encode import image_format
     from ..render.api import render_aovs
 
     try:
