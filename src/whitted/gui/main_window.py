@@ -95,7 +95,7 @@ class MainWindow(QMainWindow):
         self.properties = PropertyPanel(self.doc)
         self.properties.choose_file = self.choose_file
         self.properties.ask_keep_colour = self.ask_keep_colour
-        self.properties.interacting.connect(lambda on: self.controller.set_interacting(on))
+        self.properties.interacting.connect(self._interacting)
         self._dock(self.tree, "Scene", Qt.DockWidgetArea.LeftDockWidgetArea, 240)
         self._dock(self.properties, "Properties", Qt.DockWidgetArea.RightDockWidgetArea, 390)
 
@@ -130,8 +130,8 @@ class MainWindow(QMainWindow):
         self.viewport.clicked.connect(self.pick)
         self.viewport.key_handler = self._viewport_key
         self.viewport.overlay = self._draw_overlay
-        self.viewport.drag_started.connect(lambda: self.controller.set_interacting(True))
-        self.viewport.drag_finished.connect(lambda: self.controller.set_interacting(False))
+        self.viewport.drag_started.connect(lambda: self._interacting(True))
+        self.viewport.drag_finished.connect(lambda: self._interacting(False))
         self.viewport.orbit.connect(self._orbit)
         self.viewport.pan.connect(self._pan)
         self.viewport.zoom.connect(self._zoom)
@@ -726,7 +726,7 @@ class MainWindow(QMainWindow):
         tool.start_uv = tool.uv = self.viewport.to_picture(start)
         self.viewport.tool = tool
         self._tool_edits = 0
-        self.controller.set_interacting(True)
+        self._interacting(True)
         return True
 
     def _tool_edit(self, key, transform, merge, mode: str) -> None:
@@ -749,7 +749,7 @@ class MainWindow(QMainWindow):
 
     def _tool_finished(self, confirmed: bool, tool) -> None:
         self.viewport.tool = None
-        self.controller.set_interacting(False)
+        self._interacting(False)
         if not confirmed and self._tool_edits:
             stack = self.doc.undo_stack
             command = stack.command(stack.index() - 1)
@@ -843,6 +843,15 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ rendering
 
+    def _interacting(self, on: bool) -> None:
+        """A drag (mouse, slider, G/R/S) started or ended: coarse previews and no outline
+        updates during it (the CPU goes to the picture), refinement and the outline after."""
+        self.controller.set_interacting(on)
+        if on and self.viewport.tool is not None:  # the object moves: its old outline goes
+            self.viewport.outline = None          # (the bounding box follows it live)
+        if not on:
+            self._update_outline()
+
     def _update_preview_target(self) -> None:
         """Previews refine, when the input stops, up to the picture's size on screen."""
         r = self.viewport.fit_rect()
@@ -852,7 +861,8 @@ class MainWindow(QMainWindow):
     def _scene_changed(self, key=None) -> None:
         self._update_preview_target()
         scene = self.timeline.still(self.doc.scene)
-        if self.doc.selection is not None and self.doc.selection[0] == "objects":
+        if self.doc.selection is not None and self.doc.selection[0] == "objects" \
+                and not self.controller.interacting:  # (during a drag: when it ends)
             self.ids.request(scene)  # the outline follows
         self.viewport.set_aspect(scene.render.width, scene.render.height)
         self._update_title()
