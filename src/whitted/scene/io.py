@@ -43,6 +43,11 @@ def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene file. Raises :class:`SceneError` with file, key path and line."""
     from ..assets.files import path_problem, read_limited
 
+    if not isinstance(path, str | os.PathLike):
+        from ..errors import ArgumentError
+
+        raise ArgumentError(f"load_scene needs the path of a scene file, got "
+                            f"{type(path).__name__}")
     path = Path(path)
     name = str(path)
     # Existence first: "no such file" is more useful than "unknown format" for a typo'd path.
