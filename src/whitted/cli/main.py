@@ -537,6 +537,8 @@ def export(
         raise fail(str(exc)) from None
     try:
         scene = scene.with_settings(width=width, height=height)
+        if scene.is_animated:  # POV-Ray gets the first frame, mesh sequences named
+            scene = scene.at_frame(0)
     except ValidationError as exc:
         raise fail(_override_error(exc)) from None
     if output is None:  # the whole stem: scene.v1.toml -> scene.v1.pov
