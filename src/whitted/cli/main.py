@@ -212,14 +212,15 @@ def render(
         signal.signal(sig, on_interrupt)
     try:
         _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
-                          interrupted, signals, process_start)
+                          interrupted, signals, process_start, frame)
     finally:
         for sig in handled:
             signal.signal(sig, previous[sig])
 
 
 def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet, interrupted,
-                      signals, process_start) -> None:
+                      signals, process_start, frame: int | None) -> None:
+    from ..output.encode import image_format
     from ..render.api import render_aovs
 
     try:
@@ -242,7 +243,13 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
         err.print(Text(f"warning: {warning}"))
     written = [str(output)]
     try:
-        image.save(output, bit_depth=bit_depth)
+        if frame is not None and not interrupted.is_set() and bit_depth == 8 \
+                and image_format(output) == "png":  # the very file the film's frame K is
+            from ..animation.frames import frame_digest, write_frame_png
+
+            write_frame_png(output, image, frame_digest(scene, frame), frame)
+        else:
+            image.save(output, bit_depth=bit_depth)
         if aovs and not interrupted.is_set():
             planes = render_aovs(scene)
             for path, aov_name in zip(outputs[1:], aovs, strict=True):
@@ -302,14 +309,27 @@ def _override_error(exc: ValidationError) -> str:
     return f"{option}: {_clean_message(e)}"
 
 
-def _wait(job, interrupted: threading.Event) -> None:
+def _wait(job, interrupted: threading.Event, tick=None) -> None:
     """Wait for the job; after an interrupt, stop waiting at once if no tile is being rendered
-    yet (the first compile of the kernels takes many seconds and cannot be cut short)."""
+    yet (the first compile of the kernels takes many seconds and cannot be cut short).
+    ``tick()`` is called every tenth of a second meanwhile."""
     while job.running:
         job.join(0.1)
+        if tick is not None:
+            tick()
         if interrupted.is_set() and not job.rendering:
             return
     job.wait()
+
+
+def _show_compile(bar, task) -> None:
+    """While the first run compiles the kernels, the bar says so and how far along it is."""
+    from ..render.warm_up import compile_progress
+
+    fraction = compile_progress()
+    if fraction is not None:
+        bar.update(task, description="compiling the kernels (first run only)",
+                   completed=fraction)
 
 
 def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
@@ -326,21 +346,21 @@ def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
     )
 
     columns = (
-        TextColumn("[bold]rendering"),
+        TextColumn("[bold]{task.description}"),
         BarColumn(),
         TaskProgressColumn(),
         TextColumn("{task.fields[rays]} rays"),
         TimeRemainingColumn(),
     )
-    with Progress(*columns, console=err, transient=True) as bar:
-        task = bar.add_task("render", total=1.0, rays="0")
+    with Progress(*columns, console=err.console, transient=True) as bar:
+        task = bar.add_task("rendering", total=1.0, rays="0")
 
         def update(p) -> None:
-            bar.update(task, completed=p.fraction, rays=f"{p.rays:,}")
+            bar.update(task, description="rendering", completed=p.fraction, rays=f"{p.rays:,}")
 
         job.progress = update
         job.start()
-        _wait(job, interrupted)
+        _wait(job, interrupted, lambda: _show_compile(bar, task))
 
 
 def _model_info(path: Path) -> None:
@@ -517,6 +537,8 @@ def export(
         raise fail(str(exc)) from None
     try:
         scene = scene.with_settings(width=width, height=height)
+        if scene.is_animated:  # POV-Ray gets the first frame, mesh sequences named
+            scene = scene.at_frame(0)
     except ValidationError as exc:
         raise fail(_override_error(exc)) from None
     if output is None:  # the whole stem: scene.v1.toml -> scene.v1.pov
@@ -630,4 +652,5 @@ def _exit_now(code: int) -> None:
 
 # Commands in their own modules register themselves on `app` when imported.
 from . import animate as _animate  # noqa: E402, F401
+from . import stefan as _stefan  # noqa: E402, F401
 from . import sweep as _sweep  # noqa: E402, F401

@@ -62,6 +62,7 @@ class FilmResult:
     chunk: int = 1
     asset_bytes: int = 0
     render_seconds: float = 0.0  # the workers' time per frame, summed
+    render_cpu_seconds: float = 0.0  # their task threads' CPU time, summed
     wall_seconds: float = 0.0
     film: Path | None = None
     warnings: list[str] = field(default_factory=list)
@@ -179,6 +180,7 @@ def _render_missing(client, scene, stills, chosen, digests, paths, todo, result,
                       lambda tmp, data=outcome.png: Path(tmp).write_bytes(data))
                 result.rendered.append(outcome.frame)
                 result.render_seconds += outcome.seconds
+                result.render_cpu_seconds += outcome.cpu_seconds
                 result.warnings.extend(w for w in outcome.warnings
                                        if w not in result.warnings)
                 done += 1

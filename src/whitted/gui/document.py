@@ -186,13 +186,15 @@ class SceneDocument(QObject):
         return True
 
     def edit_item(self, key: SelectionKey, data: dict[str, Any], text: str, *,
-                  merge_key: object = None) -> None:
-        """Replace the item at ``key`` by one built from ``data``; raises EditRefused."""
+                  merge_key: object = None, select: bool = True) -> None:
+        """Replace the item at ``key`` by one built from ``data`` (and select it, unless
+        ``select`` is False: moving the view keeps what is selected); raises EditRefused."""
         old = item_of(self.scene, key)
         if old is None:
             raise EditRefused("nothing selected")
         new_item = validate_like(old, data)
-        self.apply(with_item(self.scene, key, new_item), text, select=key, merge_key=merge_key)
+        self.apply(with_item(self.scene, key, new_item), text,
+                   select=key if select else None, merge_key=merge_key)
 
     def set_field(self, key: SelectionKey, path: tuple, value: Any, text: str, *,
                   merge_key: object = None) -> None:

@@ -584,7 +584,13 @@ def save_scene(scene: Scene, path: str | Path) -> Path:
     suffix = path.suffix.lower()
     data = scene_to_dict(scene)
     if suffix == ".toml":
-        payload = tomli_w.dumps(data).encode()
+        animation = data.pop("animation", None)
+        text = tomli_w.dumps(data)
+        if animation is not None:  # one key per line, not one number per line
+            from ..animation.model import animation_toml
+
+            text += "\n" + animation_toml(animation)
+        payload = text.encode()
     elif suffix == ".json":
         payload = (json.dumps(data, indent=2) + "\n").encode()
     else:
