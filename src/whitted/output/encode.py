@@ -20,6 +20,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..errors import ArgumentError
+
 __all__ = [
     "FORMATS",
     "HDR_FORMATS",
@@ -86,23 +88,23 @@ _HUGE = 1e30
 def check_transfer(name: str) -> str:
     """Return ``name`` if it is a known transfer function, else raise ValueError."""
     if name not in TRANSFERS:
-        raise ValueError(f"unknown transfer {name!r} (use 'srgb' or 'linear')")
+        raise ArgumentError(f"unknown transfer {name!r} (use 'srgb' or 'linear')")
     return name
 
 
 def check_tonemap(name: str) -> str:
     """Return ``name`` if it is a known tone-mapping mode, else raise ValueError."""
     if name not in TONEMAPS:
-        raise ValueError(f"unknown tonemap {name!r} (use 'clamp', 'reinhard' or 'aces')")
+        raise ArgumentError(f"unknown tonemap {name!r} (use 'clamp', 'reinhard' or 'aces')")
     return name
 
 
 def check_bit_depth(bit_depth: int, fmt: str | None = None) -> int:
     """Validate an output bit depth: 8, or 16 (PNG only). ``fmt`` is a format name."""
     if isinstance(bit_depth, bool) or bit_depth not in (8, 16):
-        raise ValueError(f"bit_depth must be 8 or 16, got {bit_depth!r}")
+        raise ArgumentError(f"bit_depth must be 8 or 16, got {bit_depth!r}")
     if bit_depth == 16 and fmt is not None and fmt != "png":
-        raise ValueError(
+        raise ArgumentError(
             f"bit_depth=16 is only supported for .png (got {fmt} output; "
             ".exr, .pfm and .npy always store float32)"
         )
@@ -116,7 +118,7 @@ def image_format(path: PathLike) -> str:
     try:
         return FORMATS[suffix.lower()]
     except KeyError:
-        raise ValueError(
+        raise ArgumentError(
             f"unsupported image format '{suffix}' (use .png, .jpg, .exr, .pfm or .npy)"
         ) from None
 
@@ -127,15 +129,15 @@ def check_pixels(pixels: object) -> np.ndarray:
     try:
         arr = np.asarray(pixels)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"pixels must be a numeric (H, W, 3) array: {exc}") from exc
+        raise ArgumentError(f"pixels must be a numeric (H, W, 3) array: {exc}") from exc
     if not (np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)):
-        raise ValueError(
+        raise ArgumentError(
             f"pixels must be a numeric (integer or float) array, got dtype {arr.dtype}"
         )
     if arr.ndim != 3 or arr.shape[2] != 3:
-        raise ValueError(f"pixels must have shape (H, W, 3), got {arr.shape}")
+        raise ArgumentError(f"pixels must have shape (H, W, 3), got {arr.shape}")
     if arr.shape[0] == 0 or arr.shape[1] == 0:
-        raise ValueError(f"pixels must not be empty, got shape {arr.shape}")
+        raise ArgumentError(f"pixels must not be empty, got shape {arr.shape}")
     return np.ascontiguousarray(arr, dtype=np.float32)
 
 
@@ -573,6 +575,11 @@ def read_image(path: PathLike, *, transfer: str = "srgb") -> np.ndarray:
     check_transfer(transfer)
     fmt = image_format(path)
     p = os.fspath(path)
+    from ..assets.files import path_problem
+
+    problem = path_problem(p)
+    if problem is not None:  # only regular files: a pipe or a device would hang or never end
+        raise ArgumentError(f"{p}: {problem}")
     if fmt == "exr":
         return _read_exr(p)
     if fmt == "pfm":

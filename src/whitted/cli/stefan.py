@@ -1,0 +1,275 @@
+"""``whitted stefan``: solve, validate and film the melting of a hollow piece of ice.
+
+A thin client: the physics is :mod:`whitted.stefan`, the rendering the render API.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ..errors import WhittedError
+from .console import LazyConsole
+from .main import EXIT_INTERRUPTED, err, fail
+from .main import app as main_app
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
+                  help="The Stefan problem: a hollow piece of ice with water inside, melting.")
+main_app.add_typer(app, name="stefan")
+# tables keep their columns when the output is a file or a pipe
+out = LazyConsole(highlight=False, soft_wrap=True, emoji=False,
+                  width=None if sys.stdout.isatty() else 120)
+
+
+def _fail(message: str) -> typer.Exit:
+    return fail(message)
+
+
+class _Interrupt:
+    """Ctrl-C sets a flag the solver checks between chunks of steps."""
+
+    def __init__(self) -> None:
+        self.flag = threading.Event()
+        self.previous = None
+
+    def __enter__(self) -> _Interrupt:
+        self.previous = signal.getsignal(signal.SIGINT)
+        signal.signal(signal.SIGINT, lambda *_: self.flag.set())
+        return self
+
+    def __exit__(self, *exc) -> None:
+        signal.signal(signal.SIGINT, self.previous)
+
+
+def _load(case_path: Path):
+    from ..stefan.case import load_case
+
+    try:
+        case = load_case(case_path)
+    except WhittedError as exc:
+        raise _fail(str(exc)) from None
+    return case, case_path.read_text(encoding="utf-8")
+
+
+def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, size=(480, 360)):
+    from ..stefan.case import CaseError
+    from ..stefan.run import run_case
+
+    case, text = _load(case_path)
+    if output.exists() and not output.is_dir():
+        raise _fail(f"{output}: exists and is not a folder")
+    if output.resolve() == case_path.resolve().parent and fresh:
+        raise _fail(f"{output}: --fresh would clear the case file's own folder")
+    if fresh and output.exists():
+        for sub in ("fields", "surfaces", "scenes"):
+            for f in (output / sub).glob("*"):
+                f.unlink()
+    from rich.progress import (
+        BarColumn,
+        Progress,
+        TaskProgressColumn,
+        TextColumn,
+        TimeRemainingColumn,
+    )
+
+    columns = (TextColumn("[bold]{task.description}"), BarColumn(), TaskProgressColumn(),
+               TextColumn("t = {task.fields[t]}"), TimeRemainingColumn())
+    with _Interrupt() as stop, Progress(*columns, console=err, transient=True,
+                                        disable=quiet or not err.is_terminal) as bar:
+        task = bar.add_task("melting", total=1.0, t="0 s")
+
+        def progress(fraction: float, t: float, what: str) -> None:
+            bar.update(task, completed=fraction, t=f"{t:.0f} s")
+
+        try:
+            result = run_case(case, text, output, resume=not fresh, progress=progress,
+                              should_stop=stop.flag.is_set, scene_size=size)
+        except CaseError as exc:
+            raise _fail(str(exc)) from None
+    return case, result
+
+
+@app.command()
+def run(
+    case_path: Annotated[Path, typer.Argument(metavar="CASE", help="Case file (TOML)")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Output folder")] = Path(
+        "stefan-out"),
+    fresh: Annotated[bool, typer.Option("--fresh", help="Start over, do not resume")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
+) -> None:
+    """Compute the melt of CASE: fields (.npz), surfaces (.ply) per saved time, a time series
+    (CSV and plots) and a scene per saved time. Ctrl-C keeps what was saved; run again to
+    resume from the last saved time."""
+    case, result = _solve(case_path, output, fresh, quiet)
+    _report(result)
+    if result.interrupted:
+        err.print(f"interrupted at t = {result.end_time:.1f} s: kept the saved times up to "
+                  f"t = {result.last_saved:.0f} s in {output}; run the same command again to "
+                  "resume from there")
+        raise typer.Exit(EXIT_INTERRUPTED)
+
+
+def _report(result) -> None:
+    cells = "x".join(str(n) for n in result.cells)
+    head = (f"resumed at t = {result.resumed_from:.0f} s, " if result.resumed_from is not None
+            else "")
+    out.print(f"{head}t = {result.end_time:.0f} s after {result.steps} steps on {cells} cells "
+              f"({result.solve_seconds:.1f} s solving); saved {len(result.saved)} time(s) -> "
+              f"{result.out_dir}")
+    if result.breach_time is not None:
+        out.print(f"breach: the shell opened at t = {result.breach_time:.0f} s "
+                  f"({result.breach_time / 60:.1f} min)")
+
+
+@app.command()
+def validate(
+    full: Annotated[bool, typer.Option("--full", help="The docs' table: 1 h, finer cells "
+                                       "(minutes)")] = False,
+    plot: Annotated[Path | None, typer.Option("--plot", help="Front against time (PNG)")] = None,
+) -> None:
+    """Check the solver against exact answers and print the tables: Neumann's lambda, front
+    error against cell size, the axes, the convective slab, the sphere, the energy balance."""
+    from rich.table import Table
+
+    from ..stefan import validate as v
+
+    t0 = time.perf_counter()
+    table = Table(title="Similarity constants (root-found) against the issue's numbers")
+    for col in ("case", "computed", "quoted", "difference"):
+        table.add_column(col)
+    for r in v.lambda_rows():
+        table.add_row(r["case"], f"{r['lambda']:.6f}", f"{r['quoted']:g}",
+                      f"{r['difference']:+.2e}")
+    out.print(table)
+
+    t_end = 3600.0 if full else 600.0
+    cells = (1.0, 0.5, 0.25, 0.125)
+    table = Table(title=f"Two-phase front (+10 °C wall, -10 °C ice) after {t_end:.0f} s, 1-D")
+    for col in ("dx (mm)", "cells", "steps", "front (mm)", "exact (mm)", "error", "order",
+                "far end moved (°C)", "energy (rel.)"):
+        table.add_column(col, justify="right")
+    for r in v.convergence_rows(t_end=t_end, cells_mm=cells):
+        table.add_row(f"{r['dx_mm']:g}", str(r["cells"]), str(r["steps"]),
+                      f"{r['front_mm']:.4f}", f"{r['exact_mm']:.4f}", f"{r['error_pct']:+.2f} %",
+                      "" if r["order"] is None else f"{r['order']:.2f}",
+                      f"{r['far_change']:.1e}", f"{r['energy_rel']:.1e}")
+    out.print(table)
+
+    table = Table(title="The 1-D case along each axis and in 3-D (0.5 mm, 600 s, same dt)")
+    for col in ("run", "front (mm)", "error", "vs first (m)"):
+        table.add_column(col, justify="right")
+    for r in v.axis_rows():
+        table.add_row(r["run"], f"{r['front_mm']:.6f}", f"{r['error_pct']:+.2f} %",
+                      f"{r['vs_first']:.1e}")
+    out.print(table)
+
+    slab = v.convective_slab()
+    out.print(f"convective slab (h = 20 W/m²K, air 20 °C, 3000 s): receded "
+              f"{slab['receded_mm']:.4f} mm, h dT t / (rho_i L) = {slab['expected_mm']:.4f} mm, "
+              f"error {slab['error_pct']:+.3f} %")
+    sphere = v.sphere_roundness()
+    out.print(f"sphere of ice (radius 9 cells, 2400 s): radius spread "
+              f"{sphere['spread_start_cells']:.2f} -> {sphere['spread_end_cells']:.2f} cells; "
+              f"receded {sphere['receded_mm']:.3f} mm by volume, exact "
+              f"{sphere['receded_exact_mm']:.3f} mm")
+    energy = v.energy_balance()
+    out.print(f"energy (default case, 16 cells, 600 s): enthalpy change "
+              f"{energy['enthalpy_change_J']:.6f} J = heat in {energy['heat_in_J']:.6f} J - "
+              f"drained {energy['drained_J']:.6f} J; imbalance {energy['imbalance_J']:.1e} J "
+              f"({energy['relative']:.1e} relative)")
+    if plot is not None:
+        v.plot_front(plot)
+        out.print(f"plot -> {plot}")
+    out.print(f"({time.perf_counter() - t0:.1f} s)")
+
+
+def _stamp(path: Path, text: str):
+    """The frame as an array with the simulated time written in its corner."""
+    import numpy as np
+    from PIL import Image, ImageDraw
+
+    image = Image.open(path).convert("RGB")
+    draw = ImageDraw.Draw(image)
+    size = max(12, image.height // 18)
+    try:
+        from PIL import ImageFont
+
+        font = ImageFont.load_default(size=size)
+    except (TypeError, OSError):  # an old Pillow: its bitmap font
+        font = None
+    x, y = size // 2, size // 2
+    draw.text((x + 1, y + 1), text, fill=(0, 0, 0), font=font)
+    draw.text((x, y), text, fill=(255, 255, 255), font=font)
+    return np.asarray(image)
+
+
+@app.command()
+def film(
+    case_path: Annotated[Path, typer.Argument(metavar="CASE", help="Case file (TOML)")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Film: .mp4 or .gif")] = Path(
+        "melt.mp4"),
+    width: Annotated[int, typer.Option("--width", "-W", help="Frame width")] = 480,
+    height: Annotated[int, typer.Option("--height", "-H", help="Frame height")] = 360,
+    fps: Annotated[float, typer.Option("--fps", help="Frames per second")] = 8.0,
+    gif: Annotated[Path | None, typer.Option("--gif", help="Also write a GIF")] = None,
+    fresh: Annotated[bool, typer.Option("--fresh", help="Solve again from t = 0")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
+) -> None:
+    """Solve CASE (or resume it) into OUTPUT's folder NAME_stefan/, render one frame per saved
+    time with 'whitted animate' (the piece on a table, backlit; ice 1.31, water 1.333,
+    absorption exaggerated and said so) and encode the film with the simulated time in each
+    frame. Ctrl-C keeps the solved times and the finished frames; run again to continue."""
+    import csv
+
+    from ..output.video import encode_film, video_format
+    from ..stefan.scene import ABSORPTION_BOOST, still_life_scene, write_scene
+    from .animate import animate as animate_command
+
+    started = time.perf_counter()
+    try:
+        video_format(output)
+        if gif is not None:
+            video_format(gif)
+    except ValueError as exc:
+        raise _fail(f"{output}: {exc}") from None
+    if not output.parent.exists():
+        raise _fail(f"{output}: the folder {output.parent} does not exist")
+    work = output.with_name(output.stem + "_stefan")
+    case, result = _solve(case_path, work, fresh, quiet, size=(width, height))
+    _report(result)
+    if result.interrupted:
+        err.print(f"interrupted while solving: kept every saved time in {work}; run the same "
+                  "command again to continue")
+        raise typer.Exit(EXIT_INTERRUPTED)
+    with (work / "series.csv").open(newline="") as fh:
+        times = [float(row["time_s"]) for row in csv.DictReader(fh)]
+    count = 0  # frames: saved times from 0 on where both surfaces exist
+    while (count < len(times) and (work / "surfaces" / f"outer_{count:04d}.ply").exists()
+           and (work / "surfaces" / f"inner_{count:04d}.ply").exists()):
+        count += 1
+    if count == 0:
+        raise _fail(f"{work}: no saved time has both surfaces to film")
+    scene_path = work / "film.toml"
+    write_scene(scene_path, still_life_scene(
+        "surfaces/outer_{frame:04d}.ply", "surfaces/inner_{frame:04d}.ply", None,
+        width=width, height=height, size_cm=100 * max(case.block.size), frames=count, fps=fps))
+    frames = work / "frames"
+    render_start = time.perf_counter()
+    animate_command(scene_path=scene_path, output=frames, frames=None, fps=None, width=None,
+                    height=None, samples=None, max_depth=None, threads=None, seed=None,
+                    set_values=None, crf=18, force=False, quiet=quiet)
+    render_seconds = time.perf_counter() - render_start
+    stamped = [_stamp(frames / f"{k:04d}.png",
+                      f"t = {times[k] / 60:5.1f} min   (absorption x{ABSORPTION_BOOST:g})")
+               for k in range(count)]
+    for path in [output, *([gif] if gif is not None else [])]:
+        encode_film(stamped, path, fps)
+    out.print(f"{count} frames ({render_seconds / count:.2f} s a frame, wall) -> {output}"
+              + (f", {gif}" if gif is not None else "")
+              + f"; total {time.perf_counter() - started:.1f} s")

@@ -1,0 +1,248 @@
+"""The case file: a hollow piece of ice in warm air, every parameter, validated (pydantic).
+
+A mistake is one line naming the file, the line and the key (``CaseError``, a SceneError:
+exit status 2 in the CLI). Lengths are metres, temperatures °C, times seconds.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from ..errors import SceneError
+from .properties import ICE, LATENT_HEAT, WATER, Phase, Properties
+
+Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Vec3 = tuple[Finite, Finite, Finite]
+Size3 = tuple[Positive, Positive, Positive]
+
+
+class CaseError(SceneError):
+    """A case file that cannot be used (one line: file, line, key, problem)."""
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class PhaseProperties(_Strict):
+    """Density (kg/m³), specific heat capacity (J/kgK), thermal conductivity (W/mK)."""
+
+    rho: Positive
+    c: Positive
+    k: Positive
+
+    def phase(self) -> Phase:
+        return Phase(self.rho, self.c, self.k)
+
+
+class Block(_Strict):
+    """The piece of ice: a box of ``size`` (x, y, z; y is up) with edges rounded by
+    ``edge_radius``, standing on the table, at ``temperature`` (<= 0 °C)."""
+
+    size: Size3 = (0.04, 0.04, 0.04)
+    edge_radius: Annotated[float, Field(ge=0.0)] = 0.004
+    temperature: Annotated[float, Field(ge=-80.0, le=0.0)] = -5.0
+
+    @model_validator(mode="after")
+    def _radius_fits(self) -> Block:
+        if self.edge_radius > 0.5 * min(self.size):
+            raise ValueError(f"edge_radius {self.edge_radius:g} m is over half the block's "
+                             f"smallest side ({0.5 * min(self.size):g} m)")
+        return self
+
+
+class Cavity(_Strict):
+    """The closed cavity full of water: a sphere of ``radius`` or a box of ``size``, its
+    centre ``center`` relative to the block's centre (off centre allowed)."""
+
+    shape: Literal["sphere", "box"] = "sphere"
+    radius: Positive = 0.012
+    size: Size3 = (0.02, 0.02, 0.02)
+    center: Vec3 = (0.0, 0.0, 0.0)
+    temperature: Annotated[float, Field(ge=0.0, le=100.0)] = 20.0
+
+    def half_extent(self) -> tuple[float, float, float]:
+        if self.shape == "sphere":
+            return (self.radius,) * 3
+        return tuple(0.5 * s for s in self.size)  # type: ignore[return-value]
+
+
+class Air(_Strict):
+    """The room: air temperature (°C) and the heat transfer coefficient h (W/m²K: about
+    5-10 still air, 10-25 a gentle draught)."""
+
+    temperature: Annotated[float, Field(ge=-80.0, le=200.0)] = 25.0
+    h: Annotated[float, Field(gt=0.0, le=1.0e4)] = 20.0
+
+
+class Table(_Strict):
+    """The bottom face: ``adiabatic`` (an insulating table) or ``conducting`` (a contact
+    conductance ``h`` to a table at ``temperature``; meltwater there drains)."""
+
+    contact: Literal["adiabatic", "conducting"] = "adiabatic"
+    temperature: Annotated[float, Field(ge=-80.0, le=200.0)] = 20.0
+    h: Annotated[float, Field(gt=0.0, le=1.0e5)] = 100.0
+
+
+class Grid(_Strict):
+    """``cells`` along the block's longest side (cubic cells)."""
+
+    cells: Annotated[int, Field(ge=8, le=512)] = 64
+
+
+class Time(_Strict):
+    """Simulated time to ``end`` (s), a saved state every ``save_every`` s; the time step is
+    ``cfl`` times the stability limit unless ``dt`` is given (it must be under the limit)."""
+
+    end: Annotated[float, Field(gt=0.0, le=1.0e7)] = 3600.0
+    save_every: Annotated[float, Field(gt=0.0)] = 120.0
+    dt: Annotated[float, Field(gt=0.0)] | None = None
+    cfl: Annotated[float, Field(gt=0.0, le=1.0)] = 0.9
+
+
+class Breach(_Strict):
+    """What happens when the shell opens: ``stop`` (report the time) or ``drain`` (the cavity
+    water runs out through the hole and the melt goes on)."""
+
+    action: Literal["stop", "drain"] = "stop"
+
+
+class Surfaces(_Strict):
+    """Surface extraction: Taubin smoothing passes, and the fraction of faces to keep (1: no
+    decimation)."""
+
+    smoothing: Annotated[int, Field(ge=0, le=200)] = 10
+    keep: Annotated[float, Field(gt=0.0, le=1.0)] = 1.0
+
+
+class Case(_Strict):
+    """A Stefan case: everything the solver and the surfaces need."""
+
+    ice: PhaseProperties = PhaseProperties(rho=ICE.rho, c=ICE.c, k=ICE.k)
+    water: PhaseProperties = PhaseProperties(rho=WATER.rho, c=WATER.c, k=WATER.k)
+    latent_heat: Annotated[float, Field(gt=0.0, le=1.0e7)] = LATENT_HEAT
+    block: Block = Block()
+    cavity: Cavity = Cavity()
+    air: Air = Air()
+    table: Table = Table()
+    grid: Grid = Grid()
+    time: Time = Time()
+    breach: Breach = Breach()
+    surfaces: Surfaces = Surfaces()
+
+    @property
+    def properties(self) -> Properties:
+        return Properties(self.ice.phase(), self.water.phase(), self.latent_heat)
+
+    @property
+    def dx(self) -> float:
+        return max(self.block.size) / self.grid.cells
+
+    def check(self) -> list[tuple[str, str]]:
+        """Physical checks beyond single values: (key, problem) pairs, empty when fine."""
+        problems: list[tuple[str, str]] = []
+        b, cav = self.block, self.cavity
+        dx = self.dx
+        half = [0.5 * s for s in b.size]
+        ext = cav.half_extent()
+        # the block's centre is at half its height; the cavity must sit inside with a shell
+        shell = min(half[a] - (abs(cav.center[a]) + ext[a]) for a in range(3))
+        if shell <= 0.0:
+            where = "cavity.center" if any(cav.center) else (
+                "cavity.radius" if cav.shape == "sphere" else "cavity.size")
+            problems.append((where, f"the cavity reaches outside the block (shell "
+                             f"{shell * 1e3:.3g} mm)"))
+        elif shell < 2.0 * dx:
+            problems.append(("grid.cells", f"{self.grid.cells} cells make {dx * 1e3:.3g} mm "
+                             f"cells: too coarse for the {shell * 1e3:.3g} mm shell (needs 2 "
+                             "cells across it)"))
+        if (self.air.temperature <= 0.0 and cav.temperature <= 0.0
+                and (self.table.contact == "adiabatic" or self.table.temperature <= 0.0)):
+            problems.append(("air.temperature", "nothing melts: the air, the cavity water and "
+                             "the table are all at or below 0 °C"))
+        if self.time.dt is not None:
+            from .solver import Air as SolverAir
+            from .solver import stability_limit
+
+            limit = stability_limit(self.properties, dx, 3, self.solver_faces(),
+                                    SolverAir(self.air.temperature, self.air.h))
+            if self.time.dt > limit:
+                problems.append(("time.dt", f"{self.time.dt:g} s is over the stability limit "
+                                 f"{limit:.4g} s of {dx * 1e3:.3g} mm cells"))
+        if self.time.save_every > self.time.end:
+            problems.append(("time.save_every", f"{self.time.save_every:g} s is longer than "
+                             f"time.end ({self.time.end:g} s)"))
+        return problems
+
+    def solver_faces(self):
+        from .solver import Faces
+
+        faces = Faces.adiabatic()
+        if self.table.contact == "conducting":
+            faces.set("y-", self.table.h, self.table.temperature, drain=True)
+        return faces
+
+
+def _error_from_validation(exc: ValidationError, file: str | None, text: str | None) -> CaseError:
+    from ..scene.io import _clean_loc, _clean_message, _format_path, _toml_line
+
+    best = max(exc.errors(), key=lambda e: len(e["loc"]))
+    keys = _clean_loc(best["loc"])
+    message = "unknown key" if best["type"] == "extra_forbidden" else _clean_message(best)
+    line = _toml_line(text, keys) if text and keys else None
+    return CaseError(message, file=file, where=_format_path(keys) or None, line=line)
+
+
+def case_from_dict(data: dict, *, file: str | None = None, text: str | None = None) -> Case:
+    """Validate a case; raises :class:`CaseError` on the first problem."""
+    from ..scene.io import _parse_path, _toml_line
+
+    try:
+        case = Case.model_validate(data)
+    except ValidationError as exc:
+        raise _error_from_validation(exc, file, text) from None
+    problems = case.check()
+    if problems:
+        where, message = problems[0]
+        line = _toml_line(text, _parse_path(where)) if text else None
+        raise CaseError(message, file=file, where=where, line=line)
+    return case
+
+
+def load_case(path: str | Path) -> Case:
+    """Read and validate a case file (TOML)."""
+    path = Path(path)
+    name = str(path)
+    if not path.exists():
+        raise CaseError("no such file", file=name)
+    if path.suffix.lower() != ".toml":
+        raise CaseError(f"unknown case format {path.suffix!r} (use .toml)", file=name)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise CaseError("not UTF-8 text", file=name) from None
+    except OSError as exc:
+        raise CaseError(f"cannot read: {exc.strerror}", file=name) from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        line = getattr(exc, "lineno", None)
+        msg = str(exc).split(" (at line")[0]
+        raise CaseError(f"not valid TOML: {msg}", file=name, line=line) from None
+    return case_from_dict(data, file=name, text=text)
+
+
+def case_digest(case: Case) -> str:
+    """A short hash of everything that changes the solution (to refuse a resume that would
+    mix two cases)."""
+    import hashlib
+
+    return hashlib.sha256(case.model_dump_json().encode()).hexdigest()[:16]
+
+
+__all__ = ["Case", "CaseError", "case_digest", "case_from_dict", "load_case"]

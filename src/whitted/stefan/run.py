@@ -1,0 +1,272 @@
+"""``whitted stefan run``: compute the melt of a case and write what it produced.
+
+Output folder::
+
+    case.toml              the case, as given (a resume refuses a different one)
+    fields/state_0003.npz  the state at each saved time (compressed NumPy): enthalpy H
+                           (float64, exact, for resuming), cell kind, liquid fraction
+                           (float32), temperature (float32, NaN in air), time and totals
+    surfaces/outer_0003.ply, inner_0003.ply   ice/air and ice/water surfaces
+    scenes/frame_0003.toml a whitted scene rendering that saved time
+    series.csv             time series: ice, cavity and water volume, minimum shell
+    series.png             the same as plots
+    summary.json           breach time, end time, energy balance
+
+Every file is written atomically; an interrupted run keeps every saved time and ``run``
+again continues from the last one.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import time as wallclock
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .case import Case, CaseError, case_digest
+from .geometry import GridFrame, grid_frame, initial_state
+from .measures import measure
+from .scene import still_life_scene, write_scene
+from .solver import Air, EnthalpySolver
+from .surfaces import extract_surfaces, write_ply
+
+SERIES_COLUMNS = ("time_s", "ice_volume_cm3", "cavity_volume_cm3", "water_volume_cm3",
+                  "min_shell_mm", "breached", "energy_imbalance_J")
+
+
+@dataclass
+class RunResult:
+    out_dir: Path
+    saved: list[float] = field(default_factory=list)  # times saved in this call
+    last_saved: float | None = None  # the latest saved time (a resume starts there)
+    resumed_from: float | None = None
+    end_time: float = 0.0
+    breach_time: float | None = None
+    finished: bool = False
+    interrupted: bool = False
+    solve_seconds: float = 0.0
+    surface_seconds: list[float] = field(default_factory=list)
+    cells: tuple[int, int, int] = (0, 0, 0)
+    steps: int = 0
+
+
+def _atomic_bytes(path: Path, data: bytes) -> None:
+    tmp = path.with_name(path.name + ".part")
+    tmp.write_bytes(data)
+    tmp.replace(path)
+
+
+def _save_state(path: Path, solver: EnthalpySolver, digest: str, index: int,
+                initial_cavity: float) -> None:
+    buf = io.BytesIO()
+    f = solver.liquid_fraction().astype(np.float32)
+    np.savez_compressed(
+        buf, H=solver.H, kind=solver.kind, liquid_fraction=f,
+        temperature=solver.temperature().astype(np.float32), time=solver.time,
+        steps=solver.steps, totals=solver.totals, dx=solver.dx, digest=digest, index=index,
+        breached=solver.breached,
+        breach_time=np.nan if solver.breach_time is None else solver.breach_time,
+        initial_enthalpy=solver.initial_enthalpy, initial_cavity=initial_cavity)
+    _atomic_bytes(path, buf.getvalue())
+
+
+def _latest_state(fields: Path, digest: str) -> Path | None:
+    for path in sorted(fields.glob("state_*.npz"), reverse=True):
+        try:
+            with np.load(path) as z:
+                if str(z["digest"]) == digest:
+                    return path
+        except (OSError, ValueError, KeyError):
+            continue  # a damaged file: try the one before
+    return None
+
+
+def _write_series(path: Path, rows: list[dict]) -> None:
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=SERIES_COLUMNS, lineterminator="\n")
+    w.writeheader()
+    for row in rows:
+        w.writerow({k: row[k] for k in SERIES_COLUMNS})
+    _atomic_bytes(path, buf.getvalue().encode())
+
+
+def _read_series(path: Path) -> list[dict]:
+    if not path.exists():
+        return []
+    with path.open(newline="") as fh:
+        return [{k: (v if k == "breached" else float(v)) for k, v in row.items()}
+                for row in csv.DictReader(fh)]
+
+
+def plot_series(rows: list[dict], path: Path, breach_time: float | None) -> None:
+    """Ice, cavity and water volumes and the minimum shell thickness against time (PNG)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t = np.array([r["time_s"] for r in rows]) / 60.0
+    fig, (a, b) = plt.subplots(1, 2, figsize=(9, 3.4), dpi=110)
+    a.plot(t, [r["ice_volume_cm3"] for r in rows], label="ice")
+    a.plot(t, [r["cavity_volume_cm3"] for r in rows], label="cavity")
+    a.plot(t, [r["water_volume_cm3"] for r in rows], "--", label="cavity water")
+    a.set_xlabel("time (min)")
+    a.set_ylabel("volume (cm³)")
+    a.legend()
+    b.plot(t, [r["min_shell_mm"] for r in rows], color="C3")
+    b.set_xlabel("time (min)")
+    b.set_ylabel("thinnest shell (mm)")
+    for ax in (a, b):
+        ax.grid(alpha=0.3)
+        if breach_time is not None:
+            ax.axvline(breach_time / 60.0, color="k", lw=0.8, ls=":")
+    fig.suptitle("hollow ice piece" + (f": breach at {breach_time / 60:.1f} min"
+                                       if breach_time is not None else ""))
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png")
+    plt.close(fig)
+    _atomic_bytes(path, buf.getvalue())
+
+
+def _save_surfaces(out: Path, index: int, solver: EnthalpySolver, case: Case,
+                   frame: GridFrame) -> tuple[str | None, str | None, float]:
+    t0 = wallclock.perf_counter()
+    outer, inner = extract_surfaces(solver.H, solver.kind, case.properties, frame,
+                                    smoothing=case.surfaces.smoothing, keep=case.surfaces.keep)
+    names: list[str | None] = []
+    for label, mesh in (("outer", outer), ("inner", inner)):
+        if mesh is None or len(mesh.faces) == 0:
+            names.append(None)
+            continue
+        name = f"surfaces/{label}_{index:04d}.ply"
+        write_ply(mesh, out / name)
+        names.append(name)
+    return names[0], names[1], wallclock.perf_counter() - t0
+
+
+def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
+             progress: Callable[[float, float, str], None] | None = None,
+             should_stop: Callable[[], bool] | None = None, scene_size: tuple[int, int] =
+             (480, 360)) -> RunResult:
+    """Solve ``case`` into the folder ``out`` (see the module docstring)."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    for sub in ("fields", "surfaces", "scenes"):
+        (out / sub).mkdir(exist_ok=True)
+    digest = case_digest(case)
+    case_file = out / "case.toml"
+    if case_file.exists() and resume and _latest_state(out / "fields", digest) is None \
+            and any((out / "fields").glob("state_*.npz")):
+        raise CaseError(f"{out} holds a run of a different case (use a new folder or "
+                        "--fresh)", file=str(out))
+    _atomic_bytes(case_file, case_text.encode())
+    props = case.properties
+    frame = grid_frame(case)
+    result = RunResult(out, cells=frame.shape)
+    air = Air(case.air.temperature, case.air.h)
+    latest = _latest_state(out / "fields", digest) if resume else None
+    rows: list[dict]
+    if latest is not None:
+        with np.load(latest) as z:
+            solver = EnthalpySolver(z["H"], z["kind"], float(z["dx"]), props,
+                                    faces=case.solver_faces(), air=air, dt=case.time.dt,
+                                    cfl=case.time.cfl,
+                                    stop_on_breach=case.breach.action == "stop",
+                                    time=float(z["time"]))
+            solver.steps = int(z["steps"])
+            solver.totals[:] = z["totals"]
+            solver.initial_enthalpy = float(z["initial_enthalpy"])
+            solver.breached = bool(z["breached"])
+            bt = float(z["breach_time"])
+            solver.breach_time = None if math.isnan(bt) else bt
+            index = int(z["index"])
+            initial_cavity = float(z["initial_cavity"])
+        rows = [r for r in _read_series(out / "series.csv") if r["time_s"] <= solver.time + 1e-9]
+        result.resumed_from = solver.time
+    else:
+        H, kind, cavity, _ = initial_state(case)
+        solver = EnthalpySolver(H, kind, case.dx, props, faces=case.solver_faces(), air=air,
+                                dt=case.time.dt, cfl=case.time.cfl,
+                                stop_on_breach=case.breach.action == "stop")
+        initial_cavity = float(cavity.sum()) * case.dx ** 3
+        index = 0
+        rows = []
+        _record(out, solver, case, frame, digest, index, initial_cavity, rows, result,
+                scene_size)
+    end = case.time.end
+    every = case.time.save_every
+    t_solve = wallclock.perf_counter()
+    while solver.time < end - 1e-9 and not result.finished:
+        if solver.breached and case.breach.action == "stop":
+            result.finished = True
+            break
+        target = min(end, (index + 1) * every)
+        stopped = not solver.advance(target, should_stop=should_stop,
+                                     on_chunk=None if progress is None else
+                                     lambda: progress(solver.time / end, solver.time, "solve"))
+        if stopped:
+            result.interrupted = True
+            break
+        index += 1
+        _record(out, solver, case, frame, digest, index, initial_cavity, rows, result,
+                scene_size)
+        if progress is not None:
+            progress(solver.time / end, solver.time, "saved")
+        if not (solver.kind == 1).any() or rows[-1]["ice_volume_cm3"] <= 0.0:
+            result.finished = True  # all melted
+    result.solve_seconds = wallclock.perf_counter() - t_solve
+    if not result.interrupted and solver.time >= end - 1e-9:
+        result.finished = True
+    if solver.breached and case.breach.action == "stop":
+        result.finished = True
+    result.end_time = solver.time
+    result.last_saved = rows[-1]["time_s"] if rows else None
+    result.breach_time = solver.breach_time
+    result.steps = solver.steps
+    plot_series(rows, out / "series.png", solver.breach_time)
+    summary = {"case_digest": digest, "end_time_s": solver.time, "steps": solver.steps,
+               "dt_s": solver.dt, "dt_limit_s": solver.dt_limit, "cells": list(frame.shape),
+               "dx_m": solver.dx, "breach_time_s": solver.breach_time,
+               "breach_action": case.breach.action, "finished": result.finished,
+               "heat_in_J": solver.heat_in, "drained_J": solver.drained,
+               "energy_imbalance_J": solver.energy_error(), "saved_times": len(rows),
+               "solve_seconds": result.solve_seconds,
+               "surface_seconds_per_save": (float(np.mean(result.surface_seconds))
+                                            if result.surface_seconds else None)}
+    _atomic_bytes(out / "summary.json", json.dumps(summary, indent=2).encode())
+    return result
+
+
+def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, digest: str,
+            index: int, initial_cavity: float, rows: list[dict], result: RunResult,
+            scene_size: tuple[int, int]) -> None:
+    """Surfaces, scene, series row and (last, so a resume never skips the others) the state
+    of one saved time."""
+    outer, inner, seconds = _save_surfaces(out, index, solver, case, frame)
+    result.surface_seconds.append(seconds)
+    text = still_life_scene(None if outer is None else "../" + outer,
+                            None if inner is None else "../" + inner, solver.time,
+                            width=scene_size[0], height=scene_size[1],
+                            size_cm=100 * max(case.block.size))
+    write_scene(out / "scenes" / f"frame_{index:04d}.toml", text)
+    m = measure(solver.H, solver.kind, solver.dx, case.properties, solver.time, initial_cavity,
+                solver.breached)
+    rows[:] = [r for r in rows if r["time_s"] < solver.time - 1e-9]
+    rows.append({"time_s": solver.time, "ice_volume_cm3": m.ice_volume * 1e6,
+                 "cavity_volume_cm3": m.cavity_volume * 1e6,
+                 "water_volume_cm3": m.water_volume * 1e6, "min_shell_mm": m.min_shell * 1e3,
+                 "breached": int(m.breached), "energy_imbalance_J": solver.energy_error()})
+    _write_series(out / "series.csv", rows)
+    _save_state(out / "fields" / f"state_{index:04d}.npz", solver, digest, index,
+                initial_cavity)
+    result.saved.append(solver.time)
+
+
+__all__ = ["RunResult", "asdict", "run_case"]

@@ -1,0 +1,237 @@
+"""Validation against exact answers: the studies behind ``whitted stefan validate``, the tests
+and the table in ``docs/stefan.md``.
+
+Every study returns plain rows (dicts) so the CLI prints them, the tests assert on them and the
+docs quote them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import exact
+from .properties import Properties
+from .solver import Air, EnthalpySolver, Faces
+
+AXES = ("x", "y", "z")
+ISSUE_ONE_PHASE = {0.1: 0.220016, 1.0: 0.620063}
+ISSUE_TWO_PHASE = {"lambda": 0.2089, "front_mm": 9.14}  # +10 °C wall, -10 °C ice, 1 h
+
+
+def line_shape(n: int, axis: int, width: int = 1) -> tuple[int, int, int]:
+    """A grid of n cells along ``axis`` and ``width`` across (1: a 1-D run)."""
+    shape = [width, width, width]
+    shape[axis] = n
+    return tuple(shape)  # type: ignore[return-value]
+
+
+@dataclass
+class NeumannRun:
+    dx: float
+    cells: int
+    steps: int
+    front: float  # m, computed (melted length)
+    exact: float  # m
+    far_change: float  # °C: how much the far end's temperature moved
+    energy_error: float  # J/m² relative to the heat in
+    solver: EnthalpySolver
+
+    @property
+    def error(self) -> float:
+        return (self.front - self.exact) / self.exact
+
+
+def neumann_run(props: Properties, wall: float, initial: float, t_end: float, dx: float,
+                axis: int = 2, width: int = 1, reach_tolerance: float = 1e-6,
+                dt: float | None = None) -> NeumannRun:
+    """Melt a half space from a wall at ``wall`` °C into ice at ``initial`` °C (0: one phase)
+    on a line of cells along ``axis``; the far end sits beyond the thermal wave."""
+    if initial < 0.0:
+        length = 1.05 * exact.wave_reach(props, t_end, reach_tolerance)
+        lam = exact.two_phase_lambda(props, wall, initial)
+    else:
+        stefan = props.water.capacity * wall / props.latent_per_volume
+        lam = exact.one_phase_lambda(stefan)
+        length = 1.5 * float(exact.front(lam, props, t_end)) + 4 * dx
+    n = int(math.ceil(length / dx))
+    shape = line_shape(n, axis, width)
+    H = np.full(shape, props.enthalpy(initial, liquid=False))
+    kind = np.ones(shape, dtype=np.uint8)
+    faces = Faces.adiabatic().set(("x-", "y-", "z-")[axis], math.inf, wall)
+    solver = EnthalpySolver(H, kind, dx, props, faces=faces, dt=dt)
+    solver.advance(t_end)
+    front = solver.melted_length(axis)
+    far = [slice(None)] * 3
+    far[axis] = -1
+    t_far = float(np.max(np.abs(solver.temperature()[tuple(far)] - initial)))
+    return NeumannRun(dx, n, solver.steps, front, float(exact.front(lam, props, t_end)), t_far,
+                      solver.energy_error() / solver.heat_in, solver)
+
+
+def lambda_rows(props: Properties | None = None) -> list[dict]:
+    """The similarity constants, root-found, beside the issue's numbers."""
+    props = props or Properties()
+    rows = []
+    for st, quoted in ISSUE_ONE_PHASE.items():
+        lam = exact.one_phase_lambda(st)
+        rows.append({"case": f"one phase, St = {st:g}", "lambda": lam, "quoted": quoted,
+                     "difference": lam - quoted})
+    lam = exact.two_phase_lambda(props, 10.0, -10.0)
+    front = float(exact.front(lam, props, 3600.0)) * 1e3
+    quoted = ISSUE_TWO_PHASE["lambda"]
+    rows.append({"case": "two phase, +10 / -10 °C", "lambda": lam, "quoted": quoted,
+                 "difference": lam - quoted})
+    rows.append({"case": "two phase front after 1 h (mm)", "lambda": front,
+                 "quoted": ISSUE_TWO_PHASE["front_mm"],
+                 "difference": front - ISSUE_TWO_PHASE["front_mm"]})
+    return rows
+
+
+def convergence_rows(props: Properties | None = None, t_end: float = 3600.0,
+                     cells_mm: tuple[float, ...] = (1.0, 0.5, 0.25), wall: float = 10.0,
+                     initial: float = -10.0, axis: int = 2) -> list[dict]:
+    """Front error against cell size (1-D runs), with the observed order between rows."""
+    props = props or Properties()
+    rows: list[dict] = []
+    for mm in cells_mm:
+        run = neumann_run(props, wall, initial, t_end, mm * 1e-3, axis=axis)
+        row = {"dx_mm": mm, "cells": run.cells, "steps": run.steps, "front_mm": run.front * 1e3,
+               "exact_mm": run.exact * 1e3, "error_pct": 100 * run.error,
+               "far_change": run.far_change, "energy_rel": run.energy_error, "order": None}
+        if rows:
+            prev = rows[-1]
+            row["order"] = math.log(abs(prev["error_pct"]) / abs(row["error_pct"])) / math.log(
+                prev["dx_mm"] / mm)
+        rows.append(row)
+    return rows
+
+
+def axis_rows(props: Properties | None = None, t_end: float = 600.0, dx: float = 0.5e-3,
+              wall: float = 10.0, initial: float = -10.0) -> list[dict]:
+    """The same 1-D case along x, y and z, and as a 3-D block (4 x 4 across, adiabatic
+    sides) along z, all with the 3-D grid's time step: every front equal to the first
+    (``vs_first``, m; zero when bit-identical)."""
+    props = props or Properties()
+    block = neumann_run(props, wall, initial, t_end, dx, axis=2, width=4)
+    rows = []
+    base = None
+    for axis in range(3):
+        run = neumann_run(props, wall, initial, t_end, dx, axis=axis, dt=block.solver.dt)
+        base = run.front if base is None else base
+        rows.append({"run": f"1-D along {AXES[axis]}", "front_mm": run.front * 1e3,
+                     "error_pct": 100 * run.error, "vs_first": run.front - base})
+    front = block.solver.liquid_fraction().sum(axis=2) * dx
+    rows.append({"run": "3-D (4 x 4 x n) along z", "front_mm": float(front.mean()) * 1e3,
+                 "error_pct": 100 * block.error, "vs_first": float(np.abs(front - base).max())})
+    return rows
+
+
+def convective_slab(props: Properties | None = None, h: float = 20.0, air: float = 20.0,
+                    t_end: float = 3000.0, dx: float = 1e-3, cells: int = 40) -> dict:
+    """A slab of ice at 0 °C with air on one face: it recedes at h dT / (rho_i L)."""
+    props = props or Properties()
+    shape = (1, 1, cells)
+    H = np.zeros(shape)
+    kind = np.ones(shape, dtype=np.uint8)
+    faces = Faces.adiabatic().set("z+", h, air, drain=True)
+    solver = EnthalpySolver(H, kind, dx, props, faces=faces, air=Air(air, h))
+    solver.advance(t_end)
+    ice = float(((1.0 - solver.liquid_fraction()) * (solver.kind == 1)).sum()) * dx
+    receded = cells * dx - ice
+    expected = h * (air - 0.0) * t_end / props.latent_per_volume
+    return {"receded_mm": receded * 1e3, "expected_mm": expected * 1e3,
+            "error_pct": 100 * (receded / expected - 1.0),
+            "energy_rel": solver.energy_error() / solver.heat_in}
+
+
+def sphere_roundness(props: Properties | None = None, radius_cells: float = 9.0,
+                     h: float = 20.0, air: float = 20.0, t_end: float = 2400.0,
+                     dx: float = 1e-3) -> dict:
+    """A sphere of ice at 0 °C in uniform air: the spread of its surface radius (marching
+    cubes on the ice fraction) stays within one cell, its mean radius recedes at
+    h dT / (rho_i L)."""
+    from skimage.measure import marching_cubes
+
+    props = props or Properties()
+    n = int(2 * radius_cells + 4)
+    c = (n - 1) / 2
+    x = np.arange(n) - c
+    X, Y, Z = np.meshgrid(x, x, x, indexing="ij")
+    kind = (np.sqrt(X * X + Y * Y + Z * Z) <= radius_cells).astype(np.uint8)
+    solver = EnthalpySolver(np.zeros(kind.shape), kind, dx, props, air=Air(air, h))
+
+    def radii() -> np.ndarray:
+        occ = np.pad(np.where(solver.kind == 1, 1.0 - solver.liquid_fraction(), 0.0), 1)
+        verts = marching_cubes(occ, 0.5)[0] - 1 - c
+        return np.linalg.norm(verts, axis=1)
+
+    r0 = radii()
+    solver.advance(t_end)
+    r1 = radii()
+    rate = h * air / props.latent_per_volume
+    ice = float(((1.0 - solver.liquid_fraction()) * (solver.kind == 1)).sum())
+    r_volume = (3.0 * ice / (4.0 * math.pi)) ** (1.0 / 3.0) * dx
+    r_volume0 = (3.0 * float(kind.sum()) / (4.0 * math.pi)) ** (1.0 / 3.0) * dx
+    return {"spread_start_cells": float(r0.max() - r0.min()),
+            "receded_mm": (r_volume0 - r_volume) * 1e3, "receded_exact_mm": rate * t_end * 1e3,
+            "spread_end_cells": float(r1.max() - r1.min()),
+            "mean_radius_start_mm": float(r0.mean()) * dx * 1e3,
+            "mean_radius_end_mm": float(r1.mean()) * dx * 1e3,
+            "expected_end_mm": (float(r0.mean()) * dx - rate * t_end) * 1e3,
+            "energy_rel": solver.energy_error() / solver.heat_in}
+
+
+def energy_balance(cells: int = 16, t_end: float = 600.0) -> dict:
+    """The default case on a small grid: enthalpy change against boundary heat minus the
+    enthalpy that drained, in joules."""
+    from .case import Case
+    from .geometry import initial_state
+
+    case = Case.model_validate({"grid": {"cells": cells},
+                                "table": {"contact": "conducting"}})
+    H, kind, _, _ = initial_state(case)
+    solver = EnthalpySolver(H, kind, case.dx, case.properties, faces=case.solver_faces(),
+                            air=Air(case.air.temperature, case.air.h))
+    solver.advance(t_end)
+    change = solver.enthalpy() - solver.initial_enthalpy
+    return {"enthalpy_change_J": change, "heat_in_J": solver.heat_in,
+            "drained_J": solver.drained, "imbalance_J": solver.energy_error(),
+            "relative": solver.energy_error() / solver.heat_in}
+
+
+def plot_front(path, props: Properties | None = None, dx: float = 0.25e-3,
+               t_end: float = 3600.0, samples: int = 13) -> None:
+    """Front position against time, computed (1-D, two-phase case) beside exact (PNG)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    props = props or Properties()
+    lam = exact.two_phase_lambda(props, 10.0, -10.0)
+    n = int(math.ceil(1.05 * exact.wave_reach(props, t_end) / dx))
+    H = np.full((1, 1, n), props.enthalpy(-10.0, liquid=False))
+    solver = EnthalpySolver(H, np.ones((1, 1, n), np.uint8), dx, props,
+                            faces=Faces.adiabatic().set("z-", math.inf, 10.0))
+    times = np.linspace(0.0, t_end, samples)
+    fronts = [0.0]
+    for t in times[1:]:
+        solver.advance(float(t))
+        fronts.append(solver.melted_length(2))
+    fine = np.linspace(0.0, t_end, 200)
+    fig, ax = plt.subplots(figsize=(6, 3.6), dpi=110)
+    ax.plot(fine / 60, exact.front(lam, props, fine) * 1e3, "k-", lw=1,
+            label=f"exact (Neumann, lambda = {lam:.4f})")
+    ax.plot(times / 60, np.array(fronts) * 1e3, "o", color="C0", ms=5,
+            label=f"enthalpy method, dx = {dx * 1e3:g} mm")
+    ax.set_xlabel("time (min)")
+    ax.set_ylabel("front position (mm)")
+    ax.set_title("Two-phase melt: +10 °C wall, ice at -10 °C")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
