@@ -38,6 +38,7 @@ def make_window(qtbot, tmp_path):
         window = MainWindow(scene if scene is not None or path is not None else small_scene(),
                             path, settings=settings, **options)
         window.ask_unsaved = lambda: "discard"
+        window.properties.ask_keep_colour = lambda preset: "replace"
         window.show_error = lambda title, message: errors.append((title, message))
         window.errors = errors = []
         qtbot.addWidget(window)

@@ -69,35 +69,40 @@ def main(app: QApplication) -> None:
           f"{statistics.median(latencies) * 1000:.0f} ms, max {max(latencies) * 1000:.0f} ms "
           f"over {len(latencies)} edits")
 
-    # a full render that lasts a few seconds: the default scene at 4 samples per pixel
+    # a full render that lasts a few seconds: the default scene at 4 samples per pixel, twice
+    # (the first in a process may still load a kernel variant the previews did not need)
     window.controller.preview_enabled = False
     scene = window.doc.scene.with_settings(samples=4)
     window.doc.apply(scene, "more samples")
-    lateness: list[float] = []
-    timer = QTimer()
-    timer.setInterval(10)
-    last = [time.perf_counter()]
+    for attempt in ("first", "second"):
+        lateness: list[float] = []
+        timer = QTimer()
+        timer.setInterval(10)
+        last = [time.perf_counter()]
 
-    def tick() -> None:
-        now = time.perf_counter()
-        lateness.append(now - last[0] - 0.010)
-        last[0] = now
+        def tick(lateness=lateness, last=last) -> None:
+            now = time.perf_counter()
+            lateness.append(now - last[0] - 0.010)
+            last[0] = now
 
-    frames.clear()
-    start = time.perf_counter()
-    window.start_render()
-    last[0] = time.perf_counter()
-    timer.timeout.connect(tick)
-    timer.start()
-    wait(lambda: not window.controller.rendering)
-    timer.stop()
-    total = time.perf_counter() - start
-    first = next(t for t, kind in frames if kind == "render") - start
-    stats = window.controller.last_image.meta["stats"]
-    print(f"full render {stats.width}x{stats.height}, {stats.samples} spp, {stats.threads} "
-          f"threads: first pixels after {first * 1000:.0f} ms, done in {total:.2f} s")
-    print(f"event loop during the render: {len(lateness)} ticks of 10 ms, lateness median "
-          f"{statistics.median(lateness) * 1000:.1f} ms, max {max(lateness) * 1000:.1f} ms")
+        frames.clear()
+        start = time.perf_counter()
+        window.start_render()
+        last[0] = time.perf_counter()
+        timer.timeout.connect(tick)
+        timer.start()
+        wait(lambda: not window.controller.rendering)
+        timer.stop()
+        total = time.perf_counter() - start
+        first = next(t for t, kind in frames if kind == "render") - start
+        stats = window.controller.last_image.meta["stats"]
+        print(f"{attempt} full render {stats.width}x{stats.height}, {stats.samples} spp, "
+              f"{stats.threads} threads: first pixels after {first * 1000:.0f} ms, done in "
+              f"{total:.2f} s")
+        print(f"  event loop during it: {len(lateness)} ticks of 10 ms, lateness median "
+              f"{statistics.median(lateness) * 1000:.1f} ms, 99th percentile "
+              f"{sorted(lateness)[int(0.99 * len(lateness))] * 1000:.1f} ms, "
+              f"max {max(lateness) * 1000:.1f} ms")
     window.doc.undo_stack.setClean()
     window.close()
 

@@ -57,9 +57,10 @@ def main(app: QApplication, out: Path) -> None:
     glass = next(i for i, o in enumerate(window.doc.scene.objects) if o.type == "sphere"
                  and o.material == "glass")
     window.select(("objects", glass))
-    slow = window.doc.scene.with_settings(samples=4)
-    window.controller.render(slow)
-    window._update_render_actions()
+    wait(lambda: window.viewport.outline is not None)
+    window.doc.apply(window.doc.scene.with_settings(samples=4), "4 samples")
+    wait(lambda: window.viewport.outline is not None and window.controller.preview is None)
+    window.start_render()
     wait(lambda: window.controller.full is None or (
         window.controller.full.latest is not None
         and window.controller.full.latest.fraction > 0.4), settle=0.1)
@@ -71,9 +72,7 @@ def main(app: QApplication, out: Path) -> None:
     wait(lambda: not window.controller.rendering, settle=0.5)
     save(window, out / "editor.png")
     # 3. an invalid value refused at its field
-    window.properties.row("material", "ior").editor.line.setText("-2")
-    window.properties.row("material", "ior").editor.line.editingFinished.emit()
-    window.properties.row("radius").editor.line.setText("big")
+    window.properties.row("radius").editor.line.setText("-1")
     window.properties.row("radius").editor.line.editingFinished.emit()
     wait(lambda: True, settle=0.3)
     save(window.properties, out / "editor-invalid.png", colours=64)

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import whitted
 from whitted.animation import (
@@ -332,6 +334,7 @@ def test_tracks_from_python(scene_file):
         scene.with_animation(3, tracks=[Track("camera.fob", {0: 30})])
     saved = animated.save(scene_file.with_name("saved.toml"))
     assert whitted.load_scene(saved).animation == animated.animation
+    assert "    [4, [0, 90, 0]],\n" in saved.read_text()  # one key per line
 
 
 def test_mesh_sequence_names_each_frames_file(tmp_path):
@@ -380,3 +383,77 @@ def test_a_current_frame_is_not_rendered_again(scene_file, tmp_path):
     assert read_frame_digest(tmp_path / "f.png") == first.digest
     changed = render_frame(scene, 2, tmp_path / "f.png", samples=2)  # other settings
     assert changed.rendered and changed.digest != first.digest
+
+
+def test_cyclic_animation_runs_from_the_last_key_back_to_the_first(scene_file):
+    scene = whitted.load_scene(scene_file).model_copy(update={"animation": None})
+    tracks = [Track("lights[0].intensity", {0: 0.0, 6: 0.6})]
+    plain = scene.with_animation(12, tracks=tracks)
+    loop = plain.model_copy(update={"animation": plain.animation.model_copy(
+        update={"cyclic": True})})
+    assert plain.at_frame(9).lights[0].intensity == 0.6  # held after the last key
+    assert loop.at_frame(9).lights[0].intensity == pytest.approx(0.3)  # on its way back
+    assert loop.at_frame(3).lights[0].intensity == pytest.approx(0.3)
+
+
+def test_cyclic_spline_orbit_is_symmetric_round_the_loop():
+    scene = whitted.load_scene(Path(__file__).parents[1] / "examples" / "camera_orbit.toml")
+    assert scene.animation.cyclic
+    radius = [math.hypot(p[0], p[2]) for p in
+              (scene.at_frame(k).camera.position for k in range(48))]
+    assert max(abs(r - 9) for r in radius) < 0.02  # keys every 30 degrees: nearly a circle
+    a, b = scene.at_frame(3).camera.position, scene.at_frame(45).camera.position
+    assert a[0] == pytest.approx(-b[0]) and a[2] == pytest.approx(b[2])  # mirror images
+    assert radius[2] == pytest.approx(radius[46]) == pytest.approx(radius[14])
+
+
+# ------------------------------------------------------------------------------ properties
+
+_keys = st.lists(st.tuples(st.integers(0, 60), st.floats(-100, 100)), min_size=1, max_size=8,
+                 unique_by=lambda k: k[0]).map(sorted)
+
+
+@settings(max_examples=60, deadline=None)
+@given(_keys, st.floats(0, 60))
+def test_every_mode_passes_through_its_keys_and_linear_smooth_stay_between(keys, t):
+    times = [float(k[0]) for k in keys]
+    values = [k[1] for k in keys]
+    for mode in ("step", "linear", "smooth", "spline"):
+        for k, v in zip(times, values, strict=True):
+            assert interpolate_scalar(times, values, k, mode) == pytest.approx(v, abs=1e-9)
+    for mode in ("linear", "smooth"):
+        x = interpolate_scalar(times, values, t, mode)
+        assert min(values) - 1e-9 <= x <= max(values) + 1e-9
+
+
+def _angle_between(a, b) -> float:
+    r = _matrix(a).T @ _matrix(b)
+    return math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(r) - 1) / 2))))
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.floats(-179, 179), min_size=3, max_size=3),
+       st.lists(st.floats(-179, 179), min_size=3, max_size=3),
+       st.sampled_from(["linear", "smooth"]))
+def test_rotations_turn_steadily_the_short_way(a, b, mode):
+    total = _angle_between(a, b)  # the short way, 0..180 degrees
+    steps = 8
+    frames = [interpolate_rotation([0, steps], [a, b], k, mode) for k in range(steps + 1)]
+    np.testing.assert_allclose(_matrix(frames[-1]), _matrix(b), atol=1e-9)
+    turned = sum(_angle_between(frames[k], frames[k + 1]) for k in range(steps))
+    # no detour, no flip (either would add degrees; arccos near 1 costs ~1e-5 of rounding)
+    assert turned == pytest.approx(total, abs=1e-4)
+
+
+_names = st.text(st.characters(whitelist_categories=("L", "N"), whitelist_characters=" _-"),
+                 min_size=1, max_size=12).filter(lambda s: s.strip() == s and not s.isdigit())
+
+
+@settings(max_examples=60, deadline=None)
+@given(_names, st.integers(0, 999), st.sampled_from(["kt", "color", "rotate"]))
+def test_paths_read_back_as_written(name, index, leaf):
+    from whitted.animation.paths import format_path
+
+    for text in (f"objects[{name}].material.{leaf}", f"lights[{index}].{leaf}"):
+        steps = parse_path(text)
+        assert format_path(steps) == text and parse_path(format_path(steps)) == steps

@@ -115,6 +115,7 @@ def test_render_frame_equals_the_films_frame_at_any_thread_count(tmp_path):
     assert result.returncode == 0, result.stderr
     assert np.array_equal(np.asarray(PILImage.open(still)),
                           np.asarray(PILImage.open(film / "0003.png")))
+    assert still.read_bytes() == (film / "0003.png").read_bytes()  # the same file, hash too
     assert not (tmp_path / "f.mp4").exists()  # a folder: frames only
 
 

@@ -75,6 +75,18 @@ def local_pixels(scene) -> np.ndarray:
     return RenderJob(scene, threads=1).run().pixels
 
 
+def test_the_plugin_readied_every_worker_before_any_task(client):
+    def state() -> tuple:
+        import numba
+
+        from whitted.farm import worker
+
+        return (numba.get_num_threads(), os.environ.get("NUMBA_NUM_THREADS"),
+                worker._threads, worker.warm_seconds() is not None)
+
+    assert list(client.run(state).values()) == [(1, "1", 1, True)] * 2
+
+
 def test_band_ranges_cover_the_image_in_whole_tile_rows():
     assert band_ranges(90, 4) == [(0, 16), (16, 48), (48, 64), (64, 90)]
     assert band_ranges(90, 100) == [(0, 16), (16, 32), (32, 48), (48, 64), (64, 80), (80, 90)]
@@ -190,24 +202,12 @@ material = "glass"
 name = "blade"
 type = "mesh"
 file = "seq/blade_{frame:02d}.obj"
-
-[animation]
-frames = FRAMES
-fps = 12
-
-[[animation.tracks]]
-path = "camera.position"
-keys = [[0, [0, 1.5, 5]], [LAST, [3, 1.5, 4]]]
-
-[[animation.tracks]]
-path = "objects[ball].material.kt"
-keys = [[0, 1.0], [LAST, 0.2]]
 """
 
 
 def write_film_scene(folder: Path, examples_dir: Path, frames: int) -> Path:
-    """An animated scene with a camera move, a material track, an image texture and a mesh
-    sequence (one OBJ per frame, a triangle that turns)."""
+    """A scene file with an image texture and a mesh sequence (one OBJ per frame, a triangle
+    that grows); :func:`film_of` adds its tracks."""
     (folder / "seq").mkdir(parents=True)
     (folder / "tex").mkdir()
     shutil.copy(examples_dir / "textures/tiles.png", folder / "tex/tiles.png")
@@ -216,14 +216,25 @@ def write_film_scene(folder: Path, examples_dir: Path, frames: int) -> Path:
         (folder / f"seq/blade_{k:02d}.obj").write_text(
             f"v {x} 0 0\nv {x + 0.8} 0 0\nv {x} {1.0 + 0.05 * k} 0.2\nf 1 2 3\n")
     path = folder / "film.toml"
-    path.write_text(FILM.replace("FRAMES", str(frames)).replace("LAST", str(frames - 1)))
+    path.write_text(FILM)
     return path
+
+
+def film_of(path: Path, frames: int):
+    """The scene at ``path`` animated: a camera move and a material track over ``frames``."""
+    from whitted.animation import Track
+
+    last = frames - 1
+    return load_scene(path).with_animation(frames, 12.0, [
+        Track("camera.position", [[0, [0, 1.5, 5]], [last, [3, 1.5, 4]]]),
+        Track("objects[ball].material.kt", [[0, 1.0], [last, 0.2]]),
+    ])
 
 
 @pytest.fixture(scope="module")
 def film_scene(tmp_path_factory, examples_dir):
     folder = tmp_path_factory.mktemp("film")
-    return load_scene(write_film_scene(folder / "project", examples_dir, 8))
+    return film_of(write_film_scene(folder / "project", examples_dir, 8), 8)
 
 
 @pytest.fixture(scope="module")
@@ -297,7 +308,7 @@ def test_a_failing_frame_is_named_after_the_others_are_saved(client, examples_di
     path = write_film_scene(tmp_path / "project", examples_dir, 5)
     bad = tmp_path / "project/seq/blade_03.obj"
     bad.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n")  # no vertex 7
-    scene = load_scene(path).with_settings(width=24, height=16, samples=1)
+    scene = film_of(path, 5).with_settings(width=24, height=16, samples=1)
     folder = tmp_path / "frames"
     with pytest.raises(FrameFailed) as failure:
         render_film(client, scene, folder, assets="ship", chunk=2)

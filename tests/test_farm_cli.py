@@ -66,3 +66,89 @@ def test_without_dask_the_farm_says_what_to_install(tmp_path):
     assert len(lines) == 1 and "Traceback" not in result.stderr
     assert lines[0].startswith("error: the render farm needs dask.distributed: "
                                "pip install 'whitted[farm]'")
+
+
+FILM = """
+[render]
+width = 48
+height = 32
+
+[camera]
+position = [0, 1.5, 5]
+look_at = [0, 0.5, 0]
+
+[[lights]]
+type = "point"
+position = [3, 5, 4]
+
+[[objects]]
+type = "plane"
+material = { kd = 0.8, texture = { type = "checker", checks = 2.0 } }
+
+[[objects]]
+name = "ball"
+type = "sphere"
+center = [0, 0.5, 0]
+radius = 0.5
+material = "glass"
+
+[animation]
+frames = 6
+fps = 12
+
+[[animation.tracks]]
+path = "camera.position"
+keys = [[0, [0, 1.5, 5]], [5, [3, 1.5, 4]]]
+"""
+
+
+def test_animate_on_a_local_cluster_writes_the_local_frames_and_film(tmp_path):
+    import imageio_ffmpeg
+
+    scene = tmp_path / "turn.toml"
+    scene.write_text(FILM)
+    local = CliRunner().invoke(app, ["animate", str(scene), "-o", str(tmp_path / "local"),
+                                     "-q"])
+    assert local.exit_code == 0, local.stderr
+    result = whitted("animate", scene, "-o", tmp_path / "farm.mp4", "--cluster", "local:2",
+                     cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "6 frames (6 rendered" in result.stdout
+    names = [f"{k:04d}.png" for k in range(6)]
+    assert sorted(p.name for p in (tmp_path / "farm_frames").iterdir()) == names
+    for name in names:  # the same PNG bytes: pixels and the frame hash that resumes
+        assert (tmp_path / "farm_frames" / name).read_bytes() == (
+            tmp_path / "local" / name).read_bytes()
+    frames, _ = imageio_ffmpeg.count_frames_and_secs(str(tmp_path / "farm.mp4"))
+    meta = next(imageio_ffmpeg.read_frames(str(tmp_path / "farm.mp4")))
+    assert frames == 6 and tuple(meta["size"]) == (48, 32)
+    again = whitted("animate", scene, "-o", tmp_path / "farm.mp4", "--cluster", "local:2",
+                    cwd=tmp_path)  # resume: every frame is current
+    assert again.returncode == 0 and "6 already done" in again.stdout
+    assert "farm:" not in again.stderr  # nothing to render: no cluster was started
+
+
+@pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="Numba's default pool is 1 thread")
+def test_worker_threads_agree_with_numba_when_numba_came_first(tmp_path):
+    # A spawned Dask worker re-imports the client's main module (whitted's CLI, and Numba with
+    # it) before the Nanny sets NUMBA_NUM_THREADS: Numba's config then says one pool size and
+    # the environment another, and the next compile (a cold cache) raised RuntimeError.
+    code = """
+import os
+os.environ.pop("NUMBA_NUM_THREADS", None)
+import numba                                  # config: one thread per core
+os.environ["NUMBA_NUM_THREADS"] = "1"        # what the Nanny sets afterwards
+from whitted.farm.worker import set_worker_threads
+set_worker_threads(1)
+
+@numba.njit
+def twice(x):
+    return 2 * x
+
+assert twice(21) == 42                       # a compile re-reads the environment
+print(numba.get_num_threads(), numba.config.NUMBA_NUM_THREADS)
+"""
+    result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                            text=True, timeout=120, env=dict(os.environ))
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.split() == ["1", "1"]

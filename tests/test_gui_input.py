@@ -8,8 +8,10 @@ import pytest
 pytest.importorskip("PySide6.QtWidgets")
 
 from PySide6.QtCore import QPoint, QPointF, Qt  # noqa: E402
+from PySide6.QtGui import QColor  # noqa: E402
 
 import whitted  # noqa: E402
+import whitted.gui.widgets  # noqa: E402
 from gui_input import (  # noqa: E402, F401
     CTRL,
     SHIFT,
@@ -205,8 +207,55 @@ def test_a_model_shows_the_material_of_its_file_and_can_override_it(window, qtbo
     assert panel.material_combo.currentText() == "Custom"
     # back to the file's materials from the drop-down, with the keyboard
     combo = panel.material_combo
+    panel.ask_keep_colour = lambda preset: "replace"  # (passing the presets on the way)
     combo.setFocus()
     for _ in range(combo.count()):
         qtbot.keyClick(combo, Qt.Key.Key_Up)
-    assert window.doc.item(key).material is None
+    qtbot.waitUntil(lambda: window.doc.item(key).material is None)
     assert panel.material_combo.currentText() == "From the model file (tetra.obj)"
+
+
+def test_small_things_icons_swatches_live_colour_and_the_idle_progress_bar(window, qtbot):
+    # icons in the tree and the Add menus
+    item = window.tree.item_for(("objects", 1))
+    assert not item.icon(0).isNull()
+    assert not window.tree.item_for(("lights", 1)).icon(0).isNull()
+    assert not window.object_actions["cone"].icon().isNull()
+    assert window.progress.isHidden()  # no render: no progress bar
+    # the preset list has swatches; a preset over a custom colour asks first
+    click_tree(qtbot, window.tree, ("objects", 1))
+    panel = window.properties
+    combo = panel.material_combo
+    glass = combo.findData("preset:glass")
+    assert not combo.itemIcon(glass).isNull()
+    type_into(qtbot, panel.row("material", "color").editor.line, "#ff8800")
+    asked = []
+    panel.ask_keep_colour = lambda preset: asked.append(preset) or "keep"
+    combo.showPopup()  # open the list and click "glass"
+    view = combo.view()
+    qtbot.waitUntil(view.isVisible)
+    rect = view.visualRect(view.model().index(glass, 0))
+    qtbot.mouseClick(view.viewport(), Qt.MouseButton.LeftButton, pos=rect.center())
+    qtbot.waitUntil(lambda: bool(asked))
+    assert asked == ["glass"]
+    material = window.doc.scene.material_of(1)
+    assert material.preset == "glass" and material.kt == whitted.Material(preset="glass").kt
+    assert whitted.gui.widgets.hex_of(material.color) == "#ff8800"  # the colour was kept
+    # the colour picker changes the picture while it is open; Cancel leaves no trace
+    steps = window.doc.undo_stack.count()
+    before = window.doc.scene
+    editor = panel.row("material", "color").editor
+    qtbot.mouseClick(editor.button, Qt.MouseButton.LeftButton)
+    dialog = editor.dialog
+    assert dialog is not None and dialog.isVisible()
+    dialog.setCurrentColor(QColor("#00ff00"))
+    assert window.doc.scene.material_of(1).color == (0.0, 1.0, 0.0)  # live
+    dialog.setCurrentColor(QColor("#0000ff"))
+    assert window.doc.scene.material_of(1).color == (0.0, 0.0, 1.0)
+    dialog.reject()
+    assert window.doc.scene == before and window.doc.undo_stack.count() == steps
+    # a render shows the bar; when it ends the bar goes away
+    window.act_render.trigger()
+    assert not window.progress.isHidden()
+    qtbot.waitUntil(lambda: not window.controller.rendering, timeout=SLOW)
+    assert window.progress.isHidden()

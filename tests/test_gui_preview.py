@@ -61,3 +61,30 @@ def test_preview_is_coarse_while_dragging_and_refines_when_idle(make_window, qtb
           f"(width {first_width}); edit -> full size {1000 * c.edit_to_full[0]:.0f} ms; "
           f"drag: {during / seconds:.1f} updates/s at width {widths}; "
           f"release -> full size ({vp.image.width()}x{vp.image.height()}) {1000 * refine:.0f} ms")
+
+
+def test_g_move_drag_rate_is_logged(make_window, qtbot):  # noqa: F811
+    """A G move changes the geometry, so every preview compiles the scene again: its rate
+    (written to the log) is the slowest kind of drag."""
+    window = make_window(whitted.default_scene().with_settings(width=480, height=360))
+    vp = window.viewport
+    c = window.controller
+    qtbot.waitUntil(lambda: c.previews_done > 0, timeout=SLOW)
+    window.select(("objects", 1))
+    centre = QPointF(vp.rect().center())
+    mouse(vp, "move", centre, Qt.MouseButton.NoButton)
+    qtbot.keyClick(vp, Qt.Key.Key_G)
+    done = c.previews_done
+    t0 = time.perf_counter()
+    moves = 0
+    while time.perf_counter() - t0 < 2.0:
+        moves += 1
+        mouse(vp, "move", centre + QPointF(3 * (moves % 60), 0), Qt.MouseButton.NoButton)
+        qtbot.wait(16)
+    rate = (c.previews_done - done) / (time.perf_counter() - t0)
+    width = vp.image.width()
+    qtbot.keyClick(vp, Qt.Key.Key_Return)
+    assert window.doc.item(("objects", 1)).transform is not None
+    assert c.previews_done - done >= 3
+    print(f"\n[preview] G-move drag (geometry rebuilt each time): {rate:.1f} updates/s "
+          f"at width {width}")

@@ -124,6 +124,7 @@ def test_frame_selection_home_and_the_numpad_views(window, qtbot):
     assert cam.position[2] > cam.look_at[2] and cam.position[0] == pytest.approx(cam.look_at[0])
     qtbot.keyClick(vp, Qt.Key.Key_Home)  # everything bounded (the ball; the floor is endless)
     assert window.doc.scene.camera.look_at == pytest.approx((0.0, 0.8, 0.0))
+    assert window.doc.selection == ("objects", 1)  # moving the view keeps the selection
 
 
 def test_a_light_is_drawn_picked_and_moved_with_g(make_window, qtbot):  # noqa: F811

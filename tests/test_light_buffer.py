@@ -215,3 +215,17 @@ def test_light_buffers_give_the_image_the_bvh_walk_gives():
     walked = _render(compiled, scene)
     assert np.array_equal(with_buffers, walked)
     assert with_buffers.mean() > 0.05  # lit, not black
+
+
+def test_compile_without_light_buffers_builds_none_and_gives_the_same_image():
+    """Interactive previews compile without light buffers (most of a small scene's build
+    time): no point light gets a buffer, and the picture is the one the buffers give."""
+    scene = _cluttered_scene(LIGHTS).model_copy(update={
+        "render": whitted.RenderSettings(width=64, height=48),
+        "camera": whitted.Camera(position=(0, 4, 10), look_at=(0, 1, 0), fov=50)})
+    buffered = compile_scene(scene)
+    bare = compile_scene(scene, light_buffers=False)
+    assert (buffered.lights.table[:, LIGHT_BUFFER] >= 0).any()
+    assert (bare.lights.table[:, LIGHT_BUFFER] == -1).all()
+    assert len(bare.lights.buffer_prims) == 0
+    assert np.array_equal(_render(buffered, scene), _render(bare, scene))

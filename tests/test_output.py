@@ -486,3 +486,29 @@ def test_bad_transfer_and_tonemap(tmp_path):
         img.save(tmp_path / "a.png", transfer="rec709")
     with pytest.raises(ValueError, match="transfer"):
         read_image(tmp_path / "a.png", transfer="rec709")
+
+
+def test_8bit_srgb_table_gives_the_exact_curves_codes():
+    """encode_ldr's 8-bit sRGB table look-up equals the float64 curve then rounding, at every
+    step of the table (and three float32 values either side), on a million float32 values
+    spread over [0, 1], on values outside it, and after every tone map."""
+    from whitted.output import encode as e
+
+    def reference(v, tonemap="clamp"):
+        return e.quantize(e.linear_to_srgb(e.tonemap(v, tonemap)), 8)
+
+    _code, step = e._srgb8_table()
+    edges = step[np.isfinite(step)]
+    assert len(edges) == 255  # one step per code
+    bits = edges.view(np.uint32).astype(np.int64)
+    near = np.concatenate([bits + d for d in range(-3, 4)]).astype(np.uint32).view(np.float32)
+    spread = np.arange(0, int(np.float32(1).view(np.uint32)) + 1, 1021,
+                       dtype=np.int64).astype(np.uint32).view(np.float32)
+    odd = np.array([np.nan, np.inf, -np.inf, -1e-30, -2.0, 1.0, 1.0000001, 3e38, 0.0, 5e-45],
+                   np.float32)
+    for values in (near, spread, odd):
+        assert np.array_equal(e.encode_ldr(values, bits=8), reference(values))
+    rng = np.random.default_rng(7)
+    hdr = (rng.random((64, 48, 3)) * 9).astype(np.float32)
+    for mode in ("clamp", "reinhard", "aces"):
+        assert np.array_equal(e.encode_ldr(hdr, bits=8, tonemap=mode), reference(hdr, mode))

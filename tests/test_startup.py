@@ -8,6 +8,7 @@ docs/performance.md.
 
 from __future__ import annotations
 
+import importlib
 import json
 import os
 import subprocess
@@ -73,6 +74,9 @@ def test_public_api_resolves_every_name():
     from whitted.scene.shapes import Sphere
 
     assert whitted.Sphere is Sphere
+    importlib.import_module("whitted.render.warm_up")  # binds the subpackage to the name
+
+    assert callable(whitted.render) and whitted.render.__name__ == "render"
     with pytest.raises(AttributeError, match="no attribute 'Spheer'"):
         _ = whitted.Spheer
 
@@ -105,6 +109,7 @@ def test_kernels_loaded_from_cache_then_a_new_kernel_compiles(tmp_path):
 @pytest.mark.parametrize(("blocked", "args", "extra"), [
     ("PySide6", ["gui"], "gui"),
     ("matplotlib", ["bench", "--study", "threads", "--quick"], "plots"),
+    ("embreex", ["bench", "--quick", "--scene", "sphere1m", "--compare", "embree"], "bench"),
 ])
 def test_a_missing_extra_is_one_line_naming_it(tmp_path, blocked, args, extra):
     """Without an optional dependency the command says which extra to install (one line,
@@ -126,3 +131,108 @@ def test_a_missing_extra_is_one_line_naming_it(tmp_path, blocked, args, extra):
     assert result.returncode == 2, result.stderr
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and f"pip install 'whitted[{extra}]'" in lines[0], result.stderr
+
+
+def test_cold_compile_reports_progress_and_stops_at_once_on_ctrl_c(tmp_path):
+    """A first render on an empty cache: compile_progress() climbs from 0 while it runs, and
+    Ctrl-C (SIGINT, here sent by the process to itself once the progress is above 0) ends
+    the compile at once and the helper process with it."""
+    env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"),
+               WHITTED_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("NUMBA_CACHE_DIR", None)
+    script = textwrap.dedent("""
+        import os, signal, threading, time, json
+        import whitted
+        from whitted.render import warm_up
+
+        seen = []
+        sent = []
+        def watch():  # Ctrl-C once the compile has visibly progressed
+            while not sent:
+                fraction = warm_up.compile_progress()
+                seen.append(fraction)
+                if fraction is not None and fraction > 0.0:
+                    sent.append(time.perf_counter())
+                    os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.1)
+        threading.Thread(target=watch, daemon=True).start()
+        try:
+            whitted.render(whitted.Scene(), width=4, height=4, threads=1)
+            print("RESULT=" + json.dumps({"finished": True}))
+        except KeyboardInterrupt:
+            stopped = time.perf_counter() - sent[0]
+            helpers = []
+            for p in os.listdir("/proc"):
+                try:
+                    with open(f"/proc/{p}/stat") as f:
+                        parent = int(f.read().rsplit(")", 1)[1].split()[1])
+                except (OSError, ValueError, IndexError):
+                    continue
+                if parent == os.getpid():
+                    helpers.append(p)  # a child of this process still there
+            fractions = [f for f in seen if f is not None]
+            print("RESULT=" + json.dumps({"stopped_s": stopped, "helpers": helpers,
+                                          "progress": max(fractions, default=None),
+                                          "after": warm_up.compile_progress()}))
+    """)
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                            cwd=tmp_path, env=env, timeout=600)
+    lines = [x for x in result.stdout.splitlines() if x.startswith("RESULT=")]
+    assert lines, result.stderr[-2000:]
+    line = lines[0]
+    outcome = json.loads(line.removeprefix("RESULT="))
+    assert "finished" not in outcome, "the compile ended before the interrupt"
+    assert outcome["stopped_s"] < 3.0  # at once (Numba checks for signals between steps)
+    assert outcome["helpers"] == []  # the helper was stopped, not waited for
+    assert 0.0 < outcome["progress"] < 1.0 and outcome["after"] is None
+
+
+def test_compile_helper_ends_when_its_parent_is_gone(tmp_path):
+    """A helper started by a process that then vanishes stops instead of compiling on."""
+    env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"),
+               WHITTED_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("NUMBA_CACHE_DIR", None)
+    # the shell starts the helper (naming itself as the parent) and exits at once
+    shell = subprocess.run(
+        ["sh", "-c", f'"{sys.executable}" -m whitted.render.warm_up plain $$ '
+                     '>/dev/null 2>&1 & echo $!'],
+        capture_output=True, text=True, env=env, cwd=tmp_path, timeout=60)
+    pid = int(shell.stdout.strip())
+    import time
+
+    deadline = time.monotonic() + 15.0  # Python, NumPy and Numba start first
+    while time.monotonic() < deadline and Path(f"/proc/{pid}").exists():
+        status = Path(f"/proc/{pid}/status").read_text() if Path(f"/proc/{pid}").exists() else ""
+        if "State:\tZ" in status:
+            break
+        time.sleep(0.2)
+    alive = Path(f"/proc/{pid}").exists() and "State:\tZ" not in Path(
+        f"/proc/{pid}/status").read_text()
+    assert not alive, "the orphaned helper is still compiling"
+
+
+def test_render_in_a_terminal_draws_its_bar(tmp_path):
+    """``whitted render`` with a terminal on stderr draws the rich progress bar (the lazy
+    console must work inside rich's live display) and writes the image."""
+    import pty
+
+    out = tmp_path / "x.png"
+    env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"), COLUMNS="100", TERM="xterm")
+    pid, fd = pty.fork()
+    if pid == 0:  # the child: the CLI with the pseudo-terminal as its terminal
+        os.chdir(tmp_path)
+        os.execvpe(sys.executable, [sys.executable, "-m", "whitted", "render", "-W", "24",
+                                    "-H", "16", "-o", str(out)], env)
+    captured = b""
+    while True:
+        try:
+            chunk = os.read(fd, 4096)
+        except OSError:  # the child closed the terminal
+            break
+        if not chunk:
+            break
+        captured += chunk
+    _, status = os.waitpid(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 0, captured.decode(errors="replace")[-800:]
+    assert b"rendering" in captured and b"24x16" in captured
+    assert out.stat().st_size > 0

@@ -23,6 +23,7 @@ configure_kernel_cache()  # before any kernel module imports numba
 
 #: public name -> the module that defines it
 _LAZY = {
+    "Animation": ".animation", "Track": ".animation",
     "SceneError": ".errors", "WhittedError": ".errors",
     "Image": ".output",
     "CancelToken": ".render", "Progress": ".render", "RenderJob": ".render",
@@ -37,6 +38,7 @@ _LAZY = {
 }
 
 __all__ = [
+    "Animation", "Track",
     "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera", "CancelToken",
     "CheckerTexture", "Cone", "Cylinder", "DirectionalLight", "Disk", "DiskLight", "Gradient",
     "GradientTexture", "Image", "ImageTexture", "Material", "Mesh", "Plane",
@@ -86,6 +88,7 @@ sys.modules[__name__].__class__ = _Package
 
 
 if TYPE_CHECKING:  # for type checkers and IDEs: the same names, imported eagerly
+    from .animation import Animation, Track
     from .errors import SceneError, WhittedError
     from .output import Image
     from .render import CancelToken, Progress, RenderJob, RenderStats, render, render_aovs

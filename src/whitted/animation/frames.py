@@ -33,7 +33,7 @@ if TYPE_CHECKING:
     from ..scene.scene import Scene
 
 __all__ = ["FRAME_HASH_KEY", "FrameRenderer", "FrameResult", "frame_digest", "frame_is_current",
-           "read_frame_digest", "render_frame", "still_for_frame"]
+           "read_frame_digest", "render_frame", "still_for_frame", "write_frame_png"]
 
 FRAME_HASH_KEY = "whitted:frame-hash"
 FRAME_NUMBER_KEY = "whitted:frame"
@@ -140,6 +140,9 @@ def _write_frame_png(path: Path, image: Any, digest: str, frame: int) -> None:
     # (640x360: 6 vs 25 ms) for files about a third larger
     atomic_write(path, lambda tmp: PILImage.fromarray(data).save(
         tmp, format="PNG", pnginfo=info, compress_level=FRAME_PNG_LEVEL))
+
+
+write_frame_png = _write_frame_png  # the public name: (path, image, digest, frame)
 
 
 # ------------------------------------------------------------------------------ rendering

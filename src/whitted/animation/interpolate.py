@@ -11,7 +11,8 @@ Every function here is plain arithmetic on numbers and small NumPy arrays.
   their one neighbour). It can overshoot between keys.
 
 Before the first key the value holds at the first key's value, after the last key at the
-last one (constant extrapolation).
+last one (constant extrapolation); in a cyclic animation the keys repeat every ``frames``
+frames instead (:func:`wrap_keys`), so the value runs from the last key back to the first.
 
 Rotations (``rotate`` fields: degrees about x, then y, then z) are turned into unit
 quaternions, each key's quaternion on the same side as the previous one (so every segment
@@ -34,7 +35,7 @@ INTERPOLATIONS = ("step", "linear", "smooth", "spline")
 
 __all__ = [
     "INTERPOLATIONS", "euler_to_quaternion", "interpolate_rotation", "interpolate_scalar",
-    "interpolate_tree", "quaternion_to_euler", "slerp",
+    "interpolate_tree", "quaternion_to_euler", "slerp", "wrap_keys",
 ]
 
 
@@ -265,6 +266,19 @@ def interpolate_tree(times: Sequence[float], values: Sequence[Any], t: float, mo
         return {k: interpolate_tree(times, [v[k] for v in values], t, mode, k)
                 for k in values[0]}
     return values[_step_index(times, t)]
+
+
+def wrap_keys(times: Sequence[float], values: Sequence[Any], period: float
+              ) -> tuple[list[float], list[Any]]:
+    """Keys of a cyclic animation (frame ``period`` is frame 0 again) with the last two keys
+    repeated one period earlier and the first two one period later, so that interpolating
+    the result anywhere in 0 .. period runs from the last key back round to the first (and a
+    spline's slope at the ends comes from the other end's keys)."""
+    n = min(2, len(times))
+    before_t = [t - period for t in times[-n:]]
+    after_t = [t + period for t in times[:n]]
+    return ([*before_t, *times, *after_t],
+            [*values[-n:], *values, *values[:n]])
 
 
 def _step_index(times: Sequence[float], t: float) -> int:

@@ -67,9 +67,41 @@ class Animation(Strict):
 
     frames: int = Field(ge=1, le=MAX_FRAMES)
     fps: float = Field(default=24.0, gt=0.0, le=1000.0)
+    #: the film loops: frame ``frames`` would be frame 0 again, so every track runs from its
+    #: last key back to its first (a camera orbit that plays seamlessly in a loop)
+    cyclic: bool = False
     tracks: list[Track] = Field(default_factory=list)
 
     def track(self, path: str, keys: Any, interpolation: Interpolation = "linear") -> Animation:
         """A copy with one more track (``keys``: ``{frame: value}`` or ``[(frame, value)]``)."""
         new = Track(path, keys, interpolation=interpolation)
-        return Animation(frames=self.frames, fps=self.fps, tracks=[*self.tracks, new])
+        return Animation(frames=self.frames, fps=self.fps, cyclic=self.cyclic,
+                         tracks=[*self.tracks, new])
+
+
+def animation_toml(data: dict[str, Any]) -> str:
+    """The ``[animation]`` table (as ``model_dump(mode="json")`` gives it) as TOML text with
+    one key per line: ``[12, [9.0, 2.6, 0.0]],``."""
+    import tomlkit
+
+    doc = tomlkit.document()
+    table = tomlkit.table()
+    for name, value in data.items():
+        if name != "tracks":
+            table.add(name, value)
+    doc.add("animation", table)
+    tracks = tomlkit.aot()
+    for track in data.get("tracks", []):
+        t = tomlkit.table()
+        t.add("path", track["path"])
+        if "interpolation" in track:
+            t.add("interpolation", track["interpolation"])
+        keys = tomlkit.array()
+        for pair in track["keys"]:
+            keys.append(list(pair))
+        keys.multiline(True)
+        t.add("keys", keys)
+        tracks.append(t)
+    if data.get("tracks"):
+        table.add("tracks", tracks)
+    return tomlkit.dumps(doc)

@@ -4,7 +4,8 @@ compiled again.
 * Only the camera, background or render settings changed (a camera move): the whole
   compiled scene (geometry, BVHs, materials, lights and light buffers) is reused.
 * The lights changed too, the objects and materials did not: geometry, BVHs and the material
-  table are reused; the light table and light buffers are rebuilt.
+  table are reused; the light table is rebuilt, and the light buffers too if a point light
+  moved (they depend on where the lights are, not on their colour or intensity).
 * Objects or materials changed: the scene is compiled again, but every BVH whose primitives
   did not move is reused (:class:`~whitted.compile.reuse.BvhMemo`): a moving object
   rebuilds the scene BVH, never the BVHs of meshes that did not change.
@@ -27,6 +28,7 @@ if TYPE_CHECKING:
 __all__ = ["CompileCache", "ReuseStats"]
 
 REUSE_ALL = "all"  # nothing compiled
+REUSE_LIGHT_BUFFERS = "light buffers"  # light values changed, not where the lights are
 REUSE_GEOMETRY = "geometry"  # lights rebuilt
 REUSE_BVH = "bvh"  # compiled again, BVHs from the memo where unchanged
 REUSE_NONE = "none"
@@ -61,6 +63,26 @@ def _light_part(scene: Scene) -> tuple:
     return (scene.lights, scene.render.shadow_samples)
 
 
+def _same_buffers(previous, table):
+    """The previous lights with ``table``'s values when every light has the same type and
+    position as before (a light buffer depends on the geometry, the materials and where the
+    point lights are, not on their colour or intensity); else None."""
+    import numpy as np
+
+    from ..kernels.layout import LIGHT_BUFFER, LIGHT_BUFFER_SIDE, LIGHT_POSITION, LIGHT_TYPE
+
+    old = previous.table
+    if old.shape != table.shape:
+        return None
+    where = [LIGHT_TYPE, LIGHT_POSITION, LIGHT_POSITION + 1, LIGHT_POSITION + 2]
+    if not np.array_equal(old[:, where], table[:, where]):
+        return None
+    new = table.copy()
+    new[:, LIGHT_BUFFER] = old[:, LIGHT_BUFFER]
+    new[:, LIGHT_BUFFER_SIDE] = old[:, LIGHT_BUFFER_SIDE]
+    return previous._replace(table=new)
+
+
 class CompileCache:
     """Compiles the stills of consecutive frames, reusing what the previous one shares."""
 
@@ -72,8 +94,8 @@ class CompileCache:
         self._previous: tuple[Scene, CompiledScene] | None = None
 
     def compile(self, still: Scene) -> tuple[CompiledScene, str]:
-        """The compiled scene of ``still`` and how much was reused (``all``, ``geometry``,
-        ``bvh`` or ``none``)."""
+        """The compiled scene of ``still`` and how much was reused (``all``,
+        ``light buffers``, ``geometry``, ``bvh`` or ``none``)."""
         start = time.perf_counter()
         compiled, level = self._compile(still)
         self.stats.compile_seconds += time.perf_counter() - start
@@ -96,6 +118,10 @@ class CompileCache:
                 if _light_part(before) == _light_part(still):
                     return compiled, REUSE_ALL
                 table, ambient = light_rows(still)
+                kept = _same_buffers(compiled.lights, table)
+                if kept is not None:  # only colours or intensities changed
+                    return dataclasses.replace(compiled, lights=kept, ambient=ambient,
+                                               build_seconds=0.0), REUSE_LIGHT_BUFFERS
                 lights = build_light_buffers(geo, compiled.materials, table,
                                              has_instances=len(geo.inst_prims) > 0)
                 return dataclasses.replace(compiled, lights=lights, ambient=ambient,

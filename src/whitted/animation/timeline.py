@@ -10,15 +10,18 @@ rendered. The scene it came from is not changed.
 from __future__ import annotations
 
 import hashlib
+import math
 import re
 import string
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from pydantic import BaseModel
 
 from ..errors import SceneError
-from .interpolate import interpolate_tree
+from .interpolate import interpolate_tree, wrap_keys
 from .model import Track
 from .paths import PathError, Step, format_path, get_value, parse_path, resolve_path, set_value
 
@@ -123,7 +126,41 @@ def _prepare(scene: Scene, index: int, track: Track) -> _Ready:
         times.append(float(frame))
         values.append(_tree(get_value(keyed, steps)))
     name = steps[-1].key if isinstance(steps[-1].key, str) else None
+    if scene.animation is not None and scene.animation.cyclic:
+        times, values = wrap_keys(times, values, float(frames))
     return _Ready(steps, written, times, values, track.interpolation, name)
+
+
+_PREPARED: OrderedDict[tuple, tuple[Scene, list[_Ready]]] = OrderedDict()
+_PREPARED_LOCK = threading.Lock()
+_KEEP = 4
+
+
+def _prepared(scene: Scene) -> list[_Ready]:
+    """Every track of ``scene`` checked and its keys normalised, remembered for the last few
+    scenes (a film asks for the same scene's tracks at every frame; normalising a key
+    validates it in the scene, so a track keyed at every frame would otherwise cost the
+    square of its length)."""
+    assert scene.animation is not None
+    key = (id(scene), id(scene.animation), id(scene.objects), id(scene.lights),
+           id(scene.materials), len(scene.objects), len(scene.lights),
+           tuple((id(t), id(t.keys), len(t.keys), t.path, t.interpolation)
+                 for t in scene.animation.tracks))
+    with _PREPARED_LOCK:
+        hit = _PREPARED.get(key)
+        if hit is not None and hit[0] is scene:
+            _PREPARED.move_to_end(key)
+            return hit[1]
+    ready = [_prepare(scene, i, t) for i, t in enumerate(scene.animation.tracks)]
+    with _PREPARED_LOCK:
+        _PREPARED[key] = (scene, ready)  # holding the scene keeps its id from being reused
+        while len(_PREPARED) > _KEEP:
+            _PREPARED.popitem(last=False)
+    return ready
+
+
+def _value_at(ready: _Ready, frame: float) -> Any:
+    return interpolate_tree(ready.times, ready.values, frame, ready.interpolation, ready.name)
 
 
 def track_value(scene: Scene, track: Track | int, frame: float) -> Any:
@@ -131,7 +168,7 @@ def track_value(scene: Scene, track: Track | int, frame: float) -> Any:
     assert scene.animation is not None
     index = track if isinstance(track, int) else scene.animation.tracks.index(track)
     ready = _prepare(scene, index, scene.animation.tracks[index])
-    return interpolate_tree(ready.times, ready.values, frame, ready.interpolation, ready.name)
+    return _value_at(ready, frame)
 
 
 def check_animation(scene: Scene) -> None:
@@ -150,10 +187,10 @@ def check_animation(scene: Scene) -> None:
         ready = _prepare(scene, i, track)
         if ready.interpolation == "step" or len(ready.times) < 2:
             continue
-        first, last = int(ready.times[0]), int(ready.times[-1])
+        first = max(0, math.ceil(ready.times[0]))
+        last = min(scene.animation.frames - 1, math.floor(ready.times[-1]))
         for frame in range(first, last + 1):
-            value = interpolate_tree(ready.times, ready.values, frame, ready.interpolation,
-                                     ready.name)
+            value = _value_at(ready, frame)
             try:
                 set_value(scene, ready.written, value)
             except PathError as exc:
@@ -173,11 +210,13 @@ def scene_at_frame(scene: Scene, frame: int) -> Scene:
                          f"frame{'s' if n != 1 else ''})")
     still = scene
     if scene.animation is not None:
-        for i, track in enumerate(scene.animation.tracks):
+        try:
+            prepared = _prepared(scene)
+        except ValueError as exc:
+            raise SceneError(f"frame {frame}: {exc}") from None
+        for i, ready in enumerate(prepared):
             try:
-                ready = _prepare(scene, i, track)
-                value = interpolate_tree(ready.times, ready.values, frame, ready.interpolation,
-                                         ready.name)
+                value = _value_at(ready, frame)
                 still = set_value(still, ready.steps, value)
             except (PathError, ValueError) as exc:
                 raise SceneError(f"frame {frame}: {exc}",

@@ -71,7 +71,9 @@ def load_image(path: str | os.PathLike[str], colorspace: str = "srgb") -> np.nda
     naming the file) when the file is missing, is not an image or cannot be decoded.
     """
     if colorspace not in COLORSPACES:
-        raise ValueError(f"colorspace must be one of {COLORSPACES}, not {colorspace!r}")
+        from ..errors import ArgumentError
+
+        raise ArgumentError(f"colorspace must be one of {COLORSPACES}, not {colorspace!r}")
     name = str(path)
     try:
         resolved = Path(path).resolve()

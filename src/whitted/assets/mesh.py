@@ -28,7 +28,7 @@ import codecs
 import os
 import threading
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -59,6 +59,7 @@ class MeshData:
     triangle_records: int  # triangles after fan triangulation, degenerate ones included
     source: str  # the path
     texture_files: list[str]  # the existing texture images the materials use
+    library_files: list[str] = field(default_factory=list)  # the MTL files read (OBJ)
 
 
 _cache: OrderedDict[tuple[str, int, int], MeshData] = OrderedDict()
@@ -288,7 +289,7 @@ def load_obj_bytes(data: bytes, name: str, folder: Path) -> MeshData:
     _convert_hard_numbers(text, hard_numbers, (positions, texcoords, normals), name)
 
     warnings: list[str] = []
-    materials, face_material, texture_files = _obj_materials(
+    materials, face_material, texture_files, library_files = _obj_materials(
         text, name, folder, usemtl_spans, mtllib_spans, triangle_count, warnings
     )
 
@@ -339,6 +340,7 @@ def load_obj_bytes(data: bytes, name: str, folder: Path) -> MeshData:
         triangle_records=triangle_count,
         source=name,
         texture_files=texture_files,
+        library_files=library_files,
     )
 
 
@@ -396,9 +398,10 @@ def _obj_materials(
     mtllib_spans: np.ndarray,
     triangle_count: int,
     warnings: list[str],
-) -> tuple[list[Material], np.ndarray, list[str]]:
+) -> tuple[list[Material], np.ndarray, list[str], list[str]]:
     records: dict[str, tuple[MtlRecord, Path, str]] = {}
     seen_libraries: set[Path] = set()
+    library_files: list[str] = []
     for start, end, line in mtllib_spans.tolist():
         argument = _decode_name(text, start, end)
         for library in _library_names(argument, folder):
@@ -413,6 +416,7 @@ def _obj_materials(
             if resolved in seen_libraries:
                 continue
             seen_libraries.add(resolved)
+            library_files.append(os.fspath(path))
             parsed = read_mtl_file(path, warnings)
             if parsed is None:
                 warnings.append(f"{name}:{line}: material library '{library}' cannot be read")
@@ -459,4 +463,4 @@ def _obj_materials(
             face_material[first_triangle:last] = slot(material_name)
     if not materials:
         materials.append(Material())
-    return materials, face_material, texture_files
+    return materials, face_material, texture_files, library_files

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from ..errors import SceneError, WhittedError
+from .farm import ClusterOption, SchedulerOption, animate_on_farm
 from .main import (
     EXIT_INTERRUPTED,
     _load,
@@ -96,6 +97,8 @@ def animate(
     crf: Annotated[int, typer.Option("--crf", help="MP4 quality: 0 best .. 51 worst")] = 18,
     force: Annotated[bool, typer.Option("--force", help="Render frames already on disk")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress output")] = False,
+    cluster: ClusterOption = None,
+    scheduler: SchedulerOption = None,
 ) -> None:
     """Render every frame of SCENE to numbered PNGs (FILM_frames/0000.png ...), then encode
     the film (H.264 MP4 or GIF). Frames already rendered from the same scene and settings are
@@ -128,6 +131,9 @@ def animate(
     if not folder.parent.exists():
         raise fail(f"{output}: the folder {folder.parent} does not exist")
     folder.mkdir(exist_ok=True)
+    if cluster is not None or scheduler is not None:  # frames on a Dask cluster (cli/farm.py)
+        animate_on_farm(scene, chosen, folder, film, fps=rate, crf=crf, force=force, quiet=quiet,
+                        cluster=cluster, scheduler=scheduler, threads=threads)
 
     renderer = FrameRenderer(threads)
     cancel = CancelToken()

@@ -26,6 +26,14 @@ class LazyConsole:
     def __getattr__(self, name: str):
         return getattr(self.console, name)
 
+    # special methods are looked up on the type, not through __getattr__: rich's Live (a
+    # Progress given console=err) enters the console as a context manager
+    def __enter__(self):
+        return self.console.__enter__()
+
+    def __exit__(self, *exc):
+        return self.console.__exit__(*exc)
+
 
 class _LazyText:
     """``rich.text.Text``, imported on first use: ``Text(...)`` and ``Text.assemble(...)``."""

@@ -41,6 +41,11 @@ AOV_NAMES = ("depth", "normal", "id")
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 130
 EXIT_TERMINATED = 143  # 128 + SIGTERM
+#: After an interrupt during the first compile the render thread is abandoned; the process
+#: then ends at once (os._exit) instead of waiting for the compiler to let the interpreter
+#: shut down (seconds). Tests that run the command in-process turn this off.
+EXIT_AT_ONCE_WHEN_ABANDONED = True
+_abandoned: list[bool] = []
 #: The longest error line printed (a file may hold a huge key or value: it is cut, not echoed).
 MESSAGE_LIMIT = 400
 
@@ -147,7 +152,7 @@ def render(
     from pydantic import ValidationError
 
     from ..output.encode import check_bit_depth, image_format
-    from ..render.api import RenderJob, render_aovs
+    from ..render.api import RenderJob
 
     process_start = time.perf_counter()
     aovs = _parse_aovs(aov)
@@ -196,19 +201,32 @@ def render(
     previous = {sig: signal.getsignal(sig) for sig in handled}
 
     def on_interrupt(signum, frame) -> None:  # Ctrl-C, SIGTERM: stop after the tiles in flight
+        if interrupted.is_set():  # the second one: stop now (a write in progress is undone)
+            raise KeyboardInterrupt
         signals.append(signum)
         interrupted.set()
         job.cancel()
 
+    # the handlers stay until the image is written: a signal during the write lets it finish
     for sig in handled:
         signal.signal(sig, on_interrupt)
+    try:
+        _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
+                          interrupted, signals, process_start, frame)
+    finally:
+        for sig in handled:
+            signal.signal(sig, previous[sig])
+
+
+def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet, interrupted,
+                      signals, process_start, frame: int | None) -> None:
+    from ..output.encode import image_format
+    from ..render.api import render_aovs
+
     try:
         _run_with_progress(job, quiet, interrupted)
     except WhittedError as exc:  # a model or texture file the scene names is unusable
         raise fail(_with_scene_key(exc, scene, name)) from None
-    finally:
-        for sig in handled:
-            signal.signal(sig, previous[sig])
     exit_code = EXIT_TERMINATED if signal.SIGTERM in signals else EXIT_INTERRUPTED
     stats = job.stats
     if interrupted.is_set() and (job.running or stats.tiles_done == 0):
@@ -216,6 +234,8 @@ def render(
         # and an existing file at the output path is left as it was
         what = "terminated" if signal.SIGTERM in signals else "interrupted"
         _note(f"{what} before any tile was finished: nothing written ({output} is unchanged)")
+        if job.running:
+            _abandoned.append(True)
         raise typer.Exit(exit_code)
     image = job.image
     assert image is not None
@@ -223,7 +243,13 @@ def render(
         err.print(Text(f"warning: {warning}"))
     written = [str(output)]
     try:
-        image.save(output, bit_depth=bit_depth)
+        if frame is not None and not interrupted.is_set() and bit_depth == 8 \
+                and image_format(output) == "png":  # the very file the film's frame K is
+            from ..animation.frames import frame_digest, write_frame_png
+
+            write_frame_png(output, image, frame_digest(scene, frame), frame)
+        else:
+            image.save(output, bit_depth=bit_depth)
         if aovs and not interrupted.is_set():
             planes = render_aovs(scene)
             for path, aov_name in zip(outputs[1:], aovs, strict=True):
@@ -237,10 +263,10 @@ def render(
     stats.wall_seconds = time.perf_counter() - process_start
     if not quiet or interrupted.is_set():
         out.print(Text(f"{stats.summary()} -> {', '.join(written)}"))
-    if interrupted.is_set():
+    if interrupted.is_set():  # (a signal may have come during the write)
         what = "terminated" if signal.SIGTERM in signals else "interrupted"
         _note(f"{what}: kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")
-        raise typer.Exit(exit_code)
+        raise typer.Exit(EXIT_TERMINATED if signal.SIGTERM in signals else EXIT_INTERRUPTED)
 
 
 def _with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
@@ -248,7 +274,7 @@ def _with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
     from ..scene.io import named_files
 
     file = getattr(exc, "file", None)
-    if not file:
+    if not file or file == name:
         return str(exc)
     for keys, named in named_files(scene):
         try:
@@ -283,14 +309,27 @@ def _override_error(exc: ValidationError) -> str:
     return f"{option}: {_clean_message(e)}"
 
 
-def _wait(job, interrupted: threading.Event) -> None:
+def _wait(job, interrupted: threading.Event, tick=None) -> None:
     """Wait for the job; after an interrupt, stop waiting at once if no tile is being rendered
-    yet (the first compile of the kernels takes many seconds and cannot be cut short)."""
+    yet (the first compile of the kernels takes many seconds and cannot be cut short).
+    ``tick()`` is called every tenth of a second meanwhile."""
     while job.running:
         job.join(0.1)
+        if tick is not None:
+            tick()
         if interrupted.is_set() and not job.rendering:
             return
     job.wait()
+
+
+def _show_compile(bar, task) -> None:
+    """While the first run compiles the kernels, the bar says so and how far along it is."""
+    from ..render.warm_up import compile_progress
+
+    fraction = compile_progress()
+    if fraction is not None:
+        bar.update(task, description="compiling the kernels (first run only)",
+                   completed=fraction)
 
 
 def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
@@ -307,21 +346,21 @@ def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
     )
 
     columns = (
-        TextColumn("[bold]rendering"),
+        TextColumn("[bold]{task.description}"),
         BarColumn(),
         TaskProgressColumn(),
         TextColumn("{task.fields[rays]} rays"),
         TimeRemainingColumn(),
     )
-    with Progress(*columns, console=err, transient=True) as bar:
-        task = bar.add_task("render", total=1.0, rays="0")
+    with Progress(*columns, console=err.console, transient=True) as bar:
+        task = bar.add_task("rendering", total=1.0, rays="0")
 
         def update(p) -> None:
-            bar.update(task, completed=p.fraction, rays=f"{p.rays:,}")
+            bar.update(task, description="rendering", completed=p.fraction, rays=f"{p.rays:,}")
 
         job.progress = update
         job.start()
-        _wait(job, interrupted)
+        _wait(job, interrupted, lambda: _show_compile(bar, task))
 
 
 def _model_info(path: Path) -> None:
@@ -381,9 +420,12 @@ def info(
         return
     try:
         scene, name = _load(scene_path)
-        compiled = compile_scene(scene.at_frame(0) if scene.is_animated else scene)
     except WhittedError as exc:
         raise fail(str(exc)) from None
+    try:
+        compiled = compile_scene(scene.at_frame(0) if scene.is_animated else scene)
+    except WhittedError as exc:  # a model or texture file the scene names is unusable
+        raise fail(_with_scene_key(exc, scene, name)) from None
     r = scene.render
     out.print(Text(name, style="bold"))
     if scene.animation is not None:
@@ -495,6 +537,8 @@ def export(
         raise fail(str(exc)) from None
     try:
         scene = scene.with_settings(width=width, height=height)
+        if scene.is_animated:  # POV-Ray gets the first frame, mesh sequences named
+            scene = scene.at_frame(0)
     except ValidationError as exc:
         raise fail(_override_error(exc)) from None
     if output is None:  # the whole stem: scene.v1.toml -> scene.v1.pov
@@ -502,7 +546,7 @@ def export(
     try:
         export_pov(scene, output, source=str(scene_path) if scene_path else name)
     except WhittedError as exc:
-        raise fail(str(exc)) from None
+        raise fail(_with_scene_key(exc, scene, name)) from None
     except OSError as exc:
         raise fail(f"{output}: cannot write: {exc.strerror or exc}") from None
     r = scene.render
@@ -560,8 +604,11 @@ def main() -> None:
     ends in a traceback (set WHITTED_DEBUG=1 to see one for an internal error)."""
     import os
 
+    _abandoned.clear()
     try:
         code = app(standalone_mode=False)
+        if _abandoned and EXIT_AT_ONCE_WHEN_ABANDONED:
+            _exit_now(code if isinstance(code, int) else 0)
     except UsageError as exc:
         command = "whitted" if exc.ctx is None or exc.ctx.parent is None else (
             f"whitted {exc.ctx.info_name}"
@@ -574,6 +621,8 @@ def main() -> None:
         sys.exit(EXIT_INTERRUPTED)
     except KeyboardInterrupt:
         sys.exit(EXIT_INTERRUPTED)
+    except typer.Exit as exc:  # raised with standalone_mode=False only by an eager callback
+        sys.exit(exc.exit_code)
     except WhittedError as exc:  # a user mistake a command did not catch itself
         err.print(Text.assemble(("error:", "bold red"), " ", one_line(str(exc))), soft_wrap=True)
         sys.exit(EXIT_USER_ERROR)
@@ -588,6 +637,17 @@ def main() -> None:
             "traceback)")), soft_wrap=True)
         sys.exit(1)
     sys.exit(code if isinstance(code, int) else 0)
+
+
+def _exit_now(code: int) -> None:
+    """End the process now (output flushed), not waiting for an abandoned render thread."""
+    import contextlib
+    import os
+
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(OSError, ValueError):
+            stream.flush()
+    os._exit(code)
 
 
 # Commands in their own modules register themselves on `app` when imported.

@@ -112,7 +112,7 @@ def buffer_side(n_point_lights: int, n_prims: int, res: int = LIGHT_BUFFER_RES) 
     primitives: ``res``, less when so many lights share the LIGHT_BUFFER_CELLS budget, and
     less for a scene so small that finer cells would barely part its primitives further (at
     most CELLS_PER_PRIMITIVE cells each: a one-sphere scene gets 6 a side and builds at once)."""
-    if n_point_lights == 0:
+    if n_point_lights == 0 or res <= 0:  # res 0: no buffers at all
         return 0
     fit = min(LIGHT_BUFFER_CELLS / n_point_lights, CELLS_PER_PRIMITIVE * max(1, n_prims))
     return max(1, min(res, int(np.sqrt(fit / 6))))

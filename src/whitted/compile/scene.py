@@ -28,7 +28,7 @@ from ..kernels.layout import (
 from ..scene.scene import Scene
 from ..scene.shapes import Mesh
 from .geometry import box_corners, corners_bounds
-from .light_buffers import build_light_buffers
+from .light_buffers import LIGHT_BUFFER_RES, build_light_buffers
 from .lights import light_rows
 from .materials import MaterialTable
 from .mesh_objects import FLATTEN_LIMIT, add_flat_mesh, mesh_key, mesh_source
@@ -64,12 +64,15 @@ def packed_nodes(bvh, dtype) -> tuple[np.ndarray, np.ndarray]:
     return box, link
 
 
-def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT) -> CompiledScene:
+def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
+                  light_buffers: bool = True) -> CompiledScene:
     """Flatten ``scene`` into the kernel layout and build the BVHs over its bounded shapes.
 
     A mesh whose copies (triangles x objects using it) come to at most ``flatten_limit``
     triangles becomes triangle primitives of the scene BVH, one copy per object; a bigger one
-    is stored once and instanced."""
+    is stored once and instanced. ``light_buffers=False`` skips the point lights' light
+    buffers: the same image (shadow rays then walk the BVH), built in a fraction of the time,
+    which is what a small interactive preview wants."""
     import time
     from collections import Counter
 
@@ -149,7 +152,8 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT) -> CompiledS
                                                                     N_MAT_PARAMS)
     light_table, ambient = light_rows(scene)
     lights = build_light_buffers(geometry, mat_table, light_table,
-                                 has_instances=len(instances) > 0)
+                                 has_instances=len(instances) > 0,
+                                 res=LIGHT_BUFFER_RES if light_buffers else 0)
     if finite.any():
         bmin, bmax = lo[finite].min(axis=0), hi[finite].max(axis=0)
     else:

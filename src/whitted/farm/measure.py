@@ -61,8 +61,10 @@ def measure_local(scene, folder: Path, threads: int = 2) -> dict:
     for k in range(scene.frame_count):
         renderer.render(scene.at_frame(k), k, folder / f"{k:04d}.png", force=True)
     wall = time.perf_counter() - start
-    return {"threads": threads, "wall_s": wall, "cpu_s": time.process_time() - cpu,
-            "per_frame_s": wall / scene.frame_count}
+    cpu = time.process_time() - cpu
+    n = scene.frame_count
+    return {"threads": threads, "wall_s": wall, "cpu_s": cpu, "per_frame_s": wall / n,
+            "per_frame_cpu_s": cpu / n}
 
 
 def measure_cluster(scene, workers: int, folder: Path, overhead: bool) -> dict:
@@ -85,6 +87,7 @@ def measure_cluster(scene, workers: int, folder: Path, overhead: bool) -> dict:
         result = render_film(client, scene, folder, force=True)
         row["wall_s"] = time.perf_counter() - start
         row["per_frame_worker_s"] = result.render_seconds / max(1, len(result.rendered))
+        row["per_frame_worker_cpu_s"] = result.render_cpu_seconds / max(1, len(result.rendered))
         row["tasks"] = result.tasks
         sizes = [p.stat().st_size for p in result.paths]
         row["png_bytes_mean"] = statistics.mean(sizes)

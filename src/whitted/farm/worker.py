@@ -118,6 +118,7 @@ class FrameOutcome:
     png: bytes | None
     error: str = ""
     seconds: float = 0.0
+    cpu_seconds: float = 0.0  # this task thread's CPU time (all of it with 1 render thread)
     warnings: list[str] = field(default_factory=list)
 
 
@@ -151,7 +152,7 @@ def render_frame_chunk(scene: Scene, frames: list[int], digests: list[str],
     prepared, client_names = _prepared(scene, manifest, blobs or {})
     outcomes = []
     for frame, digest in zip(frames, digests, strict=True):
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.thread_time()
         try:
             still = still_for_frame(prepared, frame, **settings)
             compiled, _ = renderer.compile(still)
@@ -163,5 +164,6 @@ def render_frame_chunk(scene: Scene, frames: list[int], digests: list[str],
                                          client_names(reason) or type(exc).__name__))
             continue
         outcomes.append(FrameOutcome(frame, png, seconds=time.perf_counter() - start,
+                                     cpu_seconds=time.thread_time() - cpu,
                                      warnings=[client_names(w) for w in job.stats.warnings]))
     return outcomes

@@ -55,4 +55,6 @@ class SceneEdit(QUndoCommand):
             return False
         self.after = other.after
         self.select_after = other.select_after
+        if self.after == self.before:  # e.g. a colour picker cancelled: no step at all
+            self.setObsolete(True)
         return True

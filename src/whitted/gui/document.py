@@ -13,6 +13,7 @@ from PySide6.QtGui import QUndoStack
 
 from ..scene import Scene
 from .commands import SceneEdit
+from .keyframes import tracks_following_items
 from .messages import friendly_message
 
 #: what is selected: ("camera",), ("render",), ("background",), ("lights", i), ("objects", i)
@@ -39,6 +40,8 @@ def scene_fields(scene: Scene) -> dict[str, Any]:
 def rebuild_scene(scene: Scene, **update: Any) -> Scene:
     """A new validated scene with some top-level fields replaced; same base folder."""
     fields = scene_fields(scene)
+    if "animation" not in update:  # tracks follow renamed, moved and deleted items
+        update["animation"] = tracks_following_items(scene, update) or scene.animation
     fields.update(update)
     try:
         new = Scene(**fields)
@@ -154,6 +157,11 @@ class SceneDocument(QObject):
         self.undo_stack.setClean()
         self.path_changed.emit()
 
+    def show_pose(self, scene: Scene) -> None:
+        """Make ``scene`` current without an undo step: the timeline posing the scene at a
+        frame (the values its tracks drive), which is a view of the scene, not an edit."""
+        self._replace(scene, self.selection)
+
     def item(self, key: SelectionKey | None = None) -> BaseModel | None:
         return item_of(self.scene, self.selection if key is None else key)
 
@@ -178,13 +186,15 @@ class SceneDocument(QObject):
         return True
 
     def edit_item(self, key: SelectionKey, data: dict[str, Any], text: str, *,
-                  merge_key: object = None) -> None:
-        """Replace the item at ``key`` by one built from ``data``; raises EditRefused."""
+                  merge_key: object = None, select: bool = True) -> None:
+        """Replace the item at ``key`` by one built from ``data`` (and select it, unless
+        ``select`` is False: moving the view keeps what is selected); raises EditRefused."""
         old = item_of(self.scene, key)
         if old is None:
             raise EditRefused("nothing selected")
         new_item = validate_like(old, data)
-        self.apply(with_item(self.scene, key, new_item), text, select=key, merge_key=merge_key)
+        self.apply(with_item(self.scene, key, new_item), text,
+                   select=key if select else None, merge_key=merge_key)
 
     def set_field(self, key: SelectionKey, path: tuple, value: Any, text: str, *,
                   merge_key: object = None) -> None:

@@ -40,10 +40,12 @@ from .document import (
     rebuild_scene,
     set_path,
 )
+from .icons import icon_for
 from .picking import IdBuffer, id_at, outline_image
 from .properties import PropertyPanel
 from .recent import RecentFiles
 from .render_controller import RenderController
+from .timeline import attach_timeline
 from .transform_tool import TransformTool, light_position, object_bounds, object_centre
 from .tree import SceneTree
 from .viewport import Viewport
@@ -92,6 +94,8 @@ class MainWindow(QMainWindow):
         self.tree = SceneTree(self.doc)
         self.properties = PropertyPanel(self.doc)
         self.properties.choose_file = self.choose_file
+        self.properties.ask_keep_colour = self.ask_keep_colour
+        self.properties.interacting.connect(self._interacting)
         self._dock(self.tree, "Scene", Qt.DockWidgetArea.LeftDockWidgetArea, 240)
         self._dock(self.properties, "Properties", Qt.DockWidgetArea.RightDockWidgetArea, 390)
 
@@ -103,10 +107,12 @@ class MainWindow(QMainWindow):
         self.eta = QLabel("", self)
         self.statusBar().addPermanentWidget(self.eta)
         self.statusBar().addPermanentWidget(self.progress)
+        self.progress.hide()  # only while a render runs
 
         self._make_actions()
         self._make_menus()
         self._make_toolbar()
+        self.timeline = attach_timeline(self)  # frames of an animated scene, keys, films
 
         self.doc.changed.connect(self._scene_changed)
         self.doc.path_changed.connect(self._update_title)
@@ -124,8 +130,8 @@ class MainWindow(QMainWindow):
         self.viewport.clicked.connect(self.pick)
         self.viewport.key_handler = self._viewport_key
         self.viewport.overlay = self._draw_overlay
-        self.viewport.drag_started.connect(lambda: self.controller.set_interacting(True))
-        self.viewport.drag_finished.connect(lambda: self.controller.set_interacting(False))
+        self.viewport.drag_started.connect(lambda: self._interacting(True))
+        self.viewport.drag_finished.connect(lambda: self._interacting(False))
         self.viewport.orbit.connect(self._orbit)
         self.viewport.pan.connect(self._pan)
         self.viewport.zoom.connect(self._zoom)
@@ -138,7 +144,8 @@ class MainWindow(QMainWindow):
         if warm_up:
             self.viewport.caption = "Loading the render kernels (the first run compiles them)…"
             self.controller.warm_up()
-        self.controller.request_preview(self.doc.scene)
+            self.ids.warm_up(self.doc.scene)
+        self.controller.request_preview(self.timeline.still(self.doc.scene))
 
     # ------------------------------------------------------------------ layout
 
@@ -218,12 +225,15 @@ class MainWindow(QMainWindow):
         self.object_actions: dict[str, QAction] = {}
         for kind, text in catalog.OBJECT_KINDS.items():
             self.object_actions[kind] = self._action(text, lambda k=kind: self.add_object(k))
+            self.object_actions[kind].setIcon(icon_for(kind))
         self.act_model = self._action("Model from file…", self.add_model,
                                       tip="OBJ, PLY, STL, OFF, glTF")
         self.act_model.setEnabled(catalog.HAS_MESH)
+        self.act_model.setIcon(icon_for("mesh"))
         self.light_actions: dict[str, QAction] = {}
         for kind, text in catalog.LIGHT_KINDS.items():
             self.light_actions[kind] = self._action(text, lambda k=kind: self.add_light(k))
+            self.light_actions[kind].setIcon(icon_for(f"light:{kind}"))
 
     def _make_menus(self) -> None:
         bar = self.menuBar()
@@ -263,10 +273,13 @@ class MainWindow(QMainWindow):
         tools = self.addToolBar("Main")
         tools.setObjectName("main toolbar")
         tools.setMovable(False)
-        for menu, text in ((self.add_object_menu, "Add object"),
-                           (self.add_light_menu, "Add light")):
+        tools.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
+        for menu, text, icon in ((self.add_object_menu, "Add object", "sphere"),
+                                 (self.add_light_menu, "Add light", "light:point")):
             button = QToolButton(self)
             button.setText(text)
+            button.setIcon(icon_for(icon))
+            button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
             button.setMenu(menu)
             button.setPopupMode(QToolButton.ToolButtonPopupMode.InstantPopup)
             tools.addWidget(button)
@@ -301,6 +314,18 @@ class MainWindow(QMainWindow):
             f"{autosave.name} holds changes to {self.scene_name()} that were never saved "
             "(the editor closed unexpectedly). Recover them?")
         return answer == QMessageBox.StandardButton.Yes
+
+    def ask_keep_colour(self, preset: str) -> str:
+        """A preset chosen over the object's own colour: keep the colour, or take the
+        preset's? ('keep', 'replace' or 'cancel')."""
+        box = QMessageBox(QMessageBox.Icon.Question, "Keep your colour?",
+                          f"The {preset} preset has a colour of its own. Keep this object's "
+                          "colour with the preset's other values?", parent=self)
+        keep = box.addButton("Keep my colour", QMessageBox.ButtonRole.AcceptRole)
+        replace = box.addButton(f"Use the {preset} colour", QMessageBox.ButtonRole.DestructiveRole)
+        box.addButton(QMessageBox.StandardButton.Cancel)
+        box.exec()
+        return {keep: "keep", replace: "replace"}.get(box.clickedButton(), "cancel")
 
     def ask_open_path(self) -> Path | None:
         name, _ = QFileDialog.getOpenFileName(self, "Open scene", self._start_dir(), SCENE_FILTER)
@@ -567,7 +592,7 @@ class MainWindow(QMainWindow):
         if not (0 <= u <= 1 and 0 <= v <= 1):
             return None
         try:
-            ids = self.ids.ids_for(self.doc.scene)
+            ids = self.ids.ids_for(self.timeline.still(self.doc.scene))
         except WhittedError as exc:
             self.statusBar().showMessage(f"Cannot pick: {exc}", 4000)
             return None
@@ -648,11 +673,11 @@ class MainWindow(QMainWindow):
     def _update_outline(self) -> None:
         """The selected object's outline over the picture (from the current id image)."""
         key = self.doc.selection
-        ids = self.ids.ids if self.ids.scene is self.doc.scene else None
+        ids = self.ids.ids if self.ids.scene is self.timeline.still(self.doc.scene) else None
         if key is None or key[0] != "objects":
             outline = None
         elif ids is None:
-            self.ids.request(self.doc.scene)
+            self.ids.request(self.timeline.still(self.doc.scene))
             return
         else:
             outline = outline_image(ids, key[1])
@@ -701,7 +726,7 @@ class MainWindow(QMainWindow):
         tool.start_uv = tool.uv = self.viewport.to_picture(start)
         self.viewport.tool = tool
         self._tool_edits = 0
-        self.controller.set_interacting(True)
+        self._interacting(True)
         return True
 
     def _tool_edit(self, key, transform, merge, mode: str) -> None:
@@ -724,7 +749,7 @@ class MainWindow(QMainWindow):
 
     def _tool_finished(self, confirmed: bool, tool) -> None:
         self.viewport.tool = None
-        self.controller.set_interacting(False)
+        self._interacting(False)
         if not confirmed and self._tool_edits:
             stack = self.doc.undo_stack
             command = stack.command(stack.index() - 1)
@@ -777,7 +802,9 @@ class MainWindow(QMainWindow):
 
     def _camera_edit(self, camera, text: str, merge) -> None:
         try:
-            self.doc.edit_item(CAMERA, camera.model_dump(), text, merge_key=merge)
+            # the view moves; the selection stays (the camera's panel, if shown, follows)
+            self.doc.edit_item(CAMERA, camera.model_dump(), text, merge_key=merge,
+                               select=False)
         except EditRefused as exc:
             self.statusBar().showMessage(str(exc), 3000)
 
@@ -816,6 +843,15 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ rendering
 
+    def _interacting(self, on: bool) -> None:
+        """A drag (mouse, slider, G/R/S) started or ended: coarse previews and no outline
+        updates during it (the CPU goes to the picture), refinement and the outline after."""
+        self.controller.set_interacting(on)
+        if on and self.viewport.tool is not None:  # the object moves: its old outline goes
+            self.viewport.outline = None          # (the bounding box follows it live)
+        if not on:
+            self._update_outline()
+
     def _update_preview_target(self) -> None:
         """Previews refine, when the input stops, up to the picture's size on screen."""
         r = self.viewport.fit_rect()
@@ -824,8 +860,9 @@ class MainWindow(QMainWindow):
 
     def _scene_changed(self, key=None) -> None:
         self._update_preview_target()
-        scene = self.doc.scene
-        if self.doc.selection is not None and self.doc.selection[0] == "objects":
+        scene = self.timeline.still(self.doc.scene)
+        if self.doc.selection is not None and self.doc.selection[0] == "objects" \
+                and not self.controller.interacting:  # (during a drag: when it ends)
             self.ids.request(scene)  # the outline follows
         self.viewport.set_aspect(scene.render.width, scene.render.height)
         self._update_title()
@@ -836,8 +873,9 @@ class MainWindow(QMainWindow):
 
     def start_render(self) -> None:
         self.commit_pending_edit()
-        self.controller.render(self.doc.scene)
+        self.controller.render(self.timeline.still(self.doc.scene))
         self.progress.setValue(0)
+        self.progress.show()
         self.eta.setText("starting…")
         self._update_render_actions()
 
@@ -876,12 +914,15 @@ class MainWindow(QMainWindow):
             self.viewport.caption = ""
             self.viewport.update()
         self.statusBar().showMessage(text, 8000)
+        self.progress.hide()
         self._update_render_actions()
 
     def _render_failed(self, kind: str, message: str) -> None:
         self.viewport.caption = f"cannot render: {message}"
         self.viewport.update()
         self.statusBar().showMessage(f"Cannot {kind}: {message}", 8000)
+        if not self.controller.rendering:
+            self.progress.hide()
         self._update_render_actions()
 
     def _kernels_ready(self, seconds: float) -> None:
@@ -897,7 +938,7 @@ class MainWindow(QMainWindow):
     def _toggle_preview(self, on: bool) -> None:
         self.controller.preview_enabled = on
         if on:
-            self.controller.request_preview(self.doc.scene)
+            self.controller.request_preview(self.timeline.still(self.doc.scene))
 
 
 def catalog_model_filter() -> str:

@@ -4,6 +4,7 @@ the current scene, computed on a background thread at about the picture's size, 
 
 from __future__ import annotations
 
+import contextlib
 import threading
 
 import numpy as np
@@ -80,6 +81,18 @@ class IdBuffer(QObject):
         self._poll = QTimer(self)
         self._poll.setInterval(30)
         self._poll.timeout.connect(self._collect)
+
+    def warm_up(self, scene: Scene) -> None:
+        """Load the id kernel now, on a background thread (loading it holds Python's lock
+        for a second or so: better while the editor starts than in a render's first second
+        after the first click)."""
+        small = scene.with_settings(width=4, height=3)
+
+        def work() -> None:
+            with contextlib.suppress(Exception):  # the preview reports a broken scene
+                object_ids(small, 4, 3)
+
+        threading.Thread(target=work, name="whitted-ids-warm-up", daemon=True).start()
 
     def request(self, scene: Scene) -> None:
         """Compute the ids of ``scene`` soon (a burst of edits computes once)."""

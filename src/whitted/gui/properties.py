@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from pydantic import BaseModel
-from PySide6.QtCore import Qt
+from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QApplication,
     QComboBox,
@@ -37,6 +37,7 @@ from .document import (
     label_of,
     set_path,
 )
+from .icons import swatch
 from .messages import friendly_message
 from .widgets import (
     BoolEditor,
@@ -80,12 +81,17 @@ def make_editor(spec: F.Spec) -> FieldEditor:
 
 class PropertyPanel(QWidget):
     """Shows the document's selected item. ``choose_file(title, filters)`` (set by the window)
-    asks for a file and returns its path or None."""
+    asks for a file and returns its path or None. ``interacting(bool)``: a slider is held
+    (the preview goes coarse and fast) or let go."""
+
+    interacting = Signal(bool)
 
     def __init__(self, doc: SceneDocument, parent=None) -> None:
         super().__init__(parent)
         self.doc = doc
         self.choose_file: Callable[[str, str], str | None] = lambda title, filters: None
+        #: choosing a preset over a custom colour: "keep" it, "replace" it or "cancel"
+        self.ask_keep_colour: Callable[[str], str] = lambda preset: "keep"
         self.rows: dict[tuple, FieldRow] = {}
         self.specs: dict[tuple, F.Spec] = {}
         self.material_combo: QComboBox | None = None
@@ -212,6 +218,7 @@ class PropertyPanel(QWidget):
             self.specs[spec.path] = spec
             editor.committed.connect(
                 lambda value, continuous, s=spec: self.commit(s, value, continuous))
+            editor.dragging.connect(self.interacting)
             if isinstance(editor, FileEditor):
                 editor.browse.connect(lambda s=spec, e=editor: self._browse(s, e))
         if key == CAMERA:
@@ -234,13 +241,17 @@ class PropertyPanel(QWidget):
         form.addRow(QLabel("Preset"), row)
         self.material_combo = combo
         self.material_row = row
-        combo.activated.connect(lambda i: self.choose_material(combo.itemData(i)))
+        # after the drop-down's own signal has finished (the edit refreshes the panel)
+        combo.activated.connect(lambda i: QTimer.singleShot(
+            0, lambda d=combo.itemData(i): self.choose_material(d)))
 
     def _camera_tools(self) -> QGroupBox:
         box = QGroupBox("Rotate the camera")
         form = QFormLayout(box)
         self.rotate_axis = QComboBox()
         self.rotate_axis.addItems(["X", "Y", "Z"])
+        self.rotate_axis.setToolTip("the world's X, Y or Z axis (not the camera's own), "
+                                    "through the camera or through its target")
         self.rotate_axis.setCurrentIndex(1)
         self.rotate_angle = NumberEditor()
         self.rotate_angle.set_value(15.0)
@@ -257,7 +268,7 @@ class PropertyPanel(QWidget):
         h.addWidget(self.rotate_axis)
         h.addWidget(self.rotate_row, 1)
         h.addWidget(button)
-        form.addRow("Axis, angle (°)", line)
+        form.addRow("World axis, angle (°)", line)
         form.addRow("Pivot", self.rotate_pivot)
         hint = QLabel("In the picture: drag to orbit, right- or Shift-drag to pan, wheel to zoom.")
         hint.setWordWrap(True)
@@ -297,22 +308,33 @@ class PropertyPanel(QWidget):
     def _fill_material_combo(self, key: tuple, item: BaseModel) -> None:
         combo = self.material_combo
         assert combo is not None
-        combo.clear()
         obj_file = getattr(item, "file", None) if getattr(item, "type", None) == "mesh" else None
+        entries: list[tuple[str, str]] = []
         if obj_file:
             count = len(self.file_materials(key) or []) if item.material is None else 0
             name = Path(obj_file).name
-            combo.addItem(f"From the model file ({name})" if not count or count == 1 else
-                          f"From the model file ({name}, {count} materials)", "file:")
-            combo.setItemData(0, "the materials the model's own file gives (its MTL, glTF...);"
-                                 " editing a value overrides them all with this one",
-                              Qt.ItemDataRole.ToolTipRole)
-        combo.addItem("Default (grey)", "default:")
-        for name in self.doc.scene.materials:
-            combo.addItem(f"{name} (scene material)", f"named:{name}")
-        for name in PRESETS:
-            combo.addItem(f"{name} (preset)", f"preset:{name}")
-        combo.addItem("Custom", "custom:")
+            entries.append((f"From the model file ({name})" if not count or count == 1 else
+                            f"From the model file ({name}, {count} materials)", "file:"))
+        entries.append(("Default (grey)", "default:"))
+        entries += [(f"{name} (scene material)", f"named:{name}")
+                    for name in self.doc.scene.materials]
+        entries += [(f"{name} (preset)", f"preset:{name}") for name in PRESETS]
+        entries.append(("Custom", "custom:"))
+        shown = [(combo.itemText(i), combo.itemData(i)) for i in range(combo.count())]
+        if shown != entries:  # (refilled only when the list changes: never under the user)
+            combo.clear()
+            for text, data in entries:
+                kind, _, name = data.partition(":")
+                if kind == "preset":
+                    preset = Material(preset=name)
+                    combo.addItem(swatch(preset.color, shiny=preset.kr > 0 or preset.ks > 0.3),
+                                  text, data)
+                else:
+                    combo.addItem(text, data)
+            if obj_file:
+                combo.setItemData(0, "the materials the model's own file gives (its MTL, "
+                                     "glTF...); editing a value overrides them all with this "
+                                     "one", Qt.ItemDataRole.ToolTipRole)
         ref = item.material
         if ref is None and obj_file:
             current = "file:"
@@ -414,6 +436,16 @@ class PropertyPanel(QWidget):
             data["material"] = name
         elif kind == "preset":
             data["material"] = {"preset": name}
+            mine = self.shown_material(key)
+            custom = isinstance(item.material, Material) and item.material != Material(
+                preset=item.material.preset) if item.material is not None else False
+            if custom and mine.color not in (Material(preset=name).color, Material().color):
+                answer = self.ask_keep_colour(name)
+                if answer == "cancel":
+                    self._fill_material_combo(key, item)
+                    return
+                if answer == "keep":
+                    data["material"] = {"preset": name, "color": mine.color}
         else:  # custom: this object's own copy of what it shows now
             data["material"] = self.shown_material(key).model_dump()
         try:

@@ -8,6 +8,7 @@ from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import QAbstractItemView, QTreeWidget, QTreeWidgetItem
 
 from .document import BACKGROUND, CAMERA, RENDER, SceneDocument, label_of
+from .icons import icon_for
 
 KEY_ROLE = Qt.ItemDataRole.UserRole
 
@@ -48,6 +49,7 @@ class SceneTree(QTreeWidget):
                               (BACKGROUND, "Background")):
                 item = QTreeWidgetItem([text])
                 item.setData(0, KEY_ROLE, key)
+                item.setIcon(0, icon_for(key[0]))
                 self.addTopLevelItem(item)
             for kind, title in (("lights", "Lights"), ("objects", "Objects")):
                 items = getattr(scene, kind)
@@ -58,6 +60,8 @@ class SceneTree(QTreeWidget):
                 for i, obj in enumerate(items):
                     child = QTreeWidgetItem([self.text_of(obj)])
                     child.setData(0, KEY_ROLE, (kind, i))
+                    child.setIcon(0, icon_for(obj.type if kind == "objects" else
+                                              f"light:{obj.type}"))
                     child.setToolTip(0, f"{obj.type} {'light' if kind == 'lights' else ''}")
                     child.setFlags(child.flags() | Qt.ItemFlag.ItemIsEditable)
                     group.addChild(child)

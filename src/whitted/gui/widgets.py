@@ -78,6 +78,8 @@ class FieldEditor(QWidget):
     refused = Signal(str)
     #: the field holds the scene's value again (typed back): its message goes away
     restored = Signal()
+    #: a continuous change (a slider held) started (True) or ended (False)
+    dragging = Signal(bool)
 
     def set_value(self, value: object) -> None:
         raise NotImplementedError
@@ -240,6 +242,8 @@ class CoefficientEditor(FieldEditor):
         box.addWidget(self.slider, 1)
         box.addWidget(self.line)
         self.slider.sliderPressed.connect(self._new_session)
+        self.slider.sliderPressed.connect(lambda: self.dragging.emit(True))
+        self.slider.sliderReleased.connect(lambda: self.dragging.emit(False))
         self.slider.valueChanged.connect(self._slid)
         self.line.editingFinished.connect(self._finish)
 
@@ -305,6 +309,8 @@ class ColourEditor(FieldEditor):
         box = _hbox(self, self.button)
         box.addWidget(self.line)
         box.addStretch(1)
+        self.session = 0
+        self.dialog: QColorDialog | None = None  # the picker while it is open
         self.button.clicked.connect(self.pick)
         self.line.editingFinished.connect(self._finish)
 
@@ -313,10 +319,29 @@ class ColourEditor(FieldEditor):
         self.line.show_text(text)
         self.button.setStyleSheet(f"background: {text}; border: 1px solid #666;")
 
-    def pick(self) -> None:
-        colour = QColorDialog.getColor(QColor(self.line.shown), self, "Colour")
-        if colour.isValid():
-            self.choose(colour.name())
+    def pick(self) -> QColorDialog:
+        """Open the colour picker; the scene (and so the picture) follows the colour while
+        it changes, as one undo step; Cancel puts the colour back."""
+        original = self.line.shown
+        self.session = next(_sessions)
+        dialog = QColorDialog(QColor(original), self)
+        dialog.setWindowTitle("Colour")
+        dialog.setOption(QColorDialog.ColorDialogOption.NoButtons, False)
+        dialog.currentColorChanged.connect(
+            lambda c: self.committed.emit(c.name().lower(), True))
+
+        def done(result: int) -> None:
+            if result == QColorDialog.DialogCode.Accepted:
+                self.committed.emit(dialog.selectedColor().name().lower(), True)
+            else:
+                self.committed.emit(original, True)  # merges away: nothing to undo
+            self.dialog = None
+            dialog.deleteLater()
+
+        dialog.finished.connect(done)
+        self.dialog = dialog
+        dialog.open()
+        return dialog
 
     def choose(self, text: str) -> None:
         """Commit ``#rrggbb`` (what the picker gives)."""

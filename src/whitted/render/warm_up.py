@@ -14,6 +14,12 @@ saves time.
 A marker file in the cache folder (``whitted-ready-plain`` / ``whitted-ready-instances``)
 records that a variant is complete there, so a warm start starts no helper.
 
+While a cold compile runs, :func:`compile_progress` says how far along it is (functions
+compiled here and in the helper, against the count a full compile of the variant takes,
+``EXPECTED_COMPILES``): the CLI shows it in its progress bar. Stopping is immediate: an
+exception in the compile (Ctrl-C's ``KeyboardInterrupt`` in the main thread) stops the helper
+instead of waiting for it, and a helper whose parent has gone ends itself.
+
 Measured on the 2-core VM (fresh cache, the default scene's ``whitted render``): see
 docs/performance.md.
 """
@@ -43,6 +49,12 @@ _lock = threading.Lock()
 _ready: set[bool] = set()  # render kernel variants loaded here: with / without mesh instances
 _builders_ready = False
 HELPER_WAIT_SECONDS = 120.0  # a helper still busy after this is stopped (never expected)
+#: functions Numba compiles in a cold compile of each variant, this process and the helper
+#: together (counted on the 2-core VM, twice: 55 + 90 for the plain variant; 14 + 28 for the
+#: instance variant once the plain one is cached, as the render API compiles the plain
+#: variant first). Only the progress shown depends on it: a count that drifted (kernels
+#: changed, a different split between the processes) makes the fraction approximate.
+EXPECTED_COMPILES = {False: 145, True: 42}
 TINY_OBJ = b"""v 0 0 0
 v 1 0 0
 v 0 1 0
@@ -90,7 +102,7 @@ def _compile_builders() -> None:
         _builders_ready = True
 
 
-def _compile_render_kernels(compiled: CompiledScene) -> None:
+def _compile_render_kernels(compiled: CompiledScene, aovs: bool = True) -> None:
     from ..kernels.tiles import lane_workspace, render_aovs, render_tiles
 
     scene = _builders_scene()
@@ -101,6 +113,8 @@ def _compile_render_kernels(compiled: CompiledScene) -> None:
     no_tiles = np.zeros((0, 4), np.int32)  # compiles (or loads) without rendering
     render_tiles(no_tiles, fb, compiled.geometry, compiled.materials, compiled.lights,
                  params, counters, lane_workspace(params.max_depth), 0, 1)
+    if not aovs:
+        return
     render_aovs(compiled.geometry, params._replace(height=0), np.zeros((1, 1), np.float32),
                 np.zeros((1, 1, 3), np.float32), np.zeros((1, 1), np.int32),
                 lane_workspace(0), 0, 1)
@@ -109,6 +123,58 @@ def _compile_render_kernels(compiled: CompiledScene) -> None:
 def _marker(instances: bool) -> Path:
     return Path(configure_kernel_cache()) / (
         "whitted-ready-instances" if instances else "whitted-ready-plain")
+
+
+class _CompileCount:
+    """Functions compiled so far in this process (Numba's ``numba:compile`` events) and in
+    the helper (one line on its stdout per function), while a cold compile runs."""
+
+    def __init__(self, expected: int) -> None:
+        self.expected = expected
+        self.here = 0
+        self.helper = 0
+
+    @property
+    def fraction(self) -> float:
+        return min(0.99, (self.here + self.helper) / max(1, self.expected))
+
+    def read_helper(self, pipe) -> None:
+        for _line in pipe:  # on a thread of its own; ends when the helper closes its stdout
+            self.helper += 1
+
+
+class _CountCompiles:
+    """A Numba event listener adding one to ``count.here`` per function compiled."""
+
+    def __init__(self, count: _CompileCount) -> None:
+        from numba.core import event
+
+        class Listener(event.Listener):
+            def on_start(self, ev) -> None:
+                pass
+
+            def on_end(self, ev) -> None:
+                count.here += 1
+
+        self._event = event
+        self._listener = Listener()
+
+    def __enter__(self):
+        self._event.register("numba:compile", self._listener)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._event.unregister("numba:compile", self._listener)
+
+
+_progress: _CompileCount | None = None
+
+
+def compile_progress() -> float | None:
+    """How far along the first (cold) compile of the kernels is, 0..1; None when no compile
+    is running (the kernels load from the cache in a fraction of a second)."""
+    count = _progress
+    return None if count is None else count.fraction
 
 
 def _start_helper(instances: bool) -> subprocess.Popen | None:
@@ -121,8 +187,9 @@ def _start_helper(instances: bool) -> subprocess.Popen | None:
     try:
         return subprocess.Popen(
             [sys.executable, "-m", "whitted.render.warm_up",
-             "instances" if instances else "plain"],
-            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+             "instances" if instances else "plain", str(os.getpid())],
+            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+            text=True)
     except OSError:  # no interpreter to start (frozen app, exotic platform): compile alone
         return None
 
@@ -135,6 +202,12 @@ def _finish_helper(helper: subprocess.Popen | None) -> None:
     try:
         helper.wait(HELPER_WAIT_SECONDS)
     except subprocess.TimeoutExpired:
+        _stop_helper(helper)
+
+
+def _stop_helper(helper: subprocess.Popen | None) -> None:
+    """End the helper now (the compile was interrupted): what it cached so far stays."""
+    if helper is not None and helper.poll() is None:
         helper.kill()
         helper.wait()
 
@@ -142,24 +215,49 @@ def _finish_helper(helper: subprocess.Popen | None) -> None:
 def warm_up_kernels(compiled: CompiledScene | None = None) -> float:
     """Compile (first run) or load from the on-disk cache (later runs) the render kernels for
     scenes like ``compiled`` (kernels are specialised for scenes with and without mesh
-    instances; without when None) and the builders. Returns the seconds it took; 0 when all
-    of it was already loaded in this process."""
+    instances; without when None); on the first run also the builders and the AOV kernel.
+    Returns the seconds it took; 0 when all of it was already loaded in this process."""
     with _lock:
         instances = kernel_variant(compiled) if compiled is not None else False
-        if instances in _ready and _builders_ready:
+        if instances in _ready:
             return 0.0
         start = time.perf_counter()
         marker = _marker(instances)
-        helper = None if marker.exists() else _start_helper(instances)
-        try:
+        if marker.exists():
+            # warm: load the render kernel only; the builders, the model loaders and the AOV
+            # kernel load from the cache when first called (a scene without OBJ files never
+            # loads the OBJ reader, a plain render never the AOV kernel)
             _compile_render_kernels(compiled if compiled is not None
-                                    else stand_in_scene(instances))
-        finally:
-            _finish_helper(helper)
-        _compile_builders()
+                                    else stand_in_scene(instances), aovs=False)
+        else:
+            _cold_compile(instances, compiled)
         marker.touch()
         _ready.add(instances)
         return time.perf_counter() - start
+
+
+def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
+    """Compile the variant here while the helper compiles the large callees and the
+    builders, counting both for :func:`compile_progress`; on any exception (Ctrl-C) the
+    helper is stopped at once rather than waited for."""
+    global _progress
+    count = _CompileCount(EXPECTED_COMPILES[instances])
+    helper = _start_helper(instances)
+    if helper is not None and helper.stdout is not None:
+        threading.Thread(target=count.read_helper, args=(helper.stdout,),
+                         name="whitted-compile-helper-output", daemon=True).start()
+    _progress = count
+    try:
+        with _CountCompiles(count):
+            _compile_render_kernels(compiled if compiled is not None
+                                    else stand_in_scene(instances))
+            _finish_helper(helper)
+            _compile_builders()
+    except BaseException:
+        _stop_helper(helper)
+        raise
+    finally:
+        _progress = None
 
 
 def precompile_for_render(instances: bool) -> None:
@@ -173,5 +271,45 @@ def precompile_for_render(instances: bool) -> None:
     _compile_builders()
 
 
+def _end_with_parent(parent: int) -> None:
+    """The helper's watchdog: end this process when the process that started it has gone
+    (killed, or stopped without waiting), instead of compiling for nobody."""
+    while True:
+        time.sleep(0.2)
+        if os.getppid() != parent:
+            os._exit(1)
+
+
+def _helper_main(argv: list[str]) -> None:
+    instances = bool(argv) and argv[0] == "instances"
+    if len(argv) > 1:
+        threading.Thread(target=_end_with_parent, args=(int(argv[1]),), daemon=True).start()
+
+    class Report:  # one line per function compiled: the parent counts them for its progress
+        def __enter__(self):
+            from numba.core import event
+
+            class Listener(event.Listener):
+                def on_start(self, ev) -> None:
+                    pass
+
+                def on_end(self, ev) -> None:
+                    print(".", flush=True)
+
+            self.listener = Listener()
+            event.register("numba:compile", self.listener)
+
+        def __exit__(self, *exc) -> None:
+            from numba.core import event
+
+            event.unregister("numba:compile", self.listener)
+
+    try:
+        with Report():
+            precompile_for_render(instances)
+    except BrokenPipeError:  # the parent stopped reading: it has gone
+        os._exit(1)
+
+
 if __name__ == "__main__":
-    precompile_for_render(len(sys.argv) > 1 and sys.argv[1] == "instances")
+    _helper_main(sys.argv[1:])

@@ -43,6 +43,11 @@ def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene file. Raises :class:`SceneError` with file, key path and line."""
     from ..assets.files import path_problem, read_limited
 
+    if not isinstance(path, str | os.PathLike):
+        from ..errors import ArgumentError
+
+        raise ArgumentError(f"load_scene needs the path of a scene file, got "
+                            f"{type(path).__name__}")
     path = Path(path)
     name = str(path)
     # Existence first: "no such file" is more useful than "unknown format" for a typo'd path.
@@ -580,7 +585,13 @@ def save_scene(scene: Scene, path: str | Path) -> Path:
     suffix = path.suffix.lower()
     data = scene_to_dict(scene)
     if suffix == ".toml":
-        payload = tomli_w.dumps(data).encode()
+        animation = data.pop("animation", None)
+        text = tomli_w.dumps(data)
+        if animation is not None:  # one key per line, not one number per line
+            from ..animation.model import animation_toml
+
+            text += "\n" + animation_toml(animation)
+        payload = text.encode()
     elif suffix == ".json":
         payload = (json.dumps(data, indent=2) + "\n").encode()
     else:

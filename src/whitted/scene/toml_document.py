@@ -128,10 +128,13 @@ def compact_toml(scene: Scene) -> str:
         if value is not None and value != _scene_default(name):
             doc[name] = _table(compact_data(value)) if isinstance(value, BaseModel) else \
                 _item(_plain(value))
+    if scene.animation is not None:
+        doc["animation"] = _animation_table(scene.animation)
     return tomlkit.dumps(doc)
 
 
-_KNOWN_FIELDS = ("render", "camera", "background", "materials", "lights", "objects")
+_KNOWN_FIELDS = ("render", "camera", "background", "materials", "lights", "objects",
+                 "animation")  # the [animation] table: see below
 _OTHER_FIELDS = tuple(n for n in Scene.model_fields if n not in _KNOWN_FIELDS)
 
 
@@ -272,7 +275,106 @@ def edit_toml(text: str, old: Scene, new: Scene) -> str:
         else:
             doc[name] = _table(compact_data(n)) if isinstance(n, BaseModel) else \
                 _item(_plain(n))
+    if old.animation != new.animation:
+        _update_animation(doc, old.animation, new.animation)
     return tomlkit.dumps(doc)
+
+
+# ---------------------------------------------------------------------- the [animation] table
+
+
+def _keys_array(keys: list) -> Array:
+    """A track's keys, one ``[frame, value]`` a line (as people write them)."""
+    array = tomlkit.array()
+    for frame, value in sorted(keys, key=lambda k: k[0]):
+        array.append(tomlkit.item([frame, _plain(value)]))
+    array.multiline(len(keys) > 1)
+    return array
+
+
+def _track_table(track: Any) -> Table:
+    table = tomlkit.table()
+    table.trivia.indent = "\n"  # a blank line before each [[animation.tracks]]
+    table["path"] = track.path
+    if track.interpolation != "linear":
+        table["interpolation"] = track.interpolation
+    table["keys"] = _keys_array(track.keys)
+    return table
+
+
+def _animation_table(animation: Any) -> Table:
+    """``[animation]`` with its non-default values, then one ``[[animation.tracks]]`` each."""
+    table = tomlkit.table()
+    for name, value in compact_data(animation).items():
+        if name != "tracks":
+            table[name] = _item(value)
+    if animation.tracks:
+        aot = tomlkit.aot()
+        for track in animation.tracks:
+            aot.append(_track_table(track))
+        table["tracks"] = aot
+    return table
+
+
+def _update_track(table: Any, old: Any, new: Any) -> None:
+    for name in ("path", "interpolation"):
+        _set_field(table, name, old, new)
+    if old.keys == new.keys:
+        return
+    array = table.get("keys")
+    if not isinstance(array, Array) or (len(new.keys) > 1 and "\n" not in array.as_string()):
+        table["keys"] = _keys_array(new.keys)  # a one-line array grows into one key a line
+        return
+    ops = difflib.SequenceMatcher(None, [repr(k) for k in old.keys],
+                                  [repr(k) for k in new.keys], autojunk=False).get_opcodes()
+    for tag, i1, i2, j1, j2 in reversed(ops):  # keys not changed keep their spelling
+        if tag == "equal":
+            continue
+        paired = min(i2 - i1, j2 - j1) if tag == "replace" else 0
+        for k in range(paired):
+            frame, value = new.keys[j1 + k]
+            array[i1 + k] = tomlkit.item([frame, _plain(value)])
+        for index in range(i2 - 1, i1 + paired - 1, -1):
+            del array[index]
+        for k in range(j2 - 1, j1 + paired - 1, -1):
+            frame, value = new.keys[k]
+            array.insert(i1 + paired, tomlkit.item([frame, _plain(value)]))
+
+
+def _update_animation(doc: Any, old: Any, new: Any) -> None:
+    """Write the changes of the ``[animation]`` table: frames and fps in place, tracks
+    matched item by item (a new key rewrites that track's keys only)."""
+    node = doc.get("animation")
+    if new is None:
+        if node is not None:
+            del doc["animation"]
+        return
+    if old is None or not isinstance(node, Table):
+        doc["animation"] = _animation_table(new)
+        return
+    for name in ("frames", "fps"):
+        _set_field(node, name, old, new)
+    tracks = node.get("tracks")
+    if not isinstance(tracks, AoT):
+        if "tracks" in node:
+            del node["tracks"]
+        if new.tracks:
+            node["tracks"] = _animation_table(new)["tracks"]
+        return
+    ops = difflib.SequenceMatcher(None, [_key(t) for t in old.tracks],
+                                  [_key(t) for t in new.tracks], autojunk=False).get_opcodes()
+    for tag, i1, i2, j1, j2 in reversed(ops):
+        if tag == "equal":
+            continue
+        paired = min(i2 - i1, j2 - j1) if tag == "replace" else 0
+        for k in range(paired):
+            _update_track(tracks[i1 + k], old.tracks[i1 + k], new.tracks[j1 + k])
+        for index in range(i2 - 1, i1 + paired - 1, -1):
+            del tracks[index]
+        for k in range(j2 - 1, j1 + paired - 1, -1):
+            tracks.insert(i1 + paired, _track_table(new.tracks[k]))
+    if not new.tracks:
+        del node["tracks"]
 
 
 def _loads(text: str, scene: Scene) -> Scene | None:
