@@ -2,9 +2,17 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
+
+# Property tests draw the same cases on every run (CI and here): a failure is reproducible,
+# and a run never fails on a case no earlier run drew. Explore with HYPOTHESIS_PROFILE=explore.
+settings.register_profile("whitted", derandomize=True, database=None, deadline=None)
+settings.register_profile("explore", deadline=None)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "whitted"))
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 

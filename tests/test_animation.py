@@ -441,7 +441,8 @@ def test_rotations_turn_steadily_the_short_way(a, b, mode):
     frames = [interpolate_rotation([0, steps], [a, b], k, mode) for k in range(steps + 1)]
     np.testing.assert_allclose(_matrix(frames[-1]), _matrix(b), atol=1e-9)
     turned = sum(_angle_between(frames[k], frames[k + 1]) for k in range(steps))
-    assert turned == pytest.approx(total, abs=1e-5)  # no detour, no flip
+    # no detour, no flip (either would add degrees; arccos near 1 costs ~1e-5 of rounding)
+    assert turned == pytest.approx(total, abs=1e-4)
 
 
 _names = st.text(st.characters(whitelist_categories=("L", "N"), whitelist_characters=" _-"),

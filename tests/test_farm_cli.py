@@ -125,6 +125,7 @@ def test_animate_on_a_local_cluster_writes_the_local_frames_and_film(tmp_path):
     again = whitted("animate", scene, "-o", tmp_path / "farm.mp4", "--cluster", "local:2",
                     cwd=tmp_path)  # resume: every frame is current
     assert again.returncode == 0 and "6 already done" in again.stdout
+    assert "farm:" not in again.stderr  # nothing to render: no cluster was started
 
 
 @pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="Numba's default pool is 1 thread")

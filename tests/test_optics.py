@@ -171,3 +171,74 @@ def test_shadow_through_more_sheets_than_one_gather_holds():
     )
     value = whitted.render(scene).pixels[0, 0]
     assert value == pytest.approx([kt**40] * 3, rel=1e-3)
+
+
+# --- a surface between two named media: Mesh(outside=...) ---------------------------------
+
+ICE_N, WATER_N = 1.31, 1.333
+
+
+def _box_mesh(lo, hi, **fields) -> whitted.Mesh:
+    """A closed box as a triangle mesh, faces counter-clockwise seen from outside."""
+    x0, y0, z0 = lo
+    x1, y1, z1 = hi
+    v = np.array([[x0, y0, z0], [x1, y0, z0], [x1, y1, z0], [x0, y1, z0],
+                  [x0, y0, z1], [x1, y0, z1], [x1, y1, z1], [x0, y1, z1]], float)
+    f = np.array([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4],
+                  [2, 3, 7], [2, 7, 6], [1, 2, 6], [1, 6, 5], [0, 4, 7], [0, 7, 3]])
+    return whitted.Mesh(v, f, **fields)
+
+
+def _with_named_ice(scene: whitted.Scene) -> whitted.Scene:
+    return scene.model_copy(update={"materials": {"ice": _glass(ICE_N)}})
+
+
+def test_refraction_from_water_into_ice_is_total_beyond_79_degrees():
+    critical = math.degrees(math.asin(ICE_N / WATER_N))  # 79.34 deg
+    assert critical == pytest.approx(79.34, abs=0.01)
+    for angle, expect_ok in ((critical - 0.3, True), (critical + 0.3, False)):
+        d = (math.sin(math.radians(angle)), -math.cos(math.radians(angle)), 0.0)
+        ok, _ = refract(d, (0.0, 1.0, 0.0), WATER_N / ICE_N)
+        assert ok is expect_ok
+
+
+def test_water_cavity_mesh_in_ice_bends_by_their_ratio_both_ways():
+    """An ice slab holding a water cavity whose one surface names ice outside: ice -> water
+    and water -> ice each bend once by n_ice/n_water, the shift is the layered slabs'."""
+    theta = 40.0
+    ice = whitted.Box(min=(-5, -5, -1), max=(5, 5, 1), material="ice")
+    water = _box_mesh((-4, -4, -0.5), (4, 4, 0.5), material=_glass(WATER_N), outside="ice")
+    base, _ = _centroid_x(_target_scene([], theta))
+    shifted, _ = _centroid_x(_with_named_ice(_target_scene([ice, water], theta)))
+    right = _parallel_shift(math.radians(theta), [(1.0, ICE_N), (1.0, WATER_N)])
+    assert abs(shifted - base) == pytest.approx(right, abs=0.3 * PIXEL)
+
+
+def test_the_named_outside_medium_is_the_one_left_and_entered():
+    """A water box that declares ice around it bends by n_ice/n_water where it is entered and
+    left, whatever the ray came through (here air): the ray comes out parallel, shifted by
+    tan(theta) - tan(theta_w) with sin(theta_w) = sin(theta) n_ice / n_water, far less than
+    air -> water would shift it."""
+    theta = 50.0
+    th = math.radians(theta)
+    water = _box_mesh((-5, -5, -0.5), (5, 5, 0.5), material=_glass(WATER_N), outside="ice")
+    base, _ = _centroid_x(_target_scene([], theta))
+    shifted, _ = _centroid_x(_with_named_ice(_target_scene([water], theta)))
+    inside = math.asin(math.sin(th) * ICE_N / WATER_N)
+    declared = (math.tan(th) - math.tan(inside)) * math.cos(th)
+    from_air = _parallel_shift(th, [(1.0, WATER_N)])
+    assert from_air - declared > 20 * PIXEL  # the two rules are far apart
+    assert abs(shifted - base) == pytest.approx(declared, abs=0.3 * PIXEL)
+
+
+def test_named_outside_is_the_same_for_flattened_and_instanced_meshes():
+    from whitted.compile.scene import compile_scene
+
+    ice = whitted.Box(min=(-5, -5, -1), max=(5, 5, 1), material="ice")
+    water = _box_mesh((-4, -4, -0.5), (4, 4, 0.5), material=_glass(WATER_N), outside="ice")
+    scene = _with_named_ice(_target_scene([ice, water], 35.0, samples=1))
+    flat = whitted.render(scene).pixels
+    job = whitted.RenderJob(scene, compiled=compile_scene(scene, flatten_limit=0))
+    job.start()
+    instanced = job.wait().pixels
+    assert flat.max() > 0.5 and np.array_equal(flat, instanced)

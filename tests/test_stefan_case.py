@@ -126,6 +126,9 @@ def test_breach_stops_or_drains(tmp_path, action):
     case = Case.model_validate(data)
     result = run_case(case, "", tmp_path / action)
     assert result.breach_time is not None and result.breach_time < 2400.0
+    rows = list(csv.DictReader((tmp_path / action / "series.csv").open()))
+    assert rows[0]["breach_time_s"] == ""
+    assert float(rows[-1]["breach_time_s"]) == pytest.approx(result.breach_time)
     if action == "stop":
         assert result.end_time == pytest.approx(result.breach_time)
     else:

@@ -108,7 +108,12 @@ def animate_on_farm(scene: Scene, frames: range, folder: Path, film: Path | None
     note = None if quiet else (lambda line: err.print(line, markup=False, highlight=False))
     finished: list[int | None] = []
     try:
-        with farm.farm_client(cluster, scheduler, threads=threads, note=note) as client:
+        farm.check_farm_options(cluster, scheduler)
+        plan = farm.plan_film(scene, folder, frames=frames, force=force)
+        # a cluster only when frames are missing: a finished film is only encoded
+        connect = (farm.farm_client(cluster, scheduler, threads=threads, note=note)
+                   if plan.todo else nullcontext())
+        with connect as client:
             progress = bar("frames", quiet)
 
             def frame_done(done: int, total: int, frame: int | None) -> None:
@@ -120,8 +125,8 @@ def animate_on_farm(scene: Scene, frames: range, folder: Path, film: Path | None
 
             with progress if progress is not None else nullcontext():
                 task = progress.add_task("frames", total=len(frames)) if progress else None
-                result = farm.render_film(client, scene, folder, frames=frames, film=film,
-                                          fps=fps, crf=crf, force=force, progress=frame_done)
+                result = farm.render_film(client, scene, folder, film=film, fps=fps, crf=crf,
+                                          progress=frame_done, plan=plan)
     except KeyboardInterrupt:
         err.print(f"interrupted: {len(finished)} of {len(frames)} frames finished in {folder}; "
                   "run the same command again to continue")

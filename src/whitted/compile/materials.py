@@ -16,6 +16,7 @@ from ..kernels.layout import (
     MAT_KR,
     MAT_KS,
     MAT_KT,
+    MAT_OUTSIDE,
     MAT_SHININESS,
     MAT_SPECULAR,
     MAT_TEXTURE,
@@ -24,8 +25,9 @@ from ..kernels.layout import (
 from ..scene.materials import Material
 
 
-def material_row(mat: Material, texture: int = -1) -> np.ndarray:
-    """The material table row of ``mat``; ``texture`` is its row in the texture table."""
+def material_row(mat: Material, texture: int = -1, outside: int = -1) -> np.ndarray:
+    """The material table row of ``mat``; ``texture`` is its row in the texture table,
+    ``outside`` the row of the medium outside the surface (-1: none named)."""
     row = np.zeros(N_MAT_PARAMS)
     row[MAT_COLOR : MAT_COLOR + 3] = mat.color
     row[MAT_AMBIENT : MAT_AMBIENT + 3] = mat.ambient_color or mat.color
@@ -41,6 +43,7 @@ def material_row(mat: Material, texture: int = -1) -> np.ndarray:
     row[MAT_ATTEN : MAT_ATTEN + 3] = mat.attenuation_rgb()
     row[MAT_FRESNEL] = 1.0 if mat.fresnel else 0.0
     row[MAT_TEXTURE] = texture
+    row[MAT_OUTSIDE] = outside
     return row
 
 
@@ -53,7 +56,8 @@ class MaterialTable:
         self.textures: list = []
         self.texture_index: dict[str, int] = {}
 
-    def add(self, mat: Material) -> int:
+    def add(self, mat: Material, outside: int = -1) -> int:
+        """The row of ``mat`` (with ``outside``, the row of the medium outside it)."""
         tex = -1
         if mat.texture is not None:
             key = mat.texture.model_dump_json()
@@ -61,7 +65,7 @@ class MaterialTable:
                 self.texture_index[key] = len(self.textures)
                 self.textures.append(mat.texture)
             tex = self.texture_index[key]
-        row = material_row(mat, tex)
+        row = material_row(mat, tex, outside)
         key = row.tobytes()
         if key not in self.index:
             self.index[key] = len(self.rows)

@@ -86,7 +86,9 @@ def add_flat_mesh(b: PrimitiveRows, meshes: MeshTable, src: MeshSource, rows: np
 
 def mesh_key(scene: Scene, shape: Mesh) -> tuple:
     """Objects with equal keys share one stored mesh (instancing)."""
-    shading = (shape.smooth, shape.crease_angle if shape.smooth else None)
+    # the medium outside is part of the stored mesh's material rows
+    outside = None if shape.outside is None else repr(shape.outside)
+    shading = (shape.smooth, shape.crease_angle if shape.smooth else None, outside)
     if shape.file is not None:
         return ("file", str(scene.resolve_path(shape.file).resolve()), *shading)
     return ("arrays", id(shape.vertices), id(shape.faces), id(shape.normals), id(shape.uvs),

@@ -90,11 +90,14 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
         m = shape.transform.matrix() if shape.transform is not None else np.eye(4)
         if isinstance(shape, Mesh):
             key = mesh_key(scene, shape)
+            outside = -1 if shape.outside is None else materials.add(
+                scene.resolve_material(shape.outside))
             override = -1 if shape.material is None else materials.add(
-                scene.material_of(obj_index))
+                scene.material_of(obj_index), outside)
             if key not in sources:
                 src = mesh_source(scene, obj_index, shape, warnings)
-                rows = np.array([materials.add(mat) for mat in src.materials], np.int32)
+                rows = np.array([materials.add(mat, outside) for mat in src.materials],
+                                np.int32)
                 sources[key] = (src, rows)
             src, rows = sources[key]
             if uses[key] * len(src.faces) <= flatten_limit:

@@ -19,8 +19,8 @@ from __future__ import annotations
 
 from ._dask import INSTALL_HINT
 from .assets import AssetManifest, collect_assets, scene_file_names
-from .cluster import FarmError, farm_client, local_cluster, parse_cluster
-from .film import FilmResult, FrameFailed, chunk_size, render_film
+from .cluster import FarmError, check_farm_options, farm_client, local_cluster, parse_cluster
+from .film import FilmPlan, FilmResult, FrameFailed, chunk_size, plan_film, render_film
 from .still import band_ranges, render_still
 from .transfer import Shipment, ship_assets
 from .worker import WhittedWorker
@@ -29,16 +29,19 @@ __all__ = [
     "INSTALL_HINT",
     "AssetManifest",
     "FarmError",
+    "FilmPlan",
     "FilmResult",
     "FrameFailed",
     "Shipment",
     "WhittedWorker",
     "band_ranges",
+    "check_farm_options",
     "chunk_size",
     "collect_assets",
     "farm_client",
     "local_cluster",
     "parse_cluster",
+    "plan_film",
     "render_film",
     "render_still",
     "scene_file_names",

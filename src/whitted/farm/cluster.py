@@ -32,6 +32,14 @@ def parse_cluster(spec: str) -> int:
     return int(count)
 
 
+def check_farm_options(cluster: str | None, scheduler: str | None) -> None:
+    """FarmError unless exactly one of the two is given (and a cluster spec is valid)."""
+    if (cluster is None) == (scheduler is None):
+        raise FarmError("give one of --cluster local:N and --scheduler tcp://HOST:PORT")
+    if cluster is not None:
+        parse_cluster(cluster)
+
+
 def has_dashboard() -> bool:
     """Dask's dashboard needs bokeh (optional): without it there is simply none."""
     return importlib.util.find_spec("bokeh") is not None
@@ -63,8 +71,7 @@ def farm_client(cluster: str | None = None, scheduler: str | None = None, *,
     """A client of a new local cluster (``cluster="local:N"``) or of the scheduler at
     ``scheduler``, with every worker readied (kernels warm, ``threads`` render threads each:
     by default the cores shared out among a local cluster's workers, one on a remote one)."""
-    if (cluster is None) == (scheduler is None):
-        raise FarmError("give one of --cluster local:N and --scheduler tcp://HOST:PORT")
+    check_farm_options(cluster, scheduler)
     owned = None
     if cluster is not None:
         workers = parse_cluster(cluster)

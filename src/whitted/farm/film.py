@@ -83,8 +83,41 @@ def chunk_size(width: int, height: int, samples: int, frames: int, workers: int)
     return max(1, min(wanted, most))
 
 
+@dataclass
+class FilmPlan:
+    """Which frames of a film are done and which are to render (no cluster needed)."""
+
+    frames: list[int]
+    stills: list[Scene]
+    digests: list[str]
+    paths: list[Path]
+    todo: list[int]  # indices into the lists above: the frames to render
+    kept: list[int]  # frames already on disk from the same scene and settings
+
+
+def plan_film(scene: Scene, frames_dir: str | Path, *, frames: Sequence[int] | None = None,
+              force: bool = False, **settings: Any) -> FilmPlan:
+    """Each frame's still, hash and file; the frames whose PNG already holds their hash are
+    kept (unless ``force``)."""
+    from ..animation.frames import frame_digest, frame_is_current, still_for_frame
+
+    folder = Path(frames_dir)
+    count = scene.frame_count
+    chosen = list(range(count) if frames is None else frames)
+    stills = [still_for_frame(scene, k, **settings) for k in chosen]
+    digests = [frame_digest(still, k) for still, k in zip(stills, chosen, strict=True)]
+    paths = [folder / frame_file_name(k, count) for k in chosen]
+    todo, kept = [], []
+    for i, (k, digest, path) in enumerate(zip(chosen, digests, paths, strict=True)):
+        if not force and frame_is_current(path, digest):
+            kept.append(k)
+        else:
+            todo.append(i)
+    return FilmPlan(chosen, stills, digests, paths, todo, kept)
+
+
 def render_film(
-    client: Client,
+    client: Client | None,
     scene: Scene,
     frames_dir: str | Path,
     *,
@@ -97,6 +130,7 @@ def render_film(
     retries: int = RETRIES,
     force: bool = False,
     progress: Callable[[int, int, int | None], None] | None = None,
+    plan: FilmPlan | None = None,
     **settings: Any,
 ) -> FilmResult:
     """Render ``frames`` (default: all) of ``scene`` on the cluster behind ``client`` into
@@ -105,28 +139,26 @@ def render_film(
 
     ``settings`` replace render settings of every frame (``width``, ``height``, ``samples``,
     ``max_depth``, ``seed``), as ``whitted animate``'s options do. ``progress(done, total,
-    frame)`` is called once for each frame kept (frame None) or written. Raises
-    :class:`FrameFailed` for the first frame that failed, after all the others are saved."""
-    from ..animation.frames import frame_digest, frame_is_current, still_for_frame
+    frame)`` is called once for each frame kept (frame None) or written. ``plan``: from
+    :func:`plan_film` when the caller made it already (then ``client`` may be None when no
+    frame is left to render). Raises :class:`FrameFailed` for the first frame that failed,
+    after all the others are saved."""
     from ..output.encode import atomic_write
 
     started = time.perf_counter()
     folder = Path(frames_dir)
     folder.mkdir(parents=True, exist_ok=True)
-    count = scene.frame_count
-    chosen = list(range(count) if frames is None else frames)
-    stills = [still_for_frame(scene, k, **settings) for k in chosen]
-    digests = [frame_digest(still, k) for still, k in zip(stills, chosen, strict=True)]
-    paths = [folder / frame_file_name(k, count) for k in chosen]
-    result = FilmResult(chosen, paths, film=Path(film) if film is not None else None)
-    todo = []
-    for i, (k, digest, path) in enumerate(zip(chosen, digests, paths, strict=True)):
-        if not force and frame_is_current(path, digest):
-            result.kept.append(k)
-            if progress is not None:
-                progress(len(result.kept), len(chosen), None)
-        else:
-            todo.append(i)
+    if plan is None:
+        plan = plan_film(scene, folder, frames=frames, force=force, **settings)
+    chosen, stills, digests, paths, todo = (plan.frames, plan.stills, plan.digests,
+                                            plan.paths, plan.todo)
+    result = FilmResult(chosen, paths, kept=list(plan.kept),
+                        film=Path(film) if film is not None else None)
+    for done in range(1, len(plan.kept) + 1):
+        if progress is not None:
+            progress(done, len(chosen), None)
+    if todo and client is None:
+        raise ValueError(f"{len(todo)} frames to render and no client")
 
     if todo:
         _render_missing(client, scene, stills, chosen, digests, paths, todo, result,

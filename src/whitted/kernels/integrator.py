@@ -16,6 +16,7 @@ from .layout import (
     MAT_KA,
     MAT_KR,
     MAT_KT,
+    MAT_OUTSIDE,
     MAT_TEXTURE,
     MAX_MEDIA,
     PRIM_SOLID,
@@ -108,6 +109,14 @@ def _push(st_f, st_i, top, o, d, w, depth, media_src, n_media):
 
 
 @kernel(inline="always")
+def _absorbed(weight, attenuation, length):
+    """``weight`` after ``length`` in a medium of this attenuation (Beer-Lambert)."""
+    if attenuation > 0.0:
+        return weight * math.exp(-attenuation * length)
+    return weight
+
+
+@kernel(inline="always")
 def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media, scratch,
                stack, hits, listed, counters):
     """Radiance arriving along the camera ray (o, d) with unit d: I = ka·Ia + direct light +
@@ -129,10 +138,12 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
         t, prim, tri, b1, b2 = closest_hit(geo, o, d, 0.0, math.inf, stack)
         if n_media > 0:  # Beer-Lambert absorption in the medium the ray crossed
             cur = media[n_media - 1]
+            # a clear medium absorbs nothing, even over the infinite path of a ray that leaves
+            # the scene inside it (0 * inf would be NaN)
             w = (
-                w[0] * math.exp(-mats[cur, MAT_ATTEN] * t),
-                w[1] * math.exp(-mats[cur, MAT_ATTEN + 1] * t),
-                w[2] * math.exp(-mats[cur, MAT_ATTEN + 2] * t),
+                _absorbed(w[0], mats[cur, MAT_ATTEN], t),
+                _absorbed(w[1], mats[cur, MAT_ATTEN + 1], t),
+                _absorbed(w[2], mats[cur, MAT_ATTEN + 2], t),
             )
         if prim < 0:
             bg = background(params, d)
@@ -178,13 +189,23 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
                 scratch[k] = media[k]
             if geo.prim_info[prim, PRIM_SOLID]:  # media are keyed by material row
                 n1 = mats[media[n_media - 1], MAT_IOR] if n_media > 0 else 1.0
+                # a surface between two named media (a water cavity in ice): the outside
+                # medium is left on the way in and entered on the way out
+                outside = int(mats[m, MAT_OUTSIDE])
                 if entering:
+                    if outside >= 0:
+                        n_out = media_leave(scratch, n_out, outside)
+                        n1 = mats[outside, MAT_IOR]
                     n_out = media_enter(scratch, n_out, m)
                     n2 = mats[m, MAT_IOR]
                 else:
                     n_out = media_leave(scratch, n_out, m)
                     n1 = mats[m, MAT_IOR]
-                    n2 = mats[scratch[n_out - 1], MAT_IOR] if n_out > 0 else 1.0
+                    if outside >= 0:
+                        n_out = media_enter(scratch, n_out, outside)
+                        n2 = mats[outside, MAT_IOR]
+                    else:
+                        n2 = mats[scratch[n_out - 1], MAT_IOR] if n_out > 0 else 1.0
             else:  # a thin sheet: light passes straight through
                 n1 = 1.0
                 n2 = 1.0

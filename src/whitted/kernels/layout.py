@@ -50,7 +50,10 @@ MAT_IOR = 16
 MAT_ATTEN = 17
 MAT_FRESNEL = 20
 MAT_TEXTURE = 21  # row of the texture table multiplying the colour, -1 for none
-N_MAT_PARAMS = 22
+# row of the medium just outside a solid mesh's surface (the ice around a water cavity), -1:
+# whatever medium the ray arrives through
+MAT_OUTSIDE = 22
+N_MAT_PARAMS = 23
 
 # mesh_info columns (one row per distinct mesh; instances point at a row)
 MESH_ROOT = 0  # root node in the mesh_node_* arrays

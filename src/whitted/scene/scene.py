@@ -130,7 +130,11 @@ class Scene(Strict):
 
     def material_of(self, index: int) -> Material:
         """The resolved material of object ``index`` (named, preset, inline or the default)."""
-        ref = self.objects[index].material
+        return self.resolve_material(self.objects[index].material)
+
+    def resolve_material(self, ref: str | Material | None) -> Material:
+        """The material a reference names: inline, a name of ``materials``, a preset, or the
+        default for None."""
         if ref is None:
             return Material()
         if isinstance(ref, Material):

@@ -239,6 +239,11 @@ class Mesh(_Shape):
     normals where it has them (flat shading where not); ``true`` computes smooth normals where
     the file has none, keeping edges sharper than ``crease_angle`` degrees; ``false`` shades
     flat. ``solid``: the mesh bounds a volume, so rays refract into and out of it (media).
+    ``outside``: the material of the medium just outside a solid mesh (named, a preset or
+    inline), for a surface between two media such as the ice around a water cavity: a ray
+    crossing it bends once by the ratio of the two indices, whichever way it goes, and is
+    then in the medium on the far side. Unset: the medium the ray arrives through (air,
+    or a body it entered before).
     The same file used by several objects is loaded and stored once (instanced).
     """
 
@@ -251,6 +256,7 @@ class Mesh(_Shape):
     smooth: bool | None = None
     crease_angle: float = Field(default=60.0, ge=0.0, le=180.0)
     solid: bool = True
+    outside: str | Material | None = None
 
     def __init__(self, vertices: Any = None, faces: Any = None, normals: Any = None,
                  uvs: Any = None, **data: Any) -> None:

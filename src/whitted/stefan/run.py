@@ -8,7 +8,8 @@ Output folder::
                            (float32), temperature (float32, NaN in air), time and totals
     surfaces/outer_0003.ply, inner_0003.ply   ice/air and ice/water surfaces
     scenes/frame_0003.toml a whitted scene rendering that saved time
-    series.csv             time series: ice, cavity and water volume, minimum shell
+    series.csv             time series: ice, cavity and water volume, minimum shell,
+                           breach time (empty until the shell opens)
     series.png             the same as plots
     summary.json           breach time, end time, energy balance
 
@@ -37,7 +38,7 @@ from .solver import Air, EnthalpySolver
 from .surfaces import extract_surfaces, write_ply
 
 SERIES_COLUMNS = ("time_s", "ice_volume_cm3", "cavity_volume_cm3", "water_volume_cm3",
-                  "min_shell_mm", "breached", "energy_imbalance_J")
+                  "min_shell_mm", "breached", "breach_time_s", "energy_imbalance_J")
 
 
 @dataclass
@@ -100,8 +101,8 @@ def _read_series(path: Path) -> list[dict]:
     if not path.exists():
         return []
     with path.open(newline="") as fh:
-        return [{k: (v if k == "breached" else float(v)) for k, v in row.items()}
-                for row in csv.DictReader(fh)]
+        return [{k: (v if k == "breached" else None if v == "" else float(v))
+                 for k, v in row.items()} for row in csv.DictReader(fh)]
 
 
 def plot_series(rows: list[dict], path: Path, breach_time: float | None) -> None:
@@ -262,7 +263,8 @@ def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, dig
     rows.append({"time_s": solver.time, "ice_volume_cm3": m.ice_volume * 1e6,
                  "cavity_volume_cm3": m.cavity_volume * 1e6,
                  "water_volume_cm3": m.water_volume * 1e6, "min_shell_mm": m.min_shell * 1e3,
-                 "breached": int(m.breached), "energy_imbalance_J": solver.energy_error()})
+                 "breached": int(m.breached), "breach_time_s": solver.breach_time,
+                 "energy_imbalance_J": solver.energy_error()})
     _write_series(out / "series.csv", rows)
     _save_state(out / "fields" / f"state_{index:04d}.npz", solver, digest, index,
                 initial_cavity)

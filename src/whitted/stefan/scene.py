@@ -2,8 +2,9 @@
 
 Written as a whitted scene file (TOML text) beside the surfaces it names; the Stefan package
 writes it but never renders it (the CLI's ``film`` hands the scenes to the render API). The
-outer surface carries ice (ior 1.31), the inner one water (ior 1.333) and sits inside it, so
-the renderer's media stack bends a ray crossing the ice/water surface by n_ice/n_water once.
+outer surface carries ice (ior 1.31); the inner one is a single surface between two media,
+water (ior 1.333) inside and ice outside (``outside = "ice"``), so a ray crossing it bends by
+n_ice/n_water once, whichever way it goes.
 Absorption is exaggerated (``ABSORPTION_BOOST``) so the thin water and ice read on screen.
 Lengths are scaled from metres to centimetres (``transform.scale = 100``).
 """
@@ -101,6 +102,7 @@ def still_life_scene(outer: str | None, inner: str | None, time_s: float | None,
             'type = "mesh"',
             f'file = "{path}"',
             f'material = "{material}"',
+            *(['outside = "ice"'] if name == "water" else []),  # one surface, two media
             "smooth = true",
             # lifted a hair so the piece's base does not coincide with the table plane
             "transform = { scale = 100.0, translate = [0.0, 0.005, 0.0] }",
