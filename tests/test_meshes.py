@@ -309,177 +309,41 @@ def test_small_meshes_are_flattened_big_ones_instanced():
     np.testing.assert_allclose(t_flat[hit], t_inst[hit], rtol=1e-6)
 
 
-def _walk_wide(nodes, ints, root):
-    """Every leaf entry under wide node ``root`` (checking on the way that every child box
-    lies inside its parent's slot box), and the rows visited."""
-    seen, rows = [], []
-    stack = [(root, None, None)]
-    while stack:
-        node, lo, hi = stack.pop()
-        rows.append(node)
-        for k in range(4):
-            box_lo = nodes[node, [k, 4 + k, 8 + k]]
-            box_hi = nodes[node, [12 + k, 16 + k, 20 + k]]
-            count, child = int(ints[node, 28 + k]), int(ints[node, 24 + k])
-            if np.isinf(box_lo).all() and np.isinf(box_hi).all():  # an empty slot
-                assert count == 0 and (box_lo > 0).all() and (box_hi > 0).all()
-                continue
-            if lo is not None:
-                assert np.all(box_lo >= lo) and np.all(box_hi <= hi)
-            if count > 0:
-                seen.extend((first, box_lo, box_hi) for first in range(child, child + count))
-            else:
-                assert child > node  # children come after their parent
-                stack.append((child, box_lo, box_hi))
-    return seen, rows
-
-
-def test_mesh_nodes_are_wide_rows_covering_every_triangle_once():
-    """Two different meshes (so two node blocks) in 4-wide rows of 128 bytes on 64-byte
-    lines: every triangle of each mesh is in exactly one leaf, inside that leaf's box, every
-    child box lies inside its parent's, every row is reached once, and the int32 links share
-    the rows' memory."""
+def test_mesh_nodes_are_sibling_pairs_on_cache_lines():
+    """Two different meshes (so two node blocks): every interior node's children sit side by
+    side on one 64-byte line, each child's box lies inside its parent's, and the leaves list
+    every triangle of their mesh exactly once; the int32 link columns share the rows' memory."""
     v1, f1 = uv_sphere(12, 24)
     v2, f2 = cube()
     scene = whitted.Scene(objects=[whitted.Mesh(v1, f1), whitted.Mesh(v2, f2)])
     geo = compile_scene(scene, flatten_limit=0).geometry
     nodes, ints = geo.mesh_nodes, geo.mesh_node_ints
-    assert nodes.shape[1] == 32 and nodes.dtype == np.float32 and ints.dtype == np.int32
+    assert nodes.shape[1] == 8 and nodes.dtype == np.float32 and ints.dtype == np.int32
     assert np.shares_memory(nodes, ints)
     assert nodes.ctypes.data % 64 == 0
     assert len(geo.mesh_info) == 2
-    all_rows = []
     for mesh, tri_count in enumerate((len(f1), len(f2))):
         root = int(geo.mesh_info[mesh, 0])
         tri_offset = int(geo.mesh_info[mesh, 1])
-        seen, rows = _walk_wide(nodes, ints, root)
-        all_rows += rows
-        entries = np.array([e for e, _, _ in seen])
-        np.testing.assert_array_equal(np.sort(entries), tri_offset + np.arange(tri_count))
-        for entry, lo, hi in seen:
-            corners = geo.mesh_leaf_corners[entry]
-            assert np.all(corners >= lo) and np.all(corners <= hi)
-    np.testing.assert_array_equal(np.sort(all_rows), np.arange(len(nodes)))
-    # the sphere's 576 triangles: a 4-wide tree has fewer rows than the binary one's nodes
-    assert int(geo.mesh_info[1, 0]) < len(f1) // 2
-
-
-@njit(cache=False)
-def _nearest_triangles(geo, origins, directions, stack):
-    t_out = np.empty(origins.shape[0])
-    tri_out = np.empty(origins.shape[0], np.int64)
-    for k in range(origins.shape[0]):
-        o = (origins[k, 0], origins[k, 1], origins[k, 2])
-        d = (directions[k, 0], directions[k, 1], directions[k, 2])
-        t, prim, tri, b1, b2 = closest_hit(geo, o, d, 0.0, np.inf, stack)
-        t_out[k] = t if prim >= 0 else np.inf
-        tri_out[k] = tri if prim >= 0 else -1
-    return t_out, tri_out
-
-
-def _watertight_brute_force(corners, o, d):
-    """The kernel's watertight test (Woop et al.) in float64 NumPy against every triangle:
-    (nearest t, its triangle) with the kernel's rule that the first of equal t's wins is
-    not needed: random rays meet no two triangles at the same t."""
-    kz = int(np.argmax(np.abs(d)))
-    if np.abs(d[(kz + 1) % 3]) == np.abs(d[kz]) or np.abs(d[(kz + 2) % 3]) == np.abs(d[kz]):
-        return None
-    kx = kz + 1 if kz < 2 else 0
-    ky = kx + 1 if kx < 2 else 0
-    if d[kz] < 0.0:
-        kx, ky = ky, kx
-    sx, sy, sz = d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]
-    c = corners.astype(np.float64) - o
-    z = c[:, :, kz]
-    x = c[:, :, kx] - sx * z
-    y = c[:, :, ky] - sy * z
-    e0 = x[:, 2] * y[:, 1] - y[:, 2] * x[:, 1]
-    e1 = x[:, 0] * y[:, 2] - y[:, 0] * x[:, 2]
-    e2 = x[:, 1] * y[:, 0] - y[:, 1] * x[:, 0]
-    inside = ~(((e0 < 0) | (e1 < 0) | (e2 < 0)) & ((e0 > 0) | (e1 > 0) | (e2 > 0)))
-    det = e0 + e1 + e2
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = (e0 * z[:, 0] + e1 * z[:, 1] + e2 * z[:, 2]) * sz * (1.0 / det)
-    t = np.where(inside & (det != 0) & (t > 0.0), t, np.inf)
-    best = int(np.argmin(t))
-    return t[best], (best if np.isfinite(t[best]) else -1)
-
-
-def test_wide_walk_nearest_hits_equal_brute_force():
-    """3,000 random triangles (overlapping, long and thin among them) instanced: the walk's
-    nearest hit of 1,500 random rays is the brute-force nearest, t bit for bit and the same
-    triangle."""
-    rng = np.random.default_rng(11)
-    n = 3000
-    centre = rng.uniform(-4, 4, (n, 1, 3))
-    corners = centre + rng.normal(scale=rng.uniform(0.05, 0.8, (n, 1, 1)), size=(n, 3, 3))
-    corners[::7, 1] = corners[::7, 0] + rng.uniform(-6, 6, (len(corners[::7]), 3))  # thin
-    v = corners.reshape(-1, 3)
-    f = np.arange(len(v)).reshape(-1, 3)
-    geo = compile_scene(whitted.Scene(objects=[whitted.Mesh(v, f)]), flatten_limit=0).geometry
-    assert len(geo.mesh_info) == 1
-    m = 1500
-    o = rng.uniform(-9, 9, (m, 3))
-    d = rng.uniform(-3, 3, (m, 3)) - o
-    t, tri = _nearest_triangles(geo, o, d, np.empty(128, np.int32))
-    tris32 = v.astype(np.float32)[f]
-    checked = hits = 0
-    for k in range(m):
-        ref = _watertight_brute_force(tris32, o[k], d[k])
-        if ref is None:
-            continue
-        checked += 1
-        hits += np.isfinite(ref[0])
-        assert t[k] == ref[0]
-        assert tri[k] == ref[1]
-    assert checked > 1400 and hits > 700
-
-
-def _comb_bvh(depth: int):
-    """A binary BVH (depth-first layout) whose wide collapse would need a deep stack: a spine
-    of ``depth`` nodes, each with a left subtree of two interior nodes over four leaves."""
-    offset, count = [], []
-
-    def leaf():
-        offset.append(len(count))
-        count.append(1)
-
-    def node(build_left, build_right):
-        i = len(count)
-        offset.append(0)
-        count.append(0)
-        build_left()
-        offset[i] = len(count)
-        build_right()
-
-    def pair():
-        node(lambda: node(leaf, leaf), lambda: node(leaf, leaf))
-
-    def spine(k):
-        if k == 0:
-            leaf()
-        else:
-            node(pair, lambda: spine(k - 1))
-
-    spine(depth)
-    n = len(count)
-    lo = np.zeros((n, 3), np.float32)
-    return lo, lo + 1, np.array(offset), np.array(count)
-
-
-def test_wide_collapse_keeps_the_stack_within_its_room():
-    """A tree whose 4-wide collapse would push more than the walk's 64 stack entries is
-    collapsed two children a node instead; a shallow one four; leaves keep their entries."""
-    from whitted.compile.wide_bvh import STACK_ROOM, _levels, collapse, stack_need
-
-    for depth, widest in ((8, 4), (50, 2)):
-        lo, hi, offset, count = _comb_bvh(depth)
-        interior = count == 0
-        grand = stack_need(_levels(offset, count, grand=True), interior)
-        assert (grand > STACK_ROOM) == (depth == 50)
-        assert stack_need(_levels(offset, count, grand=False), interior) <= depth + 3
-        data, links, counts = collapse(lo, hi, offset, count)
-        slots = (counts > 0) | ~np.isinf(data[:, :4])
-        assert slots.sum(axis=1).max() == widest
-        leaf_entries = np.sort(links[counts > 0])
-        np.testing.assert_array_equal(leaf_entries, np.sort(offset[count > 0]))
+        assert root % 2 == 0
+        seen = []
+        stack = [root]
+        while stack:
+            node = stack.pop()
+            count = int(ints[node, 7])
+            if count > 0:
+                first = int(ints[node, 6])
+                seen.extend(range(first, first + count))
+                continue
+            first = int(ints[node, 6])
+            assert first % 2 == 0 and first > root  # the pair fills one cache line
+            for child in (first, first + 1):
+                assert np.all(nodes[child, :3] >= nodes[node, :3])
+                assert np.all(nodes[child, 3:6] <= nodes[node, 3:6])
+                stack.append(child)
+        entries = np.sort(np.array(seen))
+        np.testing.assert_array_equal(entries, tri_offset + np.arange(tri_count))
+        tris = np.sort(geo.mesh_node_tris[entries])
+        np.testing.assert_array_equal(tris, tri_offset + np.arange(tri_count))
+        # the padding row after the root holds an empty box: no ray can enter it
+        assert np.all(nodes[root + 1, :3] > nodes[root + 1, 3:6])

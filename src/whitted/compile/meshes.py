@@ -3,8 +3,7 @@
 Every distinct mesh (one model file with one normal setting, or one set of inline arrays) is
 stored once, in its own space: float32 positions, int32 triangles, per-triangle material rows,
 corner normals when it is smooth-shaded, corner uvs when it has texture coordinates, and a
-binned-SAH BVH with float32 boxes rounded outward, collapsed into 4-wide nodes
-(:mod:`.wide_bvh`). Scene objects that use it become instances
+binned-SAH BVH with float32 boxes rounded outward. Scene objects that use it become instances
 (:data:`SHAPE_MESH` primitives, in a top-level BVH of the instances) with their own transform
 and material.
 Degenerate triangles (zero area, non-finite corners) are dropped here, with a warning that
@@ -18,8 +17,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..kernels.layout import (
-    MESH_NODE_CHILD,
     MESH_NODE_COUNT,
+    MESH_NODE_HI,
+    MESH_NODE_LO,
+    MESH_NODE_OFFSET,
     MESH_NODE_WIDTH,
     MESH_NORMALS,
     MESH_ROOT,
@@ -30,7 +31,6 @@ from ..kernels.layout import (
 )
 from .normals import smooth_corner_normals
 from .reuse import cached_build_bvh
-from .wide_bvh import collapse
 
 # SAH cost of visiting a node, relative to one watertight triangle test (see compile/bvh.py)
 MESH_TRAVERSAL_COST = 2.0  # measured: 28-55 % fewer nodes than 1.0, same speed
@@ -70,6 +70,32 @@ def _round_up32(a: np.ndarray) -> np.ndarray:
     under = out.astype(np.float64) < a
     out[under] = np.nextafter(out[under], np.float32(np.inf))
     return out
+
+
+def sibling_pairs(lo: np.ndarray, hi: np.ndarray, offset: np.ndarray, count: np.ndarray):
+    """A mesh BVH from the builder's depth-first layout (left child ``i + 1``, right child
+    ``offset[i]``) in the layout the mesh walks read: the two children of an interior node
+    side by side, ``first`` and ``first + 1``, so one 64-byte cache line holds both boxes.
+    Row 0 is the root, row 1 padding (an empty box) so every pair starts on an even row; the
+    pairs follow in the depth-first order of their parents. Returns (box (N+1, 2, 3) float32,
+    link (N+1, 2) int32: interior (first child, 0), leaf (first entry, count))."""
+    n = len(count)
+    interior = np.flatnonzero(count == 0)
+    first = 2 + 2 * np.arange(len(interior))  # the pair of the k-th interior node
+    where = np.zeros(n, np.int64)  # new row of every node
+    where[interior + 1] = first
+    where[offset[interior]] = first + 1
+    rows = n + 1
+    box = np.empty((rows, 2, 3), np.float32)
+    box[:, 0] = np.inf
+    box[:, 1] = -np.inf
+    box[where, 0] = lo
+    box[where, 1] = hi
+    link = np.zeros((rows, 2), np.int32)
+    link[where, 0] = offset
+    link[where[interior], 0] = first
+    link[where, 1] = count
+    return box, link
 
 
 class MeshTable:
@@ -175,37 +201,38 @@ class MeshTable:
         self.vertices.append(verts32)
         self.faces.append((faces + self.n_vertices).astype(np.int32))
         self.tri_material.append(np.asarray(material_rows, np.int32)[face_material])
-        data, links, counts = collapse(_round_down32(bvh.node_min), _round_up32(bvh.node_max),
-                                       bvh.node_offset, bvh.node_count)
-        # global indices: interior children name their row among all meshes' nodes, leaves
-        # their first entry among all meshes' node_tris
-        links += np.where(counts > 0, self.n_tris, self.n_nodes).astype(np.int32)
-        self.node_box.append(data)
-        self.node_link.append((links, counts))
+        box, link = sibling_pairs(_round_down32(bvh.node_min), _round_up32(bvh.node_max),
+                                  bvh.node_offset, bvh.node_count)
+        # global indices: interior nodes name their first child among all meshes' nodes,
+        # leaves their first entry among all meshes' node_tris
+        leaf = link[:, 1] > 0
+        link[:, 0] += np.where(leaf, self.n_tris, self.n_nodes)
+        self.node_box.append(box)
+        self.node_link.append(link)
         self.node_tris.append((bvh.prim_order + self.n_tris).astype(np.int32))
         self.leaf_corners.append(verts32[faces[bvh.prim_order]])
         lo = np.array(bvh.node_min[0], np.float64)  # the root box: all triangles
         hi = np.array(bvh.node_max[0], np.float64)
         self.n_vertices += len(verts32)
         self.n_tris += t
-        self.n_nodes += len(data)
+        self.n_nodes += len(link)
         return CompiledMesh(index, lo, hi, t)
 
     def node_rows(self) -> dict[str, np.ndarray]:
-        """The wide mesh BVH nodes as 128-byte rows (four boxes, then four links and counts)
-        starting on a 64-byte cache line: ``mesh_nodes`` and its int32 view
-        ``mesh_node_ints``."""
+        """The mesh BVH nodes as 32-byte rows (box, then link) starting on a 64-byte cache
+        line: ``mesh_nodes`` and its int32 view ``mesh_node_ints``."""
         n = self.n_nodes
         raw = np.empty(n * MESH_NODE_WIDTH + 16, np.float32)
         skip = (-raw.ctypes.data % 64) // 4
         rows = raw[skip:skip + n * MESH_NODE_WIDTH].reshape(n, MESH_NODE_WIDTH)
         ints = rows.view(np.int32)
         if n:
-            rows[:] = np.concatenate(self.node_box)
-            ints[:, MESH_NODE_CHILD:MESH_NODE_CHILD + 4] = np.concatenate(
-                [links for links, _ in self.node_link])
-            ints[:, MESH_NODE_COUNT:MESH_NODE_COUNT + 4] = np.concatenate(
-                [counts for _, counts in self.node_link])
+            box = np.concatenate(self.node_box)
+            rows[:, MESH_NODE_LO:MESH_NODE_LO + 3] = box[:, 0]
+            rows[:, MESH_NODE_HI:MESH_NODE_HI + 3] = box[:, 1]
+            link = np.concatenate(self.node_link)
+            ints[:, MESH_NODE_OFFSET] = link[:, 0]
+            ints[:, MESH_NODE_COUNT] = link[:, 1]
         return {"mesh_nodes": rows, "mesh_node_ints": ints}
 
     def arrays(self) -> dict[str, np.ndarray]:

@@ -109,22 +109,12 @@ N_PRIM_INFO = 5
 # interior node (count 0) has its left child at n + 1 and its right child at offset.
 LINK_OFFSET = 0
 LINK_COUNT = 1
-# mesh BVH nodes (GeometryArrays.mesh_nodes), 4-wide, one 128-byte row each: the four child
-# boxes as structure of arrays (float32: 4 lower x, 4 lower y, 4 lower z, 4 upper x, ...),
-# then (mesh_node_ints, the same memory as int32) 4 child links and 4 child counts. A child
-# with count 0 is an interior node (link = its row), count > 0 a leaf (link = its first entry
-# of mesh_node_tris / mesh_leaf_corners); an empty slot has count 0 and an empty box
-# (+inf, +inf) that no ray enters.
-MESH_ARITY = 4
-MESH_NODE_LO_X = 0
-MESH_NODE_LO_Y = 4
-MESH_NODE_LO_Z = 8
-MESH_NODE_HI_X = 12
-MESH_NODE_HI_Y = 16
-MESH_NODE_HI_Z = 20
-MESH_NODE_CHILD = 24
-MESH_NODE_COUNT = 28
-MESH_NODE_WIDTH = 32
+# mesh BVH node rows (GeometryArrays.mesh_nodes): lower corner 0:3, upper corner 3:6, link 6:8
+MESH_NODE_LO = 0
+MESH_NODE_HI = 3
+MESH_NODE_OFFSET = 6
+MESH_NODE_COUNT = 7
+MESH_NODE_WIDTH = 8
 
 
 class GeometryArrays(NamedTuple):
@@ -154,11 +144,12 @@ class GeometryArrays(NamedTuple):
     tri_material: np.ndarray  # (T,) int32 material row of each triangle
     tri_normals: np.ndarray  # (Tn, 3, 3) float32 corner normals of smooth-shaded triangles
     tri_uvs: np.ndarray  # (Tu, 3, 2) float32 corner texture coordinates
-    # bottom-level nodes, 4-wide, one 128-byte row each on two 64-byte lines (MESH_NODE_*
-    # above): the four child boxes (float32, rounded outward) in mesh_nodes, the children's
-    # (link, count) in mesh_node_ints, an int32 view of the same memory
-    mesh_nodes: np.ndarray  # (N, 32) float32
-    mesh_node_ints: np.ndarray  # (N, 32) int32, the same memory
+    # bottom-level nodes, one 32-byte row each (a box test and the node's link read one cache
+    # line): columns MESH_NODE_LO, MESH_NODE_HI of mesh_nodes are the box (float32, rounded
+    # outward); columns MESH_NODE_LINK of mesh_node_ints, an int32 view of the same memory,
+    # the (offset, count) link (leaf offsets index mesh_node_tris)
+    mesh_nodes: np.ndarray  # (N, 8) float32
+    mesh_node_ints: np.ndarray  # (N, 8) int32, the same memory
     mesh_node_tris: np.ndarray  # (T,) int32 triangle indices in leaf order
     # (T, 3, 3) float32 corners of the triangles in leaf order (entry j: mesh_node_tris[j]):
     # the walks read a leaf's triangles from consecutive memory, not through two indirections
