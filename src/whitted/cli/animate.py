@@ -14,6 +14,7 @@ from ..errors import SceneError, WhittedError
 from .farm import ClusterOption, SchedulerOption, animate_on_farm
 from .main import (
     EXIT_INTERRUPTED,
+    SceneArgument,
     _load,
     _override_error,
     app,
@@ -75,9 +76,7 @@ def film_paths(output: Path) -> tuple[Path | None, Path]:
 
 @app.command()
 def animate(
-    scene_path: Annotated[
-        Path | None, typer.Argument(metavar="[SCENE]", help="Scene file; default: built-in scene")
-    ] = None,
+    scene_path: SceneArgument = None,
     output: Annotated[
         Path, typer.Option("-o", "--output", help="film.mp4, film.gif, or a folder (frames only)")
     ] = Path("film.mp4"),

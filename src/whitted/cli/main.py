@@ -37,6 +37,11 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 
+#: The optional scene-file argument of render, export, animate and sweep.
+SceneArgument = Annotated[
+    Path | None, typer.Argument(metavar="[SCENE]", help="Scene file; default: built-in scene")
+]
+
 AOV_NAMES = ("depth", "normal", "id")
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 130
@@ -120,9 +125,7 @@ def _parse_aovs(text: str | None) -> list[str]:
 
 @app.command()
 def render(
-    scene_path: Annotated[
-        Path | None, typer.Argument(metavar="[SCENE]", help="Scene file; default: built-in scene")
-    ] = None,
+    scene_path: SceneArgument = None,
     output: Annotated[Path, typer.Option("-o", "--output", help="Image to write")] = Path(
         "render.png"
     ),
@@ -514,9 +517,7 @@ def gui(
 
 @app.command()
 def export(
-    scene_path: Annotated[
-        Path | None, typer.Argument(metavar="[SCENE]", help="Scene file; default: built-in scene")
-    ] = None,
+    scene_path: SceneArgument = None,
     output: Annotated[
         Path | None, typer.Option("-o", "--output", help="File to write; default: SCENE.pov")
     ] = None,

@@ -14,6 +14,7 @@ import typer
 from ..errors import SceneError, WhittedError
 from .main import (
     EXIT_INTERRUPTED,
+    SceneArgument,
     _load,
     _override_error,
     app,
@@ -25,9 +26,7 @@ from .main import (
 
 @app.command()
 def sweep(
-    scene_path: Annotated[
-        Path | None, typer.Argument(metavar="[SCENE]", help="Scene file; default: built-in scene")
-    ] = None,
+    scene_path: SceneArgument = None,
     set_values: Annotated[
         list[str] | None, typer.Option(
             "--set", help="PATH=VALUES to sweep (START:STOP:STEP or a,b,c; one or two), "
