@@ -47,7 +47,7 @@ P_CI, P_KI, P_CW, P_KW, P_HL = 0, 1, 2, 3, 4
 TINY = 1e-300  # keeps 0/0 out of the harmonic mean of two zero conductivities
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _temperature(h, p):
     if h < 0.0:
         return h / p[P_CI]
@@ -56,7 +56,7 @@ def _temperature(h, p):
     return 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _conductivity(h, p):
     if h <= 0.0:
         return p[P_KI]
@@ -77,33 +77,95 @@ def _state_row(H, kind, p, T, K, i, j):
             K[i, j, k] = 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _face(kc, kn, tn, tc):
     return 2.0 * kc * kn / (kc + kn + TINY) * (tn - tc)
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _state(h, p):
+    """Temperature and conductivity of a body cell of enthalpy ``h``: ``_temperature`` and
+    ``_conductivity`` with every branch computed and selected (the same operations, so the
+    same bits), which lets the compiler vectorise the loops that call it."""
+    hl = p[P_HL]
+    t_ice = h / p[P_CI]
+    t_water = (h - hl) / p[P_CW]
+    k_mushy = p[P_KI] + h / hl * (p[P_KW] - p[P_KI])
+    t = t_ice if h < 0.0 else (t_water if h > hl else 0.0)
+    k = p[P_KI] if h <= 0.0 else (p[P_KW] if h >= hl else k_mushy)
+    return t, k
+
+
+@njit(cache=True, error_model="numpy")
+def _faces_x(K, T, i, fx):
+    """``fx[j, k]``: the flux term of the face between cells (i, j, k) and (i + 1, j, k), as
+    cell i computes it (``_face``); cell i + 1 adds its negation, which is what it would
+    compute itself, bit for bit (2 k_a k_b and k_a + k_b commute exactly; T_a - T_b is
+    -(T_b - T_a) exactly)."""
+    for j in range(1, K.shape[1] - 1):
+        ka = K[i, j]
+        kb = K[i + 1, j]
+        ta = T[i, j]
+        tb = T[i + 1, j]
+        f = fx[j]
+        for k in range(1, K.shape[2] - 1):
+            f[k] = _face(ka[k], kb[k], tb[k], ta[k])
+
+
+@njit(cache=True, error_model="numpy")
+def _conduct_slab(H, kind, T, K, Hn, Tn, Kn, p, g, i0, i1, fxa, fxb, fya, fyb, fz):
+    """``_conduct_row`` for the rows i0 <= i < i1, each face computed once: x faces a plane
+    at a time (``fxa`` below the current plane, ``fxb`` above), y faces a row at a time, z
+    faces along the row. The sum per cell keeps the order x-, x+, y-, y+, z-, z+, so Hn is
+    the same to the last bit."""
+    ny = H.shape[1] - 2
+    nz = H.shape[2] - 2
+    _faces_x(K, T, i0 - 1, fxa)
+    for i in range(i0, i1):
+        _faces_x(K, T, i, fxb)
+        ka = K[i, 0]
+        ta = T[i, 0]
+        kb = K[i, 1]
+        tb = T[i, 1]
+        for k in range(1, nz + 1):
+            fya[k] = _face(ka[k], kb[k], tb[k], ta[k])
+        for j in range(1, ny + 1):
+            kc = K[i, j]
+            tc = T[i, j]
+            kn = K[i, j + 1]
+            tn = T[i, j + 1]
+            for k in range(1, nz + 1):
+                fyb[k] = _face(kc[k], kn[k], tn[k], tc[k])
+            for k in range(0, nz + 1):
+                fz[k] = _face(kc[k], kc[k + 1], tc[k + 1], tc[k])
+            h = H[i, j]
+            hn = Hn[i, j]
+            xa = fxa[j]
+            xb = fxb[j]
+            for k in range(1, nz + 1):
+                s = xb[k] - xa[k]
+                s -= fya[k]
+                s += fyb[k]
+                s -= fz[k - 1]
+                s += fz[k]
+                hn[k] = h[k] + g * s
+            c = kind[i, j]
+            tt = Tn[i, j]
+            kk = Kn[i, j]
+            for k in range(1, nz + 1):
+                t, kv = _state(hn[k], p)
+                body = c[k] == BODY
+                tt[k] = t if body else 0.0
+                kk[k] = kv if body else 0.0
+            fya, fyb = fyb, fya
+        fxa, fxb = fxb, fxa
+
+
 @njit(cache=True, inline="always")
-def _conduct_row(H, kind, T, K, Hn, Tn, Kn, p, g, i, j):
-    """Hn = H + dt/dx² * sum over the six faces of k_face (T_nb - T): harmonic-mean face
-    conductivity; air and ghost neighbours (k = 0) add exactly zero. Also the temperature
-    and conductivity of Hn (Tn, Kn), so a step needs no separate pass for them."""
-    for k in range(1, H.shape[2] - 1):
-        kc = K[i, j, k]
-        tc = T[i, j, k]
-        s = _face(kc, K[i - 1, j, k], T[i - 1, j, k], tc)
-        s += _face(kc, K[i + 1, j, k], T[i + 1, j, k], tc)
-        s += _face(kc, K[i, j - 1, k], T[i, j - 1, k], tc)
-        s += _face(kc, K[i, j + 1, k], T[i, j + 1, k], tc)
-        s += _face(kc, K[i, j, k - 1], T[i, j, k - 1], tc)
-        s += _face(kc, K[i, j, k + 1], T[i, j, k + 1], tc)
-        Hn[i, j, k] = H[i, j, k] + g * s
-        if kind[i, j, k] == BODY:  # the next step's temperature and conductivity
-            h = Hn[i, j, k]
-            Tn[i, j, k] = _temperature(h, p)
-            Kn[i, j, k] = _conductivity(h, p)
-        else:
-            Tn[i, j, k] = 0.0
-            Kn[i, j, k] = 0.0
+def _slab_buffers(H):
+    ny = H.shape[1]
+    nz = H.shape[2]
+    return (np.empty((ny, nz)), np.empty((ny, nz)), np.empty(nz), np.empty(nz), np.empty(nz))
 
 
 @njit(cache=True, inline="always")
@@ -122,41 +184,51 @@ def _occupancy(H, kind, i, j, k, hl):
     return 1.0 - h / hl
 
 
-@njit(cache=True)
-def surface_scale(H, kind, i, j, k, hl):
+@njit(cache=True, inline="always")
+def _surface_scale(H, kind, i, j, k, hl, occ):
     """|n|_2 / |n|_1 of the occupancy gradient (3x3x3, Sobel weights) at a surface cell; 1
-    where it vanishes."""
+    where it vanishes. ``occ`` (27 values) is scratch: each neighbour's occupancy is
+    computed once (it enters up to three of the sums)."""
+    for a in range(3):
+        for b in range(3):
+            for c in range(3):
+                occ[9 * a + 3 * b + c] = _occupancy(H, kind, i + a - 1, j + b - 1, k + c - 1,
+                                                    hl)
     gx = 0.0
     gy = 0.0
     gz = 0.0
-    for a in range(-1, 2):
-        wa = 2.0 if a == 0 else 1.0
-        for b in range(-1, 2):
-            w = wa * (2.0 if b == 0 else 1.0)
-            gx += w * (_occupancy(H, kind, i + 1, j + a, k + b, hl)
-                       - _occupancy(H, kind, i - 1, j + a, k + b, hl))
-            gy += w * (_occupancy(H, kind, i + a, j + 1, k + b, hl)
-                       - _occupancy(H, kind, i + a, j - 1, k + b, hl))
-            gz += w * (_occupancy(H, kind, i + a, j + b, k + 1, hl)
-                       - _occupancy(H, kind, i + a, j + b, k - 1, hl))
+    for a in range(3):
+        wa = 2.0 if a == 1 else 1.0
+        for b in range(3):
+            w = wa * (2.0 if b == 1 else 1.0)
+            gx += w * (occ[18 + 3 * a + b] - occ[3 * a + b])
+            gy += w * (occ[9 * a + 6 + b] - occ[9 * a + b])
+            gz += w * (occ[9 * a + 3 * b + 2] - occ[9 * a + 3 * b])
     l1 = abs(gx) + abs(gy) + abs(gz)
     if l1 == 0.0:
         return 1.0
     return np.sqrt(gx * gx + gy * gy + gz * gz) / l1
 
 
+@njit(cache=True)
+def surface_scale(H, kind, i, j, k, hl):
+    """``_surface_scale`` with its own scratch."""
+    return _surface_scale(H, kind, i, j, k, hl, np.empty(27))
+
+
 @njit(cache=True, inline="always")
-def _boundary_flux(h_coef, t_far, drain, tc, kc, hc, dx):
+def _boundary_flux(h_coef, inv_h, t_far, drain, tc, kc, hc, dx):
     """Heat flux density (W/m²) into a cell through a face to the outside at ``t_far``:
     series resistance of the film (1/h) and the half cell (dx / 2k). A draining (air) face
-    of a cell at 0 °C has no half cell: its meltwater has left, the ice surface is at 0 °C."""
+    of a cell at 0 °C has no half cell: its meltwater has left, the ice surface is at 0 °C.
+    ``inv_h`` is 1 / ``h_coef``."""
     if h_coef == 0.0:
         return 0.0
     r = 0.0
     if not (drain and hc >= 0.0):
         r = 0.5 * dx / kc
     if h_coef != np.inf:
-        r += 1.0 / h_coef
+        r += inv_h  # 1 / h_coef, computed once
     return (t_far - tc) / r
 
 
@@ -176,10 +248,12 @@ def _neighbour(i, j, k, face):
 
 
 @njit(cache=True, inline="always")
-def _surface_cell(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, face_drain, air_h,
-                  air_t, i, j, k, scale, out, m, rescale):
+def _surface_cell(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_inv_h, face_t, face_drain,
+                  air_h, air_inv_h, air_t, i, j, k, scale, out, m, rescale, occ):
     """The boundary heat of one surface cell, added to Hn; drain if it is all liquid and a
-    face drains. ``out[m]``: heat in (J/m² of face), drained (J/m³), breach signal, drains."""
+    face drains. ``out[m]``: heat in (J/m² of face), drained (J/m³), breach signal, drains.
+    Every air face of a cell carries the same flux: it is computed once and added once per
+    face (the same sum as computing it per face)."""
     out[m, 0] = 0.0
     out[m, 1] = 0.0
     out[m, 2] = 0.0
@@ -191,24 +265,30 @@ def _surface_cell(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, face_dra
     tc = T[i, j, k]
     kc = K[i, j, k]
     outer = 0.0
-    air_faces = 0.0
+    n_air = 0
     wet = False
     for face in range(6):
         ii, jj, kk = _neighbour(i, j, k, face)
         kn = kind[ii, jj, kk]
         if kn == GHOST:
             d = face_drain[face] != 0
-            outer += _boundary_flux(face_h[face], face_t[face], d, tc, kc, hc, dx)
+            outer += _boundary_flux(face_h[face], face_inv_h[face], face_t[face], d, tc, kc,
+                                    hc, dx)
             if d and face_h[face] > 0.0:
                 wet = True
         elif kn == AIR:
-            air_faces += _boundary_flux(air_h, air_t, True, tc, kc, hc, dx)
-            if air_h > 0.0:
-                wet = True
-    if air_faces != 0.0:
-        if rescale or scale[m] < 0.0:
-            scale[m] = surface_scale(H, kind, i, j, k, hl)
-        outer += scale[m] * air_faces
+            n_air += 1
+    if n_air > 0:
+        if air_h > 0.0:
+            wet = True
+        f_air = _boundary_flux(air_h, air_inv_h, air_t, True, tc, kc, hc, dx)
+        air_faces = 0.0
+        for _ in range(n_air):
+            air_faces += f_air
+        if air_faces != 0.0:
+            if rescale or scale[m] < 0.0:
+                scale[m] = _surface_scale(H, kind, i, j, k, hl, occ)
+            outer += scale[m] * air_faces
     hn = Hn[i, j, k] + dt / dx * outer
     Hn[i, j, k] = hn
     Tn[i, j, k] = _temperature(hn, p)
@@ -221,6 +301,14 @@ def _surface_cell(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, face_dra
             ii, jj, kk = _neighbour(i, j, k, face)
             if kind[ii, jj, kk] == BODY and H[ii, jj, kk] >= hl:
                 out[m, 2] += 1.0
+
+
+@njit(cache=True)
+def _inverse(h):
+    """1 / h, 0 where h is 0 or infinite (those faces never use it)."""
+    if h > 0.0 and h != np.inf:
+        return 1.0 / h
+    return 0.0
 
 
 @njit(cache=True)
@@ -280,7 +368,7 @@ def find_surface(kind, face_h, air_h, surface, is_surface):
 @njit(cache=True, parallel=True)
 def run_steps_parallel(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, face_drain, air_h,
                        air_t, surface, scale, n_surface, is_surface, n_steps, totals,
-                       stop_on_breach, rescale_every, first_step):
+                       stop_on_breach, rescale_every, first_step, slabs):
     """Up to ``n_steps`` explicit steps (H holds the result), parallel over grid rows and
     surface cells. ``totals`` accumulates heat in, drained enthalpy, breach signals and
     drained cells; ``n_surface[0]`` is the surface list's length (grows as cells drain).
@@ -288,23 +376,32 @@ def run_steps_parallel(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, fac
     nx = H.shape[0] - 2
     ny = H.shape[1] - 2
     out = np.zeros((surface.shape[0], 4))
+    face_inv_h = np.empty(6)
+    for f in range(6):
+        face_inv_h[f] = _inverse(face_h[f])
+    air_inv_h = _inverse(air_h)
+    occ = np.empty(27)
     g = dt / (dx * dx)
     done = 0
     src = H
     dst = Hn
+    slabs = max(1, min(nx, slabs))
     for q in prange(nx * ny):
         i = q // ny
         _state_row(src, kind, p, T, K, i + 1, q - i * ny + 1)
     for step in range(n_steps):
-        for q in prange(nx * ny):
-            i = q // ny
-            _conduct_row(src, kind, T, K, dst, Tn, Kn, p, g, i + 1, q - i * ny + 1)
+        for c in prange(slabs):
+            fxa, fxb, fya, fyb, fz = _slab_buffers(src)
+            _conduct_slab(src, kind, T, K, dst, Tn, Kn, p, g, 1 + c * nx // slabs,
+                          1 + (c + 1) * nx // slabs, fxa, fxb, fya, fyb, fz)
         ns = n_surface[0]
         rescale = (first_step + step) % rescale_every == 0
-        for m in prange(ns):
-            _surface_cell(src, kind, T, K, dst, Tn, Kn, p, dt, dx, face_h, face_t,
-                          face_drain, air_h, air_t, surface[m, 0], surface[m, 1],
-                          surface[m, 2], scale, out, m, rescale)
+        for c in prange(slabs):  # chunks of the list, one scratch each
+            occ = np.empty(27)
+            for m in range(c * ns // slabs, (c + 1) * ns // slabs):
+                _surface_cell(src, kind, T, K, dst, Tn, Kn, p, dt, dx, face_h, face_inv_h,
+                              face_t, face_drain, air_h, air_inv_h, air_t, surface[m, 0],
+                              surface[m, 1], surface[m, 2], scale, out, m, rescale, occ)
         breach = 0.0
         drains = 0.0
         for m in range(ns):  # in list order: no dependence on the thread count
@@ -337,23 +434,27 @@ def run_steps_serial(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, face_
     nx = H.shape[0] - 2
     ny = H.shape[1] - 2
     out = np.zeros((surface.shape[0], 4))
+    face_inv_h = np.empty(6)
+    for f in range(6):
+        face_inv_h[f] = _inverse(face_h[f])
+    air_inv_h = _inverse(air_h)
+    occ = np.empty(27)
     g = dt / (dx * dx)
     done = 0
     src = H
     dst = Hn
+    fxa, fxb, fya, fyb, fz = _slab_buffers(H)
     for q in range(nx * ny):
         i = q // ny
         _state_row(src, kind, p, T, K, i + 1, q - i * ny + 1)
     for step in range(n_steps):
-        for q in range(nx * ny):
-            i = q // ny
-            _conduct_row(src, kind, T, K, dst, Tn, Kn, p, g, i + 1, q - i * ny + 1)
+        _conduct_slab(src, kind, T, K, dst, Tn, Kn, p, g, 1, nx + 1, fxa, fxb, fya, fyb, fz)
         ns = n_surface[0]
         rescale = (first_step + step) % rescale_every == 0
         for m in range(ns):
-            _surface_cell(src, kind, T, K, dst, Tn, Kn, p, dt, dx, face_h, face_t,
-                          face_drain, air_h, air_t, surface[m, 0], surface[m, 1],
-                          surface[m, 2], scale, out, m, rescale)
+            _surface_cell(src, kind, T, K, dst, Tn, Kn, p, dt, dx, face_h, face_inv_h,
+                          face_t, face_drain, air_h, air_inv_h, air_t, surface[m, 0],
+                          surface[m, 1], surface[m, 2], scale, out, m, rescale, occ)
         breach = 0.0
         drains = 0.0
         for m in range(ns):

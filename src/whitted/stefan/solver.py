@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 
 from . import kernels
@@ -156,13 +157,17 @@ class EnthalpySolver:
         """Up to n steps; fewer at the first sign of a breach (checked here on the field: a
         true one sets ``breach_time``; in drain mode the cavity then drains through the hole
         layer by layer, one cell per step, and the next call goes on)."""
-        runner = kernels.run_steps_parallel if self.parallel else kernels.run_steps_serial
+        args = ()
+        runner = kernels.run_steps_serial
+        if self.parallel:  # one slab of x planes per thread
+            runner = kernels.run_steps_parallel
+            args = (numba.get_num_threads(),)
         done = runner(self._Hp, self._kindp, self._T, self._K, self._Hn, self._Tn, self._Kn,
                       self._p, self.dt,
                       self.dx, self._face_h, self._face_t, self._face_drain,
                       float(self.air.h), float(self.air.temperature), self._surface,
                       self._scale, self._n_surface, self._is_surface, int(n), self.totals,
-                      not self.breached, self.rescale_every, self.steps)
+                      not self.breached, self.rescale_every, self.steps, *args)
         self.steps += done
         self.time += done * self.dt
         if self.totals[2] > 0 and not self.breached and self._confirm_breach():
