@@ -65,18 +65,6 @@ def _conductivity(h, p):
     return p[P_KI] + h / p[P_HL] * (p[P_KW] - p[P_KI])
 
 
-@njit(cache=True, inline="always")
-def _state_row(H, kind, p, T, K, i, j):
-    for k in range(1, H.shape[2] - 1):
-        if kind[i, j, k] == BODY:
-            h = H[i, j, k]
-            T[i, j, k] = _temperature(h, p)
-            K[i, j, k] = _conductivity(h, p)
-        else:
-            T[i, j, k] = 0.0
-            K[i, j, k] = 0.0
-
-
 @njit(cache=True, error_model="numpy", inline="always")
 def _face(kc, kn, tn, tc):
     return 2.0 * kc * kn / (kc + kn + TINY) * (tn - tc)
@@ -97,43 +85,65 @@ def _state(h, p):
 
 
 @njit(cache=True, error_model="numpy")
-def _faces_x(K, T, i, fx):
-    """``fx[j, k]``: the flux term of the face between cells (i, j, k) and (i + 1, j, k), as
-    cell i computes it (``_face``); cell i + 1 adds its negation, which is what it would
-    compute itself, bit for bit (2 k_a k_b and k_a + k_b commute exactly; T_a - T_b is
-    -(T_b - T_a) exactly)."""
-    for j in range(1, K.shape[1] - 1):
-        ka = K[i, j]
-        kb = K[i + 1, j]
-        ta = T[i, j]
-        tb = T[i + 1, j]
+def _state_plane(H, kind, p, i, T, K):
+    """Temperature and conductivity of the cells of plane i, ghosts included (air and ghost
+    cells 0): computed from H as a step needs them, never stored for the grid."""
+    for j in range(H.shape[1]):
+        h = H[i, j]
+        c = kind[i, j]
+        t = T[j]
+        kk = K[j]
+        for k in range(H.shape[2]):
+            tv, kv = _state(h[k], p)
+            body = c[k] == BODY
+            t[k] = tv if body else 0.0
+            kk[k] = kv if body else 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _faces_x(Ka, Ta, Kb, Tb, fx):
+    """``fx[j, k]``: the flux term of the face between cell (j, k) of plane a and of the next
+    plane b, as the cell in plane a computes it (``_face``); the cell in plane b adds its
+    negation, which is what it would compute itself, bit for bit (2 k_a k_b and k_a + k_b
+    commute exactly; T_a - T_b is -(T_b - T_a) exactly)."""
+    for j in range(1, Ka.shape[0] - 1):
+        ka = Ka[j]
+        kb = Kb[j]
+        ta = Ta[j]
+        tb = Tb[j]
         f = fx[j]
-        for k in range(1, K.shape[2] - 1):
+        for k in range(1, Ka.shape[1] - 1):
             f[k] = _face(ka[k], kb[k], tb[k], ta[k])
 
 
 @njit(cache=True, error_model="numpy")
-def _conduct_slab(H, kind, T, K, Hn, Tn, Kn, p, g, i0, i1, fxa, fxb, fya, fyb, fz):
-    """``_conduct_row`` for the rows i0 <= i < i1, each face computed once: x faces a plane
-    at a time (``fxa`` below the current plane, ``fxb`` above), y faces a row at a time, z
-    faces along the row. The sum per cell keeps the order x-, x+, y-, y+, z-, z+, so Hn is
-    the same to the last bit."""
+def _conduct_slab(H, kind, Hn, p, g, i0, i1, TA, KA, TB, KB, fxa, fxb, fya, fyb, fz):
+    """Hn = H + dt/dx² * sum over the six faces of k_face (T_nb - T) (harmonic-mean face
+    conductivity; air and ghost neighbours, k = 0, add exactly zero) for the planes
+    i0 <= i < i1. T and k come from H a plane at a time (``TA``/``KA`` and ``TB``/``KB``
+    hold two planes); each face is computed once: x faces a plane at a time (``fxa`` below
+    the current plane, ``fxb`` above), y faces a row at a time, z faces along the row. The
+    sum per cell keeps the order x-, x+, y-, y+, z-, z+: the same result to the last bit as
+    six faces per cell."""
     ny = H.shape[1] - 2
     nz = H.shape[2] - 2
-    _faces_x(K, T, i0 - 1, fxa)
+    _state_plane(H, kind, p, i0 - 1, TA, KA)
+    _state_plane(H, kind, p, i0, TB, KB)
+    _faces_x(KA, TA, KB, TB, fxa)
     for i in range(i0, i1):
-        _faces_x(K, T, i, fxb)
-        ka = K[i, 0]
-        ta = T[i, 0]
-        kb = K[i, 1]
-        tb = T[i, 1]
+        _state_plane(H, kind, p, i + 1, TA, KA)  # plane i + 1 replaces plane i - 1
+        _faces_x(KB, TB, KA, TA, fxb)
+        ka = KB[0]
+        ta = TB[0]
+        kb = KB[1]
+        tb = TB[1]
         for k in range(1, nz + 1):
             fya[k] = _face(ka[k], kb[k], tb[k], ta[k])
         for j in range(1, ny + 1):
-            kc = K[i, j]
-            tc = T[i, j]
-            kn = K[i, j + 1]
-            tn = T[i, j + 1]
+            kc = KB[j]
+            tc = TB[j]
+            kn = KB[j + 1]
+            tn = TB[j + 1]
             for k in range(1, nz + 1):
                 fyb[k] = _face(kc[k], kn[k], tn[k], tc[k])
             for k in range(0, nz + 1):
@@ -149,23 +159,19 @@ def _conduct_slab(H, kind, T, K, Hn, Tn, Kn, p, g, i0, i1, fxa, fxb, fya, fyb, f
                 s -= fz[k - 1]
                 s += fz[k]
                 hn[k] = h[k] + g * s
-            c = kind[i, j]
-            tt = Tn[i, j]
-            kk = Kn[i, j]
-            for k in range(1, nz + 1):
-                t, kv = _state(hn[k], p)
-                body = c[k] == BODY
-                tt[k] = t if body else 0.0
-                kk[k] = kv if body else 0.0
             fya, fyb = fyb, fya
+        TA, TB = TB, TA
+        KA, KB = KB, KA
         fxa, fxb = fxb, fxa
 
 
 @njit(cache=True, inline="always")
 def _slab_buffers(H):
+    """Scratch of one slab: two planes of T and k, two planes of x faces, three rows."""
     ny = H.shape[1]
     nz = H.shape[2]
-    return (np.empty((ny, nz)), np.empty((ny, nz)), np.empty(nz), np.empty(nz), np.empty(nz))
+    return (np.empty((ny, nz)), np.empty((ny, nz)), np.empty((ny, nz)), np.empty((ny, nz)),
+            np.empty((ny, nz)), np.empty((ny, nz)), np.empty(nz), np.empty(nz), np.empty(nz))
 
 
 @njit(cache=True, inline="always")
@@ -248,8 +254,8 @@ def _neighbour(i, j, k, face):
 
 
 @njit(cache=True, inline="always")
-def _surface_cell(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_inv_h, face_t, face_drain,
-                  air_h, air_inv_h, air_t, i, j, k, scale, out, m, rescale, occ):
+def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain, air_h,
+                  air_inv_h, air_t, i, j, k, scale, out, m, rescale, occ):
     """The boundary heat of one surface cell, added to Hn; drain if it is all liquid and a
     face drains. ``out[m]``: heat in (J/m² of face), drained (J/m³), breach signal, drains.
     Every air face of a cell carries the same flux: it is computed once and added once per
@@ -262,8 +268,8 @@ def _surface_cell(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_inv_h, face
         return
     hl = p[P_HL]
     hc = H[i, j, k]
-    tc = T[i, j, k]
-    kc = K[i, j, k]
+    tc = _temperature(hc, p)
+    kc = _conductivity(hc, p)
     outer = 0.0
     n_air = 0
     wet = False
@@ -291,8 +297,6 @@ def _surface_cell(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_inv_h, face
             outer += scale[m] * air_faces
     hn = Hn[i, j, k] + dt / dx * outer
     Hn[i, j, k] = hn
-    Tn[i, j, k] = _temperature(hn, p)
-    Kn[i, j, k] = _conductivity(hn, p)
     out[m, 0] = outer * dt
     if wet and hn >= hl:
         out[m, 1] = hn
@@ -312,7 +316,7 @@ def _inverse(h):
 
 
 @njit(cache=True)
-def _apply_drains(Hn, Tn, Kn, kind, surface, scale, out, n_surface, is_surface):
+def _apply_drains(Hn, kind, surface, scale, out, n_surface, is_surface):
     """Drained cells become air; their body neighbours join the surface list. Serial, in list
     order (deterministic). Returns the new list length."""
     n = n_surface
@@ -324,8 +328,6 @@ def _apply_drains(Hn, Tn, Kn, kind, surface, scale, out, n_surface, is_surface):
         k = surface[m, 2]
         kind[i, j, k] = AIR
         Hn[i, j, k] = 0.0
-        Tn[i, j, k] = 0.0
-        Kn[i, j, k] = 0.0
         for face in range(6):
             ii, jj, kk = _neighbour(i, j, k, face)
             if kind[ii, jj, kk] == BODY and is_surface[ii, jj, kk] == 0:
@@ -366,7 +368,7 @@ def find_surface(kind, face_h, air_h, surface, is_surface):
 
 
 @njit(cache=True, parallel=True)
-def run_steps_parallel(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, face_drain, air_h,
+def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
                        air_t, surface, scale, n_surface, is_surface, n_steps, totals,
                        stop_on_breach, rescale_every, first_step, slabs):
     """Up to ``n_steps`` explicit steps (H holds the result), parallel over grid rows and
@@ -374,7 +376,6 @@ def run_steps_parallel(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, fac
     drained cells; ``n_surface[0]`` is the surface list's length (grows as cells drain).
     Returns the steps done: fewer when a breach is signalled and ``stop_on_breach``."""
     nx = H.shape[0] - 2
-    ny = H.shape[1] - 2
     out = np.zeros((surface.shape[0], 4))
     face_inv_h = np.empty(6)
     for f in range(6):
@@ -386,20 +387,17 @@ def run_steps_parallel(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, fac
     src = H
     dst = Hn
     slabs = max(1, min(nx, slabs))
-    for q in prange(nx * ny):
-        i = q // ny
-        _state_row(src, kind, p, T, K, i + 1, q - i * ny + 1)
     for step in range(n_steps):
         for c in prange(slabs):
-            fxa, fxb, fya, fyb, fz = _slab_buffers(src)
-            _conduct_slab(src, kind, T, K, dst, Tn, Kn, p, g, 1 + c * nx // slabs,
-                          1 + (c + 1) * nx // slabs, fxa, fxb, fya, fyb, fz)
+            ta, ka, tb, kb, fxa, fxb, fya, fyb, fz = _slab_buffers(src)
+            _conduct_slab(src, kind, dst, p, g, 1 + c * nx // slabs, 1 + (c + 1) * nx // slabs,
+                          ta, ka, tb, kb, fxa, fxb, fya, fyb, fz)
         ns = n_surface[0]
         rescale = (first_step + step) % rescale_every == 0
         for c in prange(slabs):  # chunks of the list, one scratch each
             occ = np.empty(27)
             for m in range(c * ns // slabs, (c + 1) * ns // slabs):
-                _surface_cell(src, kind, T, K, dst, Tn, Kn, p, dt, dx, face_h, face_inv_h,
+                _surface_cell(src, kind, dst, p, dt, dx, face_h, face_inv_h,
                               face_t, face_drain, air_h, air_inv_h, air_t, surface[m, 0],
                               surface[m, 1], surface[m, 2], scale, out, m, rescale, occ)
         breach = 0.0
@@ -412,11 +410,9 @@ def run_steps_parallel(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, fac
         totals[2] += breach
         totals[3] += drains
         if drains > 0.0:
-            n_surface[0] = _apply_drains(dst, Tn, Kn, kind, surface, scale, out, ns,
+            n_surface[0] = _apply_drains(dst, kind, surface, scale, out, ns,
                                          is_surface)
         src, dst = dst, src
-        T, Tn = Tn, T
-        K, Kn = Kn, K
         done += 1
         if breach > 0.0 and stop_on_breach:
             break
@@ -426,13 +422,12 @@ def run_steps_parallel(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, fac
 
 
 @njit(cache=True)
-def run_steps_serial(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, face_drain, air_h,
+def run_steps_serial(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
                      air_t, surface, scale, n_surface, is_surface, n_steps, totals,
                      stop_on_breach, rescale_every, first_step):
     """``run_steps_parallel`` in one thread: for small grids and 1-D runs, where starting the
     threads three times a step would cost more than the work."""
     nx = H.shape[0] - 2
-    ny = H.shape[1] - 2
     out = np.zeros((surface.shape[0], 4))
     face_inv_h = np.empty(6)
     for f in range(6):
@@ -443,16 +438,13 @@ def run_steps_serial(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, face_
     done = 0
     src = H
     dst = Hn
-    fxa, fxb, fya, fyb, fz = _slab_buffers(H)
-    for q in range(nx * ny):
-        i = q // ny
-        _state_row(src, kind, p, T, K, i + 1, q - i * ny + 1)
+    ta, ka, tb, kb, fxa, fxb, fya, fyb, fz = _slab_buffers(H)
     for step in range(n_steps):
-        _conduct_slab(src, kind, T, K, dst, Tn, Kn, p, g, 1, nx + 1, fxa, fxb, fya, fyb, fz)
+        _conduct_slab(src, kind, dst, p, g, 1, nx + 1, ta, ka, tb, kb, fxa, fxb, fya, fyb, fz)
         ns = n_surface[0]
         rescale = (first_step + step) % rescale_every == 0
         for m in range(ns):
-            _surface_cell(src, kind, T, K, dst, Tn, Kn, p, dt, dx, face_h, face_inv_h,
+            _surface_cell(src, kind, dst, p, dt, dx, face_h, face_inv_h,
                           face_t, face_drain, air_h, air_inv_h, air_t, surface[m, 0],
                           surface[m, 1], surface[m, 2], scale, out, m, rescale, occ)
         breach = 0.0
@@ -465,11 +457,9 @@ def run_steps_serial(H, kind, T, K, Hn, Tn, Kn, p, dt, dx, face_h, face_t, face_
         totals[2] += breach
         totals[3] += drains
         if drains > 0.0:
-            n_surface[0] = _apply_drains(dst, Tn, Kn, kind, surface, scale, out, ns,
+            n_surface[0] = _apply_drains(dst, kind, surface, scale, out, ns,
                                          is_surface)
         src, dst = dst, src
-        T, Tn = Tn, T
-        K, Kn = Kn, K
         done += 1
         if breach > 0.0 and stop_on_breach:
             break

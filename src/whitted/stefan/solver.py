@@ -110,11 +110,7 @@ class EnthalpySolver:
         self._kindp = np.full(shape, kernels.GHOST, dtype=np.uint8)
         self._kindp[1:-1, 1:-1, 1:-1] = np.where(np.asarray(kind) == 1, 1, 0)
         self._Hp[self._kindp != 1] = 0.0
-        self._T = np.zeros(shape)
-        self._K = np.zeros(shape)
         self._Hn = np.zeros(shape)
-        self._Tn = np.zeros(shape)
-        self._Kn = np.zeros(shape)
         # rows of the grid are the parallel unit; 1-D and thin grids run in one thread (the
         # parallel kernel is faster from 24³ up: 164 vs 69 M cell updates per CPU-second)
         self.parallel = H.shape[0] * H.shape[1] >= PARALLEL_MIN_ROWS
@@ -162,9 +158,8 @@ class EnthalpySolver:
         if self.parallel:  # one slab of x planes per thread
             runner = kernels.run_steps_parallel
             args = (numba.get_num_threads(),)
-        done = runner(self._Hp, self._kindp, self._T, self._K, self._Hn, self._Tn, self._Kn,
-                      self._p, self.dt,
-                      self.dx, self._face_h, self._face_t, self._face_drain,
+        done = runner(self._Hp, self._kindp, self._Hn, self._p, self.dt, self.dx, self._face_h,
+                      self._face_t, self._face_drain,
                       float(self.air.h), float(self.air.temperature), self._surface,
                       self._scale, self._n_surface, self._is_surface, int(n), self.totals,
                       not self.breached, self.rescale_every, self.steps, *args)
