@@ -165,13 +165,14 @@ def _conduct_slab(H, kind, Hn, p, g, i0, i1, TA, KA, TB, KB, fxa, fxb, fya, fyb,
         fxa, fxb = fxb, fxa
 
 
-@njit(cache=True, inline="always")
-def _slab_buffers(H):
-    """Scratch of one slab: two planes of T and k, two planes of x faces, three rows."""
+@njit(cache=True)
+def _slab_buffers(H, slabs):
+    """Scratch of each slab, allocated once per call (not per step): two planes of T and k and
+    two planes of x faces (``planes[c, 0:6]``), three rows (``rows[c, 0:3]``), and 27
+    occupancies (``occ[c]``)."""
     ny = H.shape[1]
     nz = H.shape[2]
-    return (np.empty((ny, nz)), np.empty((ny, nz)), np.empty((ny, nz)), np.empty((ny, nz)),
-            np.empty((ny, nz)), np.empty((ny, nz)), np.empty(nz), np.empty(nz), np.empty(nz))
+    return np.empty((slabs, 6, ny, nz)), np.empty((slabs, 3, nz)), np.empty((slabs, 27))
 
 
 @njit(cache=True, inline="always")
@@ -381,21 +382,22 @@ def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h
     for f in range(6):
         face_inv_h[f] = _inverse(face_h[f])
     air_inv_h = _inverse(air_h)
-    occ = np.empty(27)
     g = dt / (dx * dx)
     done = 0
     src = H
     dst = Hn
     slabs = max(1, min(nx, slabs))
+    planes, rows, occs = _slab_buffers(H, slabs)
     for step in range(n_steps):
         for c in prange(slabs):
-            ta, ka, tb, kb, fxa, fxb, fya, fyb, fz = _slab_buffers(src)
+            pl = planes[c]
+            rw = rows[c]
             _conduct_slab(src, kind, dst, p, g, 1 + c * nx // slabs, 1 + (c + 1) * nx // slabs,
-                          ta, ka, tb, kb, fxa, fxb, fya, fyb, fz)
+                          pl[0], pl[1], pl[2], pl[3], pl[4], pl[5], rw[0], rw[1], rw[2])
         ns = n_surface[0]
         rescale = (first_step + step) % rescale_every == 0
         for c in prange(slabs):  # chunks of the list, one scratch each
-            occ = np.empty(27)
+            occ = occs[c]
             for m in range(c * ns // slabs, (c + 1) * ns // slabs):
                 _surface_cell(src, kind, dst, p, dt, dx, face_h, face_inv_h,
                               face_t, face_drain, air_h, air_inv_h, air_t, surface[m, 0],
@@ -433,12 +435,15 @@ def run_steps_serial(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
     for f in range(6):
         face_inv_h[f] = _inverse(face_h[f])
     air_inv_h = _inverse(air_h)
-    occ = np.empty(27)
     g = dt / (dx * dx)
     done = 0
     src = H
     dst = Hn
-    ta, ka, tb, kb, fxa, fxb, fya, fyb, fz = _slab_buffers(H)
+    planes, rows, occs = _slab_buffers(H, 1)
+    ta, ka, tb, kb, fxa, fxb = planes[0, 0], planes[0, 1], planes[0, 2], planes[0, 3], \
+        planes[0, 4], planes[0, 5]
+    fya, fyb, fz = rows[0, 0], rows[0, 1], rows[0, 2]
+    occ = occs[0]
     for step in range(n_steps):
         _conduct_slab(src, kind, dst, p, g, 1, nx + 1, ta, ka, tb, kb, fxa, fxb, fya, fyb, fz)
         ns = n_surface[0]
