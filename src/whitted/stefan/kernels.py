@@ -368,6 +368,22 @@ def find_surface(kind, face_h, air_h, surface, is_surface):
     return n
 
 
+@njit(cache=True)
+def _index_surface(surface, ns, plane_start, plane_cells):
+    """The surface list by grid plane (a counting sort, list order within a plane): plane i
+    holds ``plane_cells[plane_start[i - 1]:plane_start[i]]``."""
+    plane_start[:] = 0
+    for m in range(ns):
+        plane_start[surface[m, 0]] += 1
+    for q in range(1, plane_start.shape[0]):
+        plane_start[q] += plane_start[q - 1]
+    fill = plane_start[:-1].copy()
+    for m in range(ns):
+        q = surface[m, 0] - 1
+        plane_cells[fill[q]] = m
+        fill[q] += 1
+
+
 @njit(cache=True, parallel=True)
 def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
                        air_t, surface, scale, n_surface, is_surface, n_steps, totals,
@@ -388,19 +404,24 @@ def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h
     dst = Hn
     slabs = max(1, min(nx, slabs))
     planes, rows, occs = _slab_buffers(H, slabs)
+    plane_start = np.empty(nx + 1, dtype=np.int64)
+    plane_cells = np.empty(surface.shape[0], dtype=np.int64)
+    _index_surface(surface, n_surface[0], plane_start, plane_cells)
     for step in range(n_steps):
-        for c in prange(slabs):
-            pl = planes[c]
-            rw = rows[c]
-            _conduct_slab(src, kind, dst, p, g, 1 + c * nx // slabs, 1 + (c + 1) * nx // slabs,
-                          pl[0], pl[1], pl[2], pl[3], pl[4], pl[5], rw[0], rw[1], rw[2])
         ns = n_surface[0]
         rescale = (first_step + step) % rescale_every == 0
-        for c in prange(slabs):  # chunks of the list, one scratch each
+        for c in prange(slabs):  # a slab of planes, then its surface cells (cache-warm)
+            i0 = 1 + c * nx // slabs
+            i1 = 1 + (c + 1) * nx // slabs
+            pl = planes[c]
+            rw = rows[c]
+            _conduct_slab(src, kind, dst, p, g, i0, i1, pl[0], pl[1], pl[2], pl[3], pl[4],
+                          pl[5], rw[0], rw[1], rw[2])
             occ = occs[c]
-            for m in range(c * ns // slabs, (c + 1) * ns // slabs):
-                _surface_cell(src, kind, dst, p, dt, dx, face_h, face_inv_h,
-                              face_t, face_drain, air_h, air_inv_h, air_t, surface[m, 0],
+            for e in range(plane_start[i0 - 1], plane_start[i1 - 1]):
+                m = plane_cells[e]
+                _surface_cell(src, kind, dst, p, dt, dx, face_h, face_inv_h, face_t,
+                              face_drain, air_h, air_inv_h, air_t, surface[m, 0],
                               surface[m, 1], surface[m, 2], scale, out, m, rescale, occ)
         breach = 0.0
         drains = 0.0
@@ -414,6 +435,7 @@ def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h
         if drains > 0.0:
             n_surface[0] = _apply_drains(dst, kind, surface, scale, out, ns,
                                          is_surface)
+            _index_surface(surface, n_surface[0], plane_start, plane_cells)
         src, dst = dst, src
         done += 1
         if breach > 0.0 and stop_on_breach:
