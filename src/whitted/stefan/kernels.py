@@ -7,19 +7,22 @@ Arrays are padded with one ghost cell on every side. Cell kinds: ``AIR`` (0, the
 outside), ``BODY`` (1, ice, water or both; its enthalpy per volume ``H``, see
 :class:`~whitted.stefan.properties.Properties`), ``GHOST`` (2, outside the grid). Air and
 ghost cells have conductivity 0, so the conduction pass is one branch-free stencil over the
-whole grid (a face to a cell of conductivity 0 carries nothing). Heat from outside enters
-in a second, sparse pass over the list of surface cells: the faces of the grid's own boundary
-are given per side (x-, x+, y-, y+, z-, z+) as a heat transfer coefficient ``h`` (0:
-adiabatic, inf: the temperature is held), a temperature and a drain flag (1: air that carries
-meltwater away); between a body cell and an air cell the air's coefficient applies, scaled by
-|n|_2/|n|_1 of the surface normal estimated from the 3x3x3 occupancy gradient, so a staircase
-surface takes the heat of the true surface it stands for (without it a sphere melts sqrt(3)
-times faster along the diagonals). Surface cells that reach all-liquid drain (become air);
-their neighbours join the surface list.
+whole grid (a face to a cell of conductivity 0 carries nothing); it runs a slab of x planes
+per thread, with T and k computed from H two planes at a time (never stored for the grid)
+and each face computed once (``_conduct_slab``). Heat from outside enters in a sparse pass
+over the list of surface cells, each slab's right after its conduction: the faces of the
+grid's own boundary are given per side (x-, x+, y-, y+, z-, z+) as a heat transfer
+coefficient ``h`` (0: adiabatic, inf: the temperature is held), a temperature and a drain
+flag (1: air that carries meltwater away); between a body cell and an air cell the air's
+coefficient applies, scaled by |n|_2/|n|_1 of the surface normal estimated from the 3x3x3
+occupancy gradient, so a staircase surface takes the heat of the true surface it stands for
+(without it a sphere melts sqrt(3) times faster along the diagonals). Surface cells that
+reach all-liquid drain (become air); their neighbours join the surface list.
 
-No fast-math: the energy balance (enthalpy change = boundary heat - drained enthalpy) holds to
-round-off because each interior face's flux is computed with the same operands, in the same
-order, from both sides; the totals are summed in a fixed order, whatever the thread count.
+No fast-math (NumPy's error model on the arithmetic, so LLVM can vectorise: no division here
+is by zero): the energy balance (enthalpy change = boundary heat - drained enthalpy) holds to
+round-off because each interior face's flux is computed once and added to one side, negated
+(exactly) to the other; the totals are summed in a fixed order, whatever the thread count.
 """
 
 from __future__ import annotations
@@ -450,7 +453,7 @@ def run_steps_serial(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
                      air_t, surface, scale, n_surface, is_surface, n_steps, totals,
                      stop_on_breach, rescale_every, first_step):
     """``run_steps_parallel`` in one thread: for small grids and 1-D runs, where starting the
-    threads three times a step would cost more than the work."""
+    threads every step would cost more than the work."""
     nx = H.shape[0] - 2
     out = np.zeros((surface.shape[0], 4))
     face_inv_h = np.empty(6)
