@@ -111,8 +111,9 @@ class EnthalpySolver:
         self._kindp[1:-1, 1:-1, 1:-1] = np.where(np.asarray(kind) == 1, 1, 0)
         self._Hp[self._kindp != 1] = 0.0
         self._Hn = np.zeros(shape)
-        # rows of the grid are the parallel unit; 1-D and thin grids run in one thread (the
-        # parallel kernel is faster from 24³ up: 164 vs 69 M cell updates per CPU-second)
+        # slabs of x planes are the parallel unit (one per thread); 1-D and thin grids run in
+        # one thread (measured with the earlier row-parallel kernels: the parallel kernel was
+        # faster from 24³ up, 164 vs 69 M cell updates per CPU-second)
         self.parallel = H.shape[0] * H.shape[1] >= PARALLEL_MIN_ROWS
         # totals: heat in (J/m² per face), drained (J/m³ per cell), breach signals, drained
         self.totals = np.zeros(4)
