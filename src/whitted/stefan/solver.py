@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 
 from . import kernels
@@ -109,13 +110,10 @@ class EnthalpySolver:
         self._kindp = np.full(shape, kernels.GHOST, dtype=np.uint8)
         self._kindp[1:-1, 1:-1, 1:-1] = np.where(np.asarray(kind) == 1, 1, 0)
         self._Hp[self._kindp != 1] = 0.0
-        self._T = np.zeros(shape)
-        self._K = np.zeros(shape)
         self._Hn = np.zeros(shape)
-        self._Tn = np.zeros(shape)
-        self._Kn = np.zeros(shape)
-        # rows of the grid are the parallel unit; 1-D and thin grids run in one thread (the
-        # parallel kernel is faster from 24³ up: 164 vs 69 M cell updates per CPU-second)
+        # slabs of x planes are the parallel unit (one per thread); 1-D and thin grids run in
+        # one thread (measured with the earlier row-parallel kernels: the parallel kernel was
+        # faster from 24³ up, 164 vs 69 M cell updates per CPU-second)
         self.parallel = H.shape[0] * H.shape[1] >= PARALLEL_MIN_ROWS
         # totals: heat in (J/m² per face), drained (J/m³ per cell), breach signals, drained
         self.totals = np.zeros(4)
@@ -156,13 +154,16 @@ class EnthalpySolver:
         """Up to n steps; fewer at the first sign of a breach (checked here on the field: a
         true one sets ``breach_time``; in drain mode the cavity then drains through the hole
         layer by layer, one cell per step, and the next call goes on)."""
-        runner = kernels.run_steps_parallel if self.parallel else kernels.run_steps_serial
-        done = runner(self._Hp, self._kindp, self._T, self._K, self._Hn, self._Tn, self._Kn,
-                      self._p, self.dt,
-                      self.dx, self._face_h, self._face_t, self._face_drain,
+        args = ()
+        runner = kernels.run_steps_serial
+        if self.parallel:  # one slab of x planes per thread
+            runner = kernels.run_steps_parallel
+            args = (numba.get_num_threads(),)
+        done = runner(self._Hp, self._kindp, self._Hn, self._p, self.dt, self.dx, self._face_h,
+                      self._face_t, self._face_drain,
                       float(self.air.h), float(self.air.temperature), self._surface,
                       self._scale, self._n_surface, self._is_surface, int(n), self.totals,
-                      not self.breached, self.rescale_every, self.steps)
+                      not self.breached, self.rescale_every, self.steps, *args)
         self.steps += done
         self.time += done * self.dt
         if self.totals[2] > 0 and not self.breached and self._confirm_breach():
