@@ -231,6 +231,9 @@ class RenderController(QObject):
             return
         self._cancel_preview()
         pixels = self.interactive_pixels if self.interacting else self.preview_pixels
+        # never more pixels than the picture shows on screen: on a fast machine the adaptive
+        # budget grows past it, and a drag would then show more than the idle refinement
+        pixels = min(pixels, self.target_pixels)
         self._start_preview_job(scene, pixels, refining=False)
 
     def _start_preview_job(self, scene: Scene, pixels: int, *, refining: bool) -> None:
