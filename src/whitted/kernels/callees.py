@@ -18,6 +18,7 @@ from numba import typeof, types
 
 from .accel import surface_normals
 from .features import instances_possible
+from .geometry_ref import GeometryRef
 from .layout import GeometryArrays
 from .lighting import any_occluder
 from .texture import texture_color
@@ -33,6 +34,8 @@ def render_callees(geometry: GeometryArrays, materials):
     """(kernel, argument types) pairs for a scene with these arrays (their types pick the
     variant: with or without mesh instances)."""
     geo = typeof(geometry)
+    if instances_possible(geo):  # render_tiles passes the geometry by reference
+        geo = GeometryRef(geo)
     mats = typeof(materials)
     callees = [
         (surface_normals, (geo, INT, INT, REAL, REAL, VEC3)),
