@@ -467,9 +467,10 @@ def info(
         if flat:
             parts.append(f"{flat:,} triangles in the scene BVH")
         if stored:
+            traced = ("traced by Embree" if compiled.mesh_tracer == "embree"
+                      else f"{len(geo.mesh_nodes):,} mesh BVH nodes")
             parts.append(f"{len(geo.mesh_info)} stored for instancing ({stored:,} triangles, "
-                         f"{compiled.instanced_triangles - flat:,} with instances, "
-                         f"{len(geo.mesh_nodes):,} mesh BVH nodes)")
+                         f"{compiled.instanced_triangles - flat:,} with instances, {traced})")
         out.print("meshes: " + "; ".join(parts))
     for warning in compiled.warnings:
         out.print(Text(f"warning: {warning}"))

@@ -1,4 +1,5 @@
-"""Triangle meshes: watertight ray/triangle intersection and the bottom-level BVH walk.
+"""Triangle meshes: watertight ray/triangle intersection and the bottom-level BVH walk, or
+Embree's where the mesh has an Embree scene (``mesh_embree``: see compile/embree.py).
 
 A mesh is stored once in its own space (``mesh_vertices``, ``mesh_faces``) with its own BVH;
 the caller maps the ray into that space (instancing). The walks read each triangle's corners

@@ -106,6 +106,7 @@ def render_aovs(geo, params, depth, normal, object_id, work, lane, lanes):
     """Depth (distance along the unit primary ray, inf on a miss), outward geometric normal
     (zeros on a miss) and object index (-1 on a miss) through every pixel centre of the rows
     lane, lane + lanes, ..."""
+    geo = geometry_ref_if_instances(geo)  # as render_tiles: its callees' variants serve both
     for py in range(lane, params.height, lanes):
         stack = work[4]
         for px in range(params.width):
