@@ -9,6 +9,7 @@ import gc
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -23,6 +24,7 @@ from whitted.errors import SceneError
 from whitted.kernels.accel import closest_hit
 from whitted.kernels.lighting import any_occluder
 
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 pytestmark = pytest.mark.skipif(embree_library() is None, reason="Embree not installed")
 
 
@@ -231,3 +233,17 @@ def test_cli_says_in_one_line_when_embree_is_missing(tmp_path):
                          capture_output=True, text=True, env=env, timeout=300)
     assert out.returncode == 0, out.stderr
     assert (tmp_path / "y.png").exists()
+
+
+def test_scenes_without_big_meshes_never_load_embree(tmp_path):
+    """Embree is loaded by the first scene that stores a mesh for instancing, not before: a
+    plain render (and the small meshes flattened into the scene BVH) leaves it unloaded."""
+    code = ("import whitted\n"
+            "from whitted.compile import embree\n"
+            f"whitted.render({str(EXAMPLES / 'glass_cube.toml')!r}, width=16, height=12)\n"
+            "maps = open('/proc/self/maps').read()\n"
+            "print('LOADED' if 'embree' in maps or embree._library is not None else 'CLEAN')\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=600, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip().splitlines()[-1] == "CLEAN"
