@@ -295,3 +295,40 @@ def test_the_command_starts_no_blas_thread_pool_unless_asked(tmp_path):
     assert "TEARDOWN 1" in _cli_process(tmp_path, ["--version"]).stdout
     kept = _cli_process(tmp_path, ["--version"], {"OPENBLAS_NUM_THREADS": "2"})
     assert "TEARDOWN 2" in kept.stdout
+
+
+def test_numba_runtime_is_read_back_from_the_cache(tmp_path):
+    """The runtime's LLVM functions (NRT_incref, ...) are compiled once into the cache folder;
+    a later process reads them back instead of compiling them, and Numba code that allocates
+    (NRT) still compiles against them, links and runs."""
+    script = textwrap.dedent("""
+        import os, sys, glob
+        from numba.core.registry import cpu_target
+        from numba.core.runtime import nrtdynmod, rtsys
+        from whitted.kernels import jit
+
+        if sys.argv[1] == "second":
+            def no_compile(*args):
+                raise AssertionError("the runtime was compiled again")
+            nrtdynmod.create_nrt_module = no_compile
+        jit.initialize_runtime(cpu_target.target_context)
+        assert rtsys.library.get_pointer_to_function("nrt_unresolved_abort")
+        import numba, numpy as np
+
+        @numba.njit(cache=False)
+        def total(n):
+            a = np.empty(n)  # allocated through the runtime
+            for i in range(n):
+                a[i] = i
+            return a.sum()
+
+        print("FILES", len(glob.glob(os.path.join(os.environ["NUMBA_CACHE_DIR"],
+                                                   "whitted-nrt-*.bin"))), total(10))
+    """)
+    env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"),
+               NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    for run in ("first", "second"):
+        result = subprocess.run([sys.executable, "-c", script, run], capture_output=True,
+                                text=True, cwd=tmp_path, env=env, timeout=300)
+        assert result.returncode == 0, result.stderr[-2000:]
+        assert "FILES 1 45.0" in result.stdout
