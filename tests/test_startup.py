@@ -236,3 +236,99 @@ def test_render_in_a_terminal_draws_its_bar(tmp_path):
     assert os.waitstatus_to_exitcode(status) == 0, captured.decode(errors="replace")[-800:]
     assert b"rendering" in captured and b"24x16" in captured
     assert out.stat().st_size > 0
+
+
+def _cli_process(tmp_path: Path, args: list[str], env_extra: dict | None = None):
+    """``whitted ARGS`` in a fresh interpreter that also registers an atexit handler (printing
+    TEARDOWN) and reports its OPENBLAS_NUM_THREADS from one (so a test sees whether the
+    process went through the interpreter's teardown)."""
+    script = textwrap.dedent(f"""
+        import atexit, os, sys
+        atexit.register(lambda: print("TEARDOWN " + os.environ.get("OPENBLAS_NUM_THREADS",
+                                                                    "unset"), flush=True))
+        sys.argv = ["whitted", *{args!r}]
+        from whitted.cli.main import main
+        main()
+    """)
+    env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"))
+    env.pop("OPENBLAS_NUM_THREADS", None)
+    env.update(env_extra or {})
+    return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          cwd=tmp_path, env=env, timeout=600)
+
+
+def test_a_local_render_ends_without_teardown_and_keeps_its_output(tmp_path):
+    """After the image is written the process ends at once (no atexit, no interpreter
+    teardown), yet its summary line reaches a pipe and the file holds the same pixels as
+    an in-process render of the same scene."""
+    import numpy as np
+    from PIL import Image as PILImage
+
+    scene_file = REPO_ROOT / "examples" / "glass_cube.toml"
+    out = tmp_path / "x.png"
+    result = _cli_process(tmp_path, ["render", str(scene_file), "-W", "24", "-H", "16",
+                                     "-t", "2", "-o", str(out)])
+    assert result.returncode == 0, result.stderr
+    assert "TEARDOWN" not in result.stdout
+    summary = [line for line in result.stdout.splitlines() if line.startswith("24x16:")]
+    assert len(summary) == 1 and summary[0].endswith(f"-> {out}"), result.stdout
+    written = np.asarray(PILImage.open(out))
+    expected = whitted.render(str(scene_file), width=24, height=16, threads=1).to_srgb8()
+    assert written.shape == (16, 24, 3)
+    assert np.array_equal(written, expected)
+
+
+def test_other_commands_and_user_mistakes_end_normally(tmp_path):
+    """Only a local render skips the teardown: a command that failed before rendering, and
+    other commands, end through it (their atexit handlers run)."""
+    failed = _cli_process(tmp_path, ["render", str(tmp_path / "missing.toml"), "-o",
+                                     str(tmp_path / "x.png")])
+    assert failed.returncode == 2
+    assert "TEARDOWN" in failed.stdout
+    version = _cli_process(tmp_path, ["--version"])
+    assert version.returncode == 0 and "TEARDOWN" in version.stdout
+
+
+def test_the_command_starts_no_blas_thread_pool_unless_asked(tmp_path):
+    """The command's process runs NumPy with one OpenBLAS thread (its pool made importing
+    NumPy 0.05 s slower); a user's own OPENBLAS_NUM_THREADS is kept."""
+    assert "TEARDOWN 1" in _cli_process(tmp_path, ["--version"]).stdout
+    kept = _cli_process(tmp_path, ["--version"], {"OPENBLAS_NUM_THREADS": "2"})
+    assert "TEARDOWN 2" in kept.stdout
+
+
+def test_numba_runtime_is_read_back_from_the_cache(tmp_path):
+    """The runtime's LLVM functions (NRT_incref, ...) are compiled once into the cache folder;
+    a later process reads them back instead of compiling them, and Numba code that allocates
+    (NRT) still compiles against them, links and runs."""
+    script = textwrap.dedent("""
+        import os, sys, glob
+        from numba.core.registry import cpu_target
+        from numba.core.runtime import nrtdynmod, rtsys
+        from whitted.kernels import jit
+
+        if sys.argv[1] == "second":
+            def no_compile(*args):
+                raise AssertionError("the runtime was compiled again")
+            nrtdynmod.create_nrt_module = no_compile
+        jit.initialize_runtime(cpu_target.target_context)
+        assert rtsys.library.get_pointer_to_function("nrt_unresolved_abort")
+        import numba, numpy as np
+
+        @numba.njit(cache=False)
+        def total(n):
+            a = np.empty(n)  # allocated through the runtime
+            for i in range(n):
+                a[i] = i
+            return a.sum()
+
+        print("FILES", len(glob.glob(os.path.join(os.environ["NUMBA_CACHE_DIR"],
+                                                   "whitted-nrt-*.bin"))), total(10))
+    """)
+    env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"),
+               NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    for run in ("first", "second"):
+        result = subprocess.run([sys.executable, "-c", script, run], capture_output=True,
+                                text=True, cwd=tmp_path, env=env, timeout=300)
+        assert result.returncode == 0, result.stderr[-2000:]
+        assert "FILES 1 45.0" in result.stdout

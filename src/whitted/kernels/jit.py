@@ -40,8 +40,9 @@ import os
 
 from numba import config, types
 from numba.core.caching import FunctionCache
+from numba.core.compiler_lock import global_compiler_lock
 from numba.core.registry import CPUDispatcher
-from numba.core.runtime import rtsys
+from numba.core.runtime import nrtdynmod, rtsys
 
 if "NUMBA_SLP_VECTORIZE" not in os.environ:
     config.SLP_VECTORIZE = 1
@@ -73,9 +74,69 @@ class KernelCache(FunctionCache):
     is unchanged."""
 
     def load_overload(self, sig, target_context):
-        rtsys.initialize(target_context)
+        initialize_runtime(target_context)
         with self._guard_against_spurious_io_errors():
             return self._load_overload(sig, target_context)
+
+
+def _runtime_cache_file(codegen) -> str | None:
+    """Where the runtime's machine code is kept: beside the kernels, named after everything
+    the code depends on (Numba, llvmlite, the target CPU and its features)."""
+    if not config.CACHE_DIR:
+        return None
+    import hashlib
+
+    import llvmlite
+    import numba
+
+    key = repr((numba.__version__, llvmlite.__version__, codegen.magic_tuple()))
+    name = f"whitted-nrt-{hashlib.sha256(key.encode()).hexdigest()[:16]}.bin"
+    return os.path.join(config.CACHE_DIR, name)
+
+
+def _cached_nrt_functions(target_context):
+    """``nrtdynmod.compile_nrt_functions``, read back from the cache when it is there."""
+    import contextlib
+    import pickle
+
+    codegen = target_context.codegen()
+    path = _runtime_cache_file(codegen)
+    if path is not None:
+        with contextlib.suppress(Exception), open(path, "rb") as f:  # absent or unreadable:
+            return codegen.unserialize_library(pickle.load(f))  # compiled below
+    # as nrtdynmod.compile_nrt_functions does, keeping the object code to store
+    ir_module, library = nrtdynmod.create_nrt_module(target_context)
+    library.enable_object_caching()
+    library.add_ir_module(ir_module)
+    library.finalize()
+    if path is not None:  # written whole or not at all; a failure only costs the compile
+        tmp = f"{path}.{os.getpid()}.tmp"
+        try:
+            data = pickle.dumps(library.serialize_using_object_code())
+            os.makedirs(os.path.dirname(path), exist_ok=True)
+            with open(tmp, "wb") as f:
+                f.write(data)
+            os.replace(tmp, path)
+        except Exception:  # noqa: BLE001 - a read-only or full disk, an unpicklable library
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+    return library
+
+
+_compile_nrt_functions = nrtdynmod.compile_nrt_functions
+
+
+def initialize_runtime(target_context) -> None:
+    """``rtsys.initialize``, with the runtime's own LLVM functions (NRT_incref, NRT_decref,
+    ...) read back as machine code from the kernel cache folder instead of compiled by LLVM
+    in every process (20-25 ms). Numba's cache does the same for every kernel (object code
+    plus bitcode for later linking)."""
+    with global_compiler_lock:  # rtsys.initialize takes it too: no compile sees the swap
+        nrtdynmod.compile_nrt_functions = _cached_nrt_functions
+        try:
+            rtsys.initialize(target_context)
+        finally:
+            nrtdynmod.compile_nrt_functions = _compile_nrt_functions
 
 
 class KernelDispatcher(CPUDispatcher):

@@ -63,6 +63,11 @@ HDR_FORMATS: frozenset[str] = frozenset({"exr", "pfm", "npy"})
 LDR_FORMATS: frozenset[str] = frozenset({"png", "jpeg"})
 
 JPEG_QUALITY = 95  # written with 4:4:4 chroma (no subsampling): renders have sharp colour edges
+#: zlib level of 8-bit PNG stills. Measured with Pillow on renders (809x817 seed000, 800x300,
+#: 400x300): level 4 writes in about half the time of the default 6 (34 vs 86 ms, 6.9 vs
+#: 14.9 ms, 4.2 vs 11.5 ms) for files 6-25 % larger, and is both faster and smaller than 3.
+#: The pixels are the same at every level (zlib is lossless).
+PNG_COMPRESS_LEVEL = 4
 
 # sRGB (IEC 61966-2-1) constants.
 _SRGB_LINEAR_CUTOFF = 0.0031308  # in linear light
@@ -436,7 +441,7 @@ def _pil_rgb(pixels: np.ndarray, transfer: str, tonemap: str):
 
 
 def _write_png8(tmp: str, pixels: np.ndarray, transfer: str, tonemap: str) -> None:
-    _pil_rgb(pixels, transfer, tonemap).save(tmp, format="PNG")
+    _pil_rgb(pixels, transfer, tonemap).save(tmp, format="PNG", compress_level=PNG_COMPRESS_LEVEL)
 
 
 def _write_png16(tmp: str, pixels: np.ndarray, transfer: str, tonemap: str) -> None:
