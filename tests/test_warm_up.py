@@ -7,9 +7,10 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from whitted.compile.params import render_params
-from whitted.kernels import tiles
+from whitted.kernels import integrator, tiles
 from whitted.kernels.callees import render_callees
 from whitted.kernels.jit import kernel
 from whitted.kernels.layout import N_RAY_KINDS
@@ -17,21 +18,30 @@ from whitted.render import warm_up
 from whitted.scene.scene import RenderSettings, Scene
 
 
-def test_helper_compiles_the_signatures_render_tiles_calls():
-    """The helper's work is only of use if render_tiles asks for exactly these variants.
+@pytest.mark.parametrize("instances", [False, True])
+def test_helper_compiles_the_signatures_render_tiles_calls(monkeypatch, instances):
+    """The helper's work is only of use if the render kernel asks for exactly these variants.
 
-    A copy of render_tiles without a cache is compiled here: its callees then load (or
-    compile) the variants it asks for, which is what their ``overloads`` list."""
-    stand_in = warm_up.stand_in_scene(False)
+    Uncached copies of render_tiles and of the callers of the helper's kernels (trace_path,
+    direct_light) are compiled here: they ask for the variants of their callees (which load
+    or compile), and those are what the callees' twins then list in ``overloads``."""
+    def fresh(dispatcher):
+        return kernel(cache=False, inline="always")(dispatcher.py_func)
+
+    monkeypatch.setattr(tiles, "trace_path", fresh(integrator.trace_path))
+    monkeypatch.setattr(integrator, "direct_light", fresh(integrator.direct_light))
+    stand_in = warm_up.stand_in_scene(instances)
     fresh_render_tiles = kernel(cache=False)(tiles.render_tiles.py_func)
     params = render_params(Scene(), stand_in, RenderSettings(width=1, height=1))
     fresh_render_tiles(np.zeros((0, 4), np.int32), np.zeros((1, 1, 3), np.float32),
                        stand_in.geometry, stand_in.materials, stand_in.lights, params,
                        np.zeros((1, N_RAY_KINDS), np.int64), tiles.lane_workspace(1), 0, 1)
-    for dispatcher, argument_types in render_callees(stand_in.geometry, stand_in.materials):
-        assert tuple(argument_types) in dispatcher.overloads, (
+    delegated = render_callees(stand_in.geometry, stand_in.materials, params)
+    assert delegated
+    for dispatcher, argument_types in delegated:
+        assert tuple(argument_types) in dispatcher.callee.overloads, (
             f"{dispatcher.py_func.__name__}: render_tiles compiled "
-            f"{list(dispatcher.overloads)}, the helper would compile {argument_types}")
+            f"{list(dispatcher.callee.overloads)}, the helper would compile {argument_types}")
 
 
 def test_warm_up_marks_the_cache_folder():
