@@ -10,14 +10,14 @@ exactly the ones the callers ask for, or the helper's work is wasted: ``tests/te
 checks them. Integers are int64 everywhere (``jit.KernelDispatcher`` widens them); what is
 compiled is each kernel's twin for calls from kernels (``callee``).
 
-The share is chosen by measured compile times (CPU, one process, 2-core EPYC): for scenes
-without mesh instances the helper also compiles all the builders (about 8 s), so it takes
-only the shading callees ``trace_path`` reaches after ``closest_hit`` (normals 0.9 s,
-surface colour 1.0 s of the 11.7 s render kernel); for scenes with mesh instances (the
-builders are already cached) it takes the shadow rays (``shadow_transmittance``, 4.4 s of
-14.8 s), the deepest part of ``direct_light``: what remains here is ``closest_hit``,
-normals, colour, then the chain ``direct_light`` -> ``trace_path`` -> ``render_tiles``,
-each inlining the one below (about 7 s that only this process can do).
+The share is chosen by measured compile times (CPU, one process, 2-core EPYC, Zen 4): for
+scenes without mesh instances the helper also compiles all the builders and the OBJ loader
+(about 9 s), so it takes only ``surface_normals`` (0.9 s of the 10.9 s render kernel), the
+first callee ``render_tiles`` reaches after ``closest_hit``; for scenes with mesh instances
+(the builders are already cached) it takes the shadow rays (``shadow_transmittance``, about
+4 s of 12.3 s), the deepest part of ``direct_light``: what remains here is ``closest_hit``,
+normals, colour, then ``direct_light`` and ``render_tiles``, each inlining the one below
+(work only this process can do, as it needs everything below it).
 """
 
 from __future__ import annotations
@@ -26,7 +26,6 @@ from numba import typeof, types
 
 from .accel import surface_normals
 from .features import instances_possible
-from .integrator import surface_colour
 from .layout import GeometryArrays
 from .lighting import shadow_transmittance
 
@@ -48,7 +47,4 @@ def render_callees(geometry: GeometryArrays, materials, params):
         return [(shadow_transmittance, (geo, mats, typeof(params), VEC3, VEC3, REAL, INT32S,
                                         INT, INT32S, INT32S, REALS, INT, INT32S, INT, INT,
                                         BOOL))]
-    return [
-        (surface_normals, (geo, INT, INT, REAL, REAL, VEC3)),
-        (surface_colour, (geo, mats, INT, INT, INT, REAL, REAL, VEC3)),
-    ]
+    return [(surface_normals, (geo, INT, INT, REAL, REAL, VEC3))]

@@ -47,11 +47,21 @@ A kernel declared ``inline="always"`` is inlined by LLVM (Numba's ``forceinline`
 ``alwaysinline`` attribute), not by Numba's IR inliner, which deep-copies the callee's whole
 variable scope once per block of it (quadratic in the callee's size) and types the inlined
 code again in each caller. The machine code does the same arithmetic (every image stayed
-bit-identical) and runs faster: seed000 at one thread, CPU, three interleaved pairs, 0.536 ->
-0.458 s, 0.660 -> 0.452 s, 0.552 -> 0.478 s (LLVM inlines the callee it has already
-optimised). Measured with the twins (CPU, one process): the plain render kernel 15.9 -> 13.2 s,
-the kernel for scenes with mesh instances 18.4 -> 16.2 s. (Not inlining ``trace_path`` at all
-saved 1.9 s more but rendered seed000 5-10 % slower.)
+bit-identical) and runs faster (LLVM inlines a callee it has already optimised on its own).
+``trace_path`` is the exception (``numba_inline=True``: Numba's IR inliner): with LLVM
+inlining it was optimised and compiled twice, once on its own and once in ``render_tiles``,
+its one caller, and Numba's copy of it is cheap now that its own callees are not copied into
+it. Measured, CPU, with the twins, one process, cold (the plain render kernel / the one for
+scenes with mesh instances):
+
+| inlining | compile | seed000, one thread, CPU (interleaved) | ice | softshadow |
+| --- | --- | --- | --- | --- |
+| Numba's, as before | 15.9 / 18.4 s | 0.54-0.68 s | 3.71-4.10 s | 10.1-11.4 s |
+| LLVM's, ``trace_path`` too | 12.5 / 15.6 s | 0.453-0.458 s | 3.55-3.57 s | 8.55-8.59 s |
+| LLVM's, ``trace_path`` Numba's (this) | 10.9 / 12.3 s | 0.502-0.504 s | 3.68 s | 9.34 s |
+
+The middle row renders about 10 % faster than this one for 1.6 s / 3.3 s more compile
+(a one-word change on ``trace_path``), which the cold-compile goal could not afford.
 """
 
 from __future__ import annotations
@@ -161,6 +171,8 @@ def kernel(fn=None, **options):
     if opts.get("inline") == "always":  # inlined by LLVM, not by Numba (module docstring)
         del opts["inline"]
         opts["forceinline"] = True
+    if opts.pop("numba_inline", False):  # inlined by Numba into its one caller
+        opts["inline"] = "always"
     cache = opts.pop("cache", True)
     specialise_constants = opts.pop("specialise_constants", False)
 
