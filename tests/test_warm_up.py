@@ -62,3 +62,34 @@ def test_helper_process_runs_to_completion():
 def test_no_helper_when_disabled(monkeypatch):
     monkeypatch.setenv("WHITTED_COMPILE_HELPER", "0")
     assert warm_up._start_helper(False) is None
+
+
+def test_waits_for_the_helpers_callees_and_counts_its_compiles():
+    """The render process waits for a kernel the helper compiles (True: load it), not for
+    others (False at once), and stops waiting when the helper has gone without it."""
+    import threading
+    import time
+
+    lines: list[str] = []
+    more = threading.Event()
+
+    def helper_output():  # what the helper prints, line by line, as it goes
+        for k in range(3):
+            more.wait(5)
+            yield from lines[k:k + 1]
+        more.wait(5)
+
+    count = warm_up._CompileCount(10, ("a__callee", "b__callee"))
+    reader = threading.Thread(target=count.read_helper, args=(helper_output(),))
+    assert count.wait_for_helper("c__callee") is False  # not the helper's: compile here
+    lines.extend([".\n", ".\n", "done a__callee\n"])
+    reader.start()
+    start = time.monotonic()
+    more.set()
+    assert count.wait_for_helper("a__callee") is True
+    reader.join(5)
+    assert count.helper == 2 and count.fraction == 0.2
+    # the helper ended without b: the render process compiles it itself
+    assert count.helper_gone
+    assert count.wait_for_helper("b__callee") is False
+    assert time.monotonic() - start < 5

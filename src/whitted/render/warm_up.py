@@ -165,10 +165,12 @@ class _CompileCount:
     def wait_for_helper(self, name: str) -> bool:
         """Wait while the helper compiles kernel ``name`` (its twin's qualified name); True
         when it has (load it now), False when it is not the helper's or the helper is gone."""
+        deadline = time.monotonic() + HELPER_WAIT_SECONDS
         with self._changed:
             if name not in self.pending:
                 return False
-            while name in self.pending and not self.helper_gone:
+            while (name in self.pending and not self.helper_gone
+                   and time.monotonic() < deadline):
                 self._changed.wait(0.1)  # a timeout: Ctrl-C reaches this thread at once
             return name not in self.pending
 
