@@ -86,12 +86,14 @@ def test_each_level_of_reuse_renders_what_a_fresh_compile_renders(tmp_path):
 
 def test_a_mesh_keeps_its_bvh_when_another_object_moves(tmp_path):
     scene = _scene(tmp_path)
-    with BvhMemo() as memo:  # flatten_limit 0: the mesh is stored with its own BVH
-        first = compile_scene(scene.at_frame(1), flatten_limit=0)
+    # flatten_limit 0: the mesh is stored with its own BVH (whitted's: tests/test_embree.py
+    # has the memo keeping Embree's)
+    with BvhMemo() as memo:
+        first = compile_scene(scene.at_frame(1), flatten_limit=0, mesh_tracer="whitted")
         assert memo.built == 3 and memo.reused == 0  # scene, instances, the mesh
-        second = compile_scene(scene.at_frame(2), flatten_limit=0)
+        second = compile_scene(scene.at_frame(2), flatten_limit=0, mesh_tracer="whitted")
     assert memo.reused == 2 and memo.built == 4  # the mesh's and the instance BVH kept
-    fresh = compile_scene(scene.at_frame(2), flatten_limit=0)
+    fresh = compile_scene(scene.at_frame(2), flatten_limit=0, mesh_tracer="whitted")
     for name in fresh.geometry._fields:
         assert np.array_equal(getattr(second.geometry, name), getattr(fresh.geometry, name)), name
     assert not np.array_equal(first.geometry.node_box, second.geometry.node_box)

@@ -200,10 +200,17 @@ def test_compare_embree_traces_the_same_rays():
 
     scene = load_bench_scene("sphere1m", quick=True).with_settings(width=32, height=18)
     row = compare_embree(scene, repeats=1)
-    assert row["embree_rays"] == 32 * 18 + row["whitted_hits"]  # camera + one shadow per hit
+    assert row["embree_rays"] == 32 * 18 + row["walk_hits"]  # camera + one shadow per hit
     assert row["embree_triangles"] == 2 * 100 * 50 + 2  # the sphere and the ground's two
-    # the same world: the same camera rays hit the sphere or the ground (the top row is sky)
-    assert row["whitted_hits"] == row["embree_hits"] == 32 * 17
-    assert abs(row["whitted_occluded"] - row["embree_occluded"]) <= 2
+    # the same world: the same camera rays hit the sphere or the ground (the top row is sky),
+    # traced by whitted's walk, by Embree inside whitted's render, and by Embree alone
+    assert row["walk_hits"] == row["whitted_embree_hits"] == row["embree_hits"] == 32 * 17
+    assert abs(row["walk_occluded"] - row["embree_occluded"]) <= 2
+    assert abs(row["whitted_embree_occluded"] - row["embree_occluded"]) <= 2
+    # the headline is what a render uses: Embree inside whitted
+    assert row["whitted_mesh_tracer"] == "embree"
+    assert row["whitted_trace_mrays_per_s"] == row["whitted_embree_mrays_per_s"]
     assert row["ratio_embree"] == pytest.approx(
         row["whitted_trace_mrays_per_s"] / row["embree_mrays_per_s"])
+    assert row["ratio_embree_walk"] == pytest.approx(
+        row["walk_mrays_per_s"] / row["embree_mrays_per_s"])

@@ -11,6 +11,7 @@ from numba import njit
 
 import whitted
 from meshgen import cube, uv_sphere
+from whitted.compile.embree import embree_library
 from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import closest_hit, surface_normals
 from whitted.kernels.layout import PRIM_MATERIAL
@@ -46,13 +47,18 @@ def _targets(verts, faces):
     return np.concatenate([v, mid])
 
 
-# every mesh test runs both ways a mesh can be stored: flattened into the scene BVH as triangle
-# primitives (a small mesh used once) and instanced (stored once, its own BVH)
-LAYOUTS = [pytest.param(None, id="flattened"), pytest.param(0, id="instanced")]
+# every mesh test runs every way a mesh can be stored and traced: flattened into the scene BVH
+# as triangle primitives (a small mesh used once), and instanced (stored once) with whitted's
+# own mesh BVH or with Embree's (compile/embree.py; skipped where Embree does not load)
+EMBREE = pytest.mark.skipif(embree_library() is None, reason="Embree not installed")
+LAYOUTS = [pytest.param(None, id="flattened"), pytest.param("whitted", id="instanced"),
+           pytest.param("embree", id="embree", marks=EMBREE)]
 
 
 def compile_as(scene, layout):
-    return compile_scene(scene) if layout is None else compile_scene(scene, flatten_limit=layout)
+    if layout is None:
+        return compile_scene(scene)
+    return compile_scene(scene, flatten_limit=0, mesh_tracer=layout)
 
 
 TRANSFORMS = [
@@ -94,7 +100,15 @@ def test_closed_mesh_is_watertight(sphere_mesh, transform, layout):
     t_in = _hits(compiled, far, d)
     assert np.isfinite(t_in).all()
     t_out = _hits(compiled, far, d, t_in * (1 + 1e-9))
-    assert np.isfinite(t_out).all()
+    if layout == "embree":
+        # Embree's robust mode is watertight along edges, not always at a vertex that many
+        # triangles share: 3 of these sphere's 1,106 vertices let a ray aimed exactly at
+        # them in from outside (without robust mode: 626 of the 7,730 targets)
+        vertex = np.arange(len(targets)) < len(v)
+        assert np.isfinite(t_out[~vertex]).all()
+        assert (~np.isfinite(t_out[vertex])).sum() <= 0.005 * len(v)
+    else:
+        assert np.isfinite(t_out).all()
     # a million random rays from random interior points in random directions
     n = 1_000_000
     o = world(rng.uniform(-0.5, 0.5, (n, 3)))
@@ -115,7 +129,8 @@ def test_mesh_hits_match_analytic_box(layout):
     assert 1000 < np.isfinite(as_box).sum() < 2000
     np.testing.assert_array_equal(np.isfinite(as_mesh), np.isfinite(as_box))
     hit = np.isfinite(as_box)
-    np.testing.assert_allclose(as_mesh[hit], as_box[hit], rtol=1e-12, atol=1e-12)
+    exact = 1e-12 if layout != "embree" else 1e-6  # Embree traces in float32
+    np.testing.assert_allclose(as_mesh[hit], as_box[hit], rtol=exact, atol=exact)
 
 
 def test_instances_share_one_copy():
@@ -167,7 +182,7 @@ def test_smooth_normals_interpolate_the_corners(layout):
     geo, prim, tri, b1, b2, p = _one_triangle_hit(mesh, (0.25, 0.5, 1.0), (0.0, 0.0, -1.0),
                                                   layout)
     if tri >= 0:
-        assert (b1, b2) == pytest.approx((0.25, 0.5))
+        assert (b1, b2) == pytest.approx((0.25, 0.5), rel=1e-6)
     ng, ns = surface_normals(geo, prim, tri, b1, b2, p)
     assert ng == pytest.approx((0, 0, 1))
     expect = 0.25 * normals[0] + 0.25 * normals[1] + 0.5 * normals[2]
@@ -316,7 +331,7 @@ def test_mesh_nodes_are_sibling_pairs_on_cache_lines():
     v1, f1 = uv_sphere(12, 24)
     v2, f2 = cube()
     scene = whitted.Scene(objects=[whitted.Mesh(v1, f1), whitted.Mesh(v2, f2)])
-    geo = compile_scene(scene, flatten_limit=0).geometry
+    geo = compile_scene(scene, flatten_limit=0, mesh_tracer="whitted").geometry
     nodes, ints = geo.mesh_nodes, geo.mesh_node_ints
     assert nodes.shape[1] == 8 and nodes.dtype == np.float32 and ints.dtype == np.int32
     assert np.shares_memory(nodes, ints)

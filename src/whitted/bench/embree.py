@@ -89,42 +89,23 @@ def compare_embree(scene: Scene, repeats: int = 3) -> dict[str, Any]:
     except ImportError as exc:
         raise EmbreeMissing("--compare embree needs embreex: pip install 'whitted[bench]'") \
             from exc
-    from ..compile.params import render_params
-    from ..compile.scene import compile_scene
-    from ..kernels.tiles import BVH_STACK
-    from ..render.warm_up import warm_up_kernels
+    from ..compile.embree import embree_library
     from ..scene.lights import PointLight
-    from .rays import camera_rays, nearest_hits, occluded
 
     lights = [light for light in scene.lights if isinstance(light, PointLight)]
     if not lights:
         raise ValueError("the scene has no point light to cast shadow rays toward")
     light = np.asarray(lights[0].position, np.float64)
-    compiled = compile_scene(scene)
-    warm_up_kernels(compiled)
-    params = render_params(scene, compiled, scene.render)
-    n = scene.render.width * scene.render.height
-    origins = np.empty((n, 3))
-    directions = np.empty((n, 3))
-    camera_rays(params, origins, directions)
-    stack = np.empty(BVH_STACK, np.int32)
-    geo = compiled.geometry
-
-    t_hit = np.empty(n)
-    nearest_hits(geo, origins[:1], directions[:1], t_hit[:1], stack)  # compile or load
-    whitted_primary_s, _ = _best(lambda: nearest_hits(geo, origins, directions, t_hit, stack),
-                                 repeats)
-    hit = np.isfinite(t_hit)
-    points = origins[hit] + t_hit[hit, None] * directions[hit]
-    to_light = light - points
-    distance = np.linalg.norm(to_light, axis=1)
-    s_dirs = to_light / distance[:, None]
-    s_origins = points + SHADOW_OFFSET * s_dirs
-    s_tmax = distance - SHADOW_OFFSET
-    blocked = np.empty(len(s_origins), np.int32)
-    occluded(geo, compiled.materials, s_origins[:1], s_dirs[:1], s_tmax[:1], blocked[:1], stack)
-    whitted_shadow_s, _ = _best(lambda: occluded(geo, compiled.materials, s_origins, s_dirs,
-                                                 s_tmax, blocked, stack), repeats)
+    walk = _whitted_trace(scene, light, "whitted", repeats)
+    origins, directions = walk.pop("origins"), walk.pop("directions")
+    s_origins, s_dirs, s_tmax = walk.pop("s_origins"), walk.pop("s_dirs"), walk.pop("s_tmax")
+    n = len(origins)
+    result: dict[str, Any] = {f"walk_{k}": v for k, v in walk.items()}
+    if embree_library() is not None:  # the render's own Embree path (compile/embree.py)
+        traced = _whitted_trace(scene, light, "embree", repeats)
+        for key in ("origins", "directions", "s_origins", "s_dirs", "s_tmax"):
+            traced.pop(key)
+        result.update({f"whitted_embree_{k}": v for k, v in traced.items()})
 
     start = time.perf_counter()
     triangles = world_triangles(scene)
@@ -141,11 +122,9 @@ def compare_embree(scene: Scene, repeats: int = 3) -> dict[str, Any]:
         lambda: embree_scene.run(so32, sd32, query="OCCLUDED", dists=st32), repeats)
 
     rays = n + len(s_origins)
-    whitted_s = whitted_primary_s + whitted_shadow_s
     embree_s = embree_primary_s + embree_shadow_s
-    whitted_rate = rays / whitted_s / 1e6 if whitted_s > 0 else 0.0
     embree_rate = rays / embree_s / 1e6 if embree_s > 0 else 0.0
-    return {
+    result.update({
         "embree_rays": rays,
         "embree_triangles": len(triangles),
         "embree_build_s": embree_build_s,
@@ -154,10 +133,65 @@ def compare_embree(scene: Scene, repeats: int = 3) -> dict[str, Any]:
         "embree_mrays_per_s": embree_rate,
         "embree_hits": int(np.count_nonzero(embree_t < 1e30)),
         "embree_occluded": int(np.count_nonzero(np.asarray(embree_blocked) >= 0)),
-        "whitted_trace_primary_s": whitted_primary_s,
-        "whitted_trace_shadow_s": whitted_shadow_s,
-        "whitted_trace_mrays_per_s": whitted_rate,
-        "whitted_hits": int(np.count_nonzero(hit)),
-        "whitted_occluded": int(np.count_nonzero(blocked)),
-        "ratio_embree": whitted_rate / embree_rate if embree_rate > 0 else float("inf"),
+    })
+    # the headline: what a render uses (Embree inside whitted when it loads, else the walk)
+    used = "whitted_embree" if "whitted_embree_trace_s" in result else "walk"
+    for key in ("primary_s", "shadow_s", "mrays_per_s", "hits", "occluded"):
+        result[f"whitted_trace_{key}"] = result[f"{used}_{key}"]
+    result["whitted_mesh_tracer"] = "embree" if used == "whitted_embree" else "whitted"
+    for prefix in ("walk", "whitted_embree", "whitted_trace"):
+        if f"{prefix}_mrays_per_s" in result:
+            result[f"ratio_embree_{prefix}" if prefix != "whitted_trace" else "ratio_embree"] = (
+                result[f"{prefix}_mrays_per_s"] / embree_rate if embree_rate > 0
+                else float("inf"))
+    return result
+
+
+def _whitted_trace(scene: Scene, light: np.ndarray, tracer: str,
+                   repeats: int) -> dict[str, Any]:
+    """Camera rays then shadow rays toward ``light`` traced by whitted with its meshes traced
+    by ``tracer``: thread CPU seconds (best of ``repeats``), rates, counts, and the rays."""
+    from ..compile.params import render_params
+    from ..compile.scene import compile_scene
+    from ..kernels.tiles import BVH_STACK
+    from ..render.warm_up import warm_up_kernels
+    from .rays import camera_rays, nearest_hits, occluded
+
+    compiled = compile_scene(scene, mesh_tracer=tracer)
+    warm_up_kernels(compiled)
+    params = render_params(scene, compiled, scene.render)
+    n = scene.render.width * scene.render.height
+    origins = np.empty((n, 3))
+    directions = np.empty((n, 3))
+    camera_rays(params, origins, directions)
+    stack = np.empty(BVH_STACK, np.int32)
+    geo = compiled.geometry
+
+    t_hit = np.empty(n)
+    nearest_hits(geo, origins[:1], directions[:1], t_hit[:1], stack)  # compile or load
+    primary_s, _ = _best(lambda: nearest_hits(geo, origins, directions, t_hit, stack),
+                         repeats)
+    hit = np.isfinite(t_hit)
+    points = origins[hit] + t_hit[hit, None] * directions[hit]
+    to_light = light - points
+    distance = np.linalg.norm(to_light, axis=1)
+    s_dirs = to_light / distance[:, None]
+    s_origins = points + SHADOW_OFFSET * s_dirs
+    s_tmax = distance - SHADOW_OFFSET
+    blocked = np.empty(len(s_origins), np.int32)
+    occluded(geo, compiled.materials, s_origins[:1], s_dirs[:1], s_tmax[:1], blocked[:1], stack)
+    shadow_s, _ = _best(lambda: occluded(geo, compiled.materials, s_origins, s_dirs,
+                                         s_tmax, blocked, stack), repeats)
+    rays = n + len(s_origins)
+    total = primary_s + shadow_s
+    return {
+        "build_s": compiled.build_seconds,
+        "primary_s": primary_s,
+        "shadow_s": shadow_s,
+        "trace_s": total,
+        "mrays_per_s": rays / total / 1e6 if total > 0 else 0.0,
+        "hits": int(np.count_nonzero(hit)),
+        "occluded": int(np.count_nonzero(blocked)),
+        "origins": origins, "directions": directions,
+        "s_origins": s_origins, "s_dirs": s_dirs, "s_tmax": s_tmax,
     }

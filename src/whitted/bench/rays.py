@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 from ..kernels.accel import closest_hit
+from ..kernels.geometry_ref import geometry_ref_if_instances
 from ..kernels.jit import kernel
 from ..kernels.lighting import any_occluder
 from ..kernels.tiles import camera_ray
@@ -39,6 +40,7 @@ def camera_rays(params, origins, directions):
 @kernel
 def nearest_hits(geo, origins, directions, t_out, stack):
     """Distance to the nearest surface along each ray (inf where it hits nothing)."""
+    geo = geometry_ref_if_instances(geo)  # as render_tiles passes it
     for k in range(origins.shape[0]):
         o = (origins[k, 0], origins[k, 1], origins[k, 2])
         d = (directions[k, 0], directions[k, 1], directions[k, 2])
@@ -49,6 +51,7 @@ def nearest_hits(geo, origins, directions, t_out, stack):
 @kernel
 def occluded(geo, mats, origins, directions, t_max, out, stack):
     """1 where something blocks the ray before ``t_max``, else 0."""
+    geo = geometry_ref_if_instances(geo)
     for k in range(origins.shape[0]):
         o = (origins[k, 0], origins[k, 1], origins[k, 2])
         d = (directions[k, 0], directions[k, 1], directions[k, 2])

@@ -245,7 +245,7 @@ TABLE_COLUMNS = ("scene", "size", "threads", "primary", "shadow", "reflection", 
                  "peak MiB")
 POVRAY_COLUMNS = ("POV trace s", "POV wall s", "render ratio", "wall ratio",
                   "POV rays p/s/rl/rr")
-EMBREE_COLUMNS = ("trace Mrays/s", "Embree Mrays/s", "of Embree")
+EMBREE_COLUMNS = ("tracer", "trace Mrays/s", "Embree Mrays/s", "of Embree", "walk of Embree")
 
 
 def table_rows(rows: list[dict[str, Any]]) -> tuple[list[str], list[list[str]]]:
@@ -270,8 +270,10 @@ def table_rows(rows: list[dict[str, Any]]) -> tuple[list[str], list[list[str]]]:
                 line += [""] * len(POVRAY_COLUMNS)
         if embree:
             if "embree_mrays_per_s" in r:
-                line += [f"{r['whitted_trace_mrays_per_s']:.2f}",
-                         f"{r['embree_mrays_per_s']:.2f}", f"{r['ratio_embree']:.2f}"]
+                line += [r.get("whitted_mesh_tracer", "whitted"),
+                         f"{r['whitted_trace_mrays_per_s']:.2f}",
+                         f"{r['embree_mrays_per_s']:.2f}", f"{r['ratio_embree']:.2f}",
+                         f"{r.get('ratio_embree_walk', r['ratio_embree']):.2f}"]
             else:
                 line += [""] * len(EMBREE_COLUMNS)
         cells.append(line)

@@ -101,7 +101,13 @@ def sibling_pairs(lo: np.ndarray, hi: np.ndarray, offset: np.ndarray, count: np.
 class MeshTable:
     """Accumulates meshes; :meth:`arrays` returns the flat arrays for GeometryArrays."""
 
-    def __init__(self) -> None:
+    def __init__(self, mesh_tracer: str = "whitted") -> None:
+        # who traces these meshes (the scene's render.mesh_tracer), made concrete when the
+        # first mesh comes (so a scene without meshes never loads Embree): with "embree",
+        # whitted's own mesh BVHs are not built and the local faces are kept for Embree
+        self.mesh_tracer_setting = mesh_tracer
+        self.tracer: str | None = None
+        self.local_faces: list[np.ndarray] = []
         self.info: list[list[int]] = []
         self.vertices: list[np.ndarray] = []
         self.faces: list[np.ndarray] = []
@@ -177,7 +183,17 @@ class MeshTable:
         lo_tri = np.minimum(np.minimum(corners[:, 0], corners[:, 1]), corners[:, 2])
         hi_tri = np.maximum(np.maximum(corners[:, 0], corners[:, 1]), corners[:, 2])
         del corners
-        bvh = cached_build_bvh(lo_tri, hi_tri, traversal_cost=MESH_TRAVERSAL_COST)
+        if self.tracer is None:
+            from .embree import resolve_mesh_tracer
+
+            self.tracer = resolve_mesh_tracer(self.mesh_tracer_setting)
+        if self.tracer == "embree":
+            bvh = None
+            lo, hi = lo_tri.min(axis=0), hi_tri.max(axis=0)  # the root box: all triangles
+        else:
+            bvh = cached_build_bvh(lo_tri, hi_tri, traversal_cost=MESH_TRAVERSAL_COST)
+            lo = np.array(bvh.node_min[0], np.float64)
+            hi = np.array(bvh.node_max[0], np.float64)
         del lo_tri, hi_tri
 
         normal_row = -1
@@ -192,7 +208,7 @@ class MeshTable:
 
         index = len(self.info)
         row = [0] * N_MESH_INFO
-        row[MESH_ROOT] = self.n_nodes
+        row[MESH_ROOT] = self.n_nodes if bvh is not None else -1
         row[MESH_TRI_OFFSET] = self.n_tris
         row[MESH_TRI_COUNT] = t
         row[MESH_NORMALS] = normal_row
@@ -201,21 +217,22 @@ class MeshTable:
         self.vertices.append(verts32)
         self.faces.append((faces + self.n_vertices).astype(np.int32))
         self.tri_material.append(np.asarray(material_rows, np.int32)[face_material])
-        box, link = sibling_pairs(_round_down32(bvh.node_min), _round_up32(bvh.node_max),
-                                  bvh.node_offset, bvh.node_count)
-        # global indices: interior nodes name their first child among all meshes' nodes,
-        # leaves their first entry among all meshes' node_tris
-        leaf = link[:, 1] > 0
-        link[:, 0] += np.where(leaf, self.n_tris, self.n_nodes)
-        self.node_box.append(box)
-        self.node_link.append(link)
-        self.node_tris.append((bvh.prim_order + self.n_tris).astype(np.int32))
-        self.leaf_corners.append(verts32[faces[bvh.prim_order]])
-        lo = np.array(bvh.node_min[0], np.float64)  # the root box: all triangles
-        hi = np.array(bvh.node_max[0], np.float64)
+        if bvh is None:
+            self.local_faces.append(faces)
+        else:
+            box, link = sibling_pairs(_round_down32(bvh.node_min), _round_up32(bvh.node_max),
+                                      bvh.node_offset, bvh.node_count)
+            # global indices: interior nodes name their first child among all meshes' nodes,
+            # leaves their first entry among all meshes' node_tris
+            leaf = link[:, 1] > 0
+            link[:, 0] += np.where(leaf, self.n_tris, self.n_nodes)
+            self.node_box.append(box)
+            self.node_link.append(link)
+            self.node_tris.append((bvh.prim_order + self.n_tris).astype(np.int32))
+            self.leaf_corners.append(verts32[faces[bvh.prim_order]])
+            self.n_nodes += len(link)
         self.n_vertices += len(verts32)
         self.n_tris += t
-        self.n_nodes += len(link)
         return CompiledMesh(index, lo, hi, t)
 
     def node_rows(self) -> dict[str, np.ndarray]:

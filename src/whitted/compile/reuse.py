@@ -27,6 +27,9 @@ class BvhMemo:
     def __init__(self, keep: int = 16) -> None:
         self.keep = keep
         self._trees: OrderedDict[bytes, BVH] = OrderedDict()
+        # Embree scenes of meshes (compile/embree.py), by a hash of their triangles: the
+        # memo holds one reference of each (Embree's own counting), released on eviction
+        self._embree: OrderedDict[bytes, tuple[object, list[int]]] = OrderedDict()
         self.built = 0  # BVHs built while active
         self.reused = 0  # BVHs served from the memo
         self.primitives_built = 0
@@ -63,6 +66,43 @@ class BvhMemo:
             self.built += 1
             self.primitives_built += n
         return BVH(*(a.copy() if isinstance(a, np.ndarray) else a for a in tree))
+
+
+    def embree_row(self, key: bytes, library, build) -> list[int]:
+        """The Embree scene handles of a mesh with hash ``key`` (``build()`` makes them when
+        not remembered). The caller gets its own reference to each handle."""
+        import weakref
+
+        found = self._embree.get(key)
+        if found is not None:
+            self._embree.move_to_end(key)
+            self.reused += 1
+            row = found[1]
+        else:
+            row = build()
+            if not self._embree:  # the first one: release what is held when the memo goes
+                weakref.finalize(self, _release_held, self._embree)
+            self._embree[key] = (library, row)
+            self.built += 1
+            while len(self._embree) > self.keep:
+                _, (old_library, old_row) = self._embree.popitem(last=False)
+                for h in {h for h in old_row if h}:
+                    old_library.release(h)
+        for h in {h for h in row if h}:
+            library.retain(h)  # the caller's reference (the memo keeps the one build made)
+        return list(row)
+
+
+def _release_held(held: OrderedDict) -> None:
+    while held:
+        _, (library, row) = held.popitem()
+        for h in {h for h in row if h}:
+            library.release(h)
+
+
+def active_memo() -> BvhMemo | None:
+    """The :class:`BvhMemo` of the enclosing ``with``, if any."""
+    return _active.get()
 
 
 def cached_build_bvh(bounds_min: np.ndarray, bounds_max: np.ndarray, **options: object) -> BVH:

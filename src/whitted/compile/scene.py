@@ -27,6 +27,7 @@ from ..kernels.layout import (
 )
 from ..scene.scene import Scene
 from ..scene.shapes import Mesh
+from .embree import mesh_embree_array
 from .geometry import box_corners, corners_bounds
 from .light_buffers import LIGHT_BUFFER_RES, build_light_buffers
 from .lights import light_rows
@@ -52,6 +53,7 @@ class CompiledScene:
     build_seconds: float
     warnings: list[str]  # things the user should know (dropped triangles, missing textures)
     triangles: int = 0  # distinct mesh triangles stored (instances not multiplied)
+    mesh_tracer: str = "whitted"  # who traces the instanced meshes: whitted or embree
     instanced_triangles: int = 0  # triangles in the scene counting every instance
 
 
@@ -65,7 +67,7 @@ def packed_nodes(bvh, dtype) -> tuple[np.ndarray, np.ndarray]:
 
 
 def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
-                  light_buffers: bool = True) -> CompiledScene:
+                  light_buffers: bool = True, mesh_tracer: str | None = None) -> CompiledScene:
     """Flatten ``scene`` into the kernel layout and build the BVHs over its bounded shapes.
 
     A mesh whose copies (triangles x objects using it) come to at most ``flatten_limit``
@@ -79,7 +81,7 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
     start = time.perf_counter()
     b = PrimitiveRows()
     materials = MaterialTable()
-    meshes = MeshTable()
+    meshes = MeshTable(mesh_tracer or scene.render.mesh_tracer)
     mesh_of: dict[tuple, object] = {}
     sources: dict[tuple, tuple[MeshSource, np.ndarray]] = {}
     warnings: list[str] = []
@@ -137,6 +139,11 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
     # float32 marks a scene without instances: kernels specialised for it (features.py)
     inst_box, inst_link = packed_nodes(
         inst_bvh, np.float64 if len(instances) else NO_INSTANCES_DTYPE)
+    mat_table = np.array(materials.rows, dtype=np.float64).reshape(len(materials.rows),
+                                                                    N_MAT_PARAMS)
+    tracer = meshes.tracer or "whitted"
+    mesh_embree = mesh_embree_array(tracer, meshes.vertices, meshes.local_faces,
+                                    meshes.tri_material, mat_table)
     geometry = GeometryArrays(
         prim_info=prim_info,
         prim_params=params,
@@ -149,10 +156,9 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
         inst_link=inst_link,
         inst_prims=np.ascontiguousarray(instances[inst_bvh.prim_order], dtype=np.int32),
         **meshes.arrays(),
+        mesh_embree=mesh_embree,
         **compile_textures(materials.textures, scene.resolve_path)._asdict(),
     )
-    mat_table = np.array(materials.rows, dtype=np.float64).reshape(len(materials.rows),
-                                                                    N_MAT_PARAMS)
     light_table, ambient = light_rows(scene)
     lights = build_light_buffers(geometry, mat_table, light_table,
                                  has_instances=len(instances) > 0,
@@ -172,4 +178,5 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
         warnings=warnings,
         triangles=meshes.n_tris + flat,
         instanced_triangles=instanced,
+        mesh_tracer=tracer,
     )

@@ -186,7 +186,10 @@ def _render_missing(client, scene, stills, chosen, digests, paths, todo, result,
     shipment = (assets if isinstance(assets, Shipment)
                 else ship_assets(client, [stills[i] for i in todo], assets))
     position = {i: n for n, i in enumerate(todo)}  # shipment.needs is indexed like todo
-    [scene_future] = client.scatter([scene], broadcast=True, hash=False)
+    from ..compile.embree import with_concrete_mesh_tracer
+
+    [scene_future] = client.scatter([with_concrete_mesh_tracer(scene)], broadcast=True,
+                                    hash=False)
     futures = {}
     for run in runs:
         manifest, blobs = shipment.for_scenes([position[i] for i in run])

@@ -54,7 +54,10 @@ def render_still(
     ranges = band_ranges(s.height, bands or BANDS_PER_WORKER * n_workers)
     shipment = assets if isinstance(assets, Shipment) else ship_assets(client, [scene], assets)
     manifest, blobs = shipment.for_scenes([0])
-    [scene_future] = client.scatter([scene], broadcast=True, hash=False)
+    from ..compile.embree import with_concrete_mesh_tracer
+
+    [scene_future] = client.scatter([with_concrete_mesh_tracer(scene)], broadcast=True,
+                                    hash=False)
     futures = [client.submit(render_band, scene_future, a, b, manifest, blobs, pure=False,
                              retries=retries) for a, b in ranges]
     framebuffer = np.zeros((s.height, s.width, 3), np.float32)

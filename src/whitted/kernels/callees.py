@@ -26,6 +26,7 @@ from numba import typeof, types
 
 from .accel import surface_normals
 from .features import instances_possible
+from .geometry_ref import GeometryRef
 from .layout import GeometryArrays
 from .lighting import shadow_transmittance
 
@@ -42,6 +43,8 @@ def render_callees(geometry: GeometryArrays, materials, params):
     (their types pick the variant: with or without mesh instances), in the order the render
     kernel needs them."""
     geo = typeof(geometry)
+    if instances_possible(geo):  # render_tiles passes the geometry by reference
+        geo = GeometryRef(geo)
     mats = typeof(materials)
     if instances_possible(geo):
         return [(shadow_transmittance, (geo, mats, typeof(params), VEC3, VEC3, REAL, INT32S,

@@ -30,6 +30,9 @@ def has_instances(geo):
 def instances_possible(geo_type) -> bool:
     """Whether a GeometryArrays of this Numba type may hold mesh instances (False for the
     kind without, whose ``inst_box`` is float32)."""
+    from .geometry_ref import geometry_type
+
+    geo_type = geometry_type(geo_type)
     field_type = dict(zip(geo_type.fields, geo_type.types, strict=True))["inst_box"]
     return field_type.dtype != types.float32
 

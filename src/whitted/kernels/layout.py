@@ -119,6 +119,14 @@ MESH_NODE_OFFSET = 6
 MESH_NODE_COUNT = 7
 MESH_NODE_WIDTH = 8
 
+# mesh_embree columns: in row 0 the entry points, in row k + 1 mesh k's Embree scenes
+EMBREE_INTERSECT = 0  # row 0: address of rtcIntersect1
+EMBREE_OCCLUDED = 1  # row 0: address of rtcOccluded1
+EMBREE_ALL = 0  # every triangle: nearest hits, and shadows through a material override
+EMBREE_OPAQUE = 1  # the triangles whose own material is opaque (0 when none)
+EMBREE_CLEAR = 2  # the transparent ones (0 when none)
+N_EMBREE = 3
+
 
 class GeometryArrays(NamedTuple):
     """Everything a ray needs to find what it hits (all NumPy arrays, read-only in kernels).
@@ -157,6 +165,11 @@ class GeometryArrays(NamedTuple):
     # (T, 3, 3) float32 corners of the triangles in leaf order (entry j: mesh_node_tris[j]):
     # the walks read a leaf's triangles from consecutive memory, not through two indirections
     mesh_leaf_corners: np.ndarray
+    # Embree (compile/embree.py, kernels/embree.py): row 0 holds the addresses of
+    # rtcIntersect1 and rtcOccluded1 (0 without Embree), row k + 1 mesh k's Embree scene
+    # handles (columns EMBREE_ALL, EMBREE_OPAQUE, EMBREE_CLEAR; 0: none). A mesh traced by
+    # Embree has no BVH of whitted's (its MESH_ROOT is -1).
+    mesh_embree: np.ndarray  # (K + 1, N_EMBREE) int64
     # textures (see texture_layout.py): one row per texture, all image texels in one array
     tex_info: np.ndarray  # (X, N_TEX_PARAMS) float64
     tex_pixels: np.ndarray  # (P,) float32 linear RGB

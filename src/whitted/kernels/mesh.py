@@ -23,9 +23,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from .embree import embree_intersect, embree_occluded
 from .intersect import INF
 from .jit import kernel
 from .layout import (
+    EMBREE_ALL,
+    EMBREE_CLEAR,
+    EMBREE_INTERSECT,
+    EMBREE_OCCLUDED,
+    EMBREE_OPAQUE,
     MAT_KT,
     MESH_NODE_COUNT,
     MESH_NODE_HI,
@@ -132,10 +138,63 @@ def push_mesh_children(nodes, ints, node, o, inv, tmin, tmax, stack, top):
     return top
 
 
+@kernel(inline="always")
+def float32_above(x):
+    """The smallest float32 above ``x`` (as a float64): Embree's segment is closed and in
+    float32, whitted's (tmin, tmax) open, so its ends are rounded inward."""
+    y = np.float32(x)
+    if np.float64(y) <= x:
+        y = np.nextafter(y, np.float32(INF))
+    return np.float64(y)
+
+
+@kernel(inline="always")
+def float32_below(x):
+    """The largest float32 below ``x`` (as a float64; inf stays inf)."""
+    if x == INF:
+        return x
+    y = np.float32(x)
+    if np.float64(y) >= x:
+        y = np.nextafter(y, np.float32(-INF))
+    return np.float64(y)
+
+
+@kernel
+def embree_closest_hit(geo, mesh, o, d, tmin, tmax):
+    """:func:`mesh_closest_hit` by Embree (the mesh has an Embree scene)."""
+    t, prim, b1, b2 = embree_intersect(geo.mesh_embree[0, EMBREE_INTERSECT],
+                                       geo.mesh_embree[mesh + 1, EMBREE_ALL], o, d,
+                                       float32_above(tmin), float32_below(tmax))
+    if prim < 0 or not (tmin < t < tmax):
+        return INF, -1, 0.0, 0.0
+    return t, prim + geo.mesh_info[mesh, MESH_TRI_OFFSET], b1, b2
+
+
+@kernel
+def embree_occlusion(geo, mats, mesh, material, o, d, tmin, tmax):
+    """:func:`mesh_occlusion` by Embree (the mesh has an Embree scene)."""
+    fn = geo.mesh_embree[0, EMBREE_OCCLUDED]
+    tmin = float32_above(tmin)
+    tmax = float32_below(tmax)
+    if material >= 0:  # one material for every triangle
+        if not embree_occluded(fn, geo.mesh_embree[mesh + 1, EMBREE_ALL], o, d, tmin, tmax):
+            return 0
+        return 1 if mats[material, MAT_KT] < OPAQUE_KT else 2
+    opaque = geo.mesh_embree[mesh + 1, EMBREE_OPAQUE]
+    if opaque != 0 and embree_occluded(fn, opaque, o, d, tmin, tmax):
+        return 1
+    clear = geo.mesh_embree[mesh + 1, EMBREE_CLEAR]
+    if clear != 0 and embree_occluded(fn, clear, o, d, tmin, tmax):
+        return 2
+    return 0
+
+
 @kernel
 def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
     """Nearest triangle of mesh ``mesh`` hit by the ray (mesh space) in (tmin, tmax):
     (t, triangle, b1, b2), t = INF on a miss. ``stack[base:]`` is scratch."""
+    if geo.mesh_embree[mesh + 1, EMBREE_ALL] != 0:
+        return embree_closest_hit(geo, mesh, o, d, tmin, tmax)
     kx, ky, kz, sx, sy, sz = shear_setup(d)
     corners = geo.mesh_leaf_corners
     nodes = geo.mesh_nodes
@@ -174,6 +233,8 @@ def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
 def mesh_occlusion(geo, mats, mesh, material, o, d, inv, tmin, tmax, stack, base):
     """Any triangle of the mesh on the segment (tmin, tmax)? 0: none; 1: an opaque one (the
     walk stops there); 2: only transparent ones. ``material`` >= 0 overrides the triangles'."""
+    if geo.mesh_embree[mesh + 1, EMBREE_ALL] != 0:
+        return embree_occlusion(geo, mats, mesh, material, o, d, tmin, tmax)
     if material >= 0 and mats[material, MAT_KT] >= OPAQUE_KT:
         # one transparent material: any hit is a transparent one
         t, tri, _, _ = mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base)

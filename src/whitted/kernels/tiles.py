@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from .accel import closest_hit, surface_normals
+from .geometry_ref import geometry_ref_if_instances
 from .integrator import N_STACK_F, N_STACK_I, trace_path
 from .jit import kernel
 from .layout import (
@@ -68,6 +69,7 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
     the lane's scratch memory from :func:`lane_workspace`."""
     n_tiles = tiles.shape[0]
     spp = params.samples
+    geo = geometry_ref_if_instances(geo)  # one pointer for every call, not 28 arrays
     st_f, st_i, media, scratch, stack, hits, listed = work
     for t in range(lane, n_tiles, lanes):
         cnt = counters[t]

@@ -21,7 +21,10 @@ MAX_DEPTH = 64
 class RenderSettings(Strict):
     """How to render. ``threads = 0`` uses every core. ``epsilon = 0`` picks the ray offset
     from the scene's size. ``transfer``: ``srgb`` (display images) or ``linear`` (raw values,
-    to compare with hand-computed numbers). ``tonemap``: ``clamp``, ``reinhard`` or ``aces``."""
+    to compare with hand-computed numbers). ``tonemap``: ``clamp``, ``reinhard`` or ``aces``.
+    ``mesh_tracer``: who traces the big (instanced) meshes: ``embree`` (Intel's kernels, when
+    installed: ``pip install 'whitted[embree]'``), ``whitted`` (its own walk, always there)
+    or ``auto`` (Embree when it loads)."""
 
     width: int = Field(default=640, ge=1, le=100_000)
     height: int = Field(default=480, ge=1, le=100_000)
@@ -34,6 +37,7 @@ class RenderSettings(Strict):
     epsilon: float = Field(default=0.0, ge=0.0, le=1.0)
     transfer: Literal["srgb", "linear"] = "srgb"
     tonemap: Literal["clamp", "reinhard", "aces"] = "clamp"
+    mesh_tracer: Literal["auto", "whitted", "embree"] = "auto"
 
     @model_validator(mode="after")
     def _size(self) -> RenderSettings:

@@ -1,0 +1,233 @@
+"""Meshes traced by Embree (compile/embree.py, kernels/embree.py) against whitted's own walk:
+the same hits, the same shadows through opaque and transparent triangles, images that do
+not depend on the thread count, scenes released with the arrays that name them, and a clear
+error where Embree is asked for and missing."""
+
+from __future__ import annotations
+
+import gc
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from numba import njit
+
+import whitted
+from meshgen import uv_sphere
+from whitted.compile import embree as embree_module
+from whitted.compile.embree import embree_library, resolve_mesh_tracer
+from whitted.compile.scene import compile_scene
+from whitted.errors import SceneError
+from whitted.kernels.accel import closest_hit
+from whitted.kernels.lighting import any_occluder
+
+pytestmark = pytest.mark.skipif(embree_library() is None, reason="Embree not installed")
+
+
+@njit(cache=False)
+def _trace(geo, mats, origins, directions, out_t, out_tri, out_shadow, stack):
+    for k in range(origins.shape[0]):
+        o = (origins[k, 0], origins[k, 1], origins[k, 2])
+        d = (directions[k, 0], directions[k, 1], directions[k, 2])
+        t, prim, tri, b1, b2 = closest_hit(geo, o, d, 1e-9, np.inf, stack)
+        out_t[k] = t if prim >= 0 else np.inf
+        out_tri[k] = tri
+        out_shadow[k] = any_occluder(geo, mats, o, d, 1e-9, 50.0, stack)
+
+
+def _traced(compiled, origins, directions):
+    n = len(origins)
+    t, tri, shadow = np.empty(n), np.empty(n, np.int64), np.empty(n, np.int64)
+    _trace(compiled.geometry, compiled.materials, np.ascontiguousarray(origins),
+           np.ascontiguousarray(directions), t, tri, shadow, np.empty(128, np.int32))
+    return t, tri, shadow
+
+
+def _bumpy_sphere():
+    v, f = uv_sphere(40, 80)
+    rng = np.random.default_rng(11)
+    return v * rng.uniform(0.97, 1.03, (len(v), 1)), f
+
+
+def _rays(n, seed=5):
+    rng = np.random.default_rng(seed)
+    o = rng.uniform(-3.0, 3.0, (n, 3))
+    target = rng.uniform(-1.2, 1.2, (n, 3))
+    return o, target - o
+
+
+@pytest.mark.parametrize("transform", [None, whitted.Transform(
+    scale=(1.3, 0.7, 1.0), rotate=(20.0, 35.0, -10.0), translate=(0.5, -0.2, 0.3))],
+    ids=["identity", "affine"])
+def test_embree_finds_the_hits_of_whitteds_walk(transform):
+    """Random rays at a bumpy closed mesh: the same rays hit, at the same distance (to float32
+    precision) on the same triangle (but for a few rays that graze a shared edge)."""
+    v, f = _bumpy_sphere()
+    scene = whitted.Scene(objects=[whitted.Mesh(v, f, transform=transform)])
+    walk = compile_scene(scene, flatten_limit=0, mesh_tracer="whitted")
+    fast = compile_scene(scene, flatten_limit=0, mesh_tracer="embree")
+    assert walk.mesh_tracer == "whitted" and fast.mesh_tracer == "embree"
+    assert fast.geometry.mesh_info[0, 0] == -1 and len(fast.geometry.mesh_nodes) == 0
+    o, d = _rays(20_000)
+    t_walk, tri_walk, _ = _traced(walk, o, d)
+    t_fast, tri_fast, _ = _traced(fast, o, d)
+    hit = np.isfinite(t_walk)
+    assert 8_000 < hit.sum() < 19_000
+    assert (np.isfinite(t_fast) != hit).sum() <= 2  # a ray grazing the silhouette at most
+    both = hit & np.isfinite(t_fast)
+    # float32: the origin (|o| <= 5) is rounded to 3e-7, so distances agree to about 1e-6
+    np.testing.assert_allclose(t_fast[both], t_walk[both], rtol=2e-6, atol=2e-6)
+    assert (tri_fast[both] != tri_walk[both]).sum() <= 0.001 * both.sum()
+
+
+def _two_material_mesh(monkeypatch, opaque_kt=0.0, clear_kt=0.9):
+    """A unit quad in z = 0 of two triangles: the left one opaque, the right transparent."""
+    from whitted.compile import scene as compile_module
+    from whitted.compile.meshes import MeshSource
+
+    v = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], float)
+    faces = np.array([[0, 1, 3], [1, 2, 3]])  # left-lower and right-upper halves
+    mats = [whitted.Material(kt=opaque_kt), whitted.Material(kt=clear_kt, ior=1.0)]
+    src = MeshSource("two.obj", v, faces, None, None, np.array([0, 1]), mats)
+    monkeypatch.setattr(compile_module, "mesh_source", lambda *a: src)
+    return whitted.Mesh(v, faces.tolist())
+
+
+@pytest.mark.parametrize("override", [None, "clear", "opaque"])
+def test_shadows_through_mixed_materials_match_the_walk(monkeypatch, override):
+    """A mesh whose triangles mix an opaque and a transparent material blocks a shadow ray
+    through the opaque one (1), tints it through the transparent one (2), and an object's
+    material overrides both: Embree (two more scenes, one per kind) agrees with the walk."""
+    mesh = _two_material_mesh(monkeypatch)
+    if override is not None:
+        mesh = mesh.model_copy(update={"material": whitted.Material(
+            kt=0.9 if override == "clear" else 0.0)})
+    scene = whitted.Scene(objects=[mesh])
+    n = 2000
+    rng = np.random.default_rng(2)
+    o = np.column_stack([rng.uniform(-1.5, 1.5, (n, 2)), np.full(n, 2.0)])
+    d = np.tile([0.0, 0.0, -1.0], (n, 1))
+    walk = compile_scene(scene, flatten_limit=0, mesh_tracer="whitted")
+    fast = compile_scene(scene, flatten_limit=0, mesh_tracer="embree")
+    rows = fast.geometry.mesh_embree[1]
+    assert (rows[1] != rows[2]) == (rows[1] != 0 and rows[2] != 0)
+    _, _, s_walk = _traced(walk, o, d)
+    _, _, s_fast = _traced(fast, o, d)
+    np.testing.assert_array_equal(s_fast, s_walk)
+    expect = {None: {0, 1, 2}, "clear": {0, 2}, "opaque": {0, 1}}[override]
+    assert set(np.unique(s_walk)) == expect
+
+
+def test_embree_images_do_not_depend_on_threads_or_builds():
+    """Same scene, any thread count, any build of the Embree scenes: the same bits; and the
+    same picture as whitted's own walk but for float32 rounding on a few pixels."""
+    from whitted.render.api import RenderJob
+
+    v, f = _bumpy_sphere()
+    scene = whitted.Scene(
+        objects=[whitted.Mesh(v, f, material=whitted.Material(kr=0.3)),
+                 whitted.Plane(point=(0, -1.1, 0), normal=(0, 1, 0))],
+        lights=[whitted.PointLight(position=(3, 4, 5)), whitted.AmbientLight(intensity=0.2)],
+    )
+    scene.camera.position = (0.0, 0.5, 4.0)
+    scene = scene.with_settings(width=96, height=64)
+
+    def render(tracer, threads):
+        compiled = compile_scene(scene, flatten_limit=0, mesh_tracer=tracer)
+        return RenderJob(scene, threads=threads, compiled=compiled).run().pixels
+
+    one = render("embree", 1)
+    two = render("embree", 2)
+    np.testing.assert_array_equal(one, two)
+    np.testing.assert_array_equal(render("embree", 2), two)
+    differ = np.abs(render("whitted", 2) - two).max(axis=2) > 1 / 255
+    assert differ.mean() < 0.01
+
+
+def test_embree_scenes_are_released_with_their_arrays(monkeypatch):
+    """Every Embree scene a compile makes is released once, when the last array naming it
+    goes; a film's memo keeps one for the next frame and releases it in turn."""
+    library = embree_library()
+    released: list[int] = []
+    retained: list[int] = []
+    real_release, real_retain = library.release, library.retain
+    monkeypatch.setattr(library, "release", lambda h: (released.append(h), real_release(h)))
+    monkeypatch.setattr(library, "retain", lambda h: (retained.append(h), real_retain(h)))
+    v, f = uv_sphere(8, 16)
+    scene = whitted.Scene(objects=[whitted.Mesh(v, f)])
+    compiled = compile_scene(scene, flatten_limit=0, mesh_tracer="embree")
+    handle = int(compiled.geometry.mesh_embree[1, 0])
+    view = compiled.geometry.mesh_embree[1:]
+    del compiled
+    gc.collect()
+    assert released == []  # a view of the array still names it
+    del view
+    gc.collect()
+    assert released == [handle]
+
+    from whitted.compile.reuse import BvhMemo
+
+    released.clear()
+    memo = BvhMemo()
+    with memo:
+        first = compile_scene(scene, flatten_limit=0, mesh_tracer="embree")
+        second = compile_scene(scene, flatten_limit=0, mesh_tracer="embree")
+    kept = int(first.geometry.mesh_embree[1, 0])
+    assert int(second.geometry.mesh_embree[1, 0]) == kept  # built once
+    assert retained.count(kept) == 2
+    del first, second
+    gc.collect()
+    assert released == [kept, kept]  # each compile's reference
+    del memo
+    gc.collect()
+    assert released == [kept, kept, kept]  # and the memo's
+
+
+def test_tracer_choice_and_its_errors(monkeypatch):
+    monkeypatch.delenv("WHITTED_MESH_TRACER", raising=False)
+    assert resolve_mesh_tracer("auto") == "embree"
+    assert resolve_mesh_tracer("whitted") == "whitted"
+    monkeypatch.setenv("WHITTED_MESH_TRACER", "whitted")
+    assert resolve_mesh_tracer("auto") == "whitted"
+    assert resolve_mesh_tracer("embree") == "embree"  # the scene's own word wins
+    monkeypatch.setenv("WHITTED_MESH_TRACER", "fast")
+    with pytest.raises(SceneError, match="WHITTED_MESH_TRACER"):
+        resolve_mesh_tracer("auto")
+    monkeypatch.delenv("WHITTED_MESH_TRACER")
+    monkeypatch.setattr(embree_module, "embree_library", lambda: None)
+    monkeypatch.setattr(embree_module, "why_not", lambda: "no libembree4 found")
+    assert resolve_mesh_tracer("auto") == "whitted"
+    with pytest.raises(SceneError, match="Embree is not available"):
+        resolve_mesh_tracer("embree")
+
+
+def test_cli_says_in_one_line_when_embree_is_missing(tmp_path):
+    """``mesh_tracer = "embree"`` where Embree cannot load: exit 2, one line, no traceback;
+    ``auto`` renders with whitted's walk."""
+    v, f = uv_sphere(100, 200)  # two objects of 39,600 triangles: instanced
+    obj = tmp_path / "ball.obj"
+    obj.write_text("".join(f"v {x:.6f} {y:.6f} {z:.6f}\n" for x, y, z in v)
+                   + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in f))
+    lines = ["[render]", "width = 16", "height = 16", 'mesh_tracer = "embree"', "",
+             "[[objects]]", 'type = "mesh"', 'file = "ball.obj"', "",
+             "[[objects]]", 'type = "mesh"', 'file = "ball.obj"',
+             "transform = { translate = [3.0, 0.0, 0.0] }"]
+    scene_file = tmp_path / "mesh.toml"
+    scene_file.write_text("\n".join(lines) + "\n")
+    env = dict(os.environ, WHITTED_EMBREE_LIBRARY="none")
+    env.pop("WHITTED_MESH_TRACER", None)
+    whitted_cli = [sys.executable, "-m", "whitted", "render", str(scene_file), "-q", "-o"]
+    out = subprocess.run(whitted_cli + [str(tmp_path / "x.png")], capture_output=True,
+                         text=True, env=env, timeout=300)
+    assert out.returncode == 2, out.stderr
+    message = out.stderr.strip().splitlines()
+    assert len(message) == 1 and "Embree is not available" in message[0], out.stderr
+    assert "mesh.toml" in message[0] or "mesh_tracer" in message[0]
+    assert not (tmp_path / "x.png").exists()
+    out = subprocess.run(whitted_cli + [str(tmp_path / "y.png"), "--set",
+                                        "render.mesh_tracer=auto"],
+                         capture_output=True, text=True, env=env, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert (tmp_path / "y.png").exists()
