@@ -96,3 +96,24 @@ def test_inline_always_is_left_to_llvm():
     assert "_inlined_square" in llvm  # linked in, and then inlined: no call is left
     assert not [line for line in llvm.splitlines() if " call " in line
                 and "_inlined_square" in line]
+
+
+@kernel(cache=False)
+def _plain_callee(x):
+    return x + 1.0
+
+
+@kernel(cache=False, inline="always")
+def _inlined_caller(x):
+    return _plain_callee(x) * 2.0
+
+
+def test_a_callee_of_an_inlined_kernel_is_not_inlined_by_inheritance():
+    """Numba passes ``forceinline`` on to callees compiled while an alwaysinline kernel
+    compiles, unless they set it: a kernel would then be inlined or not depending on which
+    caller compiled it first (a texture lookup inlined that way lost its NaN check)."""
+    assert _inlined_caller(1.0) == 4.0
+    (caller,) = _inlined_caller.overloads.values()
+    (callee,) = _plain_callee.callee.overloads.values()
+    assert caller.fndesc.inline is True
+    assert callee.fndesc.inline is False

@@ -56,12 +56,15 @@ scenes with mesh instances):
 
 | inlining | compile | seed000, one thread, CPU (interleaved) | ice | softshadow |
 | --- | --- | --- | --- | --- |
-| Numba's, as before | 15.9 / 18.4 s | 0.54-0.68 s | 3.71-4.10 s | 10.1-11.4 s |
-| LLVM's, ``trace_path`` too | 12.5 / 15.6 s | 0.453-0.458 s | 3.55-3.57 s | 8.55-8.59 s |
-| LLVM's, ``trace_path`` Numba's (this) | 10.9 / 12.3 s | 0.502-0.504 s | 3.68 s | 9.34 s |
+| Numba's (speed: main 5565e00) | 15.9 / 18.4 s | 0.712, 0.672 s | 4.06 s | 13.02 s |
+| LLVM's, ``trace_path`` too (*) | 12.5 / 15.6 s | (0.453-0.458 s against 0.54-0.66 s) | | |
+| LLVM's, ``trace_path`` Numba's (this) | 10.9 / 10.2 s | 0.600, 0.678 s | 3.89 s | 9.85 s |
 
-The middle row renders about 10 % faster than this one for 1.6 s / 3.3 s more compile
-(a one-word change on ``trace_path``), which the cold-compile goal could not afford.
+(*) measured before ``forceinline`` was set on every kernel: Numba passes it on to the
+callees compiled while an alwaysinline kernel compiles, unless they set it, so many more
+kernels were inlined, and which ones depended on the order they were first compiled in (one
+process or another, a cache): a texture lookup inlined that way lost its NaN check in one
+order and not the other. Every kernel now says whether it is inlined.
 """
 
 from __future__ import annotations
@@ -168,6 +171,10 @@ def kernel(fn=None, **options):
     opts = {"nopython": True, "error_model": "numpy", "nogil": True, "_nrt": False,
             "fastmath": FAST_MATH, "no_cfunc_wrapper": True}
     opts.update(options)
+    # always set: Numba lets a callee compiled while an alwaysinline kernel compiles inherit
+    # the flag, so a kernel would be inlined or not depending on which caller compiled it
+    # first (in this process, or in another from whose cache it loads)
+    opts["forceinline"] = False
     if opts.get("inline") == "always":  # inlined by LLVM, not by Numba (module docstring)
         del opts["inline"]
         opts["forceinline"] = True
