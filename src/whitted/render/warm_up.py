@@ -27,8 +27,10 @@ docs/performance.md.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -145,6 +147,13 @@ class _CompileCount:
         self.pending = set(delegated)  # the helper's callees it has not finished
         self.helper_gone = False
         self._changed = threading.Condition()
+        self.interrupted = False  # Ctrl-C seen (see _interrupt_at_safe_points)
+
+    def check_interrupt(self) -> None:
+        """Raise Ctrl-C's KeyboardInterrupt again, here, if it was raised where Python
+        ignores exceptions (in an llvmlite object's ``__del__``, between two compiles)."""
+        if self.interrupted:
+            raise KeyboardInterrupt
 
     @property
     def fraction(self) -> float:
@@ -172,6 +181,7 @@ class _CompileCount:
             while (name in self.pending and not self.helper_gone
                    and time.monotonic() < deadline):
                 self._changed.wait(0.1)  # a timeout: Ctrl-C reaches this thread at once
+                self.check_interrupt()
             return name not in self.pending
 
 
@@ -183,10 +193,11 @@ class _CountCompiles:
 
         class Listener(event.Listener):
             def on_start(self, ev) -> None:
-                pass
+                count.check_interrupt()
 
             def on_end(self, ev) -> None:
                 count.here += 1
+                count.check_interrupt()
 
         self._event = event
         self._listener = Listener()
@@ -268,6 +279,27 @@ def warm_up_kernels(compiled: CompiledScene | None = None) -> float:
         return time.perf_counter() - start
 
 
+@contextlib.contextmanager
+def _interrupt_at_safe_points(count: _CompileCount):
+    """While a cold compile runs in the main thread with Python's own Ctrl-C handler: note
+    the interrupt too, so that a KeyboardInterrupt that lands in a finaliser (and is only
+    printed there) is raised again at the next compile event or wait."""
+    if (threading.current_thread() is not threading.main_thread()
+            or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
+        yield
+        return
+
+    def on_sigint(signum, frame):
+        count.interrupted = True
+        signal.default_int_handler(signum, frame)
+
+    signal.signal(signal.SIGINT, on_sigint)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
 def _delegated(instances: bool) -> list:
     """The helper's share of the render kernel's callees: (twin dispatcher, types) pairs."""
     from ..kernels.callees import render_callees
@@ -294,7 +326,7 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
         KernelCache.wait_for_helper = count.wait_for_helper
     _progress = count
     try:
-        with _CountCompiles(count):
+        with _CountCompiles(count), _interrupt_at_safe_points(count):
             _compile_render_kernels(compiled if compiled is not None
                                     else stand_in_scene(instances))
             KernelCache.wait_for_helper = None
