@@ -7,9 +7,10 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from whitted.compile.params import render_params
-from whitted.kernels import tiles
+from whitted.kernels import integrator, tiles
 from whitted.kernels.callees import render_callees
 from whitted.kernels.jit import kernel
 from whitted.kernels.layout import N_RAY_KINDS
@@ -17,21 +18,30 @@ from whitted.render import warm_up
 from whitted.scene.scene import RenderSettings, Scene
 
 
-def test_helper_compiles_the_signatures_render_tiles_calls():
-    """The helper's work is only of use if render_tiles asks for exactly these variants.
+@pytest.mark.parametrize("instances", [False, True])
+def test_helper_compiles_the_signatures_render_tiles_calls(monkeypatch, instances):
+    """The helper's work is only of use if the render kernel asks for exactly these variants.
 
-    A copy of render_tiles without a cache is compiled here: its callees then load (or
-    compile) the variants it asks for, which is what their ``overloads`` list."""
-    stand_in = warm_up.stand_in_scene(False)
+    Uncached copies of render_tiles and of the callers of the helper's kernels (trace_path,
+    direct_light) are compiled here: they ask for the variants of their callees (which load
+    or compile), and those are what the callees' twins then list in ``overloads``."""
+    def fresh(dispatcher):
+        return kernel(cache=False, inline="always")(dispatcher.py_func)
+
+    monkeypatch.setattr(tiles, "trace_path", fresh(integrator.trace_path))
+    monkeypatch.setattr(integrator, "direct_light", fresh(integrator.direct_light))
+    stand_in = warm_up.stand_in_scene(instances)
     fresh_render_tiles = kernel(cache=False)(tiles.render_tiles.py_func)
     params = render_params(Scene(), stand_in, RenderSettings(width=1, height=1))
     fresh_render_tiles(np.zeros((0, 4), np.int32), np.zeros((1, 1, 3), np.float32),
                        stand_in.geometry, stand_in.materials, stand_in.lights, params,
                        np.zeros((1, N_RAY_KINDS), np.int64), tiles.lane_workspace(1), 0, 1)
-    for dispatcher, argument_types in render_callees(stand_in.geometry, stand_in.materials):
-        assert tuple(argument_types) in dispatcher.overloads, (
+    delegated = render_callees(stand_in.geometry, stand_in.materials, params)
+    assert delegated
+    for dispatcher, argument_types in delegated:
+        assert tuple(argument_types) in dispatcher.callee.overloads, (
             f"{dispatcher.py_func.__name__}: render_tiles compiled "
-            f"{list(dispatcher.overloads)}, the helper would compile {argument_types}")
+            f"{list(dispatcher.callee.overloads)}, the helper would compile {argument_types}")
 
 
 def test_warm_up_marks_the_cache_folder():
@@ -52,3 +62,34 @@ def test_helper_process_runs_to_completion():
 def test_no_helper_when_disabled(monkeypatch):
     monkeypatch.setenv("WHITTED_COMPILE_HELPER", "0")
     assert warm_up._start_helper(False) is None
+
+
+def test_waits_for_the_helpers_callees_and_counts_its_compiles():
+    """The render process waits for a kernel the helper compiles (True: load it), not for
+    others (False at once), and stops waiting when the helper has gone without it."""
+    import threading
+    import time
+
+    lines: list[str] = []
+    more = threading.Event()
+
+    def helper_output():  # what the helper prints, line by line, as it goes
+        for k in range(3):
+            more.wait(5)
+            yield from lines[k:k + 1]
+        more.wait(5)
+
+    count = warm_up._CompileCount(10, ("a__callee", "b__callee"))
+    reader = threading.Thread(target=count.read_helper, args=(helper_output(),))
+    assert count.wait_for_helper("c__callee") is False  # not the helper's: compile here
+    lines.extend([".\n", ".\n", "done a__callee\n"])
+    reader.start()
+    start = time.monotonic()
+    more.set()
+    assert count.wait_for_helper("a__callee") is True
+    reader.join(5)
+    assert count.helper == 2 and count.fraction == 0.2
+    # the helper ended without b: the render process compiles it itself
+    assert count.helper_gone
+    assert count.wait_for_helper("b__callee") is False
+    assert time.monotonic() - start < 5

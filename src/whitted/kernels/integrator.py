@@ -116,7 +116,7 @@ def _absorbed(weight, attenuation, length):
     return weight
 
 
-@kernel(inline="always")
+@kernel(numba_inline=True)  # Numba inlines it into render_tiles, its one caller (jit.py)
 def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media, scratch,
                stack, hits, listed, counters):
     """Radiance arriving along the camera ray (o, d) with unit d: I = ka·Ia + direct light +

@@ -4,12 +4,13 @@ the first), or compiled (the first run, or after the kernels changed).
 Numba compiles one function at a time in a process, so on a cold cache the first compile is
 shared with a second process (``python -m whitted.render.warm_up``) when there are two cores
 or more. While this process compiles ``render_tiles`` (and its callees on the way, depth
-first), the helper compiles the render kernel's large callees (``kernels/callees.py``), then
-the scene builders and the OBJ loader, into the cache; ``render_tiles`` loads those callees
-instead of compiling them. Then this process waits for the helper (which by then is on the
+first), the helper compiles a share of the render kernel's callees (``kernels/callees.py``),
+then the scene builders and the OBJ loader, into the cache. When this process reaches one of
+the helper's callees it waits for it (``jit.KernelCache.wait_for_helper``) and loads it
+instead of compiling it a second time. Then it waits for the helper (which by then is on the
 builders and loader, work this process would do next) and loads what it made. Whatever the
 helper did not finish is compiled here, so the result never depends on the helper: it only
-saves time.
+saves time. The AOV kernel (depth, normal and object-id images) is compiled when first used.
 
 A marker file in the cache folder (``whitted-ready-plain`` / ``whitted-ready-instances``)
 records that a variant is complete there, so a warm start starts no helper.
@@ -26,8 +27,10 @@ docs/performance.md.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -40,6 +43,7 @@ from .._cache import configure_kernel_cache
 from ..assets.mesh import load_obj_bytes
 from ..compile.params import render_params
 from ..compile.scene import CompiledScene, compile_scene
+from ..kernels.jit import KernelCache
 from ..kernels.layout import N_RAY_KINDS
 from ..scene.lights import PointLight
 from ..scene.scene import Scene
@@ -50,11 +54,12 @@ _ready: set[bool] = set()  # render kernel variants loaded here: with / without 
 _builders_ready = False
 HELPER_WAIT_SECONDS = 120.0  # a helper still busy after this is stopped (never expected)
 #: functions Numba compiles in a cold compile of each variant, this process and the helper
-#: together (counted on the 2-core VM, twice: 55 + 90 for the plain variant; 14 + 28 for the
+#: together (counted on the 2-core VM: 71 + 93 for the plain variant; 26 + 26 for the
 #: instance variant once the plain one is cached, as the render API compiles the plain
-#: variant first). Only the progress shown depends on it: a count that drifted (kernels
-#: changed, a different split between the processes) makes the fraction approximate.
-EXPECTED_COMPILES = {False: 145, True: 42}
+#: variant first; each kernel other kernels call counts once, as its twin). Only the
+#: progress shown depends on it: a count that drifted (kernels changed, a different split
+#: between the processes) makes the fraction approximate.
+EXPECTED_COMPILES = {False: 164, True: 52}
 TINY_OBJ = b"""v 0 0 0
 v 1 0 0
 v 0 1 0
@@ -102,12 +107,16 @@ def _compile_builders() -> None:
         _builders_ready = True
 
 
-def _compile_render_kernels(compiled: CompiledScene, aovs: bool = True) -> None:
+def _stand_in_params(compiled: CompiledScene):
+    scene = _builders_scene()
+    return render_params(scene, compiled, scene.render.model_copy(update={"width": 1,
+                                                                          "height": 1}))
+
+
+def _compile_render_kernels(compiled: CompiledScene, aovs: bool = False) -> None:
     from ..kernels.tiles import lane_workspace, render_aovs, render_tiles
 
-    scene = _builders_scene()
-    params = render_params(scene, compiled, scene.render.model_copy(update={"width": 1,
-                                                                            "height": 1}))
+    params = _stand_in_params(compiled)
     fb = np.zeros((1, 1, 3), np.float32)
     counters = np.zeros((1, N_RAY_KINDS), np.int64)
     no_tiles = np.zeros((0, 4), np.int32)  # compiles (or loads) without rendering
@@ -127,20 +136,53 @@ def _marker(instances: bool) -> Path:
 
 class _CompileCount:
     """Functions compiled so far in this process (Numba's ``numba:compile`` events) and in
-    the helper (one line on its stdout per function), while a cold compile runs."""
+    the helper (one line ``.`` on its stdout per function), while a cold compile runs; and
+    the helper's share of the render kernel's callees (a line ``done <name>`` as each is in
+    the cache), which this process waits for instead of compiling them too."""
 
-    def __init__(self, expected: int) -> None:
+    def __init__(self, expected: int, delegated: tuple[str, ...] = ()) -> None:
         self.expected = expected
         self.here = 0
         self.helper = 0
+        self.pending = set(delegated)  # the helper's callees it has not finished
+        self.helper_gone = False
+        self._changed = threading.Condition()
+        self.interrupted = False  # Ctrl-C seen (see _interrupt_at_safe_points)
+
+    def check_interrupt(self) -> None:
+        """Raise Ctrl-C's KeyboardInterrupt again, here, if it was raised where Python
+        ignores exceptions (in an llvmlite object's ``__del__``, between two compiles)."""
+        if self.interrupted:
+            raise KeyboardInterrupt
 
     @property
     def fraction(self) -> float:
         return min(0.99, (self.here + self.helper) / max(1, self.expected))
 
     def read_helper(self, pipe) -> None:
-        for _line in pipe:  # on a thread of its own; ends when the helper closes its stdout
-            self.helper += 1
+        for line in pipe:  # on a thread of its own; ends when the helper closes its stdout
+            if line.startswith("done "):
+                with self._changed:
+                    self.pending.discard(line[5:].strip())
+                    self._changed.notify_all()
+            else:
+                self.helper += 1
+        with self._changed:
+            self.helper_gone = True
+            self._changed.notify_all()
+
+    def wait_for_helper(self, name: str) -> bool:
+        """Wait while the helper compiles kernel ``name`` (its twin's qualified name); True
+        when it has (load it now), False when it is not the helper's or the helper is gone."""
+        deadline = time.monotonic() + HELPER_WAIT_SECONDS
+        with self._changed:
+            if name not in self.pending:
+                return False
+            while (name in self.pending and not self.helper_gone
+                   and time.monotonic() < deadline):
+                self._changed.wait(0.1)  # a timeout: Ctrl-C reaches this thread at once
+                self.check_interrupt()
+            return name not in self.pending
 
 
 class _CountCompiles:
@@ -151,10 +193,11 @@ class _CountCompiles:
 
         class Listener(event.Listener):
             def on_start(self, ev) -> None:
-                pass
+                count.check_interrupt()
 
             def on_end(self, ev) -> None:
                 count.here += 1
+                count.check_interrupt()
 
         self._event = event
         self._listener = Listener()
@@ -236,38 +279,73 @@ def warm_up_kernels(compiled: CompiledScene | None = None) -> float:
         return time.perf_counter() - start
 
 
+@contextlib.contextmanager
+def _interrupt_at_safe_points(count: _CompileCount):
+    """While a cold compile runs in the main thread with Python's own Ctrl-C handler: note
+    the interrupt too, so that a KeyboardInterrupt that lands in a finaliser (and is only
+    printed there) is raised again at the next compile event or wait."""
+    if (threading.current_thread() is not threading.main_thread()
+            or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
+        yield
+        return
+
+    def on_sigint(signum, frame):
+        count.interrupted = True
+        signal.default_int_handler(signum, frame)
+
+    signal.signal(signal.SIGINT, on_sigint)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+def _delegated(instances: bool) -> list:
+    """The helper's share of the render kernel's callees: (twin dispatcher, types) pairs."""
+    from ..kernels.callees import render_callees
+
+    stand_in = stand_in_scene(instances)
+    return [(dispatcher.callee, argument_types) for dispatcher, argument_types
+            in render_callees(stand_in.geometry, stand_in.materials,
+                              _stand_in_params(stand_in))]
+
+
 def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
-    """Compile the variant here while the helper compiles the large callees and the
+    """Compile the variant here while the helper compiles its share of the callees and the
     builders, counting both for :func:`compile_progress`; on any exception (Ctrl-C) the
     helper is stopped at once rather than waited for."""
     global _progress
-    count = _CompileCount(EXPECTED_COMPILES[instances])
     helper = _start_helper(instances)
+    delegated = ()
     if helper is not None and helper.stdout is not None:
+        delegated = tuple(d.py_func.__qualname__ for d, _ in _delegated(instances))
+    count = _CompileCount(EXPECTED_COMPILES[instances], delegated)
+    if delegated:
         threading.Thread(target=count.read_helper, args=(helper.stdout,),
                          name="whitted-compile-helper-output", daemon=True).start()
+        KernelCache.wait_for_helper = count.wait_for_helper
     _progress = count
     try:
-        with _CountCompiles(count):
+        with _CountCompiles(count), _interrupt_at_safe_points(count):
             _compile_render_kernels(compiled if compiled is not None
                                     else stand_in_scene(instances))
+            KernelCache.wait_for_helper = None
             _finish_helper(helper)
             _compile_builders()
     except BaseException:
         _stop_helper(helper)
         raise
     finally:
+        KernelCache.wait_for_helper = None
         _progress = None
 
 
 def precompile_for_render(instances: bool) -> None:
-    """The helper's work: the render kernel's large callees, then the builders, into the
-    on-disk cache."""
-    from ..kernels.callees import render_callees
-
-    stand_in = stand_in_scene(instances)
-    for dispatcher, argument_types in render_callees(stand_in.geometry, stand_in.materials):
+    """The helper's work: its share of the render kernel's callees (a line ``done <name>``
+    after each), then the builders, into the on-disk cache."""
+    for dispatcher, argument_types in _delegated(instances):
         dispatcher.compile(argument_types)
+        print("done", dispatcher.py_func.__qualname__, flush=True)
     _compile_builders()
 
 
