@@ -18,7 +18,7 @@ from numba import njit
 import whitted
 from meshgen import uv_sphere
 from whitted.compile import embree as embree_module
-from whitted.compile.embree import embree_library, resolve_mesh_tracer
+from whitted.compile.embree import embree_addresses, embree_library, resolve_mesh_tracer
 from whitted.compile.scene import compile_scene
 from whitted.errors import SceneError
 from whitted.kernels.accel import closest_hit
@@ -113,8 +113,9 @@ def test_shadows_through_mixed_materials_match_the_walk(monkeypatch, override):
     d = np.tile([0.0, 0.0, -1.0], (n, 1))
     walk = compile_scene(scene, flatten_limit=0, mesh_tracer="whitted")
     fast = compile_scene(scene, flatten_limit=0, mesh_tracer="embree")
-    rows = fast.geometry.mesh_embree[1]
+    rows = embree_addresses(fast.geometry.mesh_info)[0]
     assert (rows[1] != rows[2]) == (rows[1] != 0 and rows[2] != 0)
+    assert (embree_addresses(walk.geometry.mesh_info) == 0).all()
     _, _, s_walk = _traced(walk, o, d)
     _, _, s_fast = _traced(fast, o, d)
     np.testing.assert_array_equal(s_fast, s_walk)
@@ -160,8 +161,8 @@ def test_embree_scenes_are_released_with_their_arrays(monkeypatch):
     v, f = uv_sphere(8, 16)
     scene = whitted.Scene(objects=[whitted.Mesh(v, f)])
     compiled = compile_scene(scene, flatten_limit=0, mesh_tracer="embree")
-    handle = int(compiled.geometry.mesh_embree[1, 0])
-    view = compiled.geometry.mesh_embree[1:]
+    handle = int(embree_addresses(compiled.geometry.mesh_info)[0, 0])
+    view = compiled.geometry.mesh_info[0:]
     del compiled
     gc.collect()
     assert released == []  # a view of the array still names it
@@ -176,8 +177,8 @@ def test_embree_scenes_are_released_with_their_arrays(monkeypatch):
     with memo:
         first = compile_scene(scene, flatten_limit=0, mesh_tracer="embree")
         second = compile_scene(scene, flatten_limit=0, mesh_tracer="embree")
-    kept = int(first.geometry.mesh_embree[1, 0])
-    assert int(second.geometry.mesh_embree[1, 0]) == kept  # built once
+    kept = int(embree_addresses(first.geometry.mesh_info)[0, 0])
+    assert int(embree_addresses(second.geometry.mesh_info)[0, 0]) == kept  # built once
     assert retained.count(kept) == 2
     del first, second
     gc.collect()

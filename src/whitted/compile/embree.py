@@ -20,8 +20,9 @@ they pay). A mesh whose triangles mix opaque and transparent materials gets two 
 scenes, one of each, so a shadow ray asks "anything opaque?" and "anything transparent?" with
 one ``rtcOccluded1`` each, exactly what whitted's own any-hit walk answers.
 
-The scenes live as long as the ``mesh_embree`` array that holds their handles (the array's
-buffer owns them), so kernels can never see a released one.
+The handles, and the addresses of ``rtcIntersect1`` and ``rtcOccluded1``, go in the meshes'
+``mesh_info`` rows (``MESH_EMBREE``); the scenes live as long as that array (its buffer owns
+them), so kernels can never see a released one.
 """
 
 from __future__ import annotations
@@ -37,7 +38,13 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SceneError
-from ..kernels.layout import EMBREE_INTERSECT, EMBREE_OCCLUDED, N_EMBREE
+from ..kernels.layout import (
+    EMBREE_CLEAR,
+    EMBREE_INTERSECT,
+    EMBREE_OCCLUDED,
+    MESH_EMBREE,
+    N_EMBREE,
+)
 
 RTC_GEOMETRY_TYPE_TRIANGLE = 0
 RTC_BUFFER_TYPE_INDEX = 0
@@ -195,25 +202,41 @@ def resolve_mesh_tracer(setting: str = "auto") -> str:
     return setting
 
 
-def handle_array(library: EmbreeLibrary | None, handles: list[list[int]]) -> np.ndarray:
-    """``GeometryArrays.mesh_embree``: row 0 the library's entry points, then one row of
-    scene handles per mesh, in memory that releases the scenes when the last array viewing it
-    goes (the arrays' ``base`` chain ends at the owning ctypes buffer)."""
+def with_addresses(mesh_info: np.ndarray, library: EmbreeLibrary | None,
+                   rows: list[list[int]]) -> np.ndarray:
+    """``mesh_info`` with each mesh's Embree scenes (``rows[k]``: EMBREE_ALL, EMBREE_OPAQUE,
+    EMBREE_CLEAR) and the library's entry points in its MESH_EMBREE columns, in memory that
+    releases the scenes when the last array viewing it goes (the arrays' ``base`` chain ends
+    at the owning ctypes buffer)."""
     import weakref
 
-    n = len(handles) + 1
-    block = (ctypes.c_int64 * (n * N_EMBREE))()
-    array = np.frombuffer(block, dtype=np.int64).reshape(n, N_EMBREE)
-    if library is not None:
-        array[0, EMBREE_INTERSECT] = library.intersect1
-        array[0, EMBREE_OCCLUDED] = library.occluded1
-    if handles:
-        array[1:] = np.asarray(handles, np.int64).reshape(n - 1, N_EMBREE)
-    # one reference per distinct handle of each row (a row's parts may be its whole scene)
-    held = [h for row in handles for h in sorted({x for x in row if x})]
-    if library is not None and held:
+    k, width = mesh_info.shape
+    block = (ctypes.c_int32 * max(k * width, 1))()
+    info = np.frombuffer(block, dtype=np.int32)[:k * width].reshape(k, width)
+    info[:] = mesh_info
+    if library is not None and rows:
+        addresses = np.zeros((k, N_EMBREE), np.int64)
+        addresses[:, :EMBREE_CLEAR + 1] = rows
+        addresses[:, EMBREE_INTERSECT] = library.intersect1
+        addresses[:, EMBREE_OCCLUDED] = library.occluded1
+        halves = addresses.view(np.uint64)
+        info[:, MESH_EMBREE:MESH_EMBREE + 2 * N_EMBREE:2] = (
+            halves & np.uint64(0xFFFFFFFF)).astype(np.uint32).view(np.int32)
+        info[:, MESH_EMBREE + 1:MESH_EMBREE + 2 * N_EMBREE:2] = (
+            halves >> np.uint64(32)).astype(np.uint32).view(np.int32)
+        # one reference per distinct handle of each row (a row's parts may be its whole scene)
+        held = [h for row in rows for h in sorted({x for x in row if x})]
         weakref.finalize(block, _release_all, library, held)
-    return array
+    return info
+
+
+def embree_addresses(mesh_info: np.ndarray) -> np.ndarray:
+    """(K, N_EMBREE) int64: the addresses in ``mesh_info``'s MESH_EMBREE columns (columns
+    EMBREE_ALL, ..., EMBREE_OCCLUDED), for inspection and tests."""
+    info = np.ascontiguousarray(mesh_info[:, MESH_EMBREE:MESH_EMBREE + 2 * N_EMBREE])
+    low = info[:, 0::2].view(np.uint32).astype(np.uint64)
+    high = info[:, 1::2].view(np.uint32).astype(np.uint64)
+    return ((high << np.uint64(32)) | low).view(np.int64)
 
 
 def _release_all(library: EmbreeLibrary, scenes: list[int]) -> None:
@@ -222,8 +245,9 @@ def _release_all(library: EmbreeLibrary, scenes: list[int]) -> None:
 
 
 def _mesh_row(library: EmbreeLibrary, v: np.ndarray, f: np.ndarray, op: np.ndarray) -> list[int]:
-    """One mesh's row of ``mesh_embree``: its scene, and its opaque and transparent parts
-    (the same scene where all its triangles are one or the other). Each distinct handle is
+    """One mesh's Embree scenes (EMBREE_ALL, EMBREE_OPAQUE, EMBREE_CLEAR): its scene, and its
+    opaque and transparent parts (the same scene where all its triangles are one or the
+    other). Each distinct handle is
     one reference, released by whoever holds the row."""
     row = [library.triangle_scene(v, f), 0, 0]
     try:
@@ -242,9 +266,10 @@ def _mesh_row(library: EmbreeLibrary, v: np.ndarray, f: np.ndarray, op: np.ndarr
 
 
 def build_mesh_scenes(library: EmbreeLibrary, vertices: list[np.ndarray],
-                      faces: list[np.ndarray], opaque: list[np.ndarray]) -> np.ndarray:
+                      faces: list[np.ndarray], opaque: list[np.ndarray]) -> list[list[int]]:
     """Embree scenes for each mesh k (``vertices[k]`` (V, 3) float32, ``faces[k]`` (T, 3)
-    indices into them, ``opaque[k]`` (T,) bool): the ``mesh_embree`` array."""
+    indices into them, ``opaque[k]`` (T,) bool): a row (EMBREE_ALL, EMBREE_OPAQUE,
+    EMBREE_CLEAR) per mesh, each distinct handle of a row one reference the caller owns."""
     from .reuse import active_memo
 
     memo = active_memo()
@@ -264,16 +289,17 @@ def build_mesh_scenes(library: EmbreeLibrary, vertices: list[np.ndarray],
     except BaseException:
         _release_all(library, [h for row in rows for h in sorted({x for x in row if x})])
         raise
-    return handle_array(library, rows)
+    return rows
 
 
-def mesh_embree_array(tracer: str, vertices: list[np.ndarray], faces: list[np.ndarray],
-                      tri_material: list[np.ndarray], materials: np.ndarray) -> np.ndarray:
-    """``GeometryArrays.mesh_embree`` for meshes k (``vertices[k]``, local ``faces[k]``,
-    ``tri_material[k]`` material-table rows of its triangles): Embree scenes when ``tracer``
-    is ``embree``, else zeros (whitted's walk)."""
+def attach_embree(tracer: str, mesh_info: np.ndarray, vertices: list[np.ndarray],
+                  faces: list[np.ndarray], tri_material: list[np.ndarray],
+                  materials: np.ndarray) -> np.ndarray:
+    """``mesh_info`` for meshes k (``vertices[k]``, local ``faces[k]``, ``tri_material[k]``
+    material-table rows of its triangles) with Embree's addresses when ``tracer`` is
+    ``embree`` (else zeros there: whitted's walk)."""
     if tracer != "embree" or not vertices:
-        return handle_array(None, [[0] * N_EMBREE for _ in vertices])
+        return mesh_info
     from ..kernels.layout import MAT_KT
     from ..kernels.mesh import OPAQUE_KT
 
@@ -282,7 +308,12 @@ def mesh_embree_array(tracer: str, vertices: list[np.ndarray], faces: list[np.nd
         raise SceneError(f"render.mesh_tracer = 'embree': Embree is not available "
                          f"({why_not()})")
     opaque = [materials[m, MAT_KT] < OPAQUE_KT for m in tri_material]
-    return build_mesh_scenes(library, vertices, faces, opaque)
+    rows = build_mesh_scenes(library, vertices, faces, opaque)
+    try:
+        return with_addresses(mesh_info, library, rows)
+    except BaseException:
+        _release_all(library, [h for row in rows for h in sorted({x for x in row if x})])
+        raise
 
 
 def with_concrete_mesh_tracer(scene):

@@ -27,7 +27,7 @@ from ..kernels.layout import (
 )
 from ..scene.scene import Scene
 from ..scene.shapes import Mesh
-from .embree import mesh_embree_array
+from .embree import attach_embree
 from .geometry import box_corners, corners_bounds
 from .light_buffers import LIGHT_BUFFER_RES, build_light_buffers
 from .lights import light_rows
@@ -142,8 +142,9 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
     mat_table = np.array(materials.rows, dtype=np.float64).reshape(len(materials.rows),
                                                                     N_MAT_PARAMS)
     tracer = meshes.tracer or "whitted"
-    mesh_embree = mesh_embree_array(tracer, meshes.vertices, meshes.local_faces,
-                                    meshes.tri_material, mat_table)
+    mesh_arrays = meshes.arrays()
+    mesh_arrays["mesh_info"] = attach_embree(tracer, mesh_arrays["mesh_info"], meshes.vertices,
+                                             meshes.local_faces, meshes.tri_material, mat_table)
     geometry = GeometryArrays(
         prim_info=prim_info,
         prim_params=params,
@@ -155,8 +156,7 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
         inst_box=inst_box,
         inst_link=inst_link,
         inst_prims=np.ascontiguousarray(instances[inst_bvh.prim_order], dtype=np.int32),
-        **meshes.arrays(),
-        mesh_embree=mesh_embree,
+        **mesh_arrays,
         **compile_textures(materials.textures, scene.resolve_path)._asdict(),
     )
     light_table, ambient = light_rows(scene)

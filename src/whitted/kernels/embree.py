@@ -1,8 +1,8 @@
 """Calls into Embree from inside the kernels: one ray against one mesh's Embree scene.
 
 The compiler (:mod:`..compile.embree`) hands the kernels two plain addresses, those of
-``rtcIntersect1`` and ``rtcOccluded1`` (``GeometryArrays.embree_calls``), and a scene
-handle per mesh (``GeometryArrays.mesh_embree``). The intrinsics below lay out Embree's
+``rtcIntersect1`` and ``rtcOccluded1``, and a scene handle per mesh (both in the mesh's
+``mesh_info`` row: ``MESH_EMBREE`` in layout.py). The intrinsics below lay out Embree's
 ``RTCRayHit`` in 128 bytes of the kernel's own stack (16-byte aligned), call through the
 address, and read the answer back: no Python, no allocation, nothing held across calls, so
 any number of render threads may call at once (Embree's traversal is thread safe).

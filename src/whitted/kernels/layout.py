@@ -61,7 +61,14 @@ MESH_TRI_OFFSET = 1  # first triangle in mesh_faces
 MESH_TRI_COUNT = 2
 MESH_NORMALS = 3  # row of tri_normals holding triangle 0's corner normals, -1: flat shading
 MESH_UVS = 4  # row of tri_uvs holding triangle 0's corner uvs, -1: none
-N_MESH_INFO = 5
+# Embree (compile/embree.py, kernels/embree.py): five 64-bit addresses, each as two int32
+# columns (low half, high half) from MESH_EMBREE + 2 * k: the mesh's Embree scenes
+# (k = EMBREE_ALL, EMBREE_OPAQUE, EMBREE_CLEAR; 0: none) and the addresses of rtcIntersect1
+# and rtcOccluded1 (k = EMBREE_INTERSECT, EMBREE_OCCLUDED). In mesh_info rather than an array
+# of their own: one more array in GeometryArrays made seed000 render 25 % slower (every
+# kernel call that is not inlined passes each array's every part)
+MESH_EMBREE = 5
+N_MESH_INFO = 15
 
 # light columns (ambient lights are summed into one colour and not stored here)
 LIGHT_POINT = 1
@@ -119,13 +126,13 @@ MESH_NODE_OFFSET = 6
 MESH_NODE_COUNT = 7
 MESH_NODE_WIDTH = 8
 
-# mesh_embree columns: in row 0 the entry points, in row k + 1 mesh k's Embree scenes
-EMBREE_INTERSECT = 0  # row 0: address of rtcIntersect1
-EMBREE_OCCLUDED = 1  # row 0: address of rtcOccluded1
-EMBREE_ALL = 0  # every triangle: nearest hits, and shadows through a material override
-EMBREE_OPAQUE = 1  # the triangles whose own material is opaque (0 when none)
+# the addresses in a mesh_info row from MESH_EMBREE (k of each, two int32 columns apiece)
+EMBREE_ALL = 0  # the mesh's every triangle: nearest hits, shadows through a material override
+EMBREE_OPAQUE = 1  # its triangles whose own material is opaque (0 when none)
 EMBREE_CLEAR = 2  # the transparent ones (0 when none)
-N_EMBREE = 3
+EMBREE_INTERSECT = 3  # address of rtcIntersect1
+EMBREE_OCCLUDED = 4  # address of rtcOccluded1
+N_EMBREE = 5
 
 
 class GeometryArrays(NamedTuple):
@@ -149,7 +156,7 @@ class GeometryArrays(NamedTuple):
     inst_box: np.ndarray  # (I, 2, 3) float64
     inst_link: np.ndarray  # (I, 2) int32
     inst_prims: np.ndarray  # (J,) int32 SHAPE_MESH primitive indices in leaf order
-    mesh_info: np.ndarray  # (K, N_MESH_INFO) int32
+    mesh_info: np.ndarray  # (K, N_MESH_INFO) int32 (with Embree's addresses: MESH_EMBREE)
     mesh_vertices: np.ndarray  # (V, 3) float32 positions
     mesh_faces: np.ndarray  # (T, 3) int32 rows of mesh_vertices, counter-clockwise = front
     tri_material: np.ndarray  # (T,) int32 material row of each triangle
@@ -165,11 +172,6 @@ class GeometryArrays(NamedTuple):
     # (T, 3, 3) float32 corners of the triangles in leaf order (entry j: mesh_node_tris[j]):
     # the walks read a leaf's triangles from consecutive memory, not through two indirections
     mesh_leaf_corners: np.ndarray
-    # Embree (compile/embree.py, kernels/embree.py): row 0 holds the addresses of
-    # rtcIntersect1 and rtcOccluded1 (0 without Embree), row k + 1 mesh k's Embree scene
-    # handles (columns EMBREE_ALL, EMBREE_OPAQUE, EMBREE_CLEAR; 0: none). A mesh traced by
-    # Embree has no BVH of whitted's (its MESH_ROOT is -1).
-    mesh_embree: np.ndarray  # (K + 1, N_EMBREE) int64
     # textures (see texture_layout.py): one row per texture, all image texels in one array
     tex_info: np.ndarray  # (X, N_TEX_PARAMS) float64
     tex_pixels: np.ndarray  # (P,) float32 linear RGB

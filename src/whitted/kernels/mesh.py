@@ -1,5 +1,6 @@
 """Triangle meshes: watertight ray/triangle intersection and the bottom-level BVH walk, or
-Embree's where the mesh has an Embree scene (``mesh_embree``: see compile/embree.py).
+Embree's where the mesh has an Embree scene (``mesh_info`` columns from ``MESH_EMBREE``: see
+compile/embree.py).
 
 A mesh is stored once in its own space (``mesh_vertices``, ``mesh_faces``) with its own BVH;
 the caller maps the ray into that space (instancing). The walks read each triangle's corners
@@ -34,6 +35,7 @@ from .layout import (
     EMBREE_OCCLUDED,
     EMBREE_OPAQUE,
     MAT_KT,
+    MESH_EMBREE,
     MESH_NODE_COUNT,
     MESH_NODE_HI,
     MESH_NODE_LO,
@@ -160,11 +162,21 @@ def float32_below(x):
     return np.float64(y)
 
 
+@kernel(inline="always")
+def embree_address(geo, mesh, k):
+    """Address ``k`` (EMBREE_ALL, ..., EMBREE_OCCLUDED) of mesh ``mesh``'s row: two int32
+    columns, the low and the high half."""
+    mesh = np.uint64(mesh)
+    low = np.int64(geo.mesh_info[mesh, MESH_EMBREE + 2 * k]) & np.int64(0xFFFFFFFF)
+    high = np.int64(geo.mesh_info[mesh, MESH_EMBREE + 2 * k + 1])
+    return (high << np.int64(32)) | low
+
+
 @kernel
 def embree_closest_hit(geo, mesh, o, d, tmin, tmax):
     """:func:`mesh_closest_hit` by Embree (the mesh has an Embree scene)."""
-    t, prim, b1, b2 = embree_intersect(geo.mesh_embree[0, EMBREE_INTERSECT],
-                                       geo.mesh_embree[mesh + 1, EMBREE_ALL], o, d,
+    t, prim, b1, b2 = embree_intersect(embree_address(geo, mesh, EMBREE_INTERSECT),
+                                       embree_address(geo, mesh, EMBREE_ALL), o, d,
                                        float32_above(tmin), float32_below(tmax))
     if prim < 0 or not (tmin < t < tmax):
         return INF, -1, 0.0, 0.0
@@ -174,17 +186,17 @@ def embree_closest_hit(geo, mesh, o, d, tmin, tmax):
 @kernel
 def embree_occlusion(geo, mats, mesh, material, o, d, tmin, tmax):
     """:func:`mesh_occlusion` by Embree (the mesh has an Embree scene)."""
-    fn = geo.mesh_embree[0, EMBREE_OCCLUDED]
+    fn = embree_address(geo, mesh, EMBREE_OCCLUDED)
     tmin = float32_above(tmin)
     tmax = float32_below(tmax)
     if material >= 0:  # one material for every triangle
-        if not embree_occluded(fn, geo.mesh_embree[mesh + 1, EMBREE_ALL], o, d, tmin, tmax):
+        if not embree_occluded(fn, embree_address(geo, mesh, EMBREE_ALL), o, d, tmin, tmax):
             return 0
         return 1 if mats[material, MAT_KT] < OPAQUE_KT else 2
-    opaque = geo.mesh_embree[mesh + 1, EMBREE_OPAQUE]
+    opaque = embree_address(geo, mesh, EMBREE_OPAQUE)
     if opaque != 0 and embree_occluded(fn, opaque, o, d, tmin, tmax):
         return 1
-    clear = geo.mesh_embree[mesh + 1, EMBREE_CLEAR]
+    clear = embree_address(geo, mesh, EMBREE_CLEAR)
     if clear != 0 and embree_occluded(fn, clear, o, d, tmin, tmax):
         return 2
     return 0
@@ -194,7 +206,7 @@ def embree_occlusion(geo, mats, mesh, material, o, d, tmin, tmax):
 def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
     """Nearest triangle of mesh ``mesh`` hit by the ray (mesh space) in (tmin, tmax):
     (t, triangle, b1, b2), t = INF on a miss. ``stack[base:]`` is scratch."""
-    if geo.mesh_embree[mesh + 1, EMBREE_ALL] != 0:
+    if embree_address(geo, mesh, EMBREE_ALL) != 0:
         return embree_closest_hit(geo, mesh, o, d, tmin, tmax)
     kx, ky, kz, sx, sy, sz = shear_setup(d)
     corners = geo.mesh_leaf_corners
@@ -234,7 +246,7 @@ def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
 def mesh_occlusion(geo, mats, mesh, material, o, d, inv, tmin, tmax, stack, base):
     """Any triangle of the mesh on the segment (tmin, tmax)? 0: none; 1: an opaque one (the
     walk stops there); 2: only transparent ones. ``material`` >= 0 overrides the triangles'."""
-    if geo.mesh_embree[mesh + 1, EMBREE_ALL] != 0:
+    if embree_address(geo, mesh, EMBREE_ALL) != 0:
         return embree_occlusion(geo, mats, mesh, material, o, d, tmin, tmax)
     if material >= 0 and mats[material, MAT_KT] >= OPAQUE_KT:
         # one transparent material: any hit is a transparent one
