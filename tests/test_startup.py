@@ -67,6 +67,64 @@ def test_plain_render_imports_no_gui_plots_or_farm(tmp_path):
         assert heavy not in loaded, f"whitted render imported {heavy}"
 
 
+def test_numba_imported_through_whitted_skips_its_scipy_and_yaml_probes(tmp_path):
+    """Numba imports SciPy and PyYAML only to probe for them (whitted/_lean_numba.py): after
+    ``import whitted`` they are skipped, and both still import afterwards."""
+    loaded = _modules_after("""
+        import whitted, sys
+        import numba
+        assert "scipy" not in sys.modules and "yaml" not in sys.modules, "probed"
+        import scipy, yaml  # still importable, for scikit-image and Dask
+        assert scipy.__version__ and yaml.safe_load("a: 1") == {"a": 1}
+        from whitted import _lean_numba
+        assert _lean_numba._finder not in sys.meta_path  # one-shot: gone once numba is in
+    """, tmp_path)
+    assert {"numba", "scipy", "yaml"} <= loaded
+
+
+def test_numba_config_file_still_read_through_whitted(tmp_path):
+    """With a ``.numba_config.yaml`` in the working folder PyYAML is imported, so Numba reads
+    the user's settings as it would without whitted."""
+    (tmp_path / ".numba_config.yaml").write_text("boundscheck: 1\n")
+    loaded = _modules_after("""
+        import whitted
+        import numba
+        assert numba.config.BOUNDSCHECK == 1, numba.config.BOUNDSCHECK
+    """, tmp_path)
+    assert "yaml" in loaded
+
+
+def test_cache_locator_checks_the_folder_and_hashes_a_source_once(tmp_path, monkeypatch):
+    """The kernels' cache locator (kernels/jit.py) gives Numba's stamp, computed once per
+    source file and state; a changed file is hashed again."""
+    from numba.core.caching import UserProvidedCacheLocator
+
+    from whitted.kernels.jit import KernelCacheLocator
+
+    source = tmp_path / "mod.py"
+    source.write_text("def f():\n    return 1\n")
+    namespace: dict = {}
+    exec(compile(source.read_text(), str(source), "exec"), namespace)
+    monkeypatch.setattr("numba.config.CACHE_DIR", str(tmp_path / "cache"))
+    calls = []
+    real = UserProvidedCacheLocator.ensure_cache_path
+
+    def counted(self):
+        calls.append(self.get_cache_path())
+        return real(self)
+
+    monkeypatch.setattr(UserProvidedCacheLocator, "ensure_cache_path", counted)
+    first = KernelCacheLocator.from_function(namespace["f"], str(source))
+    again = KernelCacheLocator.from_function(namespace["f"], str(source))
+    assert first is not None and again is not None and len(calls) == 1
+    numba_stamp = UserProvidedCacheLocator(namespace["f"], str(source)).get_source_stamp()
+    assert first.get_source_stamp() == again.get_source_stamp() == numba_stamp
+    source.write_text("def f():\n    return 2  # changed\n")
+    changed = KernelCacheLocator(namespace["f"], str(source)).get_source_stamp()
+    assert changed != numba_stamp
+    assert changed == UserProvidedCacheLocator(namespace["f"], str(source)).get_source_stamp()
+
+
 def test_public_api_resolves_every_name():
     for name in whitted.__all__:
         assert getattr(whitted, name) is not None, name

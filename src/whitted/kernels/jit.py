@@ -70,10 +70,11 @@ order and not the other. Every kernel now says whether it is inlined.
 from __future__ import annotations
 
 import os
+import threading
 import types as pytypes
 
 from numba import config, types
-from numba.core.caching import FunctionCache
+from numba.core.caching import CompileResultCacheImpl, FunctionCache, UserProvidedCacheLocator
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.registry import CPUDispatcher
 from numba.core.runtime import nrtdynmod, rtsys
@@ -96,6 +97,36 @@ def widen_integer(ty):
     return ty
 
 
+class KernelCacheLocator(UserProvidedCacheLocator):
+    """Numba's locator of the cache folder (``NUMBA_CACHE_DIR``, which whitted always sets),
+    doing once per process what Numba does for every dispatcher it creates: check that the
+    folder can be written (a temporary file made and deleted) and hash the kernel's whole
+    source file. whitted makes some 230 dispatchers at import, and the two took 15 ms of every
+    render's start-up. A source file changed while the process runs is hashed again (the key
+    holds its modification time and size, as Numba's does)."""
+
+    _writable: set[str] = set()
+    _stamps: dict[tuple, bytes] = {}
+
+    def ensure_cache_path(self):
+        path = self.get_cache_path()
+        if path not in self._writable:
+            super().ensure_cache_path()  # raises OSError when the folder is not usable
+            self._writable.add(path)
+
+    def get_source_stamp(self):
+        st = os.stat(self._py_file)
+        key = (self._py_file, st.st_mtime_ns, st.st_size)
+        stamp = self._stamps.get(key)
+        if stamp is None:
+            stamp = self._stamps[key] = super().get_source_stamp()
+        return stamp
+
+
+class KernelCacheImpl(CompileResultCacheImpl):
+    _locator_classes = [KernelCacheLocator, *CompileResultCacheImpl._locator_classes]
+
+
 class KernelCache(FunctionCache):
     """Numba's on-disk cache of one kernel, loading without first loading Numba's compiler.
 
@@ -114,6 +145,7 @@ class KernelCache(FunctionCache):
     #: helper compiles that kernel and says whether it did (then it loads instead of being
     #: compiled twice, here and there)
     wait_for_helper = None
+    _impl_class = KernelCacheImpl
 
     def load_overload(self, sig, target_context):
         initialize_runtime(target_context)
@@ -194,7 +226,19 @@ class KernelDispatcher(CPUDispatcher):
     let Python call it (see the module docstring)."""
 
     specialise_constants = False
-    callee: KernelDispatcher | None = None
+    #: makes the twin, for a kernel that has one; the twin itself is made on first use (a
+    #: kernel is compiled, or a cached caller that needs it is not in the cache): a render
+    #: whose kernels all load from the cache never makes any (117 dispatchers, 8 ms)
+    make_callee = None
+    _callee: KernelDispatcher | None = None
+
+    @property
+    def callee(self) -> KernelDispatcher | None:
+        if self._callee is None and self.make_callee is not None:
+            with _twin_lock:
+                if self._callee is None:
+                    self._callee = self.make_callee()
+        return self._callee
 
     def enable_caching(self):
         self._cache = KernelCache(self.py_func)
@@ -214,6 +258,9 @@ class KernelDispatcher(CPUDispatcher):
             if self.callee is None:
                 raise
             return self.callee.get_overload(sig)
+
+
+_twin_lock = threading.Lock()
 
 
 def _twin_function(f):
@@ -255,7 +302,8 @@ def kernel(fn=None, **options):
         if config.DISABLE_JIT:
             return f
         dispatcher = make_dispatcher(f, opts)
-        dispatcher.callee = make_dispatcher(_twin_function(f), {**opts, **CALLEE_ONLY})
+        dispatcher.make_callee = lambda: make_dispatcher(_twin_function(f),
+                                                         {**opts, **CALLEE_ONLY})
         return dispatcher
 
     return make if fn is None else make(fn)
