@@ -125,6 +125,29 @@ def test_cache_locator_checks_the_folder_and_hashes_a_source_once(tmp_path, monk
     assert changed == UserProvidedCacheLocator(namespace["f"], str(source)).get_source_stamp()
 
 
+def test_cached_environment_rebuilt_without_importing_its_module():
+    """kernels/jit.py's ``_rebuild_env``: an environment unpickled from the cache for a module
+    nobody imported gets its consts and name but does not import the module; it pickles
+    under Numba's own name, so cache files stay loadable without whitted."""
+    import pickle
+
+    from numba.core import environment
+
+    import whitted.kernels.jit  # noqa: F401 - installs the function
+
+    name = "module_never_imported_by_this_test"
+    env = environment._rebuild_env(name, [1.5, "x"], "_ZN08NumbaEnvTestOnly")
+    assert name not in sys.modules
+    assert list(env.consts) == [1.5, "x"] and env.globals == {"__name__": name}
+    assert env.can_cache()
+    assert environment.lookup_environment("_ZN08NumbaEnvTestOnly") is env
+    data = pickle.dumps(env)
+    assert b"numba.core.environment" in data and b"whitted" not in data  # not jit.py's name
+    assert pickle.loads(data) is env  # the live one, by name
+    imported = environment._rebuild_env("json", [], "_ZN08NumbaEnvTestOnlyJson")
+    assert imported.globals is sys.modules["json"].__dict__  # imported: Numba's way
+
+
 def test_public_api_resolves_every_name():
     for name in whitted.__all__:
         assert getattr(whitted, name) is not None, name
