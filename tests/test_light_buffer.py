@@ -229,3 +229,25 @@ def test_compile_without_light_buffers_builds_none_and_gives_the_same_image():
     assert (bare.lights.table[:, LIGHT_BUFFER] == -1).all()
     assert len(bare.lights.buffer_prims) == 0
     assert np.array_equal(_render(buffered, scene), _render(bare, scene))
+
+
+def test_buffers_built_on_threads_equal_the_one_thread_build():
+    """compile_scene's ``threads`` splits every light's cells into runs for a thread each
+    (compile/light_buffers.py): the cells, their lists and the table are the same arrays on
+    1, 2, 3 and 5 threads, for one light and for two (more runs than cells included)."""
+    for lights in (LIGHTS[:1], LIGHTS):
+        scene = _cluttered_scene(lights)
+        one = compile_scene(scene, threads=1).lights
+        assert one.buffer_prims.size > 0 and (one.buffer_cells[:, CELL_COUNT] > 0).any()
+        for threads in (2, 3, 5):
+            many = compile_scene(scene, threads=threads).lights
+            for name in ("table", "buffer_cells", "buffer_prims"):
+                a, b = getattr(one, name), getattr(many, name)
+                assert a.dtype == b.dtype and np.array_equal(a, b), (len(lights), threads, name)
+    tiny = whitted.Scene(objects=[whitted.Sphere(radius=1.0)], lights=LIGHTS[:1])  # 6 cells a side
+    cells = [compile_scene(tiny, threads=t).lights.buffer_cells for t in (1, 300)]
+    assert len(cells[0]) == 6 * 6 * 6 and np.array_equal(cells[0], cells[1])
+    # lists are packed one after another: each cell starts where the previous one ended
+    listed = np.maximum(one.buffer_cells[:, CELL_COUNT], 0)
+    assert np.array_equal(one.buffer_cells[1:, CELL_FIRST],
+                          np.cumsum(listed)[:-1].astype(np.int32))

@@ -68,13 +68,16 @@ def _plane_out_of_reach(P, i, light, cell, res):
 
 
 @kernel
-def list_cell_occluders(geo, mats, light, reach, res, lists, counts, opaque, stack):
-    """Fill ``lists[cell, :counts[cell]]`` with the primitives that may block rays leaving
-    ``light`` through each cell (``counts[cell]`` = -1 when there are more than the row holds)
-    and ``opaque[cell]`` with whether they are all opaque. ``reach`` is at least the distance
-    from the light to the farthest corner of the scene BVH's root box."""
+def list_cell_occluders(geo, mats, light, reach, res, lists, counts, opaque, stack, first,
+                        last):
+    """For cells ``first`` to ``last - 1``: fill ``lists[cell, :counts[cell]]`` with the
+    primitives that may block rays leaving ``light`` through the cell (``counts[cell]`` = -1
+    when there are more than the row holds) and ``opaque[cell]`` with whether they are all
+    opaque. ``reach`` is at least the distance from the light to the farthest corner of the
+    scene BVH's root box. Cells do not depend on each other: ranges may run on threads of
+    their own (``stack`` is the thread's)."""
     cap = lists.shape[1]
-    for cell in range(6 * res * res):
+    for cell in range(first, last):
         n = 0
         all_opaque = True
         for j in range(geo.unbounded.shape[0]):
@@ -96,6 +99,16 @@ def list_cell_occluders(geo, mats, light, reach, res, lists, counts, opaque, sta
                 n, cap, all_opaque)
         counts[cell] = n
         opaque[cell] = 1 if (n >= 0 and all_opaque) else 0
+
+
+@kernel
+def pack_cell_lists(lists, counts, offsets, prims):
+    """Copy each cell's list (``lists[cell, :counts[cell]]``, none when the count is -1) to
+    ``prims[offsets[cell]:]``, one after another."""
+    for cell in range(lists.shape[0]):
+        at = offsets[cell]
+        for k in range(counts[cell]):
+            prims[at + k] = lists[cell, k]
 
 
 def _reach(geo: GeometryArrays, light: np.ndarray) -> float:
@@ -120,39 +133,53 @@ def buffer_side(n_point_lights: int, n_prims: int, res: int = LIGHT_BUFFER_RES) 
 
 def build_light_buffers(geo: GeometryArrays, materials: np.ndarray, table: np.ndarray,
                         has_instances: bool, res: int = LIGHT_BUFFER_RES,
-                        cap: int = LIGHT_BUFFER_CAP) -> LightArrays:
+                        cap: int = LIGHT_BUFFER_CAP, threads: int = 1) -> LightArrays:
     """The light table with a light buffer for each point light (its LIGHT_BUFFER column set
     to its first cell; -1 for other lights, and for every light when the scene has mesh
-    instances or ``res`` is 0)."""
+    instances or ``res`` is 0). The cells are listed on ``threads`` threads, each taking an
+    equal run of every light's cells: the same buffers on any number."""
     table = table.copy()
     res = buffer_side(int(np.sum(table[:, LIGHT_TYPE] == LIGHT_POINT)), len(geo.prim_info), res)
     table[:, LIGHT_BUFFER] = -1.0
-    cells = [np.zeros((0, 3), np.int32)]
-    prims = [np.zeros(0, np.int32)]
-    n_cells = 6 * res * res
-    first_cell = 0
-    first_prim = 0
-    stack = np.empty(128, np.int32)
-    for j in range(table.shape[0]):
-        if has_instances or res <= 0 or table[j, LIGHT_TYPE] != LIGHT_POINT:
-            continue
+    lights = [j for j in range(table.shape[0])
+              if not (has_instances or res <= 0 or table[j, LIGHT_TYPE] != LIGHT_POINT)]
+    n_cells = 6 * res * res if lights else 0
+    lists = np.empty((len(lights) * n_cells, cap), np.int32)
+    counts = np.empty(len(lights) * n_cells, np.int32)
+    opaque = np.empty(len(lights) * n_cells, np.int32)
+    work = []  # (light position, reach, first cell, last cell, row offset)
+    for k, j in enumerate(lights):
         light = table[j, LIGHT_POSITION : LIGHT_POSITION + 3].copy()
-        lists = np.empty((n_cells, cap), np.int32)
-        counts = np.empty(n_cells, np.int32)
-        opaque = np.empty(n_cells, np.int32)
-        list_cell_occluders(geo, materials, (float(light[0]), float(light[1]), float(light[2])),
-                            _reach(geo, light), res, lists, counts, opaque, stack)
-        listed = np.maximum(counts, 0)
-        block = np.empty((n_cells, 3), np.int32)
-        block[:, CELL_FIRST] = first_prim + np.concatenate(([0], np.cumsum(listed)[:-1]))
-        block[:, CELL_COUNT] = counts
-        block[:, CELL_OPAQUE] = opaque
-        keep = np.arange(cap)[None, :] < listed[:, None]
-        prims.append(lists[keep].astype(np.int32))
-        cells.append(block)
-        table[j, LIGHT_BUFFER] = first_cell
+        table[j, LIGHT_BUFFER] = k * n_cells
         table[j, LIGHT_BUFFER_SIDE] = res
-        first_cell += n_cells
-        first_prim += int(listed.sum())
-    return LightArrays(table=table, buffer_cells=np.ascontiguousarray(np.concatenate(cells)),
-                       buffer_prims=np.ascontiguousarray(np.concatenate(prims)))
+        position = (float(light[0]), float(light[1]), float(light[2]))
+        reach = _reach(geo, light)
+        parts = max(1, threads)
+        bounds = [n_cells * i // parts for i in range(parts + 1)]
+        work += [(position, reach, bounds[i], bounds[i + 1], k * n_cells)
+                 for i in range(parts) if bounds[i + 1] > bounds[i]]
+
+    def run(part) -> None:
+        position, reach, first, last, row = part
+        block = slice(row, row + n_cells)  # the light's own rows: cells count from 0 in it
+        list_cell_occluders(geo, materials, position, reach, res, lists[block], counts[block],
+                            opaque[block], np.empty(128, np.int32), first, last)
+
+    if threads > 1 and len(work) > 1:
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(min(threads, len(work))) as pool:
+            list(pool.map(run, work))  # the kernel releases the GIL
+    else:
+        for part in work:
+            run(part)
+    listed = np.maximum(counts, 0)
+    offsets = np.zeros(len(listed), np.int64)
+    np.cumsum(listed[:-1], out=offsets[1:])
+    prims = np.empty(int(listed.sum()), np.int32)
+    pack_cell_lists(lists, counts, offsets, prims)
+    cells = np.empty((len(counts), 3), np.int32)
+    cells[:, CELL_FIRST] = offsets
+    cells[:, CELL_COUNT] = counts
+    cells[:, CELL_OPAQUE] = opaque
+    return LightArrays(table=table, buffer_cells=cells, buffer_prims=prims)

@@ -67,14 +67,16 @@ def packed_nodes(bvh, dtype) -> tuple[np.ndarray, np.ndarray]:
 
 
 def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
-                  light_buffers: bool = True, mesh_tracer: str | None = None) -> CompiledScene:
+                  light_buffers: bool = True, mesh_tracer: str | None = None,
+                  threads: int = 1) -> CompiledScene:
     """Flatten ``scene`` into the kernel layout and build the BVHs over its bounded shapes.
 
     A mesh whose copies (triangles x objects using it) come to at most ``flatten_limit``
     triangles becomes triangle primitives of the scene BVH, one copy per object; a bigger one
     is stored once and instanced. ``light_buffers=False`` skips the point lights' light
     buffers: the same image (shadow rays then walk the BVH), built in a fraction of the time,
-    which is what a small interactive preview wants."""
+    which is what a small interactive preview wants. ``threads`` is how many threads may
+    build the light buffers (the render's own count: the same arrays on any number)."""
     import time
     from collections import Counter
 
@@ -162,7 +164,8 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
     light_table, ambient = light_rows(scene)
     lights = build_light_buffers(geometry, mat_table, light_table,
                                  has_instances=len(instances) > 0,
-                                 res=LIGHT_BUFFER_RES if light_buffers else 0)
+                                 res=LIGHT_BUFFER_RES if light_buffers else 0,
+                                 threads=threads)
     if finite.any():
         bmin, bmax = lo[finite].min(axis=0), hi[finite].max(axis=0)
     else:

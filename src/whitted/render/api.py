@@ -271,7 +271,7 @@ class RenderJob:
         stats = self.stats
         stats.compile_seconds = warm_up_kernels()
         compiled: CompiledScene = (self.compiled if self.compiled is not None
-                                   else compile_scene(self.scene))
+                                   else compile_scene(self.scene, threads=self.threads))
         stats.compile_seconds += warm_up_kernels(compiled)
         stats.build_seconds = compiled.build_seconds
         stats.warnings = list(compiled.warnings)
