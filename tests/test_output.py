@@ -187,6 +187,69 @@ def test_png16_round_trip(tmp_path):
     )
 
 
+@settings(max_examples=60, deadline=None)
+@given(st.binary(max_size=300), st.binary(max_size=300), st.binary(max_size=70000))
+def test_adler32_combine_equals_zlib_over_the_joined_bytes(a, b, c):
+    import zlib
+
+    from whitted.output.png import adler32_combine
+
+    ab = adler32_combine(zlib.adler32(a), zlib.adler32(b), len(b))
+    assert ab == zlib.adler32(a + b)
+    assert adler32_combine(ab, zlib.adler32(c), len(c)) == zlib.adler32(a + b + c)
+
+
+@pytest.mark.parametrize("bits", [8, 16])
+def test_png_written_in_units_on_threads_is_exact_and_the_same_bytes(tmp_path, monkeypatch,
+                                                                      bits):
+    """output/png.py: an image of several deflate units (made small here) reads back with
+    exactly the codes encode_ldr gives, through Pillow or pypng and zlib's own checks (CRCs,
+    Adler-32), and its bytes do not depend on the number of threads."""
+    import zlib
+
+    from whitted.output import png as png_writer
+
+    monkeypatch.setattr(png_writer, "DEFLATE_UNIT_BYTES", 700)  # 23 units of 5-6 rows
+    px = RNG.random((125, 41, 3), dtype=np.float32) * 1.2  # some above 1: clipped
+    px[7:30, 3:20] = 0.25  # flat runs: Up filters to zeros
+    codes = encode_ldr(px, bits=bits)
+    files = {}
+    for threads in (1, 2, 5):
+        path = tmp_path / f"t{threads}.png"
+        with open(path, "wb") as f:
+            png_writer.write_png(f, 125, 41, bits, lambda y0, y1: encode_ldr(px[y0:y1],
+                                                                             bits=bits),
+                                 4, threads=threads)
+        files[threads] = path.read_bytes()
+    assert files[1] == files[2] == files[5]
+    assert len(png_writer.unit_rows(125, 41, bits)) > 10
+    with open(tmp_path / "t2.png", "rb") as f:
+        w, h, rows, info = png.Reader(file=f).read()  # checks every chunk's CRC
+        back = np.array(list(rows), dtype=np.uint16).reshape(h, w, 3)
+    assert (w, h, info["bitdepth"]) == (41, 125, bits)
+    assert np.array_equal(back, codes)
+    if bits == 8:
+        with PILImage.open(tmp_path / "t2.png") as im:
+            assert np.array_equal(np.asarray(im), codes)
+    # the IDAT stream is one zlib stream, its Adler-32 included
+    data, at = files[2], 8
+    stream = b""
+    while at < len(data):
+        (length,) = np.frombuffer(data[at:at + 4], ">u4")
+        if data[at + 4:at + 8] == b"IDAT":
+            stream += data[at + 8:at + 8 + int(length)]
+        at += 12 + int(length)
+    assert len(zlib.decompress(stream)) == 125 * (1 + 41 * 3 * bits // 8)
+
+
+def test_png_of_one_row_and_of_one_pixel(tmp_path):
+    for shape in ((1, 9, 3), (1, 1, 3), (9, 1, 3)):
+        px = RNG.random(shape, dtype=np.float32)
+        path = Image(px).save(tmp_path / "x.png")
+        with PILImage.open(path) as im:
+            assert np.array_equal(np.asarray(im), encode_ldr(px, bits=8))
+
+
 def test_linear_transfer_writes_exact_values(tmp_path):
     px = np.zeros((2, 3, 3), dtype=np.float32)
     px[0, 0] = 0.5

@@ -246,8 +246,8 @@ def test_a3_interrupt_before_the_first_tile_keeps_the_old_image(tmp_path: Path, 
     good = png_bytes(tmp_path / "out.png")
     original = api.compile_scene
 
-    def compile_then_interrupt(scene):
-        compiled = original(scene)
+    def compile_then_interrupt(scene, **options):
+        compiled = original(scene, **options)
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(0.3)  # the handler runs and cancels before the first tile
         return compiled
@@ -261,13 +261,13 @@ def test_a3_interrupt_before_the_first_tile_keeps_the_old_image(tmp_path: Path, 
 
 def test_a4_sigterm_during_the_write_lets_it_finish(tmp_path: Path, monkeypatch):
     write(tmp_path / "scene.toml", SCENE)
-    original = encode._write_png8
+    original = encode._write_png
 
     def write_and_terminate(tmp, *args):
         os.kill(os.getpid(), signal.SIGTERM)  # arrives while the file is being written
         original(tmp, *args)
 
-    monkeypatch.setattr(encode, "_write_png8", write_and_terminate)
+    monkeypatch.setattr(encode, "_write_png", write_and_terminate)
     code, out, err = run_main("render", "scene.toml", "-o", "out.png", cwd=tmp_path)
     assert code == 143, err
     assert "terminated: kept 1/1 tiles" in err
@@ -286,7 +286,7 @@ def test_a4_a_second_ctrl_c_stops_at_once_and_undoes_the_write(tmp_path: Path, m
         time.sleep(1)
         pytest.fail("the second Ctrl-C did not stop the write")
 
-    monkeypatch.setattr(encode, "_write_png8", slow_write)
+    monkeypatch.setattr(encode, "_write_png", slow_write)
     code, _out, _err = run_main("render", "scene.toml", "-o", "out.png", cwd=tmp_path)
     assert code == 130
     assert (tmp_path / "out.png").read_bytes() == good
