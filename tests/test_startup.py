@@ -126,14 +126,14 @@ def test_cache_locator_checks_the_folder_and_hashes_a_source_once(tmp_path, monk
 
 
 def test_cached_environment_rebuilt_without_importing_its_module():
-    """kernels/jit.py's ``_rebuild_env``: an environment unpickled from the cache for a module
-    nobody imported gets its consts and name but does not import the module; it pickles
+    """kernels/cache_load.py's ``_rebuild_env``: an environment unpickled from the cache for a
+    module nobody imported gets its consts and name but does not import the module; it pickles
     under Numba's own name, so cache files stay loadable without whitted."""
     import pickle
 
     from numba.core import environment
 
-    import whitted.kernels.jit  # noqa: F401 - installs the function
+    import whitted.kernels.cache_load  # noqa: F401 - installs the function
 
     name = "module_never_imported_by_this_test"
     env = environment._rebuild_env(name, [1.5, "x"], "_ZN08NumbaEnvTestOnly")
@@ -142,10 +142,70 @@ def test_cached_environment_rebuilt_without_importing_its_module():
     assert env.can_cache()
     assert environment.lookup_environment("_ZN08NumbaEnvTestOnly") is env
     data = pickle.dumps(env)
-    assert b"numba.core.environment" in data and b"whitted" not in data  # not jit.py's name
+    assert b"numba.core.environment" in data and b"whitted" not in data  # Numba's name
     assert pickle.loads(data) is env  # the live one, by name
     imported = environment._rebuild_env("json", [], "_ZN08NumbaEnvTestOnlyJson")
     assert imported.globals is sys.modules["json"].__dict__  # imported: Numba's way
+
+
+def test_symbols_read_from_machine_code_are_the_ones_the_bitcode_defines(tmp_path):
+    """kernels/cache_load.py names what a cached library defines from its ELF symbol table
+    instead of parsing its bitcode. For every kernel a render and the builders load (in a
+    fresh process: from the cache, bitcode unparsed), those names are among the bitcode's,
+    and ``get_pointer_to_function`` gives the address Numba's would for every function the
+    bitcode defines (the entry points found, the functions inlined away 0). A kernel
+    compiled afterwards that calls a loaded one links against it (the bitcode parsed
+    then)."""
+    _modules_after("""
+        import numpy as np
+        from llvmlite import binding as ll
+        from numba.core import codegen
+        import whitted
+        from whitted.kernels import cache_load
+        from whitted.kernels.jit import kernel
+        from whitted.kernels.vec import dot
+
+        states, libraries = [], []
+        lazy = codegen.JITCodeLibrary._unserialize.__func__
+
+        def recorded(cls, codegen_, state):
+            states.append(state)
+            libraries.append(lazy(cls, codegen_, state))
+            return libraries[-1]
+
+        codegen.JITCodeLibrary._unserialize = classmethod(recorded)
+        scene = whitted.Scene(objects=[whitted.Sphere(radius=1.0)],
+                              lights=[whitted.PointLight(position=(0, 4, 0))])
+        whitted.render(scene, width=8, height=8, threads=1)
+        loaded = [s for s in states if s[1] == "object"]
+        assert len(loaded) >= 4, [s[0] for s in states]
+        engine = libraries[0].codegen._engine
+        entry_points = unparsed = 0
+        for (name, _kind, (obj, bitcode)), library in zip(states, libraries):
+            mod = ll.parse_bitcode(bitcode)
+            from_bitcode = {g.name for g in (*mod.functions, *mod.global_variables)
+                            if not g.is_declaration}
+            from_elf = cache_load.elf_defined_symbols(obj)
+            assert from_elf <= from_bitcode, (name, from_elf - from_bitcode)
+            functions = {f.name for f in mod.functions if not f.is_declaration}
+            for symbol in functions:  # get_pointer_to_function answers as Numba's did
+                numba_answer = engine.get_function_address(symbol)
+                assert library.get_pointer_to_function(symbol) == numba_answer, symbol
+                entry_points += symbol.startswith("_ZN7cpython") and numba_answer != 0
+            # the other name Numba asks about: runtime-linked recursion stubs
+            assert not any(".numba.unresolved$" in g for g in from_bitcode - from_elf)
+            # parsed only when linked into a compile (a kernel's twin: its callers' compile)
+            unparsed += library._unparsed_bitcode is bitcode
+            assert library._unparsed_bitcode in (bitcode, None), name
+        assert entry_points >= 4 and unparsed >= 4, (entry_points, unparsed)
+
+        @kernel(cache=False)
+        def fresh(a):
+            return dot((a[0], a[1], a[2]), (4.0, 5.0, 6.0))
+
+        assert fresh(np.array([1.0, 2.0, 3.0])) == 32.0
+        assert cache_load.elf_defined_symbols(b"not an object file") is None
+    """, tmp_path)
 
 
 def test_public_api_resolves_every_name():

@@ -70,16 +70,16 @@ order and not the other. Every kernel now says whether it is inlined.
 from __future__ import annotations
 
 import os
-import sys
 import threading
 import types as pytypes
 
 from numba import config, types
-from numba.core import environment
 from numba.core.caching import CompileResultCacheImpl, FunctionCache, UserProvidedCacheLocator
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.registry import CPUDispatcher
 from numba.core.runtime import nrtdynmod, rtsys
+
+from . import cache_load  # noqa: F401 - faster loading of cached kernels (see there)
 
 if "NUMBA_SLP_VECTORIZE" not in os.environ:
     config.SLP_VECTORIZE = 1
@@ -205,37 +205,6 @@ def _cached_nrt_functions(target_context):
 
 
 _compile_nrt_functions = nrtdynmod.compile_nrt_functions
-
-
-_numba_rebuild_env = environment._rebuild_env
-
-
-def _rebuild_env(modname, consts, env_name):
-    """Numba's ``_rebuild_env``, which unpickles the environment of each function in a cached
-    library, without importing the function's module when it is not imported yet.
-
-    Numba imports that module to hand its globals to the environment, and the globals are
-    read only by code compiled in object mode, which no kernel is (``nopython=True``). The one
-    module a render's cached kernels named and nobody had imported was ``numba.np.arrayobj``
-    (the builders' ``np.empty``); importing it brought NumPy's masked arrays and Numba's
-    string types along: 25-30 ms of every render's start-up. The environment gets a globals
-    dict holding only the module's name, as Numba's own is recognised by (``can_cache``).
-    The function keeps Numba's name, so cache files written after this still name Numba's
-    function and load without whitted too."""
-    if modname is None or modname in sys.modules:
-        return _numba_rebuild_env(modname, consts, env_name)
-    env = environment.lookup_environment(env_name)
-    if env is None:
-        env = environment.Environment({"__name__": modname})
-        env.consts[:] = consts
-        env.env_name = env_name
-        environment.Environment._memo[env_name] = env
-    return env
-
-
-_rebuild_env.__module__ = _numba_rebuild_env.__module__
-_rebuild_env.__qualname__ = _numba_rebuild_env.__qualname__
-environment._rebuild_env = _rebuild_env
 
 
 def initialize_runtime(target_context) -> None:

@@ -1,0 +1,126 @@
+"""Loading kernels from Numba's on-disk cache with less work than Numba does.
+
+Two steps of Numba's own loading do work that a loaded kernel never uses; whitted replaces
+them (process-wide, on importing kernels/jit.py). Both keep Numba's behaviour for whatever
+does need the skipped work, and cache files stay Numba's own.
+
+**Environments without importing their modules.** Numba's ``_rebuild_env`` unpickles the
+environment of each function in a cached library and imports the function's module to hand
+its globals to the environment. Only code compiled in object mode reads them, which no
+kernel is (``nopython=True``). The one module a render's cached kernels named and nobody had
+imported was ``numba.np.arrayobj`` (the builders' ``np.empty``), whose import brought NumPy's
+masked arrays and Numba's string types along: 25-30 ms of every render's start-up. An
+environment of a module not imported yet gets a globals dict holding only the module's
+name, as Numba's own is recognised by (``can_cache``).
+
+**Bitcode parsed when it is needed.** A cached library holds its machine code and its LLVM
+bitcode, and Numba parses the bitcode at load for two things: the names the library defines
+(``get_pointer_to_function`` answers only for those: the entry points), and a module to link
+into a later compile that calls one of its functions. Parsing was half of all kernel
+loading: 21.6 of 43 ms in a render of seed000 (AMD EPYC). The names are read from the
+machine code's ELF symbol table instead: its defined global and weak symbols, which are the
+names the JIT can resolve. The bitcode also names functions inlined away and private
+constants, which have no address in the machine code; asking for one gives 0 either way (a
+test checks both on every kernel a render loads). The bitcode is parsed the first time the
+library is linked into another. An object file that is not ELF (another platform) loads Numba's way.
+"""
+
+from __future__ import annotations
+
+import struct
+import sys
+
+from llvmlite import binding as ll
+from numba.core import codegen, environment
+
+# ------------------------------------------------------------------ environments
+
+_numba_rebuild_env = environment._rebuild_env
+
+
+def _rebuild_env(modname, consts, env_name):
+    """Numba's ``_rebuild_env`` without importing a module nobody has imported."""
+    if modname is None or modname in sys.modules:
+        return _numba_rebuild_env(modname, consts, env_name)
+    env = environment.lookup_environment(env_name)
+    if env is None:
+        env = environment.Environment({"__name__": modname})
+        env.consts[:] = consts
+        env.env_name = env_name
+        environment.Environment._memo[env_name] = env
+    return env
+
+
+# pickles under Numba's name: cache files written after this load without whitted too
+_rebuild_env.__module__ = _numba_rebuild_env.__module__
+_rebuild_env.__qualname__ = _numba_rebuild_env.__qualname__
+environment._rebuild_env = _rebuild_env
+
+# ------------------------------------------------------------------ bitcode on demand
+
+ELF_MAGIC = b"\x7fELF"
+SHT_SYMTAB = 2
+SHN_UNDEF = 0
+SHN_ABS, SHN_COMMON = 0xFFF1, 0xFFF2
+SHN_LORESERVE = 0xFF00
+STB_GLOBAL, STB_WEAK = 1, 2
+
+
+def elf_defined_symbols(obj: bytes) -> set[str] | None:
+    """The global and weak symbols an ELF64 little-endian object file defines (functions and
+    data, common symbols such as Numba's environment pointers included): the names the JIT
+    linker can resolve in it. None when ``obj`` is not such a file."""
+    if obj[:4] != ELF_MAGIC or obj[4] != 2 or obj[5] != 1:  # ELFCLASS64, ELFDATA2LSB
+        return None
+    (shoff,) = struct.unpack_from("<Q", obj, 0x28)
+    shentsize, shnum = struct.unpack_from("<HH", obj, 0x3A)
+    sections = [struct.unpack_from("<IIQQQQIIQQ", obj, shoff + i * shentsize)
+                for i in range(shnum)]
+    names: set[str] = set()
+    for _name, kind, _flags, _addr, offset, size, link, _info, _align, entsize in sections:
+        if kind != SHT_SYMTAB or entsize == 0:
+            continue
+        strings = sections[link][4]
+        for at in range(offset, offset + size, entsize):
+            st_name, st_info, _other, st_shndx = struct.unpack_from("<IBBH", obj, at)
+            defined = (SHN_UNDEF < st_shndx < SHN_LORESERVE
+                       or st_shndx in (SHN_ABS, SHN_COMMON))
+            if (st_info >> 4) in (STB_GLOBAL, STB_WEAK) and defined:
+                end = obj.index(b"\0", strings + st_name)
+                names.add(obj[strings + st_name:end].decode())
+    return names
+
+
+_numba_unserialize = codegen.JITCodeLibrary._unserialize.__func__
+_numba_module_for_linking = codegen.JITCodeLibrary._get_module_for_linking
+
+
+def _unserialize(cls, codegen_, state):
+    """``CPUCodeLibrary._unserialize`` for machine code (kind ``object``), leaving the
+    bitcode unparsed; anything else goes to Numba's."""
+    name, kind, data = state
+    defined = elf_defined_symbols(data[0]) if kind == "object" else None
+    if not defined:
+        return _numba_unserialize(cls, codegen_, state)
+    object_code, shared_bitcode = data
+    library = codegen_.create_library(name)
+    assert isinstance(library, cls)
+    library.enable_object_caching()
+    library._set_compiled_object(object_code)
+    library._unparsed_bitcode = shared_bitcode
+    library._finalize_final_module()
+    codegen_._engine._defined_symbols |= defined
+    return library
+
+
+def _get_module_for_linking(self):
+    """Numba's, parsing the library's bitcode first if it was loaded without."""
+    bitcode = getattr(self, "_unparsed_bitcode", None)
+    if bitcode is not None and self._shared_module is None:
+        self._shared_module = ll.parse_bitcode(bitcode)
+        self._unparsed_bitcode = None
+    return _numba_module_for_linking(self)
+
+
+codegen.JITCodeLibrary._unserialize = classmethod(_unserialize)
+codegen.JITCodeLibrary._get_module_for_linking = _get_module_for_linking
