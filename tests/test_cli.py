@@ -281,3 +281,31 @@ def test_ctrl_c_keeps_the_part_rendered_so_far(tmp_path: Path):
         assert image.size == (size, size)
         pixels = np.asarray(image)
     assert pixels.max() > 0  # some tiles were rendered and kept
+
+
+def test_one_command_built_gives_the_same_help_and_errors_as_all(tmp_path: Path):
+    """main() lets typer build only the command the arguments name (cli/main.py
+    ``only_the_command_named``): each command's --help, a bad option, a missing value and a
+    bad value print the same as with every command built; without a command name, or with
+    the stefan group or a misspelt name, all are kept."""
+    import whitted.cli.main as cli
+
+    everything = list(cli.app.registered_commands), list(cli.app.registered_groups)
+    names = [cli._command_name(info) for info in cli.app.registered_commands]
+    assert {"render", "export", "animate", "bench", "info", "sweep"} <= set(names)
+    cases = [[name, "--help"] for name in names]
+    cases += [["render", "--no-such-option"], ["render", "--width"], ["render", "-W", "x"],
+              ["info", "a", "b", "c"], ["animate", "--frames"]]
+    for args in cases:
+        whole = CliRunner().invoke(app, args)
+        with cli.only_the_command_named(["whitted", *args]):
+            assert len(cli.app.registered_commands) == 1, args
+            assert cli.app.registered_groups == [], args
+            narrowed = CliRunner().invoke(app, args)
+        assert (narrowed.exit_code, narrowed.stdout, narrowed.stderr) == (
+            whole.exit_code, whole.stdout, whole.stderr), args
+        assert (cli.app.registered_commands, cli.app.registered_groups) == everything
+    for argv in (["whitted"], ["whitted", "--help"], ["whitted", "stefan", "--help"],
+                 ["whitted", "rendr"], ["whitted", "--version", "render"]):
+        with cli.only_the_command_named(argv):
+            assert (cli.app.registered_commands, cli.app.registered_groups) == everything
