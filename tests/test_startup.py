@@ -208,6 +208,29 @@ def test_symbols_read_from_machine_code_are_the_ones_the_bitcode_defines(tmp_pat
     """, tmp_path)
 
 
+def test_slp_vectoriser_stays_on_when_numba_was_imported_before_whitted(tmp_path):
+    """kernels/jit.py turns LLVM's SLP vectoriser on. Numba reads its settings from the
+    environment again before a compile once the environment has changed (whitted sets
+    NUMBA_CACHE_DIR when Numba is already imported): the setting must survive that, or the
+    kernels compiled then (and cached) run some 50 % slower."""
+    _modules_after("""
+        import os
+        import numba
+        from numba.core import config
+        import whitted.kernels.jit  # noqa: F401
+        assert config.SLP_VECTORIZE == 1
+        os.environ["WHITTED_TEST_CHANGE"] = "1"  # any change: Numba re-reads everything
+        config.reload_config()
+        assert config.SLP_VECTORIZE == 1, "lost on re-reading the environment"
+        assert numba.config.CACHE_DIR  # whitted's cache folder survives it too
+    """, tmp_path)
+    env = dict(os.environ, NUMBA_SLP_VECTORIZE="0")  # a user's own choice wins
+    result = subprocess.run([sys.executable, "-c", "import numba, whitted.kernels.jit; "
+                             "assert numba.config.SLP_VECTORIZE == 0"], env=env,
+                            capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+
+
 def test_public_api_resolves_every_name():
     for name in whitted.__all__:
         assert getattr(whitted, name) is not None, name
