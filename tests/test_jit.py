@@ -117,3 +117,64 @@ def test_a_callee_of_an_inlined_kernel_is_not_inlined_by_inheritance():
     (callee,) = _plain_callee.callee.overloads.values()
     assert caller.fndesc.inline is True
     assert callee.fndesc.inline is False
+
+
+def test_a_twin_gets_no_machine_code_and_its_callers_link_its_bitcode():
+    """kernels/cache_load.py: a twin's library is finalised without going into the JIT (its
+    callers link its LLVM module; its own machine code was never run) and is cached as its
+    bitcode beside an empty object code; its caller still runs it."""
+    assert _twice_scaled(2.0) == 10.0
+    (twin,) = _scaled.callee.overloads.values()
+    library = twin.library
+    assert library.name.endswith("__callee")
+    assert library._finalized
+    engine = library.codegen._engine
+    assert engine.get_function_address(twin.fndesc.mangled_name) == 0  # not in the JIT
+    name, kind, (obj, bitcode) = library.serialize_using_object_code()
+    assert (name, kind, obj) == (library.name, "object", b"") and len(bitcode) > 0
+    (caller,) = _twice_scaled.overloads.values()
+    assert caller.library.get_pointer_to_function(
+        caller.fndesc.llvm_cpython_wrapper_name) != 0
+
+
+CACHED_TWIN = '''
+import sys
+import numpy as np
+from whitted.kernels.jit import kernel
+from cached_twin_kernels import double_it, quadruple
+
+
+@kernel(cache=False)
+def octuple(x):  # compiled in every run, calling the twin (from the cache in the second)
+    return double_it(double_it(double_it(x)))
+
+
+assert quadruple(np.float64(1.5)) == 6.0
+assert octuple(np.float64(1.5)) == 12.0
+twin = next(iter(double_it.callee.overloads.values())).library
+print({None: "LOADED", "x": "COMPILED"}.get(getattr(twin, "_unparsed_bitcode", "x"), "UNPARSED"))
+'''
+
+
+def test_a_twin_from_the_cache_links_into_a_new_caller(tmp_path):
+    """A twin written to the cache by one process (bitcode, no machine code) is loaded by the
+    next for linking only, and a kernel compiled there calls it."""
+    import os
+    import subprocess
+    import sys
+
+    (tmp_path / "cached_twin_kernels.py").write_text(
+        "from whitted.kernels.jit import kernel\n\n\n"
+        "@kernel\ndef double_it(x):\n    return 2.0 * x\n\n\n"
+        "@kernel\ndef quadruple(x):\n    return double_it(double_it(x))\n")
+    (tmp_path / "run.py").write_text(CACHED_TWIN)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"),
+               PYTHONPATH=os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")]))
+    runs = [subprocess.run([sys.executable, "run.py"], cwd=tmp_path, env=env,
+                           capture_output=True, text=True, timeout=600) for _ in range(2)]
+    for run in runs:
+        assert run.returncode == 0, run.stderr
+    # the first run compiled the twin, the second loaded it and parsed its bitcode to link it
+    assert [run.stdout.strip() for run in runs] == ["COMPILED", "LOADED"]
+    cached = list((tmp_path / "cache").rglob("*double_it__callee*.nbc"))
+    assert cached, list((tmp_path / "cache").rglob("*"))

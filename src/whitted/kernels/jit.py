@@ -47,7 +47,8 @@ more code than the kernel itself. The twin has a name of its own (``<name>__call
 own cache files; a kernel called from Python (``render_tiles``, the builders, tests) compiles
 its Python-callable version as before. No kernel gets a C-callable wrapper
 (``no_cfunc_wrapper``): nothing calls them through ctypes. Measured (one process, the render
-kernel's cold compile, CPU): 18.0-19.6 -> 15.3-15.9 s.
+kernel's cold compile, CPU): 18.0-19.6 -> 15.3-15.9 s. A twin is never turned into machine
+code (its callers link its LLVM module) and is cached as bitcode: see kernels/cache_load.py.
 
 A kernel declared ``inline="always"`` is inlined by LLVM (Numba's ``forceinline``: the
 ``alwaysinline`` attribute), not by Numba's IR inliner, which deep-copies the callee's whole
@@ -278,7 +279,7 @@ def _twin_function(f):
     twin = pytypes.FunctionType(f.__code__, f.__globals__, f.__name__, f.__defaults__,
                                 f.__closure__)
     twin.__kwdefaults__ = f.__kwdefaults__
-    twin.__qualname__ = f.__qualname__ + "__callee"
+    twin.__qualname__ = f.__qualname__ + cache_load.TWIN_SUFFIX
     twin.__module__ = f.__module__
     twin.__doc__ = f.__doc__
     return twin
