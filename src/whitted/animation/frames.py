@@ -183,8 +183,12 @@ class FrameRenderer:
         self.frames_rendered = 0
 
     def compile(self, still: Scene) -> tuple[Any, str]:
-        """The compiled scene of ``still`` and what was reused (see :mod:`.reuse`)."""
-        return self.cache.compile(still)
+        """The compiled scene of ``still`` and what was reused (see :mod:`.reuse`), its light
+        buffers built on the frame's render threads."""
+        from ..render.api import available_threads
+
+        threads = self.threads if self.threads is not None else still.render.threads
+        return self.cache.compile(still, threads=max(1, threads or available_threads()))
 
     @property
     def cache(self) -> Any:

@@ -93,17 +93,18 @@ class CompileCache:
         self.stats = ReuseStats()
         self._previous: tuple[Scene, CompiledScene] | None = None
 
-    def compile(self, still: Scene) -> tuple[CompiledScene, str]:
+    def compile(self, still: Scene, threads: int = 1) -> tuple[CompiledScene, str]:
         """The compiled scene of ``still`` and how much was reused (``all``,
-        ``light buffers``, ``geometry``, ``bvh`` or ``none``)."""
+        ``light buffers``, ``geometry``, ``bvh`` or ``none``). ``threads`` may build the
+        light buffers (the same arrays on any number)."""
         start = time.perf_counter()
-        compiled, level = self._compile(still)
+        compiled, level = self._compile(still, threads)
         self.stats.compile_seconds += time.perf_counter() - start
         self.stats.frames[level] = self.stats.frames.get(level, 0) + 1
         self._previous = (still, compiled)
         return compiled, level
 
-    def _compile(self, still: Scene) -> tuple[CompiledScene, str]:
+    def _compile(self, still: Scene, threads: int) -> tuple[CompiledScene, str]:
         from ..compile.light_buffers import build_light_buffers
         from ..compile.lights import light_rows
         from ..compile.scene import compile_scene
@@ -123,13 +124,14 @@ class CompileCache:
                     return dataclasses.replace(compiled, lights=kept, ambient=ambient,
                                                build_seconds=0.0), REUSE_LIGHT_BUFFERS
                 lights = build_light_buffers(geo, compiled.materials, table,
-                                             has_instances=len(geo.inst_prims) > 0)
+                                             has_instances=len(geo.inst_prims) > 0,
+                                             threads=threads)
                 return dataclasses.replace(compiled, lights=lights, ambient=ambient,
                                            build_seconds=0.0), REUSE_GEOMETRY
         built, reused = self.memo.built, self.memo.reused
         prims_built, prims_reused = self.memo.primitives_built, self.memo.primitives_reused
         with self.memo:
-            compiled = compile_scene(still)
+            compiled = compile_scene(still, threads=threads)
         self.stats.bvh_built += self.memo.built - built
         self.stats.bvh_reused += self.memo.reused - reused
         self.stats.primitives_built += self.memo.primitives_built - prims_built
