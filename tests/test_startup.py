@@ -231,6 +231,41 @@ def test_slp_vectoriser_stays_on_when_numba_was_imported_before_whitted(tmp_path
     assert result.returncode == 0, result.stderr
 
 
+def test_arrays_typed_as_numba_types_them_without_importing_masked_arrays(tmp_path):
+    """kernels/cache_load.py types a plain ndarray without Numba's masked-array check (which
+    imports numpy.ma): the same types for every dtype, layout and write flag, masked arrays
+    and subclasses still Numba's way, and a render in a fresh process imports no numpy.ma."""
+    import numpy as np
+    import pytest
+    from numba.core import errors
+    from numba.core.typing.typeof import Purpose, typeof
+
+    from whitted.kernels import cache_load
+
+    base = np.arange(24.0).reshape(2, 3, 4)
+    readonly = base.copy()
+    readonly.flags.writeable = False
+    arrays = [base, base[:, ::2], base.T, np.asfortranarray(base), readonly,
+              np.zeros(3, np.int32), np.zeros((2, 2), np.float32), np.zeros(0, np.uint8),
+              np.zeros(4, np.complex128), np.zeros(2, np.bool_)]
+    for a in arrays:
+        ours = cache_load._typeof_ndarray(a, None)
+        numba_s = cache_load._numba_typeof_ndarray(a, None)
+        assert ours == numba_s and ours.mutable == numba_s.mutable, a
+        assert typeof(a, Purpose.argument) == numba_s
+    with pytest.raises(errors.NumbaTypeError, match="MaskedArray"):
+        typeof(np.ma.masked_array([1.0, 2.0]), Purpose.argument)
+    with pytest.raises(errors.NumbaValueError, match="dtype"):
+        cache_load._typeof_ndarray(np.zeros(2, "V8"), None)
+    loaded = _modules_after("""
+        import sys, whitted
+        whitted.render(whitted.Scene(objects=[whitted.Sphere(radius=1.0)]), width=8,
+                       height=8, threads=1)
+        assert "numpy.ma" not in sys.modules, "numpy.ma imported"
+    """, tmp_path)
+    assert "numba" in loaded
+
+
 def test_public_api_resolves_every_name():
     for name in whitted.__all__:
         assert getattr(whitted, name) is not None, name

@@ -1,4 +1,4 @@
-"""Loading kernels from Numba's on-disk cache with less work than Numba does.
+"""Loading kernels from Numba's on-disk cache, and calling them, with less work than Numba does.
 
 Two steps of Numba's own loading do work that a loaded kernel never uses; whitted replaces
 them (process-wide, on importing kernels/jit.py). Both keep Numba's behaviour for whatever
@@ -24,6 +24,12 @@ constants, which have no address in the machine code; asking for one gives 0 eit
 test checks both on every kernel a render loads). The bitcode is parsed the first time the
 library is linked into another. An object file that is not ELF (another platform) loads Numba's way.
 
+**Arrays typed without importing NumPy's masked arrays.** The first call of a kernel types
+its arguments, and Numba's ``typeof`` of an array first asks whether it is a
+``np.ma.MaskedArray``, which makes NumPy import ``numpy.ma`` (7 ms at every start-up). An
+array whose type is exactly ``np.ndarray`` cannot be one; it is typed as Numba types it, and
+anything else (a subclass) still goes to Numba's own function.
+
 **Twins are never turned into machine code.** A kernel other kernels call is compiled as a
 twin (kernels/jit.py), and its callers link the twin's LLVM module into their own: the
 twin's own machine code is never run. Numba still generates it when the twin's library is
@@ -40,8 +46,11 @@ from __future__ import annotations
 import struct
 import sys
 
+import numpy as np
 from llvmlite import binding as ll
-from numba.core import codegen, environment
+from numba.core import codegen, environment, types
+from numba.core.typing import typeof as numba_typeof
+from numba.np import numpy_support
 
 # ------------------------------------------------------------------ environments
 
@@ -139,6 +148,26 @@ def _get_module_for_linking(self):
 
 codegen.JITCodeLibrary._unserialize = classmethod(_unserialize)
 codegen.JITCodeLibrary._get_module_for_linking = _get_module_for_linking
+
+# ------------------------------------------------------------------ arrays typed
+
+_numba_typeof_ndarray = numba_typeof._typeof_ndarray
+
+
+def _typeof_ndarray(val, c):
+    """Numba's ``_typeof_ndarray``, without its masked-array check for a plain ndarray."""
+    if type(val) is not np.ndarray:
+        return _numba_typeof_ndarray(val, c)
+    try:
+        dtype = numpy_support.from_dtype(val.dtype)
+    except numba_typeof.errors.NumbaNotImplementedError:
+        raise numba_typeof.errors.NumbaValueError(
+            f"Unsupported array dtype: {val.dtype}") from None
+    return types.Array(dtype, val.ndim, numpy_support.map_layout(val),
+                       readonly=not val.flags.writeable)
+
+
+numba_typeof.typeof_impl.register(np.ndarray)(_typeof_ndarray)
 
 # ------------------------------------------------------------------ twins: no machine code
 
