@@ -69,7 +69,7 @@ def test_calls_from_kernels_compile_the_twin_without_a_python_wrapper():
     assert len(_scaled.callee.signatures) == 1
     (twin,) = _scaled.callee.overloads.values()
     assert twin.fndesc.llvm_cpython_wrapper_name not in twin.library.get_llvm_str()
-    assert _scaled.callee.py_func.__qualname__ == "_scaled__callee"  # its own cache files
+    assert _scaled.callee.py_func.__qualname__ == "_scaled__whitted_twin"  # its own cache files
     # a call from Python compiles the Python-callable version, with the same result
     assert _scaled(1.5, 2.0) == 3.0
     assert len(_scaled.signatures) == 1
@@ -126,7 +126,7 @@ def test_a_twin_gets_no_machine_code_and_its_callers_link_its_bitcode():
     assert _twice_scaled(2.0) == 10.0
     (twin,) = _scaled.callee.overloads.values()
     library = twin.library
-    assert library.name.endswith("__callee")
+    assert library.name.endswith("__whitted_twin")
     assert library._finalized
     engine = library.codegen._engine
     assert engine.get_function_address(twin.fndesc.mangled_name) == 0  # not in the JIT
@@ -176,5 +176,5 @@ def test_a_twin_from_the_cache_links_into_a_new_caller(tmp_path):
         assert run.returncode == 0, run.stderr
     # the first run compiled the twin, the second loaded it and parsed its bitcode to link it
     assert [run.stdout.strip() for run in runs] == ["COMPILED", "LOADED"]
-    cached = list((tmp_path / "cache").rglob("*double_it__callee*.nbc"))
+    cached = list((tmp_path / "cache").rglob("*double_it__whitted_twin*.nbc"))
     assert cached, list((tmp_path / "cache").rglob("*"))

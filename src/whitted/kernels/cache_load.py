@@ -171,8 +171,10 @@ numba_typeof.typeof_impl.register(np.ndarray)(_typeof_ndarray)
 
 # ------------------------------------------------------------------ twins: no machine code
 
-#: the end of a twin's name (kernels/jit.py ``_twin_function``), which Numba gives its library
-TWIN_SUFFIX = "__callee"
+#: the end of a twin's name (kernels/jit.py ``_twin_function``), which Numba gives its library;
+#: distinctive, since any Numba function in the process whose name ended so would be taken
+#: for a twin and get no machine code
+TWIN_SUFFIX = "__whitted_twin"
 
 _numba_finalize_final_module = codegen.JITCodeLibrary._finalize_final_module
 _numba_serialize_using_object_code = codegen.JITCodeLibrary.serialize_using_object_code

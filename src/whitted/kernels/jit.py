@@ -43,7 +43,7 @@ Calls from one kernel to another go to the kernel's twin (``KernelDispatcher.cal
 compiled without the wrapper that lets Python call it (``no_cpython_wrapper``): Numba would
 generate, optimise and compile that wrapper for every kernel, and for the kernels that take
 ``GeometryArrays`` (a tuple of some 30 arrays) unboxing the arguments from Python objects is
-more code than the kernel itself. The twin has a name of its own (``<name>__callee``), so its
+more code than the kernel itself. The twin has a name of its own (``<name>__whitted_twin``), so its
 own cache files; a kernel called from Python (``render_tiles``, the builders, tests) compiles
 its Python-callable version as before. No kernel gets a C-callable wrapper
 (``no_cfunc_wrapper``): nothing calls them through ctypes. Measured (one process, the render
@@ -274,7 +274,7 @@ _twin_lock = threading.Lock()
 
 
 def _twin_function(f):
-    """A copy of ``f`` under its own name (``<name>__callee``): the twin's cache files and
+    """A copy of ``f`` under its own name (``<name>__whitted_twin``): the twin's cache files and
     machine-code symbols are its own."""
     twin = pytypes.FunctionType(f.__code__, f.__globals__, f.__name__, f.__defaults__,
                                 f.__closure__)
