@@ -294,7 +294,7 @@ def test_a4_a_second_ctrl_c_stops_at_once_and_undoes_the_write(tmp_path: Path, m
 
 
 SIGTERM_AFTER_FIRST_TILES = """
-import os, signal, sys
+import os, signal, sys, time
 from whitted.render import api
 original = api.RenderJob._report
 def report(self, done, *args):
@@ -302,6 +302,11 @@ def report(self, done, *args):
     if done and not getattr(self, "_sent", False):
         self._sent = True
         os.kill(os.getpid(), signal.SIGTERM)
+        # the handler runs in the main thread once it holds the GIL: wait for it here (the
+        # sleep lets it run), or a small image could finish before it does
+        deadline = time.monotonic() + 30
+        while not self.cancel_token.cancelled and time.monotonic() < deadline:
+            time.sleep(0.001)
 api.RenderJob._report = report
 from whitted.cli.main import main
 sys.argv = ["whitted", "render", "scene.toml", "-o", "out.png", "--threads", "1"]
