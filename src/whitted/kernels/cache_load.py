@@ -1,8 +1,8 @@
 """Loading kernels from Numba's on-disk cache, and calling them, with less work than Numba does.
 
-Two steps of Numba's own loading do work that a loaded kernel never uses; whitted replaces
-them (process-wide, on importing kernels/jit.py). Both keep Numba's behaviour for whatever
-does need the skipped work, and cache files stay Numba's own.
+Four steps of Numba's own work do what a kernel never needs; whitted replaces them
+(process-wide, on importing kernels/jit.py). Each keeps Numba's behaviour for whatever does
+need the skipped work, and the cache stays in Numba's format.
 
 **Environments without importing their modules.** Numba's ``_rebuild_env`` unpickles the
 environment of each function in a cached library and imports the function's module to hand
