@@ -680,7 +680,6 @@ def only_the_command_named(argv: list[str]):
 
 def _exit_now(code: int) -> None:
     """End the process now (output flushed), not waiting for an abandoned render thread."""
-    import contextlib
     import os
 
     for stream in (sys.stdout, sys.stderr):
