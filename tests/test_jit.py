@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 from numba import types
 
-from whitted.kernels.jit import kernel, widen_integer
+from whitted.kernels.dispatcher import widen_integer
+from whitted.kernels.jit import kernel
 
 
 @kernel(cache=False)

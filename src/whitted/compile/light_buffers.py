@@ -67,7 +67,7 @@ def _plane_out_of_reach(P, i, light, cell, res):
     return True
 
 
-@kernel
+@kernel(entry=True)  # called from Python
 def list_cell_occluders(geo, mats, light, reach, res, lists, counts, opaque, stack, first,
                         last):
     """For cells ``first`` to ``last - 1``: fill ``lists[cell, :counts[cell]]`` with the
@@ -101,7 +101,7 @@ def list_cell_occluders(geo, mats, light, reach, res, lists, counts, opaque, sta
         opaque[cell] = 1 if (n >= 0 and all_opaque) else 0
 
 
-@kernel
+@kernel(entry=True)  # called from Python
 def pack_cell_lists(lists, counts, offsets, prims):
     """Copy each cell's list (``lists[cell, :counts[cell]]``, none when the count is -1) to
     ``prims[offsets[cell]:]``, one after another."""

@@ -10,11 +10,9 @@ the barycentric coordinates on the triangle.
 
 from __future__ import annotations
 
-from numba.extending import overload
-
 from .features import has_instances, instances_possible
 from .intersect import INF, intersect_local, normal_local, triangle_barycentric
-from .jit import kernel
+from .jit import kernel, overload
 from .layout import (
     MAT_KT,
     PRIM_MATERIAL,

@@ -132,6 +132,7 @@ def _unserialize(cls, codegen_, state):
     library.enable_object_caching()
     library._set_compiled_object(object_code)
     library._unparsed_bitcode = shared_bitcode
+    library.whitted_object_code = object_code  # for the native index (kernels/native.py)
     library._finalize_final_module()
     codegen_._engine._defined_symbols |= defined
     return library

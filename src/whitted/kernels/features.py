@@ -16,8 +16,7 @@ default scene's cold compile then never compiles the mesh kernels (2 s of it).
 
 from __future__ import annotations
 
-from numba import types
-from numba.extending import overload
+from .jit import overload
 
 NO_INSTANCES_DTYPE = "float32"  # dtype of GeometryArrays.inst_box in scenes without
 
@@ -30,6 +29,8 @@ def has_instances(geo):
 def instances_possible(geo_type) -> bool:
     """Whether a GeometryArrays of this Numba type may hold mesh instances (False for the
     kind without, whose ``inst_box`` is float32)."""
+    from numba import types
+
     from .geometry_ref import geometry_type
 
     geo_type = geometry_type(geo_type)

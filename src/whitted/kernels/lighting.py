@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import math
 
-from numba.extending import overload
-
 from .accel import (
     closest_hit,
     hit_analytic,
@@ -18,7 +16,7 @@ from .accel import (
 )
 from .features import has_instances, instances_possible
 from .intersect import INF
-from .jit import kernel
+from .jit import kernel, overload
 from .layout import (
     CELL_COUNT,
     CELL_FIRST,

@@ -25,9 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .embree import embree_intersect, embree_occluded
 from .intersect import INF
-from .jit import kernel
+from .jit import kernel, numba_object
 from .layout import (
     EMBREE_ALL,
     EMBREE_CLEAR,
@@ -47,6 +46,10 @@ from .layout import (
 )
 from .traverse import slab_entry
 from .vec import cross, normalize
+
+# kernels/embree.py's intrinsics are Numba extensions: imported with Numba (kernels/jit.py)
+embree_intersect = numba_object(".embree", "embree_intersect")
+embree_occluded = numba_object(".embree", "embree_occluded")
 
 OPAQUE_KT = 0.01  # the lecture's rule: an occluder with kt below this blocks the light
 

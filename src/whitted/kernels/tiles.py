@@ -14,9 +14,8 @@ import math
 import numpy as np
 
 from .accel import closest_hit, surface_normals
-from .geometry_ref import geometry_ref_if_instances
 from .integrator import N_STACK_F, N_STACK_I, trace_path
-from .jit import kernel
+from .jit import kernel, numba_object
 from .layout import (
     MAX_MEDIA,
     PRIM_OBJECT,
@@ -27,6 +26,9 @@ from .sampling import random_pair, stratum
 from .vec import madd, normalize
 
 BVH_STACK = 128
+
+# kernels/geometry_ref.py is a Numba extension: imported with Numba (kernels/jit.py)
+geometry_ref_if_instances = numba_object(".geometry_ref", "geometry_ref_if_instances")
 
 
 def lane_workspace(max_depth: int):
@@ -62,7 +64,7 @@ def camera_ray(params, x, y):
     )
 
 
-@kernel
+@kernel(entry=True)  # called from Python
 def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, lane, lanes):
     """Render this lane's share of ``tiles`` (rows of x0, y0, x1, y1) into ``framebuffer``
     (H, W, 3 float32); ``counters[t]`` receives the rays traced for tile t by kind. ``work`` is
@@ -101,7 +103,7 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
                 framebuffer[py, px, 2] = b * inv
 
 
-@kernel
+@kernel(entry=True)  # called from Python
 def render_aovs(geo, params, depth, normal, object_id, work, lane, lanes):
     """Depth (distance along the unit primary ray, inf on a miss), outward geometric normal
     (zeros on a miss) and object index (-1 on a miss) through every pixel centre of the rows

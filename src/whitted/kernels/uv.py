@@ -16,12 +16,10 @@ from __future__ import annotations
 
 import math
 
-from numba.extending import overload
-
 from .accel import to_object
 from .features import instances_possible
 from .intersect import _box_local, triangle_barycentric
-from .jit import kernel
+from .jit import kernel, overload
 from .layout import (
     DISK_TANGENT,
     FRUSTUM_TANGENT,

@@ -43,7 +43,6 @@ from .._cache import configure_kernel_cache
 from ..assets.mesh import load_obj_bytes
 from ..compile.params import render_params
 from ..compile.scene import CompiledScene, compile_scene
-from ..kernels.jit import KernelCache
 from ..kernels.layout import N_RAY_KINDS
 from ..scene.lights import PointLight
 from ..scene.scene import Scene
@@ -315,6 +314,8 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
     builders, counting both for :func:`compile_progress`; on any exception (Ctrl-C) the
     helper is stopped at once rather than waited for."""
     global _progress
+    from ..kernels.dispatcher import KernelCache  # Numba, with whitted's settings
+
     helper = _start_helper(instances)
     delegated = ()
     if helper is not None and helper.stdout is not None:
