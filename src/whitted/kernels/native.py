@@ -81,7 +81,7 @@ def enabled() -> bool:
 
 # ------------------------------------------------------------------ argument keys
 
-_ndarray, _generic = np.ndarray, np.generic
+_ndarray, _number_or_bool = np.ndarray, (np.number, np.bool_)
 _SCALARS = {bool: "bool", int: "int64", float: "float64", complex: "complex128"}
 
 
@@ -103,7 +103,7 @@ def _key(value):
         return "none"
     if isinstance(value, tuple) and hasattr(kind, "_fields"):  # a named tuple
         return ("n", kind.__module__, kind.__qualname__, *map(_key, value))
-    if isinstance(value, _generic) and kind.__module__ == "numpy":
+    if isinstance(value, _number_or_bool):  # NumPy's scalars, but not records (np.void)
         return ("s", value.dtype.str)
     raise _NoKey
 
@@ -237,15 +237,29 @@ def _entry_from_numba(dispatcher, args: tuple, key) -> dict | None:
     library = result.library
     obj = getattr(library, "whitted_object_code", None) or getattr(
         library, "_compiled_object", None)
-    if not obj or result.environment.consts:
-        return None
-    undefined = elf_undefined_symbols(obj)
-    if undefined is None:
+    undefined = elf_undefined_symbols(obj) if obj else None
+    consts = _plain_pickle(list(result.environment.consts))
+    if undefined is None or consts is None:
         return None
     return {"format": FORMAT, "key": key, "object": obj,
             "wrapper": result.fndesc.llvm_cpython_wrapper_name,
             "environment": result.fndesc.env_name, "module": result.fndesc.modname,
-            "undefined": sorted(undefined)}
+            "consts": consts, "undefined": sorted(undefined)}
+
+
+def _plain_pickle(values: list) -> bytes | None:
+    """``values`` pickled, when they unpickle without Numba (the environment's constants:
+    the dtypes of the arrays a builder returns); None otherwise."""
+    import pickletools
+
+    try:
+        data = pickle.dumps(values, protocol=pickle.HIGHEST_PROTOCOL)
+    except Exception:  # noqa: BLE001 - an object that does not pickle
+        return None
+    for _op, argument, _at in pickletools.genops(data):
+        if isinstance(argument, str) and argument.split(".")[0] in ("numba", "llvmlite"):
+            return None
+    return data
 
 
 # ------------------------------------------------------------------ ELF symbols
@@ -318,6 +332,11 @@ class _Engine:
         for value in vars(builtins).values():
             if isinstance(value, type) and issubclass(value, BaseException):
                 symbols["PyExc_" + value.__name__] = id(value)
+        self._unpickled: dict = {}
+        self._unpickle = ctypes.CFUNCTYPE(ctypes.py_object, ctypes.c_void_p, ctypes.c_int,
+                                          ctypes.c_void_p)(self._unpickle_constant)
+        if "numba.core.serialize" not in sys.modules:  # else Numba's own helper is as cheap
+            symbols["numba_unpickle"] = ctypes.cast(self._unpickle, ctypes.c_void_p).value
         self.symbols = symbols
         self.maths = helperlib.c_helpers  # C maths, bound to CPython's libm as Numba does
         self.ll = ll
@@ -333,6 +352,18 @@ class _Engine:
         self.registered: set[str] = set()
         self.call_type = ctypes.PYFUNCTYPE(ctypes.py_object, ctypes.c_void_p,
                                            ctypes.py_object, ctypes.c_void_p)
+
+    def _unpickle_constant(self, data: int, size: int, hashed: int):
+        """``numba_unpickle``: a constant the machine code holds pickled (the ndarray class a
+        builder's result is made of, an exception's details), unpickled once per place and
+        kept, as Numba's helper does (numba/core/serialize.py), but without importing the
+        numba package for it."""
+        ctypes = self.ctypes
+        key = (data, ctypes.string_at(hashed, 20))  # the pickle's SHA-1 beside its address
+        value = self._unpickled.get(key)
+        if value is None:
+            value = self._unpickled[key] = pickle.loads(ctypes.string_at(data, size))
+        return value
 
     def _resolve(self, name: str) -> bool:
         if name in self.registered:
@@ -357,6 +388,7 @@ class _Engine:
         if not wrapper or not slot:
             return None
         environment = self.dynfunc.Environment({"__name__": entry["module"]})
+        environment.consts[:] = pickle.loads(entry["consts"])  # the returned arrays' dtypes
         self.environments.append(environment)
         self.ctypes.c_void_p.from_address(slot).value = id(environment)
         call = self.call_type(wrapper)
