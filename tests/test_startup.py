@@ -67,6 +67,49 @@ def test_plain_render_imports_no_gui_plots_or_farm(tmp_path):
         assert heavy not in loaded, f"whitted render imported {heavy}"
 
 
+def test_warm_render_to_a_pipe_imports_neither_numba_nor_rich(tmp_path):
+    """A render of a scene seen before runs its kernels from the native index
+    (kernels/native.py) and, its output not being a terminal, prints its summary line
+    without rich (cli/console.py): neither is imported. The first run may compile."""
+    out = tmp_path / "x.png"
+    code = f"""
+        from whitted.cli.main import app
+        app(["render", {str(REPO_ROOT / "benchmarks" / "seed000.toml")!r}, "-W", "40",
+             "-H", "30", "-o", {str(out)!r}], standalone_mode=False)
+    """
+    _modules_after(code, tmp_path)
+    loaded = _modules_after(code, tmp_path)
+    assert out.stat().st_size > 0
+    assert "numba" not in loaded and "rich" not in loaded, loaded & {"numba", "rich"}
+
+
+def test_plain_line_is_what_rich_prints_and_needs_no_rich(tmp_path):
+    """cli/console.py writes a plain line to a file that is not a terminal itself: the same
+    bytes rich writes for it (markup and emoji codes stay literal)."""
+    import io
+
+    from rich.console import Console
+    from rich.text import Text
+
+    from whitted.cli.console import LazyConsole
+
+    for text in ("809x817: wall 0.38 s -> out.png", "[bold]not markup[/bold] :100:",
+                 "warning: \u00e9t\u00e9 \u2192 \u6f22\u5b57", "x" * 300, ""):
+        ours, theirs = io.StringIO(), io.StringIO()
+        LazyConsole(file=ours, highlight=False, soft_wrap=True, emoji=False).line(text)
+        Console(file=theirs, highlight=False, soft_wrap=True, emoji=False).print(
+            Text(text), soft_wrap=True)
+        assert ours.getvalue() == theirs.getvalue() == text + "\n"
+    console = LazyConsole(file=io.StringIO())
+    assert console.is_terminal is False and console._made is None  # rich not needed
+    loaded = _modules_after("""
+        from whitted.cli.console import out, err
+        out.line("plain")
+        assert not err.is_terminal
+    """, tmp_path)
+    assert "rich" not in loaded
+
+
 def test_numba_imported_through_whitted_skips_its_scipy_and_yaml_probes(tmp_path):
     """Numba imports SciPy and PyYAML only to probe for them (whitted/_lean_numba.py): after
     ``import whitted`` they are skipped, and both still import afterwards."""

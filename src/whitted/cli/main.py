@@ -249,7 +249,7 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
     image = job.image
     assert image is not None
     for warning in stats.warnings:
-        err.print(Text(f"warning: {warning}"))
+        err.line(f"warning: {warning}")
     written = [str(output)]
     try:
         if frame is not None and not interrupted.is_set() and bit_depth == 8 \
@@ -271,7 +271,7 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
         raise fail(str(exc)) from None
     stats.wall_seconds = time.perf_counter() - process_start
     if not quiet or interrupted.is_set():
-        out.print(Text(f"{stats.summary()} -> {', '.join(written)}"))
+        out.line(f"{stats.summary()} -> {', '.join(written)}")
     if interrupted.is_set():  # (a signal may have come during the write)
         what = "terminated" if signal.SIGTERM in signals else "interrupted"
         _note(f"{what}: kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")

@@ -15,7 +15,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..assets.images import load_image
 from ..kernels.texture_layout import (
     AXIS_CODES,
     FILTER_CODES,
@@ -85,6 +84,8 @@ def compile_textures(
         ).ravel()
         row[TEX_OFFSET : TEX_OFFSET + 2] = texture.offset
         if isinstance(texture, ImageTexture):
+            from ..assets.images import load_image  # Pillow: only for scenes with images
+
             path = Path(resolve(texture.file))
             image = load_image(path, texture.colorspace)
             key = (path.resolve(), texture.colorspace)
