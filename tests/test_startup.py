@@ -459,7 +459,8 @@ def test_render_in_a_terminal_draws_its_bar(tmp_path):
     import pty
 
     out = tmp_path / "x.png"
-    env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"), COLUMNS="100", TERM="xterm")
+    env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"), COLUMNS="100", TERM="xterm",
+               WHITTED_PROGRESS_DELAY="0")  # the bar at once, however fast the render
     pid, fd = pty.fork()
     if pid == 0:  # the child: the CLI with the pseudo-terminal as its terminal
         os.chdir(tmp_path)
@@ -574,3 +575,29 @@ def test_numba_runtime_is_read_back_from_the_cache(tmp_path):
                                 text=True, cwd=tmp_path, env=env, timeout=300)
         assert result.returncode == 0, result.stderr[-2000:]
         assert "FILES 1 45.0" in result.stdout
+
+
+def test_progress_bar_appears_only_for_a_render_still_running_after_the_delay(tmp_path,
+                                                                               monkeypatch):
+    """On a terminal the bar appears once a render has run PROGRESS_DELAY seconds (cli/main.py):
+    a render that ends sooner never shows it (nor imports rich's progress display)."""
+    import io
+
+    from rich.console import Console
+
+    from whitted.cli import main as cli
+    from whitted.cli.console import err
+
+    shown = {}
+    for delay in (0.0, 600.0):
+        screen = io.StringIO()
+        monkeypatch.setattr(err, "_made", Console(file=screen, force_terminal=True,
+                                                  width=100))
+        monkeypatch.setattr(cli, "PROGRESS_DELAY", delay)
+        out = tmp_path / f"delay{delay:g}.png"
+        cli.app(["render", str(REPO_ROOT / "examples" / "glass_cube.toml"), "-W", "32",
+                 "-H", "24", "-o", str(out)], standalone_mode=False)
+        assert out.stat().st_size > 0
+        shown[delay] = screen.getvalue()
+    assert "rendering" in shown[0.0]
+    assert shown[600.0] == ""

@@ -4,10 +4,11 @@ Importing rich costs tens of milliseconds; `whitted --help` and the import of th
 it (tests/test_startup.py). User text is printed literally: no markup, no emoji codes (a
 ":100:" on an error line stays ":100:").
 
-A line of plain text (:meth:`LazyConsole.line`) to a file that is not a terminal is written as
-it is, without making the console: what rich writes there for unstyled text printed with
-``soft_wrap`` is the text and a newline. A render whose output goes to a pipe or a file (a
-script, a film's frames, a farm worker, a benchmark) then never imports rich: 25-30 ms of its
+A line of plain text (:meth:`LazyConsole.line`) is written as it is while the console has not
+been made: what rich writes for unstyled text printed with ``soft_wrap`` is the text and a
+newline, on a terminal or not. A render never imports rich when its output goes to a pipe or
+a file (a script, a film's frames, a farm worker, a benchmark), nor on a terminal when it ends
+before its progress bar would appear (cli/main.py ``PROGRESS_DELAY``): 25-70 ms of its
 start-up.
 """
 
@@ -62,7 +63,7 @@ class LazyConsole:
 
     def line(self, text: str) -> None:
         """Print ``text`` as it is (no markup, no style) and a newline."""
-        if self._made is None and not self._terminal_possible():
+        if self._made is None:
             file = self._file
             file.write(text + "\n")
             file.flush()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
 import sys
 import threading
@@ -318,17 +319,39 @@ def _override_error(exc: ValidationError) -> str:
     return f"{option}: {_clean_message(e)}"
 
 
-def _wait(job, interrupted: threading.Event, tick=None) -> None:
+def _wait(job, interrupted: threading.Event, tick=None, until: float | None = None) -> bool:
     """Wait for the job; after an interrupt, stop waiting at once if no tile is being rendered
     yet (the first compile of the kernels takes many seconds and cannot be cut short).
-    ``tick()`` is called every tenth of a second meanwhile."""
+    ``tick()`` is called every tenth of a second meanwhile. With ``until`` (a
+    ``time.monotonic()`` deadline), False when the job is still running then."""
     while job.running:
-        job.join(0.1)
+        if until is not None:
+            left = until - time.monotonic()
+            if left <= 0:
+                return False
+            job.join(min(0.1, left))
+        else:
+            job.join(0.1)
         if tick is not None:
             tick()
         if interrupted.is_set() and not job.rendering:
-            return
+            return True
     job.wait()
+    return True
+
+
+#: seconds a render runs before its progress bar appears: a shorter one would only flash it
+#: (and a render of the timing scene would spend 40 ms importing rich's progress display);
+#: ``WHITTED_PROGRESS_DELAY`` (seconds) overrides it, 0 shows the bar at once
+PROGRESS_DELAY = 0.4
+
+
+def _progress_delay() -> float:
+    try:
+        value = float(os.environ["WHITTED_PROGRESS_DELAY"])
+    except (KeyError, ValueError):
+        return PROGRESS_DELAY
+    return value if value >= 0 else PROGRESS_DELAY
 
 
 def _show_compile(bar, task) -> None:
@@ -342,9 +365,11 @@ def _show_compile(bar, task) -> None:
 
 
 def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
+    job.start()
     if quiet or not err.is_terminal:
-        job.start()
         _wait(job, interrupted)
+        return
+    if _wait(job, interrupted, until=time.monotonic() + _progress_delay()):
         return
     from rich.progress import (
         BarColumn,
@@ -367,8 +392,7 @@ def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
         def update(p) -> None:
             bar.update(task, description="rendering", completed=p.fraction, rays=f"{p.rays:,}")
 
-        job.progress = update
-        job.start()
+        job.progress = update  # read by the job at each report: taken up from now on
         _wait(job, interrupted, lambda: _show_compile(bar, task))
 
 
