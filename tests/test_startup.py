@@ -601,3 +601,35 @@ def test_progress_bar_appears_only_for_a_render_still_running_after_the_delay(tm
         shown[delay] = screen.getvalue()
     assert "rendering" in shown[0.0]
     assert shown[600.0] == ""
+
+
+def test_terminal_check_without_rich_agrees_with_rich(monkeypatch):
+    """cli/console.py answers ``is_terminal`` by rich's rules without making the console:
+    the same answer as rich's for every combination of TTY_COMPATIBLE, FORCE_COLOR and a file
+    that is or is not a terminal."""
+    import io
+    import pty
+
+    from rich.console import Console
+
+    from whitted.cli.console import LazyConsole
+
+    master, slave = pty.openpty()
+    tty = os.fdopen(slave, "w")
+    try:
+        for compatible in (None, "0", "1", "2"):
+            for force_color in (None, "", "1"):
+                for file in (io.StringIO(), tty):
+                    for name, value in (("TTY_COMPATIBLE", compatible),
+                                        ("FORCE_COLOR", force_color)):
+                        if value is None:
+                            monkeypatch.delenv(name, raising=False)
+                        else:
+                            monkeypatch.setenv(name, value)
+                    ours = LazyConsole(file=file)
+                    assert ours.is_terminal == Console(file=file).is_terminal, (
+                        compatible, force_color, file)
+                    assert ours._made is None
+    finally:
+        tty.close()
+        os.close(master)

@@ -43,23 +43,30 @@ class LazyConsole:
 
     @property
     def is_terminal(self) -> bool:
-        """rich's answer; False without making the console when the file is plainly not a
-        terminal (not a tty, and neither ``FORCE_COLOR`` nor ``TTY_COMPATIBLE=1`` says to
-        treat it as one: rich's own rules, Jupyter aside)."""
-        if self._made is None and not self._terminal_possible():
-            return False
+        """rich's ``Console.is_terminal``, answered by rich's own rules without making the
+        console (``TTY_COMPATIBLE``, then ``FORCE_COLOR``, then ``isatty()``); Jupyter, IDLE
+        and an explicit ``force_terminal`` are left to rich."""
+        if self._made is None:
+            answer = self._terminal_by_rules()
+            if answer is not None:
+                return answer
         return self.console.is_terminal
 
-    def _terminal_possible(self) -> bool:
-        if "FORCE_COLOR" in os.environ or os.environ.get("TTY_COMPATIBLE") == "1":
-            return True
-        if "ipykernel" in sys.modules:  # rich decides about Jupyter itself
-            return True
+    def _terminal_by_rules(self) -> bool | None:
+        if ("force_terminal" in self._options or "ipykernel" in sys.modules
+                or getattr(sys.stdin, "__module__", "").startswith("idlelib")):
+            return None
+        compatible = os.environ.get("TTY_COMPATIBLE", "")
+        if compatible in ("0", "1"):
+            return compatible == "1"
+        force_color = os.environ.get("FORCE_COLOR")
+        if force_color is not None:
+            return force_color != ""
         isatty = getattr(self._file, "isatty", None)
         try:
-            return bool(isatty is not None and isatty())
+            return False if isatty is None else bool(isatty())
         except ValueError:  # a closed file
-            return True
+            return False
 
     def line(self, text: str) -> None:
         """Print ``text`` as it is (no markup, no style) and a newline."""
