@@ -199,3 +199,83 @@ def test_warm_render_needs_no_numba_and_gives_numbas_pixels(tmp_path, example):
     assert native_run == "False\n" and numba_run == "True\n"
     np.testing.assert_array_equal(np.load(tmp_path / "native.npy"),
                                   np.load(tmp_path / "numba.npy"))
+
+
+UNCACHEABLE = '''
+import numpy as np
+from whitted.kernels.jit import builder, kernel
+
+BIG = np.arange(400000.0)  # over 1 MB: Numba bakes its address into the code
+
+
+@builder
+def pick(i):
+    return BIG[i]
+
+
+@kernel(entry=True, cache=False)
+def plain(x):
+    return x + 1.0
+
+
+def make(k):
+    @builder
+    def shifted(x):
+        return x + k
+    return shifted
+
+
+@builder
+def edited(x):
+    return x + 1.0
+'''
+
+
+def test_only_what_numba_would_cache_goes_into_the_index_and_edits_invalidate(tmp_path):
+    """No entry for code with this process's addresses in it (a big global array), for a
+    kernel compiled with ``cache=False``, or for a closure; an edit of the kernel's source
+    makes the next process miss its old entry (and record the new code)."""
+    (tmp_path / "uncacheable.py").write_text(UNCACHEABLE)
+    settings = {"NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    script = """
+        import sys, warnings, uncacheable as u
+        warnings.simplefilter("ignore")
+        print(u.pick(123456), u.plain(1.0), u.make(1)(1.0), u.make(1000)(1.0), u.edited(1.0))
+        print("numba" in sys.modules)
+    """
+    for _ in range(2):  # the second process finds only the entry it may use
+        assert _run(script, tmp_path, **settings) == "123456.0 2.0 2.0 1001.0 2.0\nTrue\n"
+    index = tmp_path / "cache" / "native"
+    assert sorted(f.name.split("-")[0] for f in index.iterdir()) == ["uncacheable.edited"]
+    source = (tmp_path / "uncacheable.py").read_text().replace("return x + 1.0\n'",
+                                                               "return x + 1.0\n'")
+    (tmp_path / "uncacheable.py").write_text(
+        source.replace("def edited(x):\n    return x + 1.0", "def edited(x):\n    return x + 5.0"))
+    edited = """
+        import sys, uncacheable as u
+        print(u.edited(1.0), "numba" in sys.modules)
+    """
+    assert _run(edited, tmp_path, **settings) == "6.0 True\n"  # missed: through Numba
+    assert _run(edited, tmp_path, **settings) == "6.0 False\n"  # the new code's entry
+
+
+def test_numba_shares_the_extension_modules_loaded_for_the_native_path(tmp_path):
+    """The native path loads Numba's extension modules under Numba's names: Numba imported
+    afterwards uses the same ones (its runtime is initialised once: statistics enabled before
+    a native call stay enabled), and a native call after Numba is imported still works."""
+    (tmp_path / "native_probe.py").write_text("import numpy as np\n" + PROBE)
+    settings = {"NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    _run("import numpy as np, native_probe as p; p.ramp(5)", tmp_path, **settings)
+    assert _run("""
+        import sys, numpy as np, native_probe as p
+        assert p.ramp(5) == 30 and "numba" not in sys.modules
+        helper = sys.modules["numba._helperlib"]
+        import numba
+        from numba.core.runtime import _nrt_python
+        from numba import _helperlib
+        assert _helperlib is helper
+        _nrt_python.memsys_enable_stats()
+        assert p.ramp(6) == 55  # another key: compiled by Numba now
+        assert p.ramp(5) == 30 and _nrt_python.memsys_stats_enabled()
+        print(_nrt_python.memsys_get_stats_alloc() > 0)
+    """, tmp_path, **settings) == "True\n"

@@ -73,14 +73,17 @@ def test_warm_render_to_a_pipe_imports_neither_numba_nor_rich(tmp_path):
     without rich (cli/console.py): neither is imported. The first run may compile."""
     out = tmp_path / "x.png"
     code = f"""
+        import sys
         from whitted.cli.main import app
         app(["render", {str(REPO_ROOT / "benchmarks" / "seed000.toml")!r}, "-W", "40",
              "-H", "30", "-o", {str(out)!r}], standalone_mode=False)
+        # the numba package itself (the native path registers its extension modules only)
+        assert "numba" not in sys.modules, "numba imported"
     """
-    _modules_after(code, tmp_path)
+    _modules_after(code.replace("assert", "pass  #"), tmp_path)  # may compile
     loaded = _modules_after(code, tmp_path)
     assert out.stat().st_size > 0
-    assert "numba" not in loaded and "rich" not in loaded, loaded & {"numba", "rich"}
+    assert "rich" not in loaded
 
 
 def test_plain_line_is_what_rich_prints_and_needs_no_rich(tmp_path):
@@ -94,12 +97,14 @@ def test_plain_line_is_what_rich_prints_and_needs_no_rich(tmp_path):
     from whitted.cli.console import LazyConsole
 
     for text in ("809x817: wall 0.38 s -> out.png", "[bold]not markup[/bold] :100:",
-                 "warning: \u00e9t\u00e9 \u2192 \u6f22\u5b57", "x" * 300, ""):
+                 "warning: \u00e9t\u00e9 \u2192 \u6f22\u5b57", "x" * 300, "", "a\tb",
+                 "cr\rhere \x07\x0b\x0c"):
         ours, theirs = io.StringIO(), io.StringIO()
         LazyConsole(file=ours, highlight=False, soft_wrap=True, emoji=False).line(text)
         Console(file=theirs, highlight=False, soft_wrap=True, emoji=False).print(
             Text(text), soft_wrap=True)
-        assert ours.getvalue() == theirs.getvalue() == text + "\n"
+        assert ours.getvalue() == theirs.getvalue()
+        assert ours.getvalue() == text + "\n" or not text.isprintable()
     console = LazyConsole(file=io.StringIO())
     assert console.is_terminal is False and console._made is None  # rich not needed
     loaded = _modules_after("""

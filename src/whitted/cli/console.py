@@ -5,8 +5,9 @@ it (tests/test_startup.py). User text is printed literally: no markup, no emoji 
 ":100:" on an error line stays ":100:").
 
 A line of plain text (:meth:`LazyConsole.line`) is written as it is while the console has not
-been made: what rich writes for unstyled text printed with ``soft_wrap`` is the text and a
-newline, on a terminal or not. A render never imports rich when its output goes to a pipe or
+been made: what rich writes for unstyled printable text printed with ``soft_wrap`` is the text
+and a newline, on a terminal or not (text with tabs or control characters goes to rich, which
+expands or drops them). A render never imports rich when its output goes to a pipe or
 a file (a script, a film's frames, a farm worker, a benchmark), nor on a terminal when it ends
 before its progress bar would appear (cli/main.py ``PROGRESS_DELAY``): 25-70 ms of its
 start-up.
@@ -70,7 +71,7 @@ class LazyConsole:
 
     def line(self, text: str) -> None:
         """Print ``text`` as it is (no markup, no style) and a newline."""
-        if self._made is None:
+        if self._made is None and text.isprintable():  # rich drops or expands the others
             file = self._file
             file.write(text + "\n")
             file.flush()

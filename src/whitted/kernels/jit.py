@@ -34,7 +34,8 @@ import threading
 FAST_MATH = frozenset({"reassoc", "contract", "arcp", "nsz", "afn"})
 
 _lock = threading.RLock()
-_numba_loaded = False
+_numba_loaded = False  # Numba imported, extensions registered, kernels swapped
+_numba_imported = False  # the first two done (the swap may still be under way)
 _deferred: list = []  # registrations waiting for Numba: callables, run in order
 _defining_modules: set[str] = set()  # modules that defined kernels (swapped by load_numba)
 
@@ -59,18 +60,21 @@ def load_numba() -> None:
     """Import Numba with whitted's settings (kernels/dispatcher.py), register the deferred
     extensions, and put dispatchers where kernels will look for them (module docstring).
     Does nothing the second time."""
-    global _numba_loaded
+    global _numba_loaded, _numba_imported
     if _numba_loaded:
         return
-    with _lock:
-        if _numba_loaded:
+    with _lock:  # another thread waits here until the swap is done
+        if _numba_loaded or _numba_imported:  # done, or this thread is swapping (re-entry)
             return
         from . import dispatcher  # noqa: F401 - Numba, SLP, the cache, faster loading
 
         while _deferred:
             _deferred.pop(0)()
-        _numba_loaded = True
-        _swap_in_globals()
+        _numba_imported = True
+        try:
+            _swap_in_globals()
+        finally:
+            _numba_loaded = True
 
 
 def _swap_in_globals() -> None:

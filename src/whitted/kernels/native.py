@@ -43,6 +43,7 @@ see docs/performance.md ("Fifth speed round").
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import importlib.machinery
 import importlib.util
@@ -102,7 +103,7 @@ def _key(value):
     if value is None:
         return "none"
     if isinstance(value, tuple) and hasattr(kind, "_fields"):  # a named tuple
-        return ("n", kind.__module__, kind.__qualname__, *map(_key, value))
+        return ("n", kind.__module__, kind.__qualname__, kind._fields, *map(_key, value))
     if isinstance(value, _number_or_bool):  # NumPy's scalars, but not records (np.void)
         return ("s", value.dtype.str)
     raise _NoKey
@@ -159,10 +160,52 @@ def index_folder() -> Path:
     return Path(configure_kernel_cache()) / "native"
 
 
-def _entry_path(kernel, key) -> Path:
+_stamps: dict = {}
+
+
+@functools.cache
+def _whitted_sources() -> str:
+    """The hash of whitted's kernel sources (once per process: 1 ms)."""
+    from .._cache import kernel_source_hash
+
+    return kernel_source_hash()
+
+
+def kernel_stamp(kernel) -> str | None:
+    """What the kernel's machine code depends on besides its arguments, as Numba's own cache
+    index keys it and more: the function's compiled bytecode (constants, names, lines
+    included), its source file's size and modification time (the module's other globals,
+    which Numba freezes into the code), and whitted's kernel sources (the kernels it calls,
+    in other files). None for a kernel the index does not take: one compiled with
+    ``cache=False``, or a closure (its cells are frozen into the code too)."""
+    stamp = _stamps.get(kernel, False)
+    if stamp is False:
+        function = kernel.py_func
+        if not kernel.cache or function.__closure__:
+            stamp = None
+        else:
+            import marshal
+
+            code = function.__code__
+            try:
+                st = os.stat(code.co_filename)
+                source = (st.st_size, st.st_mtime_ns)
+            except OSError:
+                source = None
+            digest = hashlib.sha256(marshal.dumps(code))
+            digest.update(repr((source, _whitted_sources())).encode())
+            stamp = digest.hexdigest()
+        _stamps[kernel] = stamp
+    return stamp
+
+
+def _entry_path(kernel, key) -> Path | None:
+    stamp = kernel_stamp(kernel)
+    if stamp is None:
+        return None
     name = f"{kernel.__module__}.{kernel.__qualname__}"
-    digest = hashlib.sha256(repr((name, key, fingerprint())).encode()).hexdigest()[:24]
-    return index_folder() / f"{name}-{digest}.bin"
+    digest = hashlib.sha256(repr((name, key, stamp, fingerprint())).encode()).hexdigest()
+    return index_folder() / f"{name}-{digest[:24]}.bin"
 
 
 def machine_code(kernel, args: tuple):
@@ -188,8 +231,11 @@ def machine_code(kernel, args: tuple):
 
 def _load(kernel, key):
     try:
-        data = _entry_path(kernel, key).read_bytes()
-    except OSError:
+        path = _entry_path(kernel, key)
+        if path is None:
+            return None
+        data = path.read_bytes()
+    except Exception:  # noqa: BLE001 - no entry, or no CPU answer from LLVM: Numba's way
         return None
     try:
         entry = pickle.loads(data)
@@ -215,7 +261,7 @@ def remember(kernel, args: tuple) -> None:
         if entry is None:
             return
         path = _entry_path(kernel, key)
-        if path.exists():
+        if path is None or path.exists():
             return
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_name(f"{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
@@ -235,6 +281,10 @@ def _entry_from_numba(dispatcher, args: tuple, key) -> dict | None:
     if result is None:  # Numba converted the arguments to another overload: no entry
         return None
     library = result.library
+    # only code Numba itself would cache: none with addresses of this process baked in
+    # (dynamic globals: ctypes pointers, big global arrays) and none with object-mode parts
+    if library.has_dynamic_globals or any(not x.can_cache for x in result.lifted):
+        return None
     obj = getattr(library, "whitted_object_code", None) or getattr(
         library, "_compiled_object", None)
     undefined = elf_undefined_symbols(obj) if obj else None
@@ -292,20 +342,44 @@ def elf_undefined_symbols(obj: bytes) -> set[str] | None:
 # ------------------------------------------------------------------ the engine
 
 
-def _extension(package_dir: str, relative: str, name: str):
-    """Numba's extension module ``relative`` (a path under the numba package), loaded from its
-    file under the plain name ``name`` and kept out of ``sys.modules``: the ``numba`` package
-    is not imported. Its C functions are the ones Numba's copy uses (one shared library)."""
+def _extension(package_dir: str, name: str):
+    """Numba's extension module ``name`` (``numba._helperlib``, ...): the one in
+    ``sys.modules``, or loaded from its file without importing the ``numba`` package and put
+    in ``sys.modules`` under that name, where Numba's own imports (all ``from numba import
+    _helperlib`` and the like) find it. One copy per process: a second initialisation of
+    ``_nrt_python`` would reset the runtime's allocator and statistics."""
     import glob
 
+    module = sys.modules.get(name)
+    if module is not None:
+        return module
+    relative = os.path.join(*name.split(".")[1:])
     (path,) = glob.glob(os.path.join(package_dir, relative + ".*.so")) or [None]
     if path is None:
-        raise ImportError(relative)
+        raise ImportError(name)
     loader = importlib.machinery.ExtensionFileLoader(name, path)
     spec = importlib.util.spec_from_file_location(name, path, loader=loader)
     module = importlib.util.module_from_spec(spec)
     loader.exec_module(module)
+    sys.modules[name] = module
     return module
+
+
+def _import_lock():
+    """The import system's lock: no ``import numba`` in another thread sees the extension
+    modules half registered."""
+    import _imp
+    import contextlib
+
+    @contextlib.contextmanager
+    def held():
+        _imp.acquire_lock()
+        try:
+            yield
+        finally:
+            _imp.release_lock()
+
+    return held()
 
 
 class _Engine:
@@ -319,11 +393,13 @@ class _Engine:
 
         spec = importlib.util.find_spec("numba")
         package_dir = os.path.dirname(spec.origin)
-        helperlib = _extension(package_dir, "_helperlib", "_helperlib")
-        dynfunc = _extension(package_dir, "_dynfunc", "_dynfunc")
-        nrt = _extension(package_dir, os.path.join("core", "runtime", "_nrt_python"),
-                         "_nrt_python")
-        nrt.memsys_use_cpython_allocator()  # as numba/core/runtime/nrt.py does
+        with _import_lock():
+            helperlib = _extension(package_dir, "numba._helperlib")
+            dynfunc = _extension(package_dir, "numba._dynfunc")
+            nrt_loaded = "numba.core.runtime._nrt_python" in sys.modules
+            nrt = _extension(package_dir, "numba.core.runtime._nrt_python")
+        if not nrt_loaded:
+            nrt.memsys_use_cpython_allocator()  # as numba/core/runtime/nrt.py does
         symbols = {"_Py_NoneStruct": id(None)}
         for table in (helperlib.c_helpers, dynfunc.c_helpers):
             symbols.update(("numba_" + name, address) for name, address in table.items())
@@ -333,10 +409,12 @@ class _Engine:
             if isinstance(value, type) and issubclass(value, BaseException):
                 symbols["PyExc_" + value.__name__] = id(value)
         self._unpickled: dict = {}
-        self._unpickle = ctypes.CFUNCTYPE(ctypes.py_object, ctypes.c_void_p, ctypes.c_int,
+        self._unpickle = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int,
                                           ctypes.c_void_p)(self._unpickle_constant)
-        if "numba.core.serialize" not in sys.modules:  # else Numba's own helper is as cheap
-            symbols["numba_unpickle"] = ctypes.cast(self._unpickle, ctypes.c_void_p).value
+        self._incref = ctypes.pythonapi.Py_IncRef
+        self._incref.argtypes = (ctypes.py_object,)
+        self._incref.restype = None
+        symbols["numba_unpickle"] = ctypes.cast(self._unpickle, ctypes.c_void_p).value
         self.symbols = symbols
         self.maths = helperlib.c_helpers  # C maths, bound to CPython's libm as Numba does
         self.ll = ll
@@ -347,7 +425,9 @@ class _Engine:
         machine = ll.Target.from_default_triple().create_target_machine(
             cpu=ll.get_host_cpu_name(), features=ll.get_host_cpu_features().flatten(),
             opt=0, reloc="default", codemodel="jitdefault")
-        self.engine = ll.create_mcjit_compiler(ll.parse_assembly(""), machine)
+        self.context = ll.create_context()  # not the global one Numba compiles in
+        self.engine = ll.create_mcjit_compiler(ll.parse_assembly("", context=self.context),
+                                               machine)
         self.environments = []  # kept alive as long as the code that points at them
         self.registered: set[str] = set()
         self.call_type = ctypes.PYFUNCTYPE(ctypes.py_object, ctypes.c_void_p,
@@ -359,21 +439,42 @@ class _Engine:
         kept, as Numba's helper does (numba/core/serialize.py), but without importing the
         numba package for it."""
         ctypes = self.ctypes
-        key = (data, ctypes.string_at(hashed, 20))  # the pickle's SHA-1 beside its address
-        value = self._unpickled.get(key)
-        if value is None:
-            value = self._unpickled[key] = pickle.loads(ctypes.string_at(data, size))
-        return value
+        interrupted = False
+        while True:  # a Ctrl-C arriving here is delivered again once this has returned
+            try:
+                key = (data, ctypes.string_at(hashed, 20))  # the pickle's SHA-1, its address
+                value = self._unpickled.get(key)
+                if value is None:
+                    value = self._unpickled[key] = pickle.loads(ctypes.string_at(data, size))
+                self._incref(value)  # a new reference, as Numba's helper returns
+                address = id(value)
+                break
+            except KeyboardInterrupt:
+                interrupted = True
+            except BaseException:  # noqa: BLE001 - NULL, as Numba's helper gives on failure
+                address = None
+                break
+        if interrupted:
+            import _thread
+
+            _thread.interrupt_main()
+        return address
 
     def _resolve(self, name: str) -> bool:
+        """Whether ``name`` resolves, registering it as Numba would: a C maths function to
+        Numba's binding of it (the same address Numba registers, whoever does it first);
+        anything that already resolves (the process's own symbols, Numba's helpers once
+        Numba has registered them) as it does, never replaced; else Numba's helper of that
+        name (``numba_*``, ``NRT_*``) from the extension modules."""
         if name in self.registered:
             return True
-        address = self.symbols.get(name) or (self.maths.get(name) if not
-                                             name.startswith(("numba_", "NRT_")) else None)
-        if address:
+        address = None if name.startswith(("numba_", "NRT_")) else self.maths.get(name)
+        if address is None and not self.ll.address_of_symbol(name):
+            address = self.symbols.get(name)
+            if not address:
+                return False
+        if address is not None:
             self.ll.add_symbol(name, address)
-        elif not self.ll.address_of_symbol(name):
-            return False
         self.registered.add(name)
         return True
 
