@@ -43,7 +43,6 @@ to address 0. A twin's code runs only inside its callers, whose environment is t
 
 from __future__ import annotations
 
-import struct
 import sys
 
 import numpy as np
@@ -51,6 +50,8 @@ from llvmlite import binding as ll
 from numba.core import codegen, environment, types
 from numba.core.typing import typeof as numba_typeof
 from numba.np import numpy_support
+
+from .elf import elf_symbols
 
 # ------------------------------------------------------------------ environments
 
@@ -77,37 +78,11 @@ environment._rebuild_env = _rebuild_env
 
 # ------------------------------------------------------------------ bitcode on demand
 
-ELF_MAGIC = b"\x7fELF"
-SHT_SYMTAB = 2
-SHN_UNDEF = 0
-SHN_ABS, SHN_COMMON = 0xFFF1, 0xFFF2
-SHN_LORESERVE = 0xFF00
-STB_GLOBAL, STB_WEAK = 1, 2
-
-
 def elf_defined_symbols(obj: bytes) -> set[str] | None:
-    """The global and weak symbols an ELF64 little-endian object file defines (functions and
-    data, common symbols such as Numba's environment pointers included): the names the JIT
-    linker can resolve in it. None when ``obj`` is not such a file."""
-    if obj[:4] != ELF_MAGIC or obj[4] != 2 or obj[5] != 1:  # ELFCLASS64, ELFDATA2LSB
-        return None
-    (shoff,) = struct.unpack_from("<Q", obj, 0x28)
-    shentsize, shnum = struct.unpack_from("<HH", obj, 0x3A)
-    sections = [struct.unpack_from("<IIQQQQIIQQ", obj, shoff + i * shentsize)
-                for i in range(shnum)]
-    names: set[str] = set()
-    for _name, kind, _flags, _addr, offset, size, link, _info, _align, entsize in sections:
-        if kind != SHT_SYMTAB or entsize == 0:
-            continue
-        strings = sections[link][4]
-        for at in range(offset, offset + size, entsize):
-            st_name, st_info, _other, st_shndx = struct.unpack_from("<IBBH", obj, at)
-            defined = (SHN_UNDEF < st_shndx < SHN_LORESERVE
-                       or st_shndx in (SHN_ABS, SHN_COMMON))
-            if (st_info >> 4) in (STB_GLOBAL, STB_WEAK) and defined:
-                end = obj.index(b"\0", strings + st_name)
-                names.add(obj[strings + st_name:end].decode())
-    return names
+    """The global and weak symbols an ELF64 little-endian object file defines: the names the
+    JIT linker can resolve in it (kernels/elf.py). None when ``obj`` is not such a file."""
+    symbols = elf_symbols(obj)
+    return None if symbols is None else symbols[0]
 
 
 _numba_unserialize = codegen.JITCodeLibrary._unserialize.__func__

@@ -49,12 +49,13 @@ import importlib.machinery
 import importlib.util
 import os
 import pickle
-import struct
 import sys
 import threading
 from pathlib import Path
 
 import numpy as np
+
+from .elf import elf_symbols
 
 FORMAT = 1
 #: NUMBA_* settings that leave the machine code as it is
@@ -314,29 +315,11 @@ def _plain_pickle(values: list) -> bytes | None:
 
 # ------------------------------------------------------------------ ELF symbols
 
-SHT_SYMTAB = 2
-
-
 def elf_undefined_symbols(obj: bytes) -> set[str] | None:
-    """The symbols an ELF64 little-endian object file needs from elsewhere; None when it is
-    not such a file."""
-    if obj[:4] != b"\x7fELF" or obj[4] != 2 or obj[5] != 1:
-        return None
-    (shoff,) = struct.unpack_from("<Q", obj, 0x28)
-    shentsize, shnum = struct.unpack_from("<HH", obj, 0x3A)
-    sections = [struct.unpack_from("<IIQQQQIIQQ", obj, shoff + i * shentsize)
-                for i in range(shnum)]
-    names: set[str] = set()
-    for _name, kind, _flags, _addr, offset, size, link, _info, _align, entsize in sections:
-        if kind != SHT_SYMTAB or entsize == 0:
-            continue
-        strings = sections[link][4]
-        for at in range(offset + entsize, offset + size, entsize):  # entry 0 is null
-            st_name, _st_info, _other, st_shndx = struct.unpack_from("<IBBH", obj, at)
-            if st_shndx == 0 and st_name:
-                end = obj.index(b"\0", strings + st_name)
-                names.add(obj[strings + st_name:end].decode())
-    return names
+    """The symbols an ELF64 little-endian object file needs from elsewhere (kernels/elf.py);
+    None when it is not such a file."""
+    symbols = elf_symbols(obj)
+    return None if symbols is None else symbols[1]
 
 
 # ------------------------------------------------------------------ the engine
