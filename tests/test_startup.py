@@ -638,3 +638,32 @@ def test_terminal_check_without_rich_agrees_with_rich(monkeypatch):
     finally:
         tty.close()
         os.close(master)
+
+
+def test_render_pauses_the_garbage_collector_only_for_its_set_up(tmp_path):
+    """``whitted render`` runs its imports and scene reading with the cyclic collector paused
+    (cli/main.py ``_resume_collector``), and the job with it on, the set-up's objects frozen;
+    a render that ends in a usage error leaves it on too, and other commands never touch it."""
+    out = tmp_path / "x.png"
+    _modules_after(f"""
+        import gc, sys
+        import whitted.cli.main as cli
+        cli.EXIT_AT_ONCE_WHEN_ABANDONED = False
+        seen = []
+        job_run = cli._render_and_write
+        def watched(*args, **kwargs):
+            seen.append((gc.isenabled(), gc.get_freeze_count() > 0))
+            return job_run(*args, **kwargs)
+        cli._render_and_write = watched
+        for argv in (["render", "-W", "16", "-H", "12", "-o", {str(out)!r}],
+                     ["render", "-W", "-5", "-o", {str(out)!r}], ["--version"]):
+            sys.argv = ["whitted", *argv]
+            gc.unfreeze()
+            try:
+                cli.main()
+            except SystemExit:
+                pass
+            assert gc.isenabled(), argv
+        assert seen == [(True, True)], seen
+    """, tmp_path)
+    assert out.stat().st_size > 0
