@@ -151,6 +151,7 @@ def test_entry_points_run_from_the_index_in_a_fresh_process(tmp_path):
             p.total(np.arange(5.0), -1.0)
         except ValueError as e:
             assert str(e) == "negative scale", e
+            assert "numba" not in sys.modules, "Numba imported to raise"
         else:
             raise AssertionError("no exception")
         assert p.total(np.arange(5, dtype=np.float32), 1.0) == 10.0  # another key: Numba

@@ -327,13 +327,10 @@ def _wait(job, interrupted: threading.Event, tick=None, until: float | None = No
     ``tick()`` is called every tenth of a second meanwhile. With ``until`` (a
     ``time.monotonic()`` deadline), False when the job is still running then."""
     while job.running:
-        if until is not None:
-            left = until - time.monotonic()
-            if left <= 0:
-                return False
-            job.join(min(0.1, left))
-        else:
-            job.join(0.1)
+        left = 0.1 if until is None else min(0.1, until - time.monotonic())
+        if left <= 0:
+            return False
+        job.join(left)
         if tick is not None:
             tick()
         if interrupted.is_set() and not job.rendering:
@@ -651,8 +648,6 @@ def _resume_collector() -> None:
 def main() -> None:
     """Console entry point: usage mistakes end as one ``error:`` line and status 2; nothing
     ends in a traceback (set WHITTED_DEBUG=1 to see one for an internal error)."""
-    import os
-
     if len(sys.argv) > 1 and sys.argv[1] == "render" and gc.isenabled():
         gc.disable()  # until the render's set-up is done: _resume_collector
         _collector_paused.append(True)
@@ -727,8 +722,6 @@ def only_the_command_named(argv: list[str]):
 
 def _exit_now(code: int) -> None:
     """End the process now (output flushed), not waiting for an abandoned render thread."""
-    import os
-
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(OSError, ValueError):
             stream.flush()

@@ -52,10 +52,6 @@ def _jit_disabled() -> bool:
         return False
 
 
-def numba_loaded() -> bool:
-    return _numba_loaded
-
-
 def load_numba() -> None:
     """Import Numba with whitted's settings (kernels/dispatcher.py), register the deferred
     extensions, and put dispatchers where kernels will look for them (module docstring).

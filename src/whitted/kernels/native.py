@@ -17,7 +17,7 @@ argument types. One file per kernel and key, written whole or not at all.
 **The key** (:func:`argument_key`) holds what Numba types an argument by: an array's dtype,
 dimensions, layout (C, F or neither), whether it is writeable and aligned; a scalar's kind
 (bool, int64, float64, complex128, a NumPy scalar's dtype); a tuple's or named tuple's
-elements (and the named tuple's class); None. Numba's wrapper trusts the types it was
+elements (and the named tuple's class and fields); None. Numba's wrapper trusts the types it was
 compiled for: an array of another dtype would be read as if it were that one. So an argument
 of any other kind (a subclass of ndarray, a list, a Python int beyond 64 bits) has no key, and
 the call goes to Numba. The file's name also holds the CPU (name and features, as LLVM reports
@@ -33,8 +33,8 @@ on one it cannot resolve); one that is missing sends the call to Numba.
 
 **When not.** Only on Linux (ELF objects), with ``NUMBA_*`` settings that do not change code
 (the cache folder, threads, SLP), no ``.numba_config.yaml`` in the working folder, and unless
-``WHITTED_NATIVE=0``. An exception raised inside a kernel imports Numba to build it (Numba's
-C helpers do); nothing else does.
+``WHITTED_NATIVE=0``. An exception raised inside a kernel arrives as Numba raises it, without
+Numba being imported: its details are unpickled by the engine's ``numba_unpickle``.
 
 Measured, AMD EPYC (Zen 4), ``whitted render benchmarks/seed000.toml -t 2``, whole process:
 see docs/performance.md ("Fifth speed round").
