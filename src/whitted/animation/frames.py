@@ -3,10 +3,11 @@
 Each frame PNG carries, in a text chunk, a hash of everything its pixels depend on: the
 still of that frame (every scene value, its seed, image size, samples, ...), the frame
 number, the renderer's kernel sources, and the size and modification time of every model and
-texture file the still names. A later run compares that hash with the one it would write and
-skips the frame when they match: films resume where they stopped, and a change to the scene
-renders again exactly the frames it changes. Thread counts are not part of the hash (images
-do not depend on them).
+texture file the still names; and the fingerprint of the renderer that made it
+(:mod:`whitted.fingerprint`, recorded by whichever process rendered it: a farm's worker). A
+later run compares both with its own and skips the frame when they match: films resume where
+they stopped, and a change to the scene renders again exactly the frames it changes. Thread
+counts are not part of the hash (images do not depend on them).
 
 :func:`render_frame` is the plain function a render farm calls per frame; a
 :class:`FrameRenderer` renders many frames in one process and reuses what it can between
@@ -107,35 +108,45 @@ def frame_digest(still: Scene, frame: int) -> str:
     return h.hexdigest()
 
 
-def read_frame_digest(path: str | Path) -> str | None:
-    """The frame hash recorded in a PNG written by :func:`render_frame` (None when the file
-    is missing, unreadable or has none)."""
+def _read_frame_record(path: str | Path) -> dict[str, Any]:
     from PIL import Image as PILImage
 
     try:
         with PILImage.open(path) as im:
-            text = getattr(im, "text", None) or im.info
-            value = text.get(FRAME_HASH_KEY)
+            return dict(getattr(im, "text", None) or im.info)
     except (OSError, ValueError, SyntaxError):
-        return None
+        return {}
+
+
+def read_frame_digest(path: str | Path) -> str | None:
+    """The frame hash recorded in a PNG written by :func:`render_frame` (None when the file
+    is missing, unreadable or has none)."""
+    value = _read_frame_record(path).get(FRAME_HASH_KEY)
     return value if isinstance(value, str) else None
 
 
 def frame_is_current(path: str | Path, digest: str) -> bool:
-    """Whether ``path`` is a finished frame PNG with hash ``digest``."""
-    return read_frame_digest(path) == digest
+    """Whether ``path`` is a finished frame PNG with hash ``digest``, rendered by this
+    renderer (its recorded fingerprint, :mod:`whitted.fingerprint`, is this process's)."""
+    from ..fingerprint import FINGERPRINT_KEY, renderer_fingerprint
+
+    record = _read_frame_record(path)
+    return (record.get(FRAME_HASH_KEY) == digest
+            and record.get(FINGERPRINT_KEY) == renderer_fingerprint())
 
 
 def _write_frame_png(path: Path, image: Any, digest: str, frame: int) -> None:
     from PIL import Image as PILImage
     from PIL.PngImagePlugin import PngInfo
 
+    from ..fingerprint import FINGERPRINT_KEY, renderer_fingerprint
     from ..output.encode import atomic_write
 
     data = image.to_srgb8()
     info = PngInfo()
     info.add_text(FRAME_HASH_KEY, digest)
     info.add_text(FRAME_NUMBER_KEY, str(int(frame)))
+    info.add_text(FINGERPRINT_KEY, renderer_fingerprint())  # the renderer that made it
     # zlib level 1: a film's frames are working files; 4x faster to write than level 6
     # (640x360: 6 vs 25 ms) for files about a third larger
     atomic_write(path, lambda tmp: PILImage.fromarray(data).save(

@@ -19,20 +19,24 @@ from __future__ import annotations
 
 from ._dask import INSTALL_HINT
 from .assets import AssetManifest, collect_assets, scene_file_names
-from .cluster import FarmError, check_farm_options, farm_client, local_cluster, parse_cluster
+from .cluster import check_farm_options, farm_client, local_cluster, parse_cluster
+from .errors import ClusterLost, FarmError
 from .film import FilmPlan, FilmResult, FrameFailed, chunk_size, plan_film, render_film
 from .still import band_ranges, render_still
 from .transfer import Shipment, ship_assets
+from .watch import Watch
 from .worker import WhittedWorker
 
 __all__ = [
     "INSTALL_HINT",
     "AssetManifest",
+    "ClusterLost",
     "FarmError",
     "FilmPlan",
     "FilmResult",
     "FrameFailed",
     "Shipment",
+    "Watch",
     "WhittedWorker",
     "band_ranges",
     "check_farm_options",

@@ -1,22 +1,30 @@
 """Getting a Dask client for the command line: ``--cluster local:N`` starts a LocalCluster of N
 worker processes on this machine (loopback only), ``--scheduler tcp://HOST:PORT`` joins an
 existing cluster whose workers have whitted installed. Either way the workers are readied by
-the :class:`~whitted.farm.worker.WhittedWorker` plugin before they take work."""
+the :class:`~whitted.farm.worker.WhittedWorker` plugin before they take work, and a worker
+that cannot be (another whitted, none at all) is named in one line and given no task."""
 
 from __future__ import annotations
 
 import importlib.util
+import signal
+import socket
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from urllib.parse import urlsplit
 
-from ..errors import WhittedError
 from ..render.api import available_threads
 from ._dask import Client, LocalCluster
+from .errors import ClusterLost, FarmError
+from .watch import Watch, ready_workers
 from .worker import WhittedWorker
 
+#: seconds to wait for a scheduler that does not answer (a refused connection fails at once)
+CONNECT_SECONDS = 10
 
-class FarmError(WhittedError):
-    """A farm option or cluster the user gave cannot be used (one line, exit status 2)."""
+__all__ = ["ClusterLost", "FarmError", "check_farm_options", "farm_client", "local_cluster",
+           "parse_cluster", "reach_scheduler"]
 
 
 def parse_cluster(spec: str) -> int:
@@ -40,6 +48,28 @@ def check_farm_options(cluster: str | None, scheduler: str | None) -> None:
         parse_cluster(cluster)
 
 
+def reach_scheduler(address: str, timeout: float = CONNECT_SECONDS) -> None:
+    """Open (and close) a TCP connection to the scheduler at ``tcp://HOST:PORT``: a refused
+    connection or an unknown host fails at once, with one line (Dask would retry for its
+    whole timeout)."""
+    parts = urlsplit(address if "://" in address else f"tcp://{address}")
+    try:
+        port = parts.port
+    except ValueError:
+        port = None
+    if parts.scheme not in ("tcp", "tls") or not parts.hostname or port is None:
+        raise FarmError(f"--scheduler {address}: not an address tcp://HOST:PORT")
+    try:
+        with socket.create_connection((parts.hostname, port), timeout=timeout):
+            pass
+    except TimeoutError:
+        raise ClusterLost(f"--scheduler {address}: no answer in {timeout:.0f} s (is a "
+                          "scheduler running there, and the port open?)") from None
+    except OSError as exc:
+        raise ClusterLost(f"--scheduler {address}: cannot reach the scheduler "
+                          f"({exc.strerror or exc})") from None
+
+
 def has_dashboard() -> bool:
     """Dask's dashboard needs bokeh (optional): without it there is simply none."""
     return importlib.util.find_spec("bokeh") is not None
@@ -56,12 +86,58 @@ def dashboard_link(client: Client) -> str | None:
 
 
 def local_cluster(workers: int, threads: int) -> LocalCluster:
-    """``workers`` processes of one Dask thread each, each rendering with ``threads`` lanes."""
-    return LocalCluster(
-        n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-        dashboard_address="127.0.0.1:0",  # a free port (a page only with bokeh)
-        env={"NUMBA_NUM_THREADS": str(threads)},
-    )
+    """``workers`` processes of one Dask thread each, each rendering with ``threads`` lanes.
+    They start with Ctrl-C ignored (the client stops them itself: a terminal's Ctrl-C
+    reaches every process of its group, and each printed its traceback)."""
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        return LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+            dashboard_address="127.0.0.1:0",  # a free port (a page only with bokeh)
+            env={"NUMBA_NUM_THREADS": str(threads)},
+        )
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, previous)
+
+
+def ready_cluster(client: Client, plugin: WhittedWorker,
+                  note: Callable[[str], None] | None = None) -> list[str]:
+    """Register ``plugin`` (every worker readied: kernels loaded, or compiled with progress
+    told through ``note``); name each worker that cannot render in one line. Returns the
+    ready workers; raises :class:`ClusterLost` when there is none."""
+    watch = Watch(client, note)  # its events: the cold workers' progress, mismatches
+    failure = None
+    try:
+        try:
+            client.register_plugin(plugin)
+        except (OSError, TimeoutError) as exc:
+            raise watch.lost(exc) from None
+        except Exception as exc:  # noqa: BLE001 - a worker that cannot load the plugin
+            failure = exc
+        info = client.scheduler_info(n_workers=-1)
+        ready = ready_workers(info)
+        states = dict(watch.states)
+    finally:
+        watch.close()
+    why = f"{type(failure).__name__}: {failure}" if failure is not None else ""
+    reasons = []
+    for worker in info.get("workers", {}):
+        if worker in ready:
+            continue
+        state = states.get(worker) or {}
+        if state.get("status") == "mismatch":
+            reasons.append(f"worker {worker} runs {state['fingerprint']}, not the client's "
+                           f"{state['wanted']}")
+        else:
+            reasons.append(f"worker {worker} cannot load whitted ({why or 'no answer'})")
+    if not ready:
+        raise ClusterLost("no worker can render: " + ("; ".join(reasons) or "no workers"))
+    for reason in reasons:
+        if note is not None:
+            note(f"farm: {reason}: it gets no tasks")
+    return ready
 
 
 @contextmanager
@@ -70,7 +146,8 @@ def farm_client(cluster: str | None = None, scheduler: str | None = None, *,
                 note: Callable[[str], None] | None = None) -> Iterator[Client]:
     """A client of a new local cluster (``cluster="local:N"``) or of the scheduler at
     ``scheduler``, with every worker readied (kernels warm, ``threads`` render threads each:
-    by default the cores shared out among a local cluster's workers, one on a remote one)."""
+    by default the cores shared out among a local cluster's workers, one on a remote one).
+    Workers that cannot render are named through ``note`` and get no tasks."""
     check_farm_options(cluster, scheduler)
     owned = None
     if cluster is not None:
@@ -80,21 +157,43 @@ def farm_client(cluster: str | None = None, scheduler: str | None = None, *,
         client = Client(owned)
     else:
         threads = threads or 1
+        reach_scheduler(scheduler)
         try:
-            client = Client(scheduler, timeout="20s")
+            client = Client(scheduler, timeout=f"{CONNECT_SECONDS}s")
         except (OSError, TimeoutError, ValueError) as exc:
-            raise FarmError(f"--scheduler {scheduler}: cannot reach the scheduler ({exc})"
-                            ) from None
+            raise ClusterLost(f"--scheduler {scheduler}: cannot reach the scheduler ({exc})"
+                              ) from None
     try:
         link = dashboard_link(client)
         if note is not None:
-            n = len(client.scheduler_info().get("workers", {}))
-            note(f"farm: {n} worker{'s' if n != 1 else ''} at {client.scheduler.address}, "
-                 f"{threads} render thread{'s' if threads != 1 else ''} each"
+            info = client.scheduler_info(n_workers=-1).get("workers", {})
+            n = len(info)
+            total = sum(w.get("nthreads", 1) for w in info.values())
+            note(f"farm: {n} worker{'s' if n != 1 else ''} ({total} Dask thread"
+                 f"{'s' if total != 1 else ''}) at {client.scheduler.address}, "
+                 f"{threads} render thread{'s' if threads != 1 else ''} a task"
                  + (f"; dashboard {link}" if link else ""))
-        client.register_plugin(WhittedWorker(threads=threads, warm=warm))
+        ready_cluster(client, WhittedWorker(threads=threads, warm=warm), note)
         yield client
     finally:
-        client.close()
+        _close_quietly(client, owned)
+
+
+def _close_quietly(client: Client, owned: LocalCluster | None) -> None:
+    """Close the client (and the cluster it started) without Dask's tracebacks: a scheduler
+    already gone is no error at this point."""
+    import logging
+
+    quiet = [logging.getLogger(name) for name in ("distributed", "tornado", "asyncio")]
+    levels = [log.level for log in quiet]
+    for log in quiet:
+        log.setLevel(logging.CRITICAL)
+    try:
+        client.close(timeout=5)
         if owned is not None:
-            owned.close()
+            owned.close(timeout=10)
+    except Exception:  # noqa: BLE001 - closing what is already gone
+        pass
+    finally:
+        for log, level in zip(quiet, levels, strict=True):
+            log.setLevel(level)

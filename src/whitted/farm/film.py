@@ -21,6 +21,7 @@ whole numbered sequence is on disk, in frame order.
 from __future__ import annotations
 
 import math
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -29,15 +30,16 @@ from typing import Any
 
 from ..errors import WhittedError
 from ..scene.scene import Scene
-from ._dask import Client, as_completed
+from ._dask import Client
 from .transfer import AssetMode, Shipment, ship_assets
 from .worker import render_frame_chunk
 
 RETRIES = 2
-#: samples (pixels x samples per pixel) a task should hold at least: about a second of work
-#: at this machine's few Mrays/s, so Dask's few milliseconds per task are noise
-SAMPLES_PER_TASK = 1_000_000
-TASKS_PER_WORKER = 3  # at least this many tasks a worker, so the last ones finish together
+#: a task holds at least this much work when frames are short (Dask's ~10 ms a task is noise)
+TASK_SECONDS = 2.0
+#: and every render thread gets at least this many tasks when frames allow, so that the last
+#: round of tasks, when threads run out of work one by one, is short
+ROUNDS = 4
 
 
 class FrameFailed(WhittedError):
@@ -66,6 +68,8 @@ class FilmResult:
     wall_seconds: float = 0.0
     film: Path | None = None
     warnings: list[str] = field(default_factory=list)
+    interrupted: bool = False  # stopped by ``cancel``: what arrived is written, no film
+    threads: int = 0  # the cluster's Dask threads when the tasks were sized
 
 
 def frame_file_name(frame: int, count: int) -> str:
@@ -74,12 +78,16 @@ def frame_file_name(frame: int, count: int) -> str:
     return f"{frame:0{max(4, len(str(count - 1)))}d}.png"
 
 
-def chunk_size(width: int, height: int, samples: int, frames: int, workers: int) -> int:
-    """Frames per task: enough that a task holds about :data:`SAMPLES_PER_TASK` samples,
-    few enough that every worker gets :data:`TASKS_PER_WORKER` tasks."""
-    per_frame = max(1, width * height * samples)
-    wanted = max(1, math.ceil(SAMPLES_PER_TASK / per_frame))
-    most = max(1, frames // (TASKS_PER_WORKER * max(1, workers)))
+def chunk_size(frames: int, threads: int, frame_seconds: float | None) -> int:
+    """Frames per task for ``frames`` frames on ``threads`` render threads in all (the Dask
+    threads of every worker) when a frame takes ``frame_seconds`` (measured; None: not yet,
+    then 1). Enough frames that a task holds :data:`TASK_SECONDS` of work, few enough that
+    each thread gets :data:`ROUNDS` tasks: the last round, when threads finish one by one,
+    lasts at most one task (TASK_SECONDS, or one frame when frames are long)."""
+    if frame_seconds is None or frames <= 0:
+        return 1
+    wanted = math.ceil(TASK_SECONDS / max(frame_seconds, 1e-6))
+    most = max(1, frames // (ROUNDS * max(1, threads)))
     return max(1, min(wanted, most))
 
 
@@ -131,6 +139,9 @@ def render_film(
     force: bool = False,
     progress: Callable[[int, int, int | None], None] | None = None,
     plan: FilmPlan | None = None,
+    cancel: threading.Event | None = None,
+    note: Callable[[str], None] | None = None,
+    stall_floor: float | None = None,
     **settings: Any,
 ) -> FilmResult:
     """Render ``frames`` (default: all) of ``scene`` on the cluster behind ``client`` into
@@ -141,8 +152,13 @@ def render_film(
     ``max_depth``, ``seed``), as ``whitted animate``'s options do. ``progress(done, total,
     frame)`` is called once for each frame kept (frame None) or written. ``plan``: from
     :func:`plan_film` when the caller made it already (then ``client`` may be None when no
-    frame is left to render). Raises :class:`FrameFailed` for the first frame that failed,
-    after all the others are saved."""
+    frame is left to render). ``cancel``: set it to stop (the frames that arrived are written,
+    ``result.interrupted`` is True, no film is encoded). ``note``: one line for each thing a
+    wrangler should know (a worker that cannot render, a stalled one). ``stall_floor``: the
+    least seconds before a worker is called stalled (:mod:`whitted.farm.watch`). Raises
+    :class:`FrameFailed` for the first frame that failed, after all the others are saved, and
+    :class:`~whitted.farm.watch.ClusterLost` when the cluster cannot go on (what arrived is
+    written)."""
     from ..output.encode import atomic_write
 
     started = time.perf_counter()
@@ -163,8 +179,11 @@ def render_film(
     if todo:
         _render_missing(client, scene, stills, chosen, digests, paths, todo, result,
                         chunk=chunk, assets=assets, retries=retries, settings=settings,
-                        progress=progress, write=atomic_write)
+                        progress=progress, write=atomic_write, cancel=cancel, note=note,
+                        stall_floor=stall_floor)
     result.wall_seconds = time.perf_counter() - started
+    if result.interrupted:
+        return result
     if result.failed:
         frame = min(result.failed)
         raise FrameFailed(frame, result.failed[frame])
@@ -178,36 +197,61 @@ def render_film(
 
 
 def _render_missing(client, scene, stills, chosen, digests, paths, todo, result, *, chunk,
-                    assets, retries, settings, progress, write) -> None:
-    s = stills[todo[0]].render
-    workers = max(1, len(client.scheduler_info().get("workers", {})))
-    size = chunk or chunk_size(s.width, s.height, s.samples, len(todo), workers)
-    runs = [todo[i:i + size] for i in range(0, len(todo), size)]
-    shipment = (assets if isinstance(assets, Shipment)
-                else ship_assets(client, [stills[i] for i in todo], assets))
-    position = {i: n for n, i in enumerate(todo)}  # shipment.needs is indexed like todo
+                    assets, retries, settings, progress, write, cancel, note,
+                    stall_floor) -> None:
     from ..compile.embree import with_concrete_mesh_tracer
+    from .watch import STALL_FLOOR, Watch, cancel_quietly, run_tasks
+    from .worker import TASK_RESOURCES, hold
 
-    [scene_future] = client.scatter([with_concrete_mesh_tracer(scene)], broadcast=True,
-                                    hash=False)
-    futures = {}
-    for run in runs:
-        manifest, blobs = shipment.for_scenes([position[i] for i in run])
-        future = client.submit(render_frame_chunk, scene_future, [chosen[i] for i in run],
-                               [digests[i] for i in run], settings, manifest, blobs,
-                               pure=False, retries=retries)
-        futures[future] = run
-    result.tasks, result.chunk, result.asset_bytes = len(runs), size, shipment.bytes
-    where = {chosen[i]: paths[i] for i in todo}
-    done = len(result.kept)
+    watch = Watch(client, note, stall_floor=STALL_FLOOR if stall_floor is None
+                  else stall_floor)
+    tasks: dict[Any, list[int]] = {}
     try:
-        for future in as_completed(futures):
-            if future.status == "error":  # the task itself failed, after its retries
-                exc = future.exception()
-                for i in futures[future]:
+        info = client.scheduler_info(n_workers=-1)
+        threads = max(1, sum(w.get("nthreads", 1) for w in info.get("workers", {}).values()))
+        result.threads = threads
+        shipment = (assets if isinstance(assets, Shipment)
+                    else ship_assets(client, [stills[i] for i in todo], assets))
+        position = {i: n for n, i in enumerate(todo)}  # shipment.needs is indexed like todo
+        # the scene as a task's result: a worker that lost it (killed, restarted) gets it
+        # again, computed from the task, from wherever it still is
+        scene_future = client.submit(hold, with_concrete_mesh_tracer(scene), pure=False,
+                                     resources=TASK_RESOURCES)
+
+        def submit(run: list[int], workers: list[str] | None = None):
+            manifest, blobs = shipment.for_scenes([position[i] for i in run])
+            return client.submit(render_frame_chunk, scene_future, [chosen[i] for i in run],
+                                 [digests[i] for i in run], settings, manifest, blobs,
+                                 pure=False, retries=retries, resources=TASK_RESOURCES,
+                                 workers=workers, allow_other_workers=False)
+
+        # sizing: a first round of one frame a task, one for each render thread; the rest,
+        # in chunks sized from the first frame's measured time (chunk_size), once it is known
+        later = list(todo)
+        if chunk:
+            first, later = later, []
+            runs = [first[i:i + chunk] for i in range(0, len(first), chunk)]
+        else:
+            first, later = later[:threads], later[threads:]
+            runs = [[i] for i in first]
+        for run in runs:
+            tasks[submit(run)] = run
+        result.tasks, result.chunk, result.asset_bytes = len(runs), chunk or 1, shipment.bytes
+        where = {chosen[i]: paths[i] for i in todo}
+        done = [len(result.kept)]
+
+        def on_done(future, run: list[int]) -> None:
+            if future.status == "cancelled":  # by the scheduler: it is going
+                raise watch.lost()
+            if future.status != "finished":  # the task itself failed, after its retries
+                exc = future.exception() if future.status == "error" else None
+                for i in run:
                     result.failed[chosen[i]] = _reason(exc)
-                continue
-            for outcome in future.result():
+                return
+            outcomes = future.result()
+            watch.record(o.seconds for o in outcomes if o.png is not None)
+            interrupt = None
+            for outcome in outcomes:  # each written, even after a Ctrl-C in the progress
                 if outcome.png is None:
                     result.failed[outcome.frame] = outcome.error
                     continue
@@ -218,11 +262,34 @@ def _render_missing(client, scene, stills, chosen, digests, paths, todo, result,
                 result.render_cpu_seconds += outcome.cpu_seconds
                 result.warnings.extend(w for w in outcome.warnings
                                        if w not in result.warnings)
-                done += 1
-                if progress is not None:
-                    progress(done, len(chosen), outcome.frame)
+                done[0] += 1
+                if progress is not None and interrupt is None:
+                    try:
+                        progress(done[0], len(chosen), outcome.frame)
+                    except KeyboardInterrupt as exc:
+                        interrupt = exc
+            if interrupt is not None:
+                raise interrupt
+
+        def between() -> None:
+            if not later or not (result.rendered or result.failed):
+                return
+            measured = (result.render_seconds / len(result.rendered)
+                        if result.rendered else None)
+            size = chunk_size(len(later), threads, measured)
+            runs = [later[i:i + size] for i in range(0, len(later), size)]
+            later.clear()
+            for run in runs:
+                tasks[submit(run)] = run
+            result.tasks += len(runs)
+            result.chunk = max(result.chunk, size)
+            watch.frames_per_task = size
+
+        finished = run_tasks(watch, tasks, submit, on_done, cancel=cancel, between=between)
+        result.interrupted = not finished
     finally:
-        client.cancel(list(futures))
+        watch.close()
+        cancel_quietly(client, tasks)
 
 
 def _reason(exc: BaseException | None) -> str:

@@ -1,8 +1,10 @@
 """Sending scenes and their files to the workers through Dask.
 
-Each file's bytes are scattered once under the key ``whitted-asset-<sha256>`` (the same file
-asked for twice, by two frames or two runs on one client, is one piece of data) and replicated
-on two workers, so losing one worker loses no file. A task that needs files takes their futures
+Each file's bytes become the result of a task under the key ``whitted-asset-<sha256>`` (the
+same file asked for twice, by two frames or two runs on one client, is one piece of data):
+a task's result, not scattered data, so that when every worker that held it is lost Dask
+computes it again (from the bytes the task was submitted with) instead of failing the tasks
+that need it. A task that needs files takes their futures
 as arguments: Dask brings each blob to each worker once (from whichever worker has it, not
 from the client), and :func:`~whitted.farm.assets.materialise` writes it into that worker's
 disk cache.
@@ -10,6 +12,7 @@ disk cache.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
@@ -26,7 +29,6 @@ from .assets import (
 
 AssetMode = Literal["auto", "ship", "shared"]
 ASSET_MODES = ("auto", "ship", "shared")
-REPLICAS = 2
 
 
 @dataclass
@@ -57,11 +59,16 @@ class Shipment:
 
 
 def workers_see(client: Client, stamps: dict[str, tuple[int, int]]) -> bool:
-    """Whether every worker (at least one) sees every file as the client does (``stamps``:
+    """Whether every ready worker (at least one) sees every file as the client does (``stamps``:
     size and modification time by absolute path, from :func:`file_stamps`)."""
+    from .watch import ready_workers
+
     if not stamps:
         return True
-    answers = client.run(files_visible, stamps)
+    workers = ready_workers(client.scheduler_info(n_workers=-1))
+    if not workers:
+        return False
+    answers = client.run(files_visible, stamps, workers=workers)
     return bool(answers) and all(answers.values())
 
 
@@ -77,10 +84,13 @@ def ship_assets(client: Client, scenes: Sequence[Scene], mode: AssetMode = "auto
     if not stamped[0] or (mode == "auto" and workers_see(client, stamped[0])):
         return Shipment()
     manifest, paths, needs = collect_assets(scenes, stamped)
-    data = {ASSET_KEY_PREFIX + digest: path.read_bytes() for digest, path in paths.items()}
-    scattered = client.scatter(data, hash=False)
-    n_workers = len(client.scheduler_info().get("workers", {}))
-    if n_workers > 1:
-        client.replicate(list(scattered.values()), n=min(REPLICAS, n_workers))
-    blobs = {key[len(ASSET_KEY_PREFIX):]: future for key, future in scattered.items()}
+    from .worker import TASK_RESOURCES, hold
+
+    blobs = {}
+    with warnings.catch_warnings():  # big files make a "large graph": meant, and said above
+        warnings.simplefilter("ignore", UserWarning)
+        for digest, path in paths.items():
+            blobs[digest] = client.submit(hold, path.read_bytes(),
+                                          key=ASSET_KEY_PREFIX + digest,
+                                          resources=TASK_RESOURCES)
     return Shipment(manifest, blobs, needs)

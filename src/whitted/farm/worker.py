@@ -7,9 +7,20 @@ the render kernels from the worker's Numba cache, compiling them there on a cold
 (:func:`whitted.render.warm_up.warm_up_kernels`). That happens before the worker runs its first
 task, so no frame pays for it and no two frames on one worker compile twice.
 
+Before any of that it compares the worker's renderer fingerprint (whitted's version and a hash
+of its kernel sources, :mod:`whitted.fingerprint`) with the client's, which the plugin carries:
+a worker running another whitted is never given a task. A worker offers the Dask resource
+:data:`RESOURCE` (one unit per Dask thread) only once it is readied, and every whitted task
+asks for one unit: a worker that is still compiling, runs another whitted, or cannot load
+whitted at all (the plugin fails to unpickle there) takes no task. What the plugin finds is
+logged as a Dask event on the topic :data:`EVENT_TOPIC` (``ready``, ``mismatch``,
+``compiling`` with the fraction done), and every finished frame and band as one on
+:data:`PROGRESS_TOPIC`: the client watches those for stalls (:mod:`whitted.farm.watch`).
+
 The tasks are plain functions of this module (workers import them from their own whitted):
 :func:`render_band` renders some rows of a still, :func:`render_frame_chunk` some frames of a
-film.
+film, :func:`hold` gives back the scene it was submitted with (the scene is a task's result,
+not scattered data, so that a worker that lost it gets it again: see :mod:`.film`).
 """
 
 from __future__ import annotations
@@ -32,6 +43,12 @@ from ._dask import WorkerPlugin
 from .assets import AssetManifest, materialise, worker_scene
 
 PLUGIN_NAME = "whitted-worker"
+#: the Dask resource a readied worker offers, one unit per Dask thread; each task takes one
+RESOURCE = "whitted"
+TASK_RESOURCES = {RESOURCE: 1}
+EVENT_TOPIC = "whitted-worker"  # ready / mismatch / compiling, one event each
+PROGRESS_TOPIC = "whitted-progress"  # a frame or band finished on a worker
+COMPILE_NOTE_SECONDS = 2.0  # how often a compiling worker says how far it is
 _threads = 1  # render threads of this worker process (set by the plugin)
 _warm_seconds: float | None = None
 
@@ -71,20 +88,83 @@ def warm_seconds() -> float | None:
     return _warm_seconds
 
 
+def quiet_interrupts() -> None:
+    """Ignore Ctrl-C's SIGINT in this worker process: a terminal's Ctrl-C reaches every
+    process of its group, and the client stops its workers itself (without this, each
+    worker of a ``--cluster local:N`` printed its own traceback)."""
+    import signal
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 class WhittedWorker(WorkerPlugin):
     """Readies each worker: ``threads`` render threads (default 1: one worker per core is the
-    usual layout), kernels loaded before the first task when ``warm``."""
+    usual layout), kernels loaded before the first task when ``warm``. ``fingerprint``: the
+    renderer the worker must run (default: this process's, the client's); a worker with
+    another one is left without the :data:`RESOURCE` that whitted's tasks need."""
 
     name = PLUGIN_NAME
 
-    def __init__(self, threads: int = 1, warm: bool = True) -> None:
+    def __init__(self, threads: int = 1, warm: bool = True,
+                 fingerprint: str | None = None) -> None:
+        from ..fingerprint import renderer_fingerprint
+
         self.threads = threads
         self.warm = warm
+        self.fingerprint = fingerprint or renderer_fingerprint()
 
     async def setup(self, worker) -> None:
+        from ..fingerprint import renderer_fingerprint
+
+        quiet_interrupts()
+        mine = renderer_fingerprint()
+        if mine != self.fingerprint:
+            worker.log_event(EVENT_TOPIC, {"worker": worker.address, "status": "mismatch",
+                                           "fingerprint": mine, "wanted": self.fingerprint})
+            await worker.set_resources(**{RESOURCE: 0})
+            return
         set_worker_threads(self.threads)
+        seconds = 0.0
         if self.warm:  # off the event loop, so the worker keeps answering the scheduler
-            await asyncio.get_running_loop().run_in_executor(None, warm_worker)
+            seconds = await self._warm(worker)
+        worker.log_event(EVENT_TOPIC, {"worker": worker.address, "status": "ready",
+                                       "fingerprint": mine, "warm_seconds": seconds})
+        await worker.set_resources(**{RESOURCE: worker.state.nthreads})
+
+    @staticmethod
+    async def _warm(worker) -> float:
+        """Warm the kernels on a thread; while a cold compile runs, say how far it is."""
+        from ..render.warm_up import compile_progress
+
+        done = asyncio.get_running_loop().run_in_executor(None, warm_worker)
+        while True:
+            try:
+                return await asyncio.wait_for(asyncio.shield(done), COMPILE_NOTE_SECONDS)
+            except TimeoutError:
+                fraction = compile_progress()
+                if fraction is not None:
+                    worker.log_event(EVENT_TOPIC, {"worker": worker.address,
+                                                   "status": "compiling",
+                                                   "fraction": fraction})
+
+
+def hold(value: Any) -> Any:
+    """The value this task was submitted with: data every task needs (the scene) kept as a
+    task's result, so that Dask computes it again on another worker when the ones holding
+    it are lost (scattered data would be gone with them)."""
+    return value
+
+
+def _progress(**message: Any) -> None:
+    """Tell the client (through the scheduler) that a frame or band finished here."""
+    from ._dask import get_worker
+
+    try:
+        worker = get_worker()
+    except ValueError:  # not in a worker (a test calling the task directly)
+        return
+    worker.log_event(PROGRESS_TOPIC, {"worker": worker.address, **message})
 
 
 def _prepared(scene: Scene, manifest: AssetManifest | None,
@@ -107,6 +187,7 @@ def render_band(scene: Scene, start: int, stop: int, manifest: AssetManifest | N
     job = RenderJob(prepared, threads=_threads, rows=(start, stop))
     job.run()
     job.stats.warnings = [client_names(w) for w in job.stats.warnings]
+    _progress(band=start)
     return start, job.framebuffer[start:stop].copy(), job.stats
 
 
@@ -166,4 +247,5 @@ def render_frame_chunk(scene: Scene, frames: list[int], digests: list[str],
         outcomes.append(FrameOutcome(frame, png, seconds=time.perf_counter() - start,
                                      cpu_seconds=time.thread_time() - cpu,
                                      warnings=[client_names(w) for w in job.stats.warnings]))
+        _progress(frame=frame, seconds=outcomes[-1].seconds)
     return outcomes

@@ -1,0 +1,298 @@
+"""Watching a cluster while a farm job waits for its tasks: never wait forever.
+
+The client waits for its tasks in short steps (:data:`POLL_SECONDS`) and between them looks
+at the cluster (:class:`Watch`):
+
+- **Workers that cannot render.** A worker whose renderer fingerprint differs from the
+  client's, or that cannot load whitted at all, never offers the ``whitted`` resource, so it
+  is never given a task (:mod:`.worker`); the watch names it in one line, once. When no worker
+  can render (none is ready or compiling kernels) for :data:`STALL_FLOOR` seconds, the job
+  ends with one line saying why (every worker lost, or which ones run what).
+- **Stalls.** A worker that holds whitted tasks is *stalled* when it has sent no heartbeat to
+  the scheduler, or finished no frame or band, for the stall limit::
+
+      limit = max(STALL_FLOOR, STALL_FACTOR * frames_per_task * frame_seconds)
+
+  where ``frame_seconds`` is the median time of the frames (bands) finished so far in this
+  job; before the first one, the limit is :data:`FIRST_TASK_LIMIT` for progress (heartbeats
+  keep their floor). A stalled worker (hung, stopped with SIGSTOP, swapping) is excluded: its
+  tasks are submitted again for the other ready workers only, and the first result of a
+  task is the one kept. When no other worker is left, the job ends with one line.
+- **The scheduler lost.** The client's connection gone for good ends the job with one line.
+
+Every such ending is a :class:`~whitted.farm.errors.ClusterLost` (exit status 3):
+what the farm had finished (frames written, bands) is kept.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import statistics
+import threading
+import time
+from collections.abc import Callable, Iterable
+from typing import Any
+
+from ._dask import Client, Future, distributed
+from .errors import ClusterLost
+from .worker import EVENT_TOPIC, PROGRESS_TOPIC, RESOURCE
+
+POLL_SECONDS = 0.5
+STALL_FLOOR = 30.0  # seconds: never less than this before a worker is called stalled
+STALL_FACTOR = 10.0  # times the expected time of a task
+FIRST_TASK_LIMIT = 600.0  # seconds without a finished frame before any frame was measured
+
+
+def ready_workers(info: dict[str, Any]) -> list[str]:
+    """The workers of ``client.scheduler_info()`` that the whitted plugin readied."""
+    return [w for w, d in info.get("workers", {}).items()
+            if d.get("resources", {}).get(RESOURCE, 0) > 0]
+
+
+class Watch:
+    """What the client knows of the workers while a job runs: their state from the whitted
+    plugin's events, their progress, which ones are excluded as stalled."""
+
+    def __init__(self, client: Client, note: Callable[[str], None] | None = None, *,
+                 stall_floor: float = STALL_FLOOR) -> None:
+        self.client = client
+        self.note = note or (lambda line: None)
+        self.stall_floor = stall_floor
+        self.started = time.monotonic()
+        self._lock = threading.Lock()
+        self.states: dict[str, dict[str, Any]] = {}  # worker -> its last plugin event
+        self.last_progress: dict[str, float] = {}  # worker -> when it last finished one
+        self.seconds: list[float] = []  # each finished frame's (band's) time
+        self.first_seen: dict[str, float] = {}
+        self.heartbeats: dict[str, tuple[float, float]] = {}  # worker -> (last_seen, since)
+        self.busy_since: dict[str, float] = {}
+        self.excluded: set[str] = set()
+        self.told: set[str] = set()
+        self.no_worker_since: float | None = None
+        self.frames_per_task = 1
+        for _, message in client.get_events(EVENT_TOPIC):  # what happened before this job
+            self.states[message.get("worker", "?")] = message
+        client.subscribe_topic(EVENT_TOPIC, self._on_worker_event)
+        client.subscribe_topic(PROGRESS_TOPIC, self._on_progress)
+
+    def close(self) -> None:
+        for topic in (EVENT_TOPIC, PROGRESS_TOPIC):
+            with contextlib.suppress(Exception):  # a lost scheduler: nothing to unsubscribe
+                self.client.unsubscribe_topic(topic)
+
+    # ------------------------------------------------------------------ events (any thread)
+
+    def _on_worker_event(self, event: tuple[float, dict[str, Any]]) -> None:
+        _, message = event
+        worker = message.get("worker", "?")
+        with self._lock:
+            before = self.states.get(worker) or {}
+            self.states[worker] = message
+        if message.get("status") == "compiling":  # a cold worker: say so, in tenths
+            tenth = int(10 * message.get("fraction", 0.0))
+            if before.get("status") != "compiling" or int(10 * before["fraction"]) != tenth:
+                self.note(f"farm: worker {worker} is compiling the kernels (a cold cache: "
+                          f"first run of this whitted there): {10 * tenth}%")
+
+    def _on_progress(self, event: tuple[float, dict[str, Any]]) -> None:
+        _, message = event
+        with self._lock:
+            self.last_progress[message["worker"]] = time.monotonic()
+            if "seconds" in message:
+                self.seconds.append(float(message["seconds"]))
+
+    def record(self, seconds: Iterable[float]) -> None:
+        """Frame (band) times learnt from results (events may come later than results)."""
+        with self._lock:
+            self.seconds.extend(seconds)
+
+    # ------------------------------------------------------------------ waiting
+
+    def wait(self, futures: Iterable[Future]) -> set[Future]:
+        """The futures done after at most :data:`POLL_SECONDS` (maybe none)."""
+        pending = list(futures)
+        if not pending:
+            return set()
+        try:
+            done, _ = distributed.wait(pending, timeout=POLL_SECONDS,
+                                       return_when="FIRST_COMPLETED")
+        except TimeoutError:
+            return set()
+        except (OSError, distributed.comm.CommClosedError) as exc:
+            raise self.lost(exc) from None
+        return set(done)
+
+    def lost(self, exc: BaseException | None = None) -> ClusterLost:
+        where = getattr(self.client.scheduler, "address", None) or "the scheduler"
+        why = f" ({_first_line(exc)})" if exc is not None and str(exc).strip() else ""
+        return ClusterLost(f"lost the connection to the scheduler at {where}{why}")
+
+    def ready_workers(self, info: dict[str, Any]) -> list[str]:
+        return [w for w in ready_workers(info) if w not in self.excluded]
+
+    def limit(self) -> float:
+        """The stall limit now (module docstring)."""
+        with self._lock:
+            seconds = list(self.seconds)
+        if not seconds:
+            return max(self.stall_floor, FIRST_TASK_LIMIT)
+        expected = self.frames_per_task * statistics.median(seconds)
+        return max(self.stall_floor, STALL_FACTOR * expected)
+
+    def check(self, keys: set[str]) -> tuple[list[str], set[str]]:
+        """Look at the cluster: (the ready workers, our task keys to submit again because
+        their worker is stalled or excluded). Raises :class:`ClusterLost`."""
+        if self.client.status not in ("running", "connecting", "newly-created"):
+            raise self.lost()
+        try:
+            info = self.client.scheduler_info(n_workers=-1)
+            processing = self.client.processing()
+        except (OSError, distributed.comm.CommClosedError, TimeoutError) as exc:
+            raise self.lost(exc) from None
+        now = time.monotonic()
+        workers = info.get("workers", {})
+        self._tell_unready(workers, now)
+        ready = self.ready_workers(info)
+        moved: set[str] = set()
+        for worker, held in processing.items():
+            ours = keys.intersection(str(k) for k in held)
+            if not ours:
+                self.busy_since.pop(worker, None)
+                continue
+            if worker in self.excluded:
+                moved |= ours
+                continue
+            stalled = self._stalled(worker, workers.get(worker, {}), now)
+            if stalled:
+                self.excluded.add(worker)
+                moved |= ours
+                ready = [w for w in ready if w != worker]
+                self.note(f"farm: worker {worker} {stalled}; its {len(ours)} task"
+                          f"{'s' if len(ours) != 1 else ''} go to "
+                          + (f"the other {len(ready)} worker{'s' if len(ready) != 1 else ''}"
+                             if ready else "no other worker"))
+        if ready:
+            self.no_worker_since = None
+        else:
+            self._no_worker(workers, now)
+        return ready, moved
+
+    def _stalled(self, worker: str, identity: dict[str, Any], now: float) -> str:
+        """Why ``worker`` (holding our tasks) is stalled, or ''."""
+        since = self.busy_since.setdefault(worker, now)
+        seen = identity.get("last_seen")
+        last_seen, unchanged_since = self.heartbeats.get(worker, (None, now))
+        if seen != last_seen:
+            self.heartbeats[worker] = (seen, now)
+        elif now - unchanged_since > self.stall_floor:
+            return f"sent no heartbeat for {now - unchanged_since:.0f} s"
+        with self._lock:
+            progress = self.last_progress.get(worker)
+        quiet = now - max(since, progress or since)
+        limit = self.limit()
+        if quiet > limit:
+            return (f"finished nothing for {quiet:.0f} s (the stall limit: {limit:.0f} s, "
+                    "docs/farm.md)")
+        return ""
+
+    def _tell_unready(self, workers: dict[str, Any], now: float) -> None:
+        """One line for each worker that will not render (once)."""
+        with self._lock:
+            states = dict(self.states)
+        for worker, identity in workers.items():
+            self.first_seen.setdefault(worker, now)
+            if worker in self.told or identity.get("resources", {}).get(RESOURCE, 0) > 0:
+                continue
+            line = self.unready_reason(worker, states.get(worker), now)
+            if line:
+                self.told.add(worker)
+                self.note(f"farm: {line}: it gets no tasks")
+
+    def unready_reason(self, worker: str, state: dict[str, Any] | None, now: float) -> str:
+        if state is not None and state.get("status") == "mismatch":
+            return (f"worker {worker} runs {state['fingerprint']}, not the client's "
+                    f"{state['wanted']}")
+        if state is None and now - self.first_seen.get(worker, now) > self.stall_floor:
+            return (f"worker {worker} has not loaded whitted in {self.stall_floor:.0f} s "
+                    "(is whitted[farm] installed there?)")
+        return ""
+
+    def _no_worker(self, workers: dict[str, Any], now: float) -> None:
+        with self._lock:
+            states = dict(self.states)
+        compiling = [w for w in workers if (states.get(w) or {}).get("status") == "compiling"
+                     and w not in self.excluded]
+        if compiling:
+            self.no_worker_since = None
+            return
+        if self.no_worker_since is None:
+            self.no_worker_since = now
+            return
+        if now - self.no_worker_since <= self.stall_floor:
+            return
+        if not workers:
+            raise ClusterLost(f"every worker was lost ({now - self.no_worker_since:.0f} s "
+                              "without one)")
+        reasons = []
+        for worker in workers:
+            reason = (f"worker {worker} stalled" if worker in self.excluded
+                      else self.unready_reason(worker, states.get(worker), now + 1e9)
+                      or f"worker {worker} is not ready")
+            reasons.append(reason)
+        raise ClusterLost("no worker can render: " + "; ".join(reasons))
+
+
+def _first_line(exc: BaseException | None) -> str:
+    text = str(exc).strip().splitlines()[0] if exc is not None and str(exc).strip() else ""
+    return text or type(exc).__name__
+
+
+def run_tasks(watch: Watch, tasks: dict[Future, Any],
+              submit: Callable[[Any, list[str] | None], Future],
+              on_done: Callable[[Future, Any], None], *,
+              cancel: threading.Event | None = None,
+              between: Callable[[], None] | None = None) -> bool:
+    """Wait for every task of ``tasks`` (future -> its work item), calling ``on_done(future,
+    item)`` for each as it finishes (``future.status`` "finished", "error" or "cancelled").
+    Work of a stalled worker is submitted again with ``submit(item, workers)``, the ready
+    workers; ``between()`` runs after each step (it may add tasks). Returns False when
+    ``cancel`` was set (the tasks that had finished are handled first); on Ctrl-C
+    (KeyboardInterrupt) the finished ones are handled too, then it is raised again."""
+    try:
+        while tasks:
+            if cancel is not None and cancel.is_set():
+                _finish(tasks, on_done)
+                return False
+            for future in watch.wait(tasks):
+                on_done(future, tasks.pop(future))
+            if between is not None:
+                between()
+            if not tasks:
+                break
+            ready, moved = watch.check({str(f.key) for f in tasks})
+            stalled = [f for f in tasks if str(f.key) in moved]
+            if stalled and not ready:
+                raise ClusterLost("every worker that could render stalled or was lost")
+            for future in stalled:
+                item = tasks.pop(future)
+                future.cancel()
+                tasks[submit(item, ready)] = item
+    except KeyboardInterrupt:
+        _finish(tasks, on_done)
+        raise
+    return True
+
+
+def _finish(tasks: dict[Future, Any], on_done: Callable[[Future, Any], None]) -> None:
+    """Handle the tasks that already finished (their results are on the workers)."""
+    for future in [f for f in tasks if f.status == "finished"]:
+        try:
+            on_done(future, tasks.pop(future))
+        except (OSError, distributed.comm.CommClosedError, TimeoutError):
+            break  # the cluster is going: what is written stays written
+
+
+def cancel_quietly(client: Client, futures: Iterable[Future]) -> None:
+    """Cancel ``futures``; a scheduler already gone has nothing left to cancel."""
+    with contextlib.suppress(Exception):
+        client.cancel(list(futures))
