@@ -268,10 +268,17 @@ def assert_frames_match(folder: Path, local_frames: dict[int, bytes], frames) ->
         assert data == local_frames[k], f"frame {k}: the PNG differs from the local one"
 
 
-def test_chunk_size_packs_short_frames_and_keeps_every_worker_busy():
-    assert chunk_size(48, 32, 2, 240, 2) == 40  # 1e6 samples a task wanted, 40 at most
-    assert chunk_size(48, 32, 2, 8, 2) == 1  # 8 frames: 3 tasks a worker come first
-    assert chunk_size(1920, 1080, 4, 1000, 10) == 1  # a long frame is a task of its own
+def test_chunk_size_packs_short_frames_and_keeps_every_thread_busy():
+    # 0.01 s frames: 200 make the 2 s a task should hold; 1,000 frames on 2 threads allow
+    # 1000 // (4 * 2) = 125 a task at most
+    assert chunk_size(1000, 2, 0.01) == 125
+    assert chunk_size(10_000, 2, 0.01) == 200
+    assert chunk_size(8, 2, 0.01) == 1  # 8 frames: 4 rounds for each thread come first
+    assert chunk_size(1000, 10, 1.3) == 2  # ceil(2 / 1.3) frames of 1.3 s
+    assert chunk_size(1000, 10, 60.0) == 1  # a long frame is a task of its own
+    assert chunk_size(1000, 10, None) == 1  # not measured yet: one frame a task
+    # the 10 nodes x 32 threads: 1,000 frames are 1,000 tasks for the 320 threads
+    assert chunk_size(1000, 320, 0.05) == 1
 
 
 def test_film_on_two_workers_is_the_local_film_frame_by_frame(client, film_scene,

@@ -1,10 +1,18 @@
 """Command-line glue for the render farm: ``whitted render ... --cluster local:N`` or
-``--scheduler tcp://HOST:PORT`` (and the same options of ``whitted animate``)."""
+``--scheduler tcp://HOST:PORT`` (and the same options of ``whitted animate``).
+
+Exit status: 0 done; 2 a bad option or scene, a frame that failed (named); 3 the cluster
+cannot do the job (scheduler unreachable or lost, no worker able to render: every one lost,
+stalled, or running another whitted); 130 interrupted (143 terminated). Whatever arrived
+before the end (frames, bands) is kept."""
 
 from __future__ import annotations
 
+import signal
+import threading
 import time
-from contextlib import nullcontext
+from collections.abc import Iterator
+from contextlib import contextmanager, nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -17,9 +25,11 @@ if TYPE_CHECKING:
 
     from ..scene.scene import Scene
 
+EXIT_CLUSTER = 3  # the cluster cannot do the job (docs/farm.md)
+
 ClusterOption = Annotated[
     str | None, typer.Option("--cluster", help="Render on a new local Dask cluster: local:N "
-                             "worker processes (needs whitted[farm])")]
+                             "worker processes (needs whitted\\[farm])")]
 SchedulerOption = Annotated[
     str | None, typer.Option("--scheduler", help="Render on the Dask cluster at "
                              "tcp://HOST:PORT (workers need whitted installed)")]
@@ -34,6 +44,49 @@ def farm_module():
     except ImportError as exc:
         raise fail(str(exc)) from None
     return farm
+
+
+def cluster_fail(message: str) -> typer.Exit:
+    """One line, exit status :data:`EXIT_CLUSTER`."""
+    from .main import fail
+
+    fail(message)
+    return typer.Exit(EXIT_CLUSTER)
+
+
+@contextmanager
+def stop_on_signals() -> Iterator[tuple[threading.Event, list[int]]]:
+    """While the farm works: the first Ctrl-C (SIGINT) or SIGTERM sets the event (the job
+    stops after writing what arrived), a second Ctrl-C stops at once."""
+    stop = threading.Event()
+    signals: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield stop, signals
+        return
+
+    def on_signal(signum, frame) -> None:
+        if stop.is_set() and signum == signal.SIGINT:
+            raise KeyboardInterrupt
+        signals.append(signum)
+        stop.set()
+
+    handled = (signal.SIGINT, signal.SIGTERM)
+    previous = {sig: signal.getsignal(sig) for sig in handled}
+    for sig in handled:
+        signal.signal(sig, on_signal)
+    try:
+        yield stop, signals
+    finally:
+        for sig in handled:
+            signal.signal(sig, previous[sig])
+
+
+def _stopped_status(signals: list[int]) -> tuple[str, int]:
+    from .main import EXIT_INTERRUPTED, EXIT_TERMINATED
+
+    if signal.SIGTERM in signals:
+        return "terminated", EXIT_TERMINATED
+    return "interrupted", EXIT_INTERRUPTED
 
 
 def bar(label: str, quiet: bool) -> Progress | None:
@@ -55,33 +108,57 @@ def bar(label: str, quiet: bool) -> Progress | None:
 
 def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
                          scheduler: str | None, threads: int | None, quiet: bool,
-                         bit_depth: int, aovs: list[str]) -> None:
-    """``whitted render`` on a cluster: bands across the workers, one image written here."""
-    from .main import _save_npy, err, fail, out
+                         bit_depth: int, aovs: list[str], frame: int | None = None) -> None:
+    """``whitted render`` on a cluster: bands across the workers, one image written here
+    (with ``frame``, an 8-bit PNG is the film's frame file, record included, as locally).
+    Stopped part way, the bands that arrived are written, as a local render keeps its
+    tiles."""
+    from .main import _note, _save_npy, err, fail, out
 
     farm = farm_module()
     start = time.perf_counter()
     note = None if quiet else (lambda line: err.print(line, markup=False, highlight=False))
     try:
-        with farm.farm_client(cluster, scheduler, threads=threads, note=note) as client:
+        # Ctrl-C while the cluster starts stops at once; later, after the bands that arrived
+        with farm.farm_client(cluster, scheduler, threads=threads, note=note) as client, \
+                stop_on_signals() as (stop, signals):
             progress = bar("rendering bands", quiet)
-            if progress is None:
-                image = farm.render_still(client, scene)
-            else:
-                with progress:
-                    task = progress.add_task("bands", total=None)
-                    image = farm.render_still(
-                        client, scene,
-                        progress=lambda done, total: progress.update(task, completed=done,
-                                                                     total=total))
-    except WhittedError as exc:  # a bad option, an unreachable scheduler, a bad model file
+            with progress if progress is not None else nullcontext():
+                task = progress.add_task("bands", total=None) if progress else None
+                image = farm.render_still(
+                    client, scene, cancel=stop, note=note,
+                    progress=None if progress is None else (
+                        lambda done, total: progress.update(task, completed=done,
+                                                            total=total)))
+    except KeyboardInterrupt:  # a second Ctrl-C, or one while the cluster started
+        _note(f"interrupted: nothing written ({output} is unchanged)")
+        raise typer.Exit(130) from None
+    except farm.ClusterLost as exc:
+        raise cluster_fail(str(exc)) from None
+    except WhittedError as exc:  # a bad option, a bad model file
         raise fail(str(exc)) from None
     stats = image.meta["stats"]
+    if stats.cancelled and stats.tiles_done == 0:
+        what, code = _stopped_status(signals)
+        _note(f"{what} before any band was finished: nothing written ({output} is unchanged)")
+        raise typer.Exit(code)
     for warning in stats.warnings:
         err.print(f"warning: {warning}", markup=False, highlight=False)
-    image.save(output, bit_depth=bit_depth)
+    from ..output.encode import image_format
+
+    try:
+        if frame is not None and not stats.cancelled and bit_depth == 8 \
+                and image_format(output) == "png":  # the very file the film's frame K is
+            from ..animation.frames import frame_digest, write_frame_png
+
+            write_frame_png(output, image, frame_digest(scene, frame), frame)
+        else:
+            image.save(output, bit_depth=bit_depth)
+    except OSError as exc:
+        raise fail(f"{getattr(exc, 'filename', None) or output}: cannot write: "
+                   f"{exc.strerror or exc}") from None
     written = [str(output)]
-    if aovs:  # one cheap pass through the pixel centres: done here
+    if aovs and not stats.cancelled:  # one cheap pass through the pixel centres: done here
         from ..render.api import render_aovs
 
         planes = render_aovs(scene)
@@ -90,9 +167,13 @@ def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
             _save_npy(path, planes[name])
             written.append(str(path))
     stats.wall_seconds = time.perf_counter() - start
-    if not quiet:
+    if not quiet or stats.cancelled:
         out.print(f"{stats.summary()} on {image.meta['workers']} workers "
-                  f"({image.meta['bands']} bands) -> {', '.join(written)}")
+                  f"({image.meta['bands']} bands) -> {', '.join(written)}", highlight=False)
+    if stats.cancelled:
+        what, code = _stopped_status(signals)
+        _note(f"{what}: kept {stats.tiles_done}/{stats.tiles_total} bands in {output}")
+        raise typer.Exit(code)
     raise typer.Exit(0)
 
 
@@ -101,19 +182,29 @@ def animate_on_farm(scene: Scene, frames: range, folder: Path, film: Path | None
                     scheduler: str | None, threads: int | None) -> None:
     """``whitted animate`` on a cluster: frames as tasks, each written here as it arrives
     (resumable, as the local command), then the film encoded from the whole sequence."""
-    from .main import EXIT_INTERRUPTED, err, fail, out
+    from .main import err, fail, out
 
     farm = farm_module()
     start = time.perf_counter()
     note = None if quiet else (lambda line: err.print(line, markup=False, highlight=False))
     finished: list[int | None] = []
+    signals: list[int] = []
+
+    def stopped(extra: str = "") -> typer.Exit:
+        what, code = _stopped_status(signals)
+        err.print(f"{what}: {len(finished)} of {len(frames)} frames finished in {folder}"
+                  f"{extra}; run the same command again to continue", markup=False,
+                  highlight=False)
+        return typer.Exit(code)
+
     try:
         farm.check_farm_options(cluster, scheduler)
         plan = farm.plan_film(scene, folder, frames=frames, force=force)
         # a cluster only when frames are missing: a finished film is only encoded
         connect = (farm.farm_client(cluster, scheduler, threads=threads, note=note)
                    if plan.todo else nullcontext())
-        with connect as client:
+        with connect as client, stop_on_signals() as (stop, caught):
+            signals = caught
             progress = bar("frames", quiet)
 
             def frame_done(done: int, total: int, frame: int | None) -> None:
@@ -126,15 +217,19 @@ def animate_on_farm(scene: Scene, frames: range, folder: Path, film: Path | None
             with progress if progress is not None else nullcontext():
                 task = progress.add_task("frames", total=len(frames)) if progress else None
                 result = farm.render_film(client, scene, folder, film=film, fps=fps, crf=crf,
-                                          progress=frame_done, plan=plan)
-    except KeyboardInterrupt:
-        err.print(f"interrupted: {len(finished)} of {len(frames)} frames finished in {folder}; "
-                  "run the same command again to continue")
-        raise typer.Exit(EXIT_INTERRUPTED) from None
-    except WhittedError as exc:  # a bad option, an unreachable scheduler, a failed frame
+                                          progress=frame_done, plan=plan, cancel=stop,
+                                          note=note)
+    except KeyboardInterrupt:  # a second Ctrl-C (or one while the cluster started)
+        raise stopped() from None
+    except farm.ClusterLost as exc:
+        kept = f" ({len(finished)} of {len(frames)} frames are in {folder})" if finished else ""
+        raise cluster_fail(f"{exc}{kept}") from None
+    except WhittedError as exc:  # a bad option, a failed frame
         raise fail(str(exc)) from None
     except (ValueError, OSError) as exc:  # the encoder
         raise fail(f"{film}: cannot encode: {exc}") from None
+    if result.interrupted:
+        raise stopped()
     for warning in result.warnings:
         err.print(f"warning: {warning}", markup=False, highlight=False)
     if not quiet:

@@ -200,7 +200,8 @@ def render(
     _resume_collector()  # set-up done: the job (or the farm's client) runs with it
     if cluster is not None or scheduler is not None:  # bands on a Dask cluster (cli/farm.py)
         render_still_on_farm(scene, output, cluster=cluster, scheduler=scheduler,
-                             threads=threads, quiet=quiet, bit_depth=bit_depth, aovs=aovs)
+                             threads=threads, quiet=quiet, bit_depth=bit_depth, aovs=aovs,
+                             frame=frame)
 
     try:
         job = RenderJob(scene)

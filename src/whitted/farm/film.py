@@ -46,7 +46,8 @@ class FrameFailed(WhittedError):
     """A frame could not be rendered: ``frame`` and the reason, in one line."""
 
     def __init__(self, frame: int, reason: str) -> None:
-        super().__init__(f"frame {frame}: {reason}")
+        prefix = f"frame {frame}:"  # a reason that names its frame already is not told twice
+        super().__init__(reason if reason.startswith(prefix) else f"{prefix} {reason}")
         self.frame = frame
         self.reason = reason
 
