@@ -10,6 +10,7 @@ import importlib.util
 import signal
 import socket
 import threading
+import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from urllib.parse import urlsplit
@@ -118,10 +119,11 @@ def ready_cluster(client: Client, plugin: WhittedWorker,
             failure = exc
         info = client.scheduler_info(n_workers=-1)
         ready = ready_workers(info)
-        states = dict(watch.states)
+        states = _states(client, [w for w in info.get("workers", {}) if w not in ready])
     finally:
         watch.close()
-    why = f"{type(failure).__name__}: {failure}" if failure is not None else ""
+    why = (str(failure) if type(failure) is Exception else f"{type(failure).__name__}: "
+           f"{failure}") if failure is not None else ""
     reasons = []
     for worker in info.get("workers", {}):
         if worker in ready:
@@ -138,6 +140,19 @@ def ready_cluster(client: Client, plugin: WhittedWorker,
         if note is not None:
             note(f"farm: {reason}: it gets no tasks")
     return ready
+
+
+def _states(client: Client, workers: list[str], wait: float = 2.0) -> dict[str, dict]:
+    """The plugin's last event of each worker (a mismatch comes as an event: waited for a
+    moment, it may follow the plugin's answer)."""
+    from .worker import EVENT_TOPIC
+
+    end = time.monotonic() + wait
+    while True:
+        states = {m.get("worker"): m for _, m in client.get_events(EVENT_TOPIC)}
+        if all(w in states for w in workers) or time.monotonic() > end:
+            return states
+        time.sleep(0.05)
 
 
 @contextmanager

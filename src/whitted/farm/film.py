@@ -70,6 +70,7 @@ class FilmResult:
     film: Path | None = None
     warnings: list[str] = field(default_factory=list)
     interrupted: bool = False  # stopped by ``cancel``: what arrived is written, no film
+    workers: dict[int, str] = field(default_factory=dict)  # frame -> the worker that made it
     threads: int = 0  # the cluster's Dask threads when the tasks were sized
 
 
@@ -202,7 +203,7 @@ def _render_missing(client, scene, stills, chosen, digests, paths, todo, result,
                     stall_floor) -> None:
     from ..compile.embree import with_concrete_mesh_tracer
     from .watch import STALL_FLOOR, Watch, cancel_quietly, run_tasks
-    from .worker import TASK_RESOURCES, hold
+    from .worker import TASK_RESOURCES, scene_argument
 
     watch = Watch(client, note, stall_floor=STALL_FLOOR if stall_floor is None
                   else stall_floor)
@@ -216,8 +217,7 @@ def _render_missing(client, scene, stills, chosen, digests, paths, todo, result,
         position = {i: n for n, i in enumerate(todo)}  # shipment.needs is indexed like todo
         # the scene as a task's result: a worker that lost it (killed, restarted) gets it
         # again, computed from the task, from wherever it still is
-        scene_future = client.submit(hold, with_concrete_mesh_tracer(scene), pure=False,
-                                     resources=TASK_RESOURCES)
+        scene_future = scene_argument(client, with_concrete_mesh_tracer(scene))
 
         def submit(run: list[int], workers: list[str] | None = None):
             manifest, blobs = shipment.for_scenes([position[i] for i in run])
@@ -249,7 +249,7 @@ def _render_missing(client, scene, stills, chosen, digests, paths, todo, result,
                 for i in run:
                     result.failed[chosen[i]] = _reason(exc)
                 return
-            outcomes = future.result()
+            outcomes = watch.result(future)
             watch.record(o.seconds for o in outcomes if o.png is not None)
             interrupt = None
             for outcome in outcomes:  # each written, even after a Ctrl-C in the progress
@@ -259,6 +259,7 @@ def _render_missing(client, scene, stills, chosen, digests, paths, todo, result,
                 write(where[outcome.frame],
                       lambda tmp, data=outcome.png: Path(tmp).write_bytes(data))
                 result.rendered.append(outcome.frame)
+                result.workers[outcome.frame] = outcome.worker
                 result.render_seconds += outcome.seconds
                 result.render_cpu_seconds += outcome.cpu_seconds
                 result.warnings.extend(w for w in outcome.warnings

@@ -58,7 +58,7 @@ def render_still(
     :class:`~whitted.farm.watch.ClusterLost` when the cluster cannot go on."""
     from ..compile.embree import with_concrete_mesh_tracer
     from .watch import STALL_FLOOR, Watch, cancel_quietly, run_tasks
-    from .worker import TASK_RESOURCES, hold
+    from .worker import TASK_RESOURCES, scene_argument
 
     start = time.perf_counter()
     if scene.is_animated:  # as the render API does: an animated scene renders its frame 0
@@ -79,8 +79,7 @@ def render_still(
         shipment = (assets if isinstance(assets, Shipment)
                     else ship_assets(client, [scene], assets))
         manifest, blobs = shipment.for_scenes([0])
-        scene_future = client.submit(hold, with_concrete_mesh_tracer(scene), pure=False,
-                                     resources=TASK_RESOURCES)
+        scene_future = scene_argument(client, with_concrete_mesh_tracer(scene))
 
         def submit(band: tuple[int, int], workers: list[str] | None = None):
             return client.submit(render_band, scene_future, band[0], band[1], manifest, blobs,
@@ -93,7 +92,7 @@ def render_still(
         def on_done(future, band: tuple[int, int]) -> None:
             if future.status == "cancelled":
                 raise watch.lost()
-            row, rows, band_stats = future.result()  # a failed band raises its error
+            row, rows, band_stats = watch.result(future)  # a failed band raises its error
             framebuffer[row:row + len(rows)] = rows
             watch.record([band_stats.render_seconds])
             for kind, count in band_stats.rays.items():

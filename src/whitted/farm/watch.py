@@ -13,11 +13,17 @@ at the cluster (:class:`Watch`):
 
       limit = max(STALL_FLOOR, STALL_FACTOR * frames_per_task * frame_seconds)
 
-  where ``frame_seconds`` is the median time of the frames (bands) finished so far in this
-  job; before the first one, the limit is :data:`FIRST_TASK_LIMIT` for progress (heartbeats
-  keep their floor). A stalled worker (hung, stopped with SIGSTOP, swapping) is excluded: its
+  where ``frame_seconds`` is the longest time of a frame (band) finished so far in this job;
+  for a worker that has finished none yet (its first task also compiles the scene's geometry
+  and loads kernels), the progress limit is :data:`FIRST_TASK_LIMIT`; heartbeats always keep
+  the floor. A stalled worker (hung, stopped with SIGSTOP, swapping) is excluded: its
   tasks are submitted again for the other ready workers only, and the first result of a
   task is the one kept. When no other worker is left, the job ends with one line.
+- **Tasks left without a worker.** Dask gives a task that no worker could take when it was
+  scheduled (every worker lost, or still readying) to the first worker that *joins* with the
+  resource, but a worker offers it only once readied, after joining: such a task would wait
+  forever beside an idle ready worker. A task that is on no worker for :data:`KICK_SECONDS`
+  while a ready worker has a free thread is submitted again (the first result is kept).
 - **The scheduler lost.** The client's connection gone for good ends the job with one line.
 
 Every such ending is a :class:`~whitted.farm.errors.ClusterLost` (exit status 3):
@@ -27,7 +33,6 @@ what the farm had finished (frames written, bands) is kept.
 from __future__ import annotations
 
 import contextlib
-import statistics
 import threading
 import time
 from collections.abc import Callable, Iterable
@@ -40,7 +45,8 @@ from .worker import EVENT_TOPIC, PROGRESS_TOPIC, RESOURCE
 POLL_SECONDS = 0.5
 STALL_FLOOR = 30.0  # seconds: never less than this before a worker is called stalled
 STALL_FACTOR = 10.0  # times the expected time of a task
-FIRST_TASK_LIMIT = 600.0  # seconds without a finished frame before any frame was measured
+FIRST_TASK_LIMIT = 600.0  # seconds without a finished frame, before a worker's first one
+KICK_SECONDS = 5.0  # a task on no worker this long, beside an idle ready worker: again
 
 
 def ready_workers(info: dict[str, Any]) -> list[str]:
@@ -69,7 +75,9 @@ class Watch:
         self.excluded: set[str] = set()
         self.told: set[str] = set()
         self.no_worker_since: float | None = None
+        self.unplaced: dict[str, float] = {}  # our task key -> since when it is on no worker
         self.frames_per_task = 1
+        self.result_seconds = stall_floor  # the longest wait for a finished task's result
         for _, message in client.get_events(EVENT_TOPIC):  # what happened before this job
             self.states[message.get("worker", "?")] = message
         client.subscribe_topic(EVENT_TOPIC, self._on_worker_event)
@@ -101,6 +109,24 @@ class Watch:
             if "seconds" in message:
                 self.seconds.append(float(message["seconds"]))
 
+    def result(self, future: Future) -> Any:
+        """``future.result()``, or TimeoutError when the worker holding it does not hand it
+        over within the floor of the stall limit (stopped, or gone without a word)."""
+        return future.result(timeout=self.result_seconds)
+
+    def give_up_on(self, future: Future) -> list[str]:
+        """Exclude the workers holding ``future``'s result (it did not come back)."""
+        try:
+            holders = list(self.client.who_has([future]).get(future.key, ()))
+        except (OSError, TimeoutError):
+            holders = []
+        for worker in holders:
+            if worker not in self.excluded:
+                self.excluded.add(worker)
+                self.note(f"farm: worker {worker} did not hand over a finished task in "
+                          f"{self.result_seconds:.0f} s; the task goes to other workers")
+        return holders
+
     def record(self, seconds: Iterable[float]) -> None:
         """Frame (band) times learnt from results (events may come later than results)."""
         with self._lock:
@@ -130,13 +156,14 @@ class Watch:
     def ready_workers(self, info: dict[str, Any]) -> list[str]:
         return [w for w in ready_workers(info) if w not in self.excluded]
 
-    def limit(self) -> float:
-        """The stall limit now (module docstring)."""
+    def limit(self, worker: str | None = None) -> float:
+        """The progress limit now, for ``worker`` (module docstring)."""
         with self._lock:
             seconds = list(self.seconds)
-        if not seconds:
+            started = worker is None or worker in self.last_progress
+        if not seconds or not started:
             return max(self.stall_floor, FIRST_TASK_LIMIT)
-        expected = self.frames_per_task * statistics.median(seconds)
+        expected = self.frames_per_task * max(seconds)
         return max(self.stall_floor, STALL_FACTOR * expected)
 
     def check(self, keys: set[str]) -> tuple[list[str], set[str]]:
@@ -173,9 +200,29 @@ class Watch:
                              if ready else "no other worker"))
         if ready:
             self.no_worker_since = None
+            moved |= self._unplaced(keys, processing, ready, workers, now)
         else:
             self._no_worker(workers, now)
         return ready, moved
+
+    def _unplaced(self, keys: set[str], processing: dict, ready: list[str],
+                  workers: dict[str, Any], now: float) -> set[str]:
+        """Our tasks on no worker for :data:`KICK_SECONDS` while a ready worker has a free
+        thread (module docstring)."""
+        placed = {str(k) for held in processing.values() for k in held}
+        for key in list(self.unplaced):
+            if key not in keys or key in placed:
+                del self.unplaced[key]
+        for key in keys - placed:
+            self.unplaced.setdefault(key, now)
+        free = any(len(processing.get(w, ())) < workers.get(w, {}).get("nthreads", 1)
+                   for w in ready)
+        if not free:
+            return set()
+        stuck = {k for k, since in self.unplaced.items() if now - since > KICK_SECONDS}
+        for key in stuck:
+            del self.unplaced[key]
+        return stuck
 
     def _stalled(self, worker: str, identity: dict[str, Any], now: float) -> str:
         """Why ``worker`` (holding our tasks) is stalled, or ''."""
@@ -189,7 +236,7 @@ class Watch:
         with self._lock:
             progress = self.last_progress.get(worker)
         quiet = now - max(since, progress or since)
-        limit = self.limit()
+        limit = self.limit(worker)
         if quiet > limit:
             return (f"finished nothing for {quiet:.0f} s (the stall limit: {limit:.0f} s, "
                     "docs/farm.md)")
@@ -253,43 +300,57 @@ def run_tasks(watch: Watch, tasks: dict[Future, Any],
               cancel: threading.Event | None = None,
               between: Callable[[], None] | None = None) -> bool:
     """Wait for every task of ``tasks`` (future -> its work item), calling ``on_done(future,
-    item)`` for each as it finishes (``future.status`` "finished", "error" or "cancelled").
-    Work of a stalled worker is submitted again with ``submit(item, workers)``, the ready
-    workers; ``between()`` runs after each step (it may add tasks). Returns False when
-    ``cancel`` was set (the tasks that had finished are handled first); on Ctrl-C
-    (KeyboardInterrupt) the finished ones are handled too, then it is raised again."""
+    item)`` for each as it finishes (``future.status`` "finished", "error" or "cancelled";
+    it takes the result with ``watch.result(future)``). Work of a stalled worker, or whose
+    finished result its worker does not hand over, is submitted again with ``submit(item,
+    workers)``, the ready workers; ``between()`` runs after each step (it may add tasks).
+    Returns False when ``cancel`` was set (the tasks that had finished are handled first); on
+    Ctrl-C (KeyboardInterrupt) the finished ones are handled too, then it is raised again."""
+
+    def again(items: list[Any], ready: list[str]) -> None:
+        if items and not ready:
+            raise ClusterLost("every worker that could render stalled or was lost")
+        for item in items:
+            tasks[submit(item, ready)] = item
+
     try:
         while tasks:
             if cancel is not None and cancel.is_set():
-                _finish(tasks, on_done)
+                _finish(watch, tasks, on_done)
                 return False
             for future in watch.wait(tasks):
-                on_done(future, tasks.pop(future))
+                item = tasks.pop(future)
+                try:
+                    on_done(future, item)
+                except TimeoutError:  # its worker holds the result and does not answer
+                    watch.give_up_on(future)
+                    again([item], watch.ready_workers(watch.client.scheduler_info(
+                        n_workers=-1)))
             if between is not None:
                 between()
             if not tasks:
                 break
             ready, moved = watch.check({str(f.key) for f in tasks})
             stalled = [f for f in tasks if str(f.key) in moved]
-            if stalled and not ready:
-                raise ClusterLost("every worker that could render stalled or was lost")
+            items = [tasks.pop(f) for f in stalled]
             for future in stalled:
-                item = tasks.pop(future)
                 future.cancel()
-                tasks[submit(item, ready)] = item
+            again(items, ready)
     except KeyboardInterrupt:
-        _finish(tasks, on_done)
+        _finish(watch, tasks, on_done)
         raise
     return True
 
 
-def _finish(tasks: dict[Future, Any], on_done: Callable[[Future, Any], None]) -> None:
+def _finish(watch: Watch, tasks: dict[Future, Any],
+            on_done: Callable[[Future, Any], None]) -> None:
     """Handle the tasks that already finished (their results are on the workers)."""
+    watch.result_seconds = min(watch.result_seconds, 5.0)  # stopping: no long waits
     for future in [f for f in tasks if f.status == "finished"]:
         try:
             on_done(future, tasks.pop(future))
         except (OSError, distributed.comm.CommClosedError, TimeoutError):
-            break  # the cluster is going: what is written stays written
+            continue  # the cluster is going: what is written stays written
 
 
 def cancel_quietly(client: Client, futures: Iterable[Future]) -> None:

@@ -156,15 +156,33 @@ def hold(value: Any) -> Any:
     return value
 
 
-def _progress(**message: Any) -> None:
-    """Tell the client (through the scheduler) that a frame or band finished here."""
+#: a scene that pickles to at most this many bytes travels inside each task (no worker holds
+#: anything another needs); a bigger one is a task's result every task depends on
+SCENE_INLINE_BYTES = 64 * 1024
+
+
+def scene_argument(client: Any, scene: Scene) -> Any:
+    """What tasks take as their scene: the scene itself when small (:data:`SCENE_INLINE_BYTES`),
+    else the future of a :func:`hold` task: either way a worker that lost it, or a new one,
+    gets it again (from the task, or computed again), never from a worker that stopped."""
+    import pickle
+
+    if len(pickle.dumps(scene, protocol=pickle.HIGHEST_PROTOCOL)) <= SCENE_INLINE_BYTES:
+        return scene
+    return client.submit(hold, scene, pure=False, resources=TASK_RESOURCES)
+
+
+def _progress(**message: Any) -> str:
+    """Tell the client (through the scheduler) that a frame or band finished here; this
+    worker's address ('' outside a worker)."""
     from ._dask import get_worker
 
     try:
         worker = get_worker()
     except ValueError:  # not in a worker (a test calling the task directly)
-        return
+        return ""
     worker.log_event(PROGRESS_TOPIC, {"worker": worker.address, **message})
+    return worker.address
 
 
 def _prepared(scene: Scene, manifest: AssetManifest | None,
@@ -201,6 +219,7 @@ class FrameOutcome:
     seconds: float = 0.0
     cpu_seconds: float = 0.0  # this task thread's CPU time (all of it with 1 render thread)
     warnings: list[str] = field(default_factory=list)
+    worker: str = ""  # the address of the worker that rendered it
 
 
 def frame_png(image: Any, digest: str, frame: int) -> bytes:
@@ -247,5 +266,5 @@ def render_frame_chunk(scene: Scene, frames: list[int], digests: list[str],
         outcomes.append(FrameOutcome(frame, png, seconds=time.perf_counter() - start,
                                      cpu_seconds=time.thread_time() - cpu,
                                      warnings=[client_names(w) for w in job.stats.warnings]))
-        _progress(frame=frame, seconds=outcomes[-1].seconds)
+        outcomes[-1].worker = _progress(frame=frame, seconds=outcomes[-1].seconds)
     return outcomes

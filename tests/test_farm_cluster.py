@@ -1,0 +1,392 @@
+"""The farm on clusters a render wrangler meets: a scheduler and workers started with the
+``dask scheduler`` / ``dask worker`` commands on 127.0.0.1, workers running another whitted or
+none, workers stopped (SIGSTOP), killed or lost, the scheduler lost (issue 26)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+import pytest
+
+distributed = pytest.importorskip("distributed")
+
+from whitted.animation.frames import render_frame  # noqa: E402
+from whitted.farm import ClusterLost, WhittedWorker, render_film  # noqa: E402
+from whitted.farm.cluster import ready_cluster  # noqa: E402
+from whitted.fingerprint import FINGERPRINT_KEY, renderer_fingerprint  # noqa: E402
+
+SRC = Path(__file__).resolve().parents[1] / "src"
+DASK_CLI = str(Path(sys.executable).parent / "dask")  # the `dask` command of this Python
+DASK = [DASK_CLI, "worker"]
+SCHEDULER = [DASK_CLI, "scheduler"]
+
+FILM = """
+[render]
+width = 24
+height = 16
+samples = 1
+
+[camera]
+position = [0, 1.5, 5]
+look_at = [0, 0.5, 0]
+
+[[lights]]
+type = "point"
+position = [3, 5, 4]
+
+[[objects]]
+type = "plane"
+material = { kd = 0.8, texture = { type = "checker", checks = 2.0 } }
+
+[[objects]]
+name = "ball"
+type = "sphere"
+center = [0, 0.5, 0]
+radius = 0.5
+material = "glass"
+
+[animation]
+frames = 8
+fps = 12
+
+[[animation.tracks]]
+path = "camera.position"
+keys = [[0, [0, 1.5, 5]], [7, [3, 1.5, 4]]]
+"""
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def wait_for(condition, what: str, limit: float = 120.0) -> None:
+    """Wait until ``condition()`` holds (checked every 50 ms); fail naming ``what`` after
+    ``limit`` seconds (a hang guard, not a timing assert)."""
+    end = time.monotonic() + limit
+    while not condition():
+        if time.monotonic() > end:
+            raise AssertionError(f"still waiting for {what}")
+        time.sleep(0.05)
+
+
+def env_with(pythonpath: str | None = None, **extra: str) -> dict[str, str]:
+    env = dict(os.environ, **extra)
+    if pythonpath is not None:
+        env["PYTHONPATH"] = pythonpath
+    return env
+
+
+@contextmanager
+def processes():
+    """Processes started by a test, each ended (its own id) when the test is done."""
+    started: list[subprocess.Popen] = []
+
+    def start(args, **kwargs) -> subprocess.Popen:
+        proc = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                **kwargs)
+        started.append(proc)
+        return proc
+
+    try:
+        yield start
+    finally:
+        for proc in started:
+            if proc.poll() is None:
+                os.kill(proc.pid, signal.SIGCONT)
+                proc.kill()
+            proc.wait(timeout=30)
+
+
+@pytest.fixture
+def film_scene(tmp_path):
+    from whitted import load_scene
+
+    path = tmp_path / "film.toml"
+    path.write_text(FILM)
+    return load_scene(path)
+
+
+@pytest.fixture
+def local_frames(film_scene, tmp_path) -> dict[int, bytes]:
+    folder = tmp_path / "local"
+    folder.mkdir()
+    frames = {}
+    for k in range(film_scene.frame_count):
+        render_frame(film_scene, k, folder / f"{k:04d}.png", threads=1)
+        frames[k] = (folder / f"{k:04d}.png").read_bytes()
+    return frames
+
+
+def other_whitted(tmp_path: Path) -> Path:
+    """A copy of whitted's sources with one line of ``kernels/integrator.py`` changed."""
+    copy = tmp_path / "other-src"
+    shutil.copytree(SRC, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    integrator = copy / "whitted/kernels/integrator.py"
+    integrator.write_text(integrator.read_text() + "\nCHANGED_ON_THIS_WORKER = 1\n")
+    return copy
+
+
+def no_whitted(tmp_path: Path) -> Path:
+    """A folder that, first on PYTHONPATH, makes ``import whitted`` fail as if it were not
+    installed."""
+    shadow = tmp_path / "no-whitted/whitted"
+    shadow.mkdir(parents=True)
+    (shadow / "__init__.py").write_text(
+        "raise ModuleNotFoundError(\"No module named 'whitted'\", name='whitted')\n")
+    return shadow.parent
+
+
+@pytest.fixture
+def scheduler():
+    """A ``dask scheduler`` on 127.0.0.1 and a function starting ``dask worker``s for it."""
+    port = free_port()
+    with processes() as start:
+        proc = start([*SCHEDULER, "--host", "127.0.0.1", "--port", str(port),
+                      "--dashboard-address", ":0"], env=env_with())
+        address = f"tcp://127.0.0.1:{port}"
+        wait_for(lambda: _listening(port) or proc.poll() is not None, "the scheduler")
+        assert proc.poll() is None
+
+        def worker(*args: str, pythonpath: str | None = None, **env: str) -> subprocess.Popen:
+            return start([*DASK, address, "--host", "127.0.0.1", "--nthreads", "1",
+                          "--dashboard-address", ":0", *args],
+                         env=env_with(pythonpath, NUMBA_NUM_THREADS="1", **env))
+
+        yield address, worker, proc
+
+
+def _listening(port: int) -> bool:
+    try:
+        with socket.create_connection(("127.0.0.1", port), timeout=1):
+            return True
+    except OSError:
+        return False
+
+
+def workers_of(client) -> dict[str, dict]:
+    return client.scheduler_info(n_workers=-1)["workers"]
+
+
+# ------------------------------------------------------------------------------ fingerprint
+
+
+def test_a_frame_records_its_renderer_and_another_renderers_frame_is_not_current(
+        film_scene, tmp_path):
+    from PIL import Image
+    from PIL.PngImagePlugin import PngInfo
+
+    from whitted.animation.frames import frame_digest, frame_is_current, still_for_frame
+
+    path = tmp_path / "0003.png"
+    render_frame(film_scene, 3, path, threads=1)
+    with Image.open(path) as im:
+        record = dict(im.text)
+    assert record[FINGERPRINT_KEY] == renderer_fingerprint()
+    assert renderer_fingerprint().startswith("whitted ")
+    digest = frame_digest(still_for_frame(film_scene, 3), 3)
+    assert frame_is_current(path, digest)
+    info = PngInfo()  # the same frame, as another whitted would have recorded it
+    for key, value in record.items():
+        info.add_text(key, "whitted 0.0.9 kernels 0123456789abcdef"
+                      if key == FINGERPRINT_KEY else value)
+    with Image.open(path) as im:
+        im.save(tmp_path / "other.png", pnginfo=info)
+    assert not frame_is_current(tmp_path / "other.png", digest)
+
+
+def test_a_worker_with_another_whitted_gets_no_tasks_and_is_named(scheduler, film_scene,
+                                                                  local_frames, tmp_path):
+    address, worker, _ = scheduler
+    worker("--name", "good", pythonpath=str(SRC))
+    worker("--name", "other", pythonpath=str(other_whitted(tmp_path)))
+    notes: list[str] = []
+    with distributed.Client(address) as client:
+        client.wait_for_workers(2)
+        ready = ready_cluster(client, WhittedWorker(threads=1), notes.append)
+        by_name = {d["name"]: w for w, d in workers_of(client).items()}
+        assert ready == [by_name["good"]]
+        [line] = [n for n in notes if by_name["other"] in n]
+        assert "runs whitted" in line and "not the client's" in line
+        assert line.endswith("it gets no tasks")
+        result = render_film(client, film_scene, tmp_path / "frames", chunk=1)
+    assert set(result.workers.values()) == {by_name["good"]}
+    for k in range(8):
+        data = (tmp_path / "frames" / f"{k:04d}.png").read_bytes()
+        assert data == local_frames[k]
+
+
+def test_no_worker_with_this_whitted_is_one_line_naming_them(scheduler, tmp_path):
+    address, worker, _ = scheduler
+    worker("--name", "other", pythonpath=str(other_whitted(tmp_path)))
+    worker("--name", "none", pythonpath=f"{no_whitted(tmp_path)}{os.pathsep}{SRC}")
+    with distributed.Client(address) as client:
+        client.wait_for_workers(2)
+        by_name = {d["name"]: w for w, d in workers_of(client).items()}
+        with pytest.raises(ClusterLost) as lost:
+            ready_cluster(client, WhittedWorker(threads=1), None)
+    message = str(lost.value)
+    assert "\n" not in message and message.startswith("no worker can render: ")
+    assert f"worker {by_name['other']} runs whitted" in message
+    assert f"worker {by_name['none']} cannot load whitted (ModuleNotFoundError" in message
+
+
+# ------------------------------------------------------------------------------ hangs
+
+
+def test_a_worker_without_whitted_joining_mid_film_does_not_hang_it(scheduler, film_scene,
+                                                                   local_frames, tmp_path):
+    address, worker, _ = scheduler
+    worker("--name", "good", pythonpath=str(SRC))
+    joined: list[subprocess.Popen] = []
+    with distributed.Client(address) as client:
+        client.wait_for_workers(1)
+        ready_cluster(client, WhittedWorker(threads=1), None)
+
+        def join_one(done, total, frame) -> None:
+            if joined:
+                return
+            joined.append(worker("--name", "bare",
+                                 pythonpath=f"{no_whitted(tmp_path)}{os.pathsep}{SRC}"))
+            # the film goes on only once the bare worker has joined (or given up)
+            wait_for(lambda: len(workers_of(client)) == 2 or joined[0].poll() is not None,
+                     "the worker without whitted")
+
+        result = render_film(client, film_scene, tmp_path / "frames", chunk=1,
+                             progress=join_one)
+        good = {w for w, d in workers_of(client).items() if d["name"] == "good"}
+    assert joined and sorted(result.rendered) == list(range(8))
+    assert set(result.workers.values()) == good
+    for k in range(8):
+        assert (tmp_path / "frames" / f"{k:04d}.png").read_bytes() == local_frames[k]
+
+
+def test_a_stopped_worker_stalls_nothing_its_tasks_go_elsewhere(scheduler, film_scene,
+                                                                 local_frames, tmp_path):
+    address, worker, _ = scheduler
+    procs = [worker("--name", f"w{i}", pythonpath=str(SRC)) for i in range(2)]
+    notes: list[str] = []
+    stopped: list[str] = []
+    try:
+        with distributed.Client(address) as client:
+            client.wait_for_workers(2)
+            ready_cluster(client, WhittedWorker(threads=1), None)
+            pids = client.run(os.getpid)
+
+            def stop_a_busy_worker(done, total, frame) -> None:
+                if stopped:
+                    return
+                busy = [w for w, keys in client.processing().items() if keys]
+                if busy:  # SIGSTOP: the worker holds its tasks and answers nothing
+                    os.kill(pids[busy[0]], signal.SIGSTOP)
+                    stopped.append(busy[0])
+
+            try:
+                result = render_film(client, film_scene, tmp_path / "frames", chunk=1,
+                                     progress=stop_a_busy_worker, note=notes.append,
+                                     stall_floor=2.0)
+            except ClusterLost:
+                print(notes)
+                raise
+    finally:
+        for proc in procs:
+            os.kill(proc.pid, signal.SIGCONT)
+    assert stopped and sorted(result.rendered) == list(range(8))
+    told = [n for n in notes if n.startswith(f"farm: worker {stopped[0]} ")]
+    assert told and all("\n" not in n for n in told)  # it is named, in one line each
+    for k in range(8):
+        assert (tmp_path / "frames" / f"{k:04d}.png").read_bytes() == local_frames[k]
+
+
+def test_a_killed_lone_worker_costs_retries_not_the_film(film_scene, local_frames, tmp_path):
+    from whitted.farm import farm_client
+
+    killed: list[int] = []
+    with farm_client("local:1", threads=1) as client:
+        pid = client.run(os.getpid)
+
+        def kill_it(done, total, frame) -> None:
+            if not killed:  # its nanny starts a new one: it has neither scene nor kernels
+                os.kill(next(iter(pid.values())), signal.SIGKILL)
+                killed.append(frame)
+
+        result = render_film(client, film_scene, tmp_path / "frames", chunk=1,
+                             progress=kill_it)
+        assert next(iter(client.run(os.getpid).values())) != next(iter(pid.values()))
+    assert killed and sorted(result.rendered) == list(range(8))
+    for k in range(8):
+        assert (tmp_path / "frames" / f"{k:04d}.png").read_bytes() == local_frames[k]
+
+
+def test_losing_every_worker_ends_in_one_line_keeping_the_frames(scheduler, film_scene,
+                                                                 tmp_path):
+    address, worker, _ = scheduler
+    lone = worker("--name", "lone", "--no-nanny", pythonpath=str(SRC))
+    with distributed.Client(address) as client:
+        client.wait_for_workers(1)
+        ready_cluster(client, WhittedWorker(threads=1), None)
+
+        def kill_it(done, total, frame) -> None:
+            if lone.poll() is None:
+                lone.kill()
+                lone.wait()
+
+        with pytest.raises(ClusterLost) as lost:
+            render_film(client, film_scene, tmp_path / "frames", chunk=1, progress=kill_it,
+                        stall_floor=1.0)
+    assert str(lost.value).startswith("every worker was lost")
+    assert len(list((tmp_path / "frames").glob("*.png"))) >= 1
+
+
+def test_losing_the_scheduler_ends_in_one_line_keeping_the_frames(scheduler, tmp_path):
+    address, worker, scheduler_proc = scheduler
+    worker("--name", "w", pythonpath=str(SRC))
+    scene = tmp_path / "film.toml"
+    scene.write_text(FILM.replace("frames = 8", "frames = 400"))
+    with distributed.Client(address) as client:  # the worker ready before the command
+        client.wait_for_workers(1)
+    command = [sys.executable, "-m", "whitted", "animate", str(scene), "-o",
+               str(tmp_path / "frames"), "--scheduler", address, "-q"]
+    run = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           text=True, env=env_with())
+    try:
+        wait_for(lambda: any((tmp_path / "frames").glob("*.png")) or run.poll() is not None,
+                 "the first frame")
+        scheduler_proc.kill()
+        _, stderr = run.communicate(timeout=120)
+    finally:
+        if run.poll() is None:
+            run.kill()
+    assert run.returncode == 3, stderr
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in stderr, stderr
+    assert lines[0].startswith(f"error: lost the connection to the scheduler at {address}")
+    assert len(list((tmp_path / "frames").glob("*.png"))) >= 1
+
+
+def test_an_unreachable_scheduler_is_one_line_at_once(tmp_path):
+    port = free_port()  # nothing listens there: the connection is refused
+    result = subprocess.run([sys.executable, "-m", "whitted", "render", "-W", "8", "-H", "8",
+                             "-o", str(tmp_path / "x.png"), "--scheduler",
+                             f"tcp://127.0.0.1:{port}"], capture_output=True, text=True,
+                            timeout=120, env=env_with())
+    assert result.returncode == 3
+    assert result.stderr.strip().splitlines() == [
+        f"error: --scheduler tcp://127.0.0.1:{port}: cannot reach the scheduler "
+        "(Connection refused)"]
+    assert not (tmp_path / "x.png").exists()
+    bad = subprocess.run([sys.executable, "-m", "whitted", "render", "-o",
+                          str(tmp_path / "x.png"), "--scheduler", "head-node"],
+                         capture_output=True, text=True, timeout=120, env=env_with())
+    assert bad.returncode == 2
+    assert bad.stderr.strip() == ("error: --scheduler head-node: not an address "
+                                  "tcp://HOST:PORT")
