@@ -81,6 +81,25 @@ def stop_on_signals() -> Iterator[tuple[threading.Event, list[int]]]:
             signal.signal(sig, previous[sig])
 
 
+@contextmanager
+def quiet_dask_logs() -> Iterator[None]:
+    """Dask's own log lines (reconnect attempts, restarted workers, its tracebacks) off while
+    the command runs: the farm tells a wrangler what happened in its own lines."""
+    import logging
+
+    names = ["distributed", "tornado", "asyncio"] + [
+        name for name in logging.root.manager.loggerDict if name.startswith("distributed.")]
+    loggers = [logging.getLogger(name) for name in names]
+    levels = [log.level for log in loggers]
+    for log in loggers:
+        log.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for log, level in zip(loggers, levels, strict=True):
+            log.setLevel(level)
+
+
 def _stopped_status(signals: list[int]) -> tuple[str, int]:
     from .main import EXIT_INTERRUPTED, EXIT_TERMINATED
 
@@ -120,7 +139,8 @@ def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
     note = None if quiet else (lambda line: err.print(line, markup=False, highlight=False))
     try:
         # Ctrl-C while the cluster starts stops at once; later, after the bands that arrived
-        with farm.farm_client(cluster, scheduler, threads=threads, note=note) as client, \
+        with quiet_dask_logs(), \
+                farm.farm_client(cluster, scheduler, threads=threads, note=note) as client, \
                 stop_on_signals() as (stop, signals):
             progress = bar("rendering bands", quiet)
             with progress if progress is not None else nullcontext():
@@ -203,7 +223,7 @@ def animate_on_farm(scene: Scene, frames: range, folder: Path, film: Path | None
         # a cluster only when frames are missing: a finished film is only encoded
         connect = (farm.farm_client(cluster, scheduler, threads=threads, note=note)
                    if plan.todo else nullcontext())
-        with connect as client, stop_on_signals() as (stop, caught):
+        with quiet_dask_logs(), connect as client, stop_on_signals() as (stop, caught):
             signals = caught
             progress = bar("frames", quiet)
 

@@ -36,6 +36,7 @@ import contextlib
 import threading
 import time
 from collections.abc import Callable, Iterable
+from concurrent.futures import CancelledError
 from typing import Any
 
 from ._dask import Client, Future, distributed
@@ -144,8 +145,8 @@ class Watch:
                                        return_when="FIRST_COMPLETED")
         except TimeoutError:
             return set()
-        except (OSError, distributed.comm.CommClosedError) as exc:
-            raise self.lost(exc) from None
+        except (OSError, distributed.comm.CommClosedError, CancelledError) as exc:
+            raise self.lost(exc if not isinstance(exc, CancelledError) else None) from None
         return set(done)
 
     def lost(self, exc: BaseException | None = None) -> ClusterLost:
