@@ -127,7 +127,7 @@ def test_animate_errors_are_one_line(tmp_path):
         (["-o", str(tmp_path / "x.avi")], "unsupported film format '.avi'"),
         (["--set", "objects[ball].radius=-1"], "error: --set: objects[ball].radius: input "
                                                "should be greater than 0"),
-        (["--fps", "0"], "error: --fps: must be > 0, got 0"),
+        (["--fps", "0"], "error: --fps: must be 0.01 .. 1000 frames a second for MP4, got 0"),
     ]:
         result = _whitted("animate", str(scene), *args)
         assert result.returncode == 2
