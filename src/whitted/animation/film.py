@@ -188,12 +188,13 @@ def prepare_film(
     scene_path: str | Path | None = None,
     fps_where: str | None = None,
 ) -> FilmPlan:
-    """Every check :func:`render_film` makes before its first frame (nothing is written but
-    the frames folder): the frames asked for exist, the frame rate is one the film's format
-    takes (``fps_where`` names where it came from: ``--fps`` or ``animation.fps``), the film and the frames can be written
-    where they go, none of them is a file the film reads (``scene_path``, its models, their
-    MTL files and textures, every file of a mesh sequence), and no file in the frames' way
-    was written by anyone but whitted. One-line :class:`~whitted.WhittedError` otherwise."""
+    """Every check :func:`render_film` makes before its first frame (nothing is written):
+    the frames asked for exist, the frame rate is one the film's format takes (``fps_where``
+    names where it came from: ``--fps`` or ``animation.fps``), the film and the frames can
+    be written where they go, none of them is a file the film reads (``scene_path``, its
+    models, their MTL files and textures, every file of a mesh sequence), and no file in the
+    frames' way was written by anyone but whitted. One-line :class:`~whitted.WhittedError`
+    otherwise."""
     from ..output.safety import check_memory, check_outputs, input_files
     from ..output.video import DEFAULT_CRF, check_crf, check_fps, video_format
 

@@ -1,18 +1,17 @@
 """Render frames of an animated scene to PNG files that say what they are a picture of.
 
-Each frame PNG carries, in a text chunk, a hash of everything its pixels depend on: the
-still of that frame (every scene value, its seed, image size, samples, ...), the frame
-number, the renderer's kernel sources, and the size and modification time of every file the
-frame reads: the model and texture files the still names, and each model's own material
-libraries (MTL) and the textures those name (:func:`model_files`). A later run compares that hash with the one it would write and
-skips the frame when they match: films resume where they stopped, and a change to the scene
-renders again exactly the frames it changes. Thread counts are not part of the hash (images
-do not depend on them).
+Each frame PNG carries, in a text chunk, a hash of everything its pixels depend on: the still of
+that frame (every scene value, its seed, image size, samples, ...), the frame number, the
+renderer's kernel sources, and the size and modification time of every file the frame reads: the
+model and texture files the still names, and each model's own material libraries (MTL) and the
+textures those name (:func:`model_files`). A later run compares that hash with the one it would
+write and skips the frame when they match: films resume where they stopped, and a change to the
+scene renders again exactly the frames it changes. Thread counts are not part of the hash
+(images do not depend on them).
 
 :func:`render_frame` is the plain function a render farm calls per frame; a
-:class:`FrameRenderer` renders many frames in one process and reuses what it can between
-them (kernels, and compiled geometry when only camera, lights or material values change).
-"""
+:class:`FrameRenderer` renders many frames in one process and reuses what it can between them
+(kernels, and compiled geometry when only camera, lights or material values change)."""
 
 from __future__ import annotations
 
