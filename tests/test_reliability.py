@@ -206,7 +206,7 @@ def test_a3_a4_signal_during_the_first_compile_stops_at_once_and_writes_nothing(
         release.set()
     assert time.perf_counter() - start < 5.0
     assert code == status, (code, out, err)
-    assert f"{word} before any tile was finished: nothing written" in err
+    assert f"{word}: before any tile was finished: nothing written" in err
     assert (tmp_path / "out.png").read_bytes() == good  # the good image is kept
 
 
@@ -233,7 +233,7 @@ def test_a3_ctrl_c_during_the_first_compile_ends_the_process_at_once(tmp_path: P
                             capture_output=True, text=True, timeout=100)
     assert time.perf_counter() - start < 60  # not the 120 s of the compile
     assert result.returncode == 130, result.stderr
-    assert "interrupted before any tile was finished: nothing written" in result.stderr
+    assert "interrupted: before any tile was finished: nothing written" in result.stderr
     assert not (tmp_path / "out.png").exists()
 
 
