@@ -31,9 +31,13 @@ SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 class InterruptGuard:
-    """SIGINT and SIGTERM handled alike while the ``with`` block runs (see the module)."""
+    """SIGINT and SIGTERM handled alike while the ``with`` block runs (see the module).
+    ``at_once``: the first signal raises ``KeyboardInterrupt`` too, for work that cannot look
+    at an event (a Dask client waiting for its workers): the command catches it and ends with
+    :meth:`exit`, the code saying which signal came."""
 
-    def __init__(self) -> None:
+    def __init__(self, *, at_once: bool = False) -> None:
+        self.at_once = at_once
         self.event = threading.Event()
         self.signum: int | None = None
         self._callbacks: list[Callable[[], object]] = []
@@ -66,6 +70,8 @@ class InterruptGuard:
         self.event.set()
         for callback in self._callbacks:
             callback()
+        if self.at_once:
+            raise KeyboardInterrupt
 
     def interrupt(self, signum: int = signal.SIGINT) -> None:
         """What a signal does, from code (tests, a caller that stops the command)."""
