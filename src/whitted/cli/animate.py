@@ -114,7 +114,8 @@ def animate(
 
 class _FilmProgress:
     """Two bars on a terminal (frames with ETA; the current frame's tiles), else one line
-    per frame; nothing when quiet."""
+    per frame on stdout (stderr is for warnings and the one line of an error or interrupt);
+    nothing when quiet."""
 
     def __init__(self, total: int, quiet: bool) -> None:
         self.quiet = quiet
@@ -165,5 +166,4 @@ class _FilmProgress:
             elif not self.quiet:
                 result = p.result
                 state = f"{result.seconds:.2f} s" if result.rendered else "already done"
-                err.print(f"frame {p.frame} ({self.done}/{self.total}): {state}",
-                          highlight=False)
+                out.line(f"frame {p.frame} ({self.done}/{self.total}): {state}")

@@ -308,7 +308,7 @@ def film(
 
 
 def _frame_line(p) -> None:
-    """One line per frame finished (render_film's progress)."""
+    """One line per frame finished (render_film's progress), on stdout."""
     if p.event == "done":
         state = f"{p.result.seconds:.2f} s" if p.result.rendered else "already done"
-        err.line(f"frame {p.frame} ({p.done}/{p.total}): {state}")
+        out.line(f"frame {p.frame} ({p.done}/{p.total}): {state}")

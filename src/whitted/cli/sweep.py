@@ -16,7 +16,6 @@ from .main import (
     _load,
     _override_error,
     app,
-    err,
     fail,
     out,
 )
@@ -112,8 +111,7 @@ def sweep(
                 paths.append(path)
                 if not quiet:
                     state = f"{result.seconds:.2f} s" if result.rendered else "already done"
-                    err.print(f"{cell.label} ({cell.index + 1}/{len(cells)}): {state}",
-                              highlight=False, markup=False)
+                    out.line(f"{cell.label} ({cell.index + 1}/{len(cells)}): {state}")
         except WhittedError as exc:
             raise fail(str(exc)) from None
         except OSError as exc:
