@@ -556,12 +556,6 @@ def export(
     if output is None:  # the whole stem: scene.v1.toml -> scene.v1.pov
         output = Path((scene_path.stem if scene_path else "default") + ".pov")
     try:
-        from ..output.safety import check_outputs
-
-        check_outputs([output], scene, scene_path)  # writable, and none of the scene's files
-    except WhittedError as exc:
-        raise fail(str(exc)) from None
-    try:
         export_pov(scene, output, source=str(scene_path) if scene_path else name)
     except WhittedError as exc:
         raise fail(_with_scene_key(exc, scene, name)) from None
