@@ -127,7 +127,7 @@ def check_frame_files(folder: Path, files: Sequence[Path], inputs: Sequence[Path
     ``files`` that exists is a frame PNG whitted wrote (it carries the frame record). Any
     other file in the way is an :class:`OutputError` naming it: a film or a sweep never
     writes over a file it did not write."""
-    from ..assets.files import same_file
+    from ..files import same_file
     from ..output.safety import check_output_place
 
     try:

@@ -53,7 +53,7 @@ def sweep(
     from ..animation.frames import FrameRenderer
     from ..animation.overrides import apply_overrides, parse_assignment, parse_values
     from ..animation.sweep import sweep_cells
-    from ..output.encode import atomic_write
+    from ..files import atomic_write
     from ..output.safety import check_memory, check_outputs, input_files
     from ..render.api import CancelToken
 

@@ -31,7 +31,7 @@ from typing import Protocol
 import numpy as np
 
 from ..errors import RenderCancelled
-from .encode import atomic_write
+from ..files import atomic_write
 
 __all__ = ["DEFAULT_CRF", "FPS_MAX", "FPS_MIN", "VIDEO_FORMATS", "check_crf", "check_fps",
            "encode_film", "even_size", "pad_to_even", "video_format"]
