@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import os
+import signal
 import sys
 import threading
 import time
@@ -21,7 +22,7 @@ except ImportError:  # pragma: no cover - depends on the installed typer
 from ..errors import WhittedError, shorten
 from .console import Text, err, out
 from .farm import ClusterOption, SchedulerOption, render_still_on_farm
-from .interrupt import EXIT_INTERRUPTED, InterruptGuard
+from .interrupt import InterruptGuard, command_finished, exit_code_of, last_signal
 
 if TYPE_CHECKING:
     import numpy as np
@@ -609,6 +610,7 @@ def main() -> None:
     try:
         with only_the_command_named(sys.argv):
             code = app(standalone_mode=False)
+        command_finished()
         if (_abandoned or _ends_at_once) and EXIT_AT_ONCE_WHEN_ABANDONED:
             _exit_now(code if isinstance(code, int) else 0)
     except UsageError as exc:
@@ -619,10 +621,11 @@ def main() -> None:
         err.print(Text.assemble(("error:", "bold red"), " ",
                                 one_line(exc.format_message()) + hint), soft_wrap=True)
         sys.exit(EXIT_USER_ERROR)
-    except typer.Abort:
-        sys.exit(EXIT_INTERRUPTED)
-    except KeyboardInterrupt:
-        sys.exit(EXIT_INTERRUPTED)
+    except (typer.Abort, KeyboardInterrupt):  # a second signal: stopped at once
+        signum = last_signal()
+        err.line(f"{'terminated' if signum == signal.SIGTERM else 'interrupted'}: stopped at "
+                 "once (what was being written was not kept)")
+        sys.exit(exit_code_of(signum))
     except typer.Exit as exc:  # raised with standalone_mode=False only by an eager callback
         sys.exit(exc.exit_code)
     except WhittedError as exc:  # a user mistake a command did not catch itself
