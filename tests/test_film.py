@@ -572,3 +572,33 @@ def test_prepare_film_writes_nothing(tmp_path):
     with pytest.raises(SceneError, match="frame 7 is outside"):
         prepare_film(scene, tmp_path / "f.gif", frames=[7])
     assert film_api.film_fps(scene) == 8.0
+
+
+def test_the_editors_film_job_runs_the_film_api_and_stops(tmp_path):
+    from whitted.gui.film_job import FilmJob
+
+    scene = load_scene(_scene(tmp_path, frames=3))
+    job = FilmJob(scene, tmp_path / "f.gif", threads=1)
+    job.start()
+    job.join(120)
+    assert job.finished and job.error is None and not job.stopped
+    assert (job.done, job.rendered, job.kept, job.total) == (3, 3, 0, 3)
+    assert job.fraction == 1.0 and job.frames_dir == tmp_path / "f_frames"
+    with PILImage.open(tmp_path / "f.gif") as im:
+        assert im.n_frames == 3
+    again = FilmJob(scene, tmp_path / "f.gif", threads=1)
+    again.start()
+    again.join(120)
+    assert (again.done, again.rendered, again.kept) == (3, 0, 3)
+    stopped = FilmJob(scene, tmp_path / "g.gif", threads=1)
+    stopped.cancel.cancel()  # stopped before its first frame
+    stopped.start()
+    stopped.join(120)
+    assert stopped.finished and stopped.stopped and stopped.done == 0
+    assert not (tmp_path / "g.gif").exists()
+    with pytest.raises(ValueError, match="a film is .mp4 or .gif"):
+        FilmJob(scene, tmp_path / "folder").start()
+    (tmp_path / "h_frames").mkdir()
+    (tmp_path / "h_frames" / "0000.png").write_bytes(b"mine")
+    with pytest.raises(OutputError, match="whitted did not write it"):
+        FilmJob(scene, tmp_path / "h.gif").start()
