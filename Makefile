@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 # Compiled kernels are kept here between runs (see src/whitted/_cache.py).
 export WHITTED_CACHE_DIR ?= $(CURDIR)/.cache
 
-.PHONY: demo test test-timing lint install install-test bench clean
+.PHONY: demo test test-timing coverage lint install install-test bench clean
 
 $(BIN)/whitted: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -34,6 +34,16 @@ test: install-test
 ## The tests whose outcome depends on the machine's speed (marker `timing`), run apart
 test-timing: install-test
 	$(BIN)/python -m pytest -q -m timing
+
+## Line coverage of the whole suite, subprocesses included, plus the kernels as plain Python
+coverage: install-test
+	rm -rf .cache/coverage && mkdir -p .cache/coverage
+	$(BIN)/python -m coverage run -m pytest -q -x
+	NUMBA_DISABLE_JIT=1 $(BIN)/python -m coverage run -m pytest -q -x -m python_kernels
+	$(BIN)/python -m coverage combine -q
+	$(BIN)/python -m coverage report --sort=cover
+	$(BIN)/python -m coverage report --omit='*/gui/*,*/cli/*,*/program.py,*/__main__.py' \
+	  --format=total | sed 's/^/non-interface code (without cli\/, gui\/): /; s/$$/ %/'
 
 ## Render the benchmark scenes (benchmarks/) and print the timing table
 bench: install
