@@ -6,9 +6,9 @@ shared with a second process (``python -m whitted.render.warm_up``) when there a
 or more. While this process compiles ``render_tiles`` (and its callees on the way, depth
 first), the helper compiles a share of the render kernel's callees (``kernels/callees.py``),
 then the scene builders and the OBJ loader, into the cache. When this process reaches one of
-the helper's callees it waits for it (``kernels/dispatcher.py``'s ``KernelCache.wait_for_helper``) and loads it
-instead of compiling it a second time (with the tuned dispatcher, kernels/dispatcher.py; with
-stock Numba it loads it if the helper is done, or compiles it too). Then it waits for the
+the helper's callees it waits for it (``KernelCache.wait_for_helper``, kernels/dispatcher.py)
+and loads it instead of compiling it a second time (with stock Numba, which has neither the
+twins nor the wait, the helper compiles only the builders and the loader). Then it waits for the
 helper (which by then is on the builders and loader, work this process would do next) and
 loads what it made. Whatever the
 helper did not finish is compiled here, so the result never depends on the helper: it only
