@@ -17,20 +17,20 @@ keeps a list of their SHA-256 sums (:data:`SUMS`, written by whitted under a loc
 at all) and, before Numba first loads anything in a process (:func:`prepare`), checks every
 cache file against it:
 
-- a file whose sum differs from its entry, and which is the same file (inode) the entry was
-  made for, was damaged in place: it is deleted (Numba then compiles that kernel again and
-  caches it anew) and one ``warning:`` line says how many were;
-- a file that was replaced since (Numba writes a new file and renames it over the old one) or
-  that the list does not name yet (written by a process that has not sealed it yet, or was
-  stopped first) is not trusted either: in whitted's own folder it is deleted silently (it is
-  compiled again); in a folder the user named with ``NUMBA_CACHE_DIR``, which may hold other
-  programs' cache files, it is taken as found;
+- a file whose sum differs from its entry was damaged (or replaced by hand): it is deleted
+  (Numba then compiles that kernel again and caches it anew) and one ``warning:`` line says
+  how many were;
+- a file the list does not name (written by a process that was stopped before it sealed
+  it, or put there by hand) is not trusted either: in whitted's own folder it is deleted
+  silently (it is compiled again); in a folder the user named with ``NUMBA_CACHE_DIR``, which
+  may hold other programs' cache files, it is taken as found;
 - a damaged list is a list of nothing: every file is then compiled again, with one warning.
 
 After Numba wrote files (a compile of a kernel called from Python, the warm-up), whitted
-:func:`seal` s them: the files that are new or were replaced (a new inode) since this process
-last looked get their entries; a file changed in place keeps its old entry, so damage is never
-sealed. Two processes compiling at once take turns through a lock file (``whitted.lock``); the
+:func:`seal` s them: the files that are new since this process last looked, or were replaced
+by a new file (a new inode: Numba writes a file whole and renames it into place), get their
+entries; a file changed in place keeps its old entry, so damage is not sealed. A list that
+names files by content only survives copying the folder elsewhere (a container image). Two processes compiling at once take turns through a lock file (``whitted.lock``); the
 cold compile of the render kernels holds it throughout (render/warm_up.py), so a second cold
 render waits and then loads what the first compiled.
 """
@@ -188,8 +188,8 @@ class KernelCache:
         except (OSError, ValueError):
             return {}, True
         if not isinstance(data, dict) or not all(
-                isinstance(v, list) and len(v) == 3 and isinstance(v[0], str)
-                and isinstance(v[1], int) and isinstance(v[2], int) for v in data.values()):
+                isinstance(v, list) and len(v) == 2 and isinstance(v[0], str)
+                and isinstance(v[1], int) for v in data.values()):
             return {}, True
         return data, False
 
@@ -232,8 +232,8 @@ class KernelCache:
                     continue
                 if entry is None and not damaged_list and not self.own:
                     continue  # another program's file in the user's NUMBA_CACHE_DIR
-                if entry is not None and entry[2] == st.st_ino:
-                    damaged += 1  # changed in place
+                if entry is not None:
+                    damaged += 1
                 if entry is not None or self.own or damaged_list:
                     with contextlib.suppress(OSError):
                         os.unlink(path)
@@ -281,12 +281,10 @@ class KernelCache:
                 entry = sums.get(name)
                 if seen is not None and seen[0] == st.st_ino and entry is not None:
                     continue  # as checked (or changed in place: not sealed)
-                if entry is not None and entry[2] == st.st_ino:
-                    continue  # sealed by another process
                 digest = self._digest(os.path.join(self.folder, name))
                 if digest is None:
                     continue
-                sums[name] = [digest, st.st_size, st.st_ino]
+                sums[name] = [digest, st.st_size]
                 self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
                 changed = True
             if changed or damaged_list:
