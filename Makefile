@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 # Compiled kernels are kept here between runs (see src/whitted/_cache.py).
 export WHITTED_CACHE_DIR ?= $(CURDIR)/.cache
 
-.PHONY: demo test test-oldest-numba lint install install-test bench clean
+.PHONY: demo test test-oldest-numba test-timing lint install install-test bench clean
 
 $(BIN)/whitted: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -49,6 +49,10 @@ test-oldest-numba: $(OLDEST_VENV)/.ready
 	WHITTED_CACHE_DIR=$(CURDIR)/.cache-oldest-numba $(OLDEST_VENV)/bin/python -m pytest -q \
 		-p no:cacheprovider tests/test_kernel_cache.py tests/test_jit.py \
 		tests/test_shapes.py -k 'not two_cold'
+
+## The tests whose outcome depends on the machine's speed (marker `timing`), run apart
+test-timing: install-test
+	$(BIN)/python -m pytest -q -m timing
 
 ## Render the benchmark scenes (benchmarks/) and print the timing table
 bench: install
