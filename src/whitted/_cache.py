@@ -30,7 +30,8 @@ After Numba wrote files (a compile of a kernel called from Python, the warm-up),
 :func:`seal` s them: the files that are new since this process last looked, or were replaced
 by a new file (a new inode: Numba writes a file whole and renames it into place), get their
 entries; a file changed in place keeps its old entry, so damage is not sealed. A list that
-names files by content only survives copying the folder elsewhere (a container image). Two processes compiling at once take turns through a lock file (``whitted.lock``); the
+names files by content only survives copying the folder elsewhere (a container image). Two
+processes compiling at once take turns through a lock file (``whitted.lock``); the
 cold compile of the render kernels holds it throughout (render/warm_up.py), so a second cold
 render waits and then loads what the first compiled.
 """
