@@ -19,6 +19,8 @@ from pathlib import Path
 import numpy as np
 import psutil
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from PIL import Image as PILImage
 
 from whitted.animation import film as film_api
@@ -602,3 +604,60 @@ def test_the_editors_film_job_runs_the_film_api_and_stops(tmp_path):
     (tmp_path / "h_frames" / "0000.png").write_bytes(b"mine")
     with pytest.raises(OutputError, match="whitted did not write it"):
         FilmJob(scene, tmp_path / "h.gif").start()
+
+
+# ----------------------------------------------------------------- the guard itself
+
+
+def test_the_guard_handles_sigint_and_sigterm_alike(capsys):
+    import typer
+
+    from whitted.cli.interrupt import InterruptGuard
+
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    cancelled = []
+    with InterruptGuard() as guard:
+        guard.on_interrupt(lambda: cancelled.append(True))
+        assert not guard.interrupted
+        os.kill(os.getpid(), signal.SIGTERM)  # handled between two bytecodes of this thread
+        assert guard.interrupted and guard.terminated and cancelled == [True]
+        assert guard.exit_code == 143 and guard.word == "terminated"
+        with pytest.raises(KeyboardInterrupt):  # the second one stops at once
+            os.kill(os.getpid(), signal.SIGINT)
+        late = []
+        guard.on_interrupt(lambda: late.append(True))  # registered after: called at once
+        assert late == [True]
+        exit_ = guard.exit("kept  3 of 5\nframes")
+    assert isinstance(exit_, typer.Exit) and exit_.exit_code == 143
+    assert capsys.readouterr().err == "terminated: kept 3 of 5 frames\n"
+    assert {s: signal.getsignal(s) for s in before} == before  # restored
+    with pytest.raises(KeyboardInterrupt), InterruptGuard(at_once=True) as guard:
+        os.kill(os.getpid(), signal.SIGINT)
+    assert guard.exit_code == 130 and guard.word == "interrupted"
+
+
+# ----------------------------------------------------------------- fuzzing the new inputs
+
+
+@given(st.text(max_size=30), st.integers(1, 20_000))
+def test_frame_ranges_are_in_the_film_or_one_line(text, count):
+    try:
+        frames = parse_frame_range(text, count)
+    except SceneError as exc:
+        assert "\n" not in str(exc) and str(exc).startswith("--frames: ")
+        return
+    assert len(frames) >= 1 and 0 <= frames[0] <= frames[-1] < count
+
+
+@given(st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10, 10**400),
+                 st.text(max_size=8), st.none()),
+       st.sampled_from(["mp4", "gif"]))
+def test_fps_is_a_rate_the_format_takes_or_one_line(fps, fmt):
+    try:
+        rate = video.check_fps(fps, fmt)
+    except ValueError as exc:
+        assert "\n" not in str(exc) and str(exc).startswith("must be")
+        return
+    assert video.FPS_MIN <= rate <= video.FPS_MAX[fmt]
+    if fmt == "gif":  # the delay fits a GIF's 16 bits of hundredths of a second
+        assert 2 <= round(100 / rate) <= 65_535
