@@ -661,3 +661,14 @@ def test_fps_is_a_rate_the_format_takes_or_one_line(fps, fmt):
     assert video.FPS_MIN <= rate <= video.FPS_MAX[fmt]
     if fmt == "gif":  # the delay fits a GIF's 16 bits of hundredths of a second
         assert 2 <= round(100 / rate) <= 65_535
+
+
+def test_stefan_run_refuses_to_write_over_its_case_file(tmp_path, monkeypatch):
+    project = tmp_path / "proj"
+    project.mkdir()
+    case = project / "case.toml"
+    case.write_text("[grid]\ncells = 12\n")
+    os.utime(case, ns=(1, 1))
+    one_line(run_main(monkeypatch, "stefan", "run", case, "-o", project, cwd=tmp_path), 2,
+             "case.toml: is an input of this job")
+    assert case.stat().st_mtime_ns == 1 and sorted(project.iterdir()) == [case]

@@ -40,6 +40,23 @@ def _load(case_path: Path):
     return case, case_path.read_text(encoding="utf-8")
 
 
+#: the files a run writes at the top of its folder (stefan/run.py)
+RUN_FILES = ("case.toml", "series.csv", "summary.json", "series.png")
+
+
+def _check_run_outputs(case_path: Path, output: Path) -> None:
+    """The output-safety check of ``render`` for a run's folder: its files can be written
+    there and none of them is the case file the run reads (one line)."""
+    from ..output.safety import check_outputs
+
+    if not output.is_dir():  # the run makes it
+        return
+    try:
+        check_outputs([output / name for name in RUN_FILES], inputs=[case_path])
+    except WhittedError as exc:
+        raise _fail(str(exc)) from None
+
+
 def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, guard: InterruptGuard,
            size=(480, 360)):
     from ..stefan.case import CaseError
@@ -48,6 +65,7 @@ def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, guard: Inter
     case, text = _load(case_path)
     if output.exists() and not output.is_dir():
         raise _fail(f"{output}: exists and is not a folder")
+    _check_run_outputs(case_path, output)
     if output.resolve() == case_path.resolve().parent and fresh:
         raise _fail(f"{output}: --fresh would clear the case file's own folder")
     if fresh and output.exists():
