@@ -13,10 +13,10 @@ from typing import Annotated
 import typer
 
 from ..errors import WhittedError
+from .app import app as main_app
+from .app import err, fail
 from .console import LazyConsole
 from .interrupt import InterruptGuard
-from .main import app as main_app
-from .main import err, fail
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="The Stefan problem: a hollow piece of ice with water inside, melting.")
@@ -30,7 +30,7 @@ def _fail(message: str) -> typer.Exit:
     return fail(message)
 
 
-def _load(case_path: Path):
+def load_scene_argument(case_path: Path):
     from ..stefan.case import load_case
 
     try:
@@ -62,7 +62,7 @@ def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, guard: Inter
     from ..stefan.case import CaseError
     from ..stefan.run import run_case
 
-    case, text = _load(case_path)
+    case, text = load_scene_argument(case_path)
     if output.exists() and not output.is_dir():
         raise _fail(f"{output}: exists and is not a folder")
     _check_run_outputs(case_path, output)
@@ -225,9 +225,9 @@ def _check_film_options(case_path: Path, output: Path, gif: Path | None, width: 
     try:
         RenderSettings(width=width, height=height)
     except ValidationError as exc:
-        from .main import _override_error
+        from .app import override_error
 
-        raise _fail(_override_error(exc)) from None
+        raise _fail(override_error(exc)) from None
     films = [output, *([gif] if gif is not None else [])]
     formats = []
     for option, path in zip(("-o", "--gif"), films, strict=False):
