@@ -6,10 +6,12 @@ differ from their defaults.
 - :func:`compact_data`: an item (or a whole scene) as plain data with only non-default values
 - :func:`compact_toml`: a whole scene as compact TOML (a file that did not exist before)
 - :func:`edit_toml`: the text of a TOML scene file with the changes from ``old`` to ``new``
+- :func:`edited_toml`: that edit, read back and checked, or None when it cannot be made
 - :func:`save_scene_toml`: write a scene, style-preserving when the file's text is known
 
-Every result is read back and compared with the scene before it is written; if a file's own
-style cannot carry an edit, the scene is written compactly instead (nothing is ever lost)."""
+Every result is read back and compared with the scene before it is written. When a file's own
+style cannot carry an edit, :func:`scene_toml` writes the scene compactly (nothing is lost);
+the editor asks first (:func:`edited_toml` says None) rather than rewrite a user's file."""
 
 from __future__ import annotations
 
@@ -385,15 +387,23 @@ def _loads(text: str, scene: Scene) -> Scene | None:
     return loaded
 
 
+def edited_toml(scene: Scene, text: str, loaded: Scene) -> str | None:
+    """``text`` (the file as read, which loaded as ``loaded``) with only the edits that make
+    it ``scene`` written into it, checked by reading it back; None when the file's own style
+    cannot carry them (the caller then asks before writing the whole file afresh)."""
+    try:
+        edited = edit_toml(text, loaded, scene)
+    except (KeyError, TypeError, ValueError, tomlkit.exceptions.TOMLKitError):
+        return None
+    return edited if _loads(edited, scene) == scene else None
+
+
 def scene_toml(scene: Scene, *, text: str | None = None, loaded: Scene | None = None) -> str:
     """The TOML to save ``scene`` as: ``text`` (the file as read, which loaded as ``loaded``)
     with only the edits written into it, else the compact form. Checked by reading it back."""
     if text is not None and loaded is not None:
-        try:
-            edited = edit_toml(text, loaded, scene)
-        except (KeyError, TypeError, ValueError, tomlkit.exceptions.TOMLKitError):
-            edited = None
-        if edited is not None and _loads(edited, scene) == scene:
+        edited = edited_toml(scene, text, loaded)
+        if edited is not None:
             return edited
     compact = compact_toml(scene)
     if _loads(compact, scene) == scene:
@@ -406,15 +416,17 @@ def scene_toml(scene: Scene, *, text: str | None = None, loaded: Scene | None = 
 
 
 def save_scene_toml(scene: Scene, path: str | Path, *, text: str | None = None,
-                    loaded: Scene | None = None) -> str:
-    """Write ``scene`` to the TOML file ``path`` atomically (see :func:`scene_toml`); relative
-    model and texture names are rewritten when the folder changes. Returns the text written."""
+                    loaded: Scene | None = None, payload: str | None = None) -> str:
+    """Write ``scene`` to the TOML file ``path`` atomically (see :func:`scene_toml`, or
+    ``payload`` when the caller has made the text already); relative model and texture names
+    are rewritten when the folder changes. Returns the text written."""
     from ..output.encode import atomic_write
 
     path = Path(path)
-    if path.parent.resolve() != scene.base_dir.resolve():
-        scene = rebase_files(scene, path.parent)
-        text = loaded = None  # another folder: file names change, write it afresh
-    payload = scene_toml(scene, text=text, loaded=loaded)
+    if payload is None:
+        if path.parent.resolve() != scene.base_dir.resolve():
+            scene = rebase_files(scene, path.parent)
+            text = loaded = None  # another folder: file names change, write it afresh
+        payload = scene_toml(scene, text=text, loaded=loaded)
     atomic_write(path, lambda tmp: Path(tmp).write_text(payload, encoding="utf-8"))
     return payload
