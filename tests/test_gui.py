@@ -388,6 +388,9 @@ def test_camera_position_rotation_and_mouse(window, qtbot):
         else:
             vp.mouseReleaseEvent(event)
 
+    # View > Lock camera to view: in camera view, the mouse moves the scene's camera
+    window.acts["lock_camera"].trigger()
+    assert window.navigation.camera_view and window.navigation.locked
     before = window.doc.scene.camera
     send(QMouseEvent.Type.MouseButtonPress, start, Qt.MouseButton.LeftButton)
     for dx in (10, 20, 30):

@@ -631,10 +631,9 @@ def attach_timeline(window: MainWindow) -> TimelinePanel:
         window.addAction(act)  # works wherever the focus is in the window
         return act
 
-    panel.act_key = action("&Insert key", panel.insert_key, "I",
-                           "key the selected item's placement (or the camera) at this frame")
-    panel.act_delete_key = action("&Delete key", panel.delete_key, "Alt+I",
-                                  "remove the selection's keys at this frame")
+    # Insert key (I) and Delete key (Alt+I) are rows of the window's actions table
+    panel.act_key = window.acts["insert_key"]
+    panel.act_delete_key = window.acts["delete_key"]
     panel.act_play = action("&Play / Stop", panel.toggle_play, None,
                             "play the preview of the animation")
     panel.act_film = action("&Render animation…", lambda: panel.render_animation(), None,
