@@ -91,7 +91,9 @@ def test_every_menu_shortcut_works_in_every_focus_state(window, qtbot):
     field of the properties panel (as shown, and while a value is typed in it): the action
     runs, once, and no other. A field being typed in keeps letters, digits, Delete, Home
     and its own undo/redo; every command key (Ctrl, Alt, F-keys, Esc) still reaches the
-    window (Ctrl+E used to be taken by the field as "end of line")."""
+    window (Ctrl+E used to be taken by the field as "end of line": that binding exists under
+    X11, so run this under Xvfb with QT_QPA_PLATFORM=xcb to see it; the offscreen platform's
+    key scheme has no Ctrl+E)."""
     counts: dict[str, int] = {}
     for name, action in window.acts.items():
         action.triggered.disconnect()  # count, do not run (Quit, Open...)
@@ -119,6 +121,9 @@ def test_every_menu_shortcut_works_in_every_focus_state(window, qtbot):
         field.setText(field.text() + "1")  # a value being typed
         return field
 
+    # a field being typed in undoes its typing with the platform's undo/redo keys
+    field_undo = [*QKeySequence.keyBindings(QKeySequence.StandardKey.Undo),
+                  *QKeySequence.keyBindings(QKeySequence.StandardKey.Redo)]
     states = {"picture": focus_picture, "tree": focus_tree, "field": focus_field,
               "typing": focus_typing}
     command = (Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.AltModifier)
@@ -134,7 +139,7 @@ def test_every_menu_shortcut_works_in_every_focus_state(window, qtbot):
                     combo.key() == Qt.Key.Key_Escape
                 text_field = state in ("field", "typing")
                 field_keeps = (text_field and not is_command) or (
-                    state == "typing" and row.name in ("undo", "redo"))
+                    state == "typing" and QKeySequence(text) in field_undo)
                 counts.clear()
                 _press(qtbot, widget, text)
                 expected = {} if field_keeps else {row.name: 1}
