@@ -53,8 +53,8 @@ def seen_object(window) -> tuple[int, QPoint]:
 
 
 @pytest.mark.parametrize("name", NAMES)
-def test_an_example_keyed_and_saved_changes_only_by_its_new_keys(make_window, qtbot, examples,
-                                                                  name):
+def test_an_example_keyed_and_saved_changes_only_by_its_new_keys(
+        make_window, qtbot, examples, name):  # noqa: F811
     path = examples / name
     text = path.read_text(encoding="utf-8")
     original = whitted.load_scene(path)
@@ -84,7 +84,7 @@ def test_an_example_keyed_and_saved_changes_only_by_its_new_keys(make_window, qt
     assert len(anim.tracks) > (len(before.tracks) if before is not None else 0)
 
 
-def test_camera_orbit_stays_cyclic_after_a_key(make_window, qtbot, examples):
+def test_camera_orbit_stays_cyclic_after_a_key(make_window, qtbot, examples):  # noqa: F811
     """The report's case: the teal cone keyed in camera_orbit.toml; the film still loops."""
     path = examples / "camera_orbit.toml"
     window = make_window(whitted.load_scene(path), path, preview=False, warm_up=False)
@@ -99,8 +99,8 @@ def test_camera_orbit_stays_cyclic_after_a_key(make_window, qtbot, examples):
     assert "cyclic = true" in path.read_text(encoding="utf-8")
 
 
-def test_a_save_that_would_rewrite_the_file_asks_first(make_window, qtbot, examples,
-                                                       monkeypatch):
+def test_a_save_that_would_rewrite_the_file_asks_first(
+        make_window, qtbot, examples, monkeypatch):  # noqa: F811
     """When the file's own layout cannot carry an edit, Ctrl+S asks; "cancel" leaves the
     file byte for byte; "rewrite" writes the whole scene."""
     path = examples / "glass_cube.toml"

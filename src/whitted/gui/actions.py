@@ -5,7 +5,8 @@ keys of a running G/R/S move): Help > Controls lists them too.
 
 Every shortcut is the window's: it works wherever the focus is. A text field being typed in
 keeps its own keys (letters, digits, Delete, Home, arrows, its undo while a value is typed);
-:class:`ShortcutGuard` hands every other menu shortcut (Ctrl+E, Ctrl+S...) on to the window. A slider keeps its own keys (Home, End, the arrows)."""
+:class:`ShortcutGuard` hands every other menu shortcut (Ctrl+E, Ctrl+S...) on to the window.
+A slider keeps its own keys (Home, End, the arrows)."""
 
 from __future__ import annotations
 

@@ -12,8 +12,8 @@ from PySide6.QtWidgets import QApplication
 
 from ..errors import WhittedError
 from ..scene import Scene, load_scene, save_scene
-from ..scene.io import rebase_files
 from ..scene.toml_document import edited_toml, save_scene_toml, scene_toml
+from ..scene.writing import rebase_files
 from .autosave import recovery_for
 
 

@@ -24,9 +24,11 @@ from pydantic import BaseModel
 from tomlkit.items import AoT, Array, InlineTable, Table
 
 from ..errors import SceneError
-from .io import parse_scene_text, rebase_files, scene_from_dict
+from ..files import atomic_write
+from .io import parse_scene_text, scene_from_dict
 from .materials import Material
 from .scene import Scene
+from .writing import rebase_files, scene_to_dict
 
 # ---------------------------------------------------------------------- compact data
 
@@ -410,8 +412,6 @@ def scene_toml(scene: Scene, *, text: str | None = None, loaded: Scene | None = 
         return compact
     import tomli_w
 
-    from .io import scene_to_dict
-
     return tomli_w.dumps(scene_to_dict(scene))  # every value spelt out: always loads back
 
 
@@ -420,8 +420,6 @@ def save_scene_toml(scene: Scene, path: str | Path, *, text: str | None = None,
     """Write ``scene`` to the TOML file ``path`` atomically (see :func:`scene_toml`, or
     ``payload`` when the caller has made the text already); relative model and texture names
     are rewritten when the folder changes. Returns the text written."""
-    from ..output.encode import atomic_write
-
     path = Path(path)
     if payload is None:
         if path.parent.resolve() != scene.base_dir.resolve():
