@@ -58,8 +58,11 @@ def test_g_with_the_focus_in_the_tree_moves_the_selection_and_keeps_it(window, q
     qtbot.keyClick(vp, Qt.Key.Key_Return)
     assert vp.tool is None and window.doc.selection == ball5
     moved = window.doc.item(ball5)
-    assert moved.transform.translate == pytest.approx((1.0, 0.0, 0.0))
-    assert moved.center == before.center
+    # a sphere moves its centre, and the panel's Centre shows where it is now
+    assert moved.center == pytest.approx((before.center[0] + 1.0, *before.center[1:]))
+    assert moved.transform is None
+    shown = tuple(float(e.text()) for e in window.properties.row("center").editor.lines)
+    assert shown == pytest.approx(moved.center)
     # R, then Z: the status says "Rotate about Z"
     qtbot.keyClick(tree, Qt.Key.Key_R)
     qtbot.keyClick(vp, Qt.Key.Key_Z)
@@ -185,13 +188,14 @@ def test_shift_click_selects_more_and_g_and_delete_act_on_all_in_one_step(window
     qtbot.keyClick(window.viewport, Qt.Key.Key_Z)
     qtbot.keyClicks(window.viewport, "2")
     qtbot.keyClick(window.viewport, Qt.Key.Key_Return)
-    for key in (b1, b3):
-        assert window.doc.item(key).transform.translate == pytest.approx((0.0, 0.0, 2.0))
+    for key, ball in ((b1, balls_scene().objects[2]), (b3, balls_scene().objects[4])):
+        assert window.doc.item(key).center == pytest.approx(
+            (ball.center[0], ball.center[1], ball.center[2] + 2.0))
     assert window.doc.undo_stack.count() == steps + 1  # both moved in one step
     assert set(window.doc.selected_keys()) == {b1, b3}
     qtbot.keyClick(tree, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
-    for key in (b1, b3):
-        assert window.doc.item(key).transform is None
+    assert window.doc.item(b1) == balls_scene().objects[2]
+    assert window.doc.item(b3) == balls_scene().objects[4]
     # in the picture: Shift+click adds, Delete removes both in one step
     qtbot.keyClick(tree, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier
                    | Qt.KeyboardModifier.ShiftModifier)

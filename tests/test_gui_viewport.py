@@ -70,16 +70,17 @@ def test_g_moves_the_selection_on_the_ground_and_typed_values_along_an_axis(wind
         mouse(vp, "move", QPointF(start) + QPointF(dx, 0), Qt.MouseButton.NoButton)
     qtbot.mouseClick(vp, Qt.MouseButton.LeftButton, pos=start + QPoint(30, 0))
     assert vp.tool is None
-    t = window.doc.item(("objects", 1)).transform
-    assert t.translate[0] > 0.05 and t.translate[1] == 0.0  # right, and not off the ground
+    c = window.doc.item(("objects", 1)).center  # a sphere: G moves its centre
+    assert c[0] > 0.05 and c[1] == 0.8  # right, and not off the ground
+    assert window.doc.item(("objects", 1)).transform is None
     assert window.doc.undo_stack.count() == steps + 1  # the whole move is one step
     # G, Z, a typed value, Enter: exactly that far along z
-    before = t.translate
+    before = c
     qtbot.keyClick(vp, Qt.Key.Key_G)
     qtbot.keyClick(vp, Qt.Key.Key_Z)
     qtbot.keyClicks(vp, "-1.5")
     qtbot.keyClick(vp, Qt.Key.Key_Return)
-    after = window.doc.item(("objects", 1)).transform.translate
+    after = window.doc.item(("objects", 1)).center
     assert after == pytest.approx((before[0], before[1], before[2] - 1.5))
     # R with a typed angle turns it about y; Esc during S cancels, leaving nothing to redo
     qtbot.keyClicks(vp, "r90")

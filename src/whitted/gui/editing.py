@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 from PySide6.QtCore import QObject, Qt
 
 from ..errors import WhittedError
@@ -18,9 +17,14 @@ from .picking import id_at
 from .transform_tool import TransformTool, light_position
 
 
+def _moves_its_centre(obj) -> bool:
+    """A shape with a ``center`` and no transform of its own: G moves the centre."""
+    return getattr(obj, "center", None) is not None and getattr(obj, "transform", 1) is None
+
+
 class GroupTool:
     """One G/R/S operation on several items: a :class:`TransformTool` per item gets the
-    same pointer and keys; their results make one edit (``commit(results, merge_key)``)."""
+    same pointer and keys; their results make one edit (``commit(results, merge_key, group)``)."""
 
     def __init__(self, mode: str, scene, keys: list, start, size, commit, finish,
                  status) -> None:
@@ -48,7 +52,7 @@ class GroupTool:
 
     def _apply(self) -> None:
         if self.results:
-            self._commit(dict(self.results), self.merge_key)
+            self._commit(dict(self.results), self.merge_key, self)
 
     def set_start(self, uv) -> None:
         for tool in self.tools:
@@ -137,7 +141,8 @@ class Editing(QObject):
             start = viewport.picture_rect().center()
         scene = self.doc.scene.model_copy(update={"camera": window.navigation.camera()})
         tool = GroupTool(mode, scene, keys, start, (viewport.width(), viewport.height()),
-                         commit=lambda results, merge: self._tool_edit(results, merge, mode),
+                         commit=lambda results, merge, group: self._tool_edit(results, merge, mode,
+                                                                      group),
                          finish=self._tool_finished,
                          status=lambda text: self._status(text))
         tool.set_start(viewport.to_picture(start))
@@ -147,20 +152,21 @@ class Editing(QObject):
         window.interacting(True)
         return True
 
-    def _tool_edit(self, results: dict, merge, mode: str) -> None:
+    def _tool_edit(self, results: dict, merge, mode: str, tool: GroupTool) -> None:
         scene = self.doc.scene
         update = {kind: list(getattr(scene, kind)) for kind in ("lights", "objects")}
-        tool = self.window_.viewport.tool
         for key, value in results.items():
             kind, index = key
             item = update[kind][index]
             data = item.model_dump()
+            sub = next(t for t in tool.tools if (t.kind, t.index) == key)
             if kind == "lights":  # a light moves by the vector, from where it was at the start
-                sub = next((t for t in tool.tools if (t.kind, t.index) == key), None) \
-                    if tool is not None else None
                 field = "position" if "position" in data else "center"
-                start = sub.centre if sub is not None else np.asarray(data[field])
-                data[field] = tuple(round(float(v), 6) + 0.0 for v in start + value)
+                data[field] = tuple(round(float(v), 6) + 0.0 for v in sub.centre + value)
+            elif mode == "move" and _moves_its_centre(sub.obj):
+                # a shape placed by its centre moves its centre: the panel shows where it is
+                data["center"] = tuple(round(float(c + t), 6) + 0.0 for c, t in zip(
+                    sub.obj.center, value.translate, strict=True))
             else:
                 data["transform"] = value.model_dump()
             update[kind][index] = type(item).model_validate(data)
