@@ -98,3 +98,42 @@ def test_the_preview_size_follows_the_picture_on_screen(make_window, qtbot):  # 
     assert window.controller.target_pixels > 0
     window.resize(size)
     qtbot.waitUntil(lambda: window.controller.target_pixels == expected(), timeout=5000)
+
+
+def test_new_objects_land_in_view_on_the_floor_and_are_seen(window, qtbot):
+    from pathlib import Path
+
+    from whitted.gui import camera_ops
+    from whitted.gui.transform_tool import item_bounds
+
+    def seen_whole(key) -> bool:
+        scene = window.doc.scene
+        lo, hi = item_bounds(scene.objects[key[1]], scene)
+        s = scene.render
+        for corner in ((x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                       for z in (lo[2], hi[2])):
+            uv = camera_ops.project(window.navigation.camera(), s.width, s.height, corner)
+            if uv is None or not all(0.0 <= c <= 1.0 for c in uv):
+                return False
+        return True
+
+    # a plane with a floor there already: a wall behind the scene, facing the view, seen
+    window.object_actions["plane"].trigger()
+    plane = window.doc.selection
+    ids = window.ids.ids_for(window.shown_scene())
+    assert (ids == plane[1]).mean() > 0.05
+    assert window.doc.scene.objects[plane[1]].normal != (0.0, 1.0, 0.0)
+    # after looking around, new things land where the view looks, whole in the picture
+    vp = window.viewport
+    c = QPointF(vp.picture_rect().center())
+    drag(vp, c, [c + QPointF(-25 * i, 0) for i in range(1, 5)])
+    assert not window.navigation.camera_view
+    for kind in ("sphere", "box", "cone"):
+        window.object_actions[kind].trigger()
+        key = window.doc.selection
+        assert seen_whole(key), kind
+        lo, _ = item_bounds(window.doc.item(key), window.doc.scene)
+        assert lo[1] == pytest.approx(0.0, abs=1e-6), kind  # resting on the floor
+    model = Path(__file__).parents[1] / "examples" / "models" / "teapot.obj"
+    key = window.add_model(model)
+    assert key is not None and seen_whole(key)

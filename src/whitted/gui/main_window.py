@@ -17,11 +17,15 @@ from PySide6.QtCore import QSettings, Qt
 from PySide6.QtGui import QAction, QCloseEvent
 from PySide6.QtWidgets import (
     QApplication,
+    QDialog,
+    QDialogButtonBox,
     QDockWidget,
     QFileDialog,
     QMainWindow,
     QMessageBox,
+    QTextBrowser,
     QToolButton,
+    QVBoxLayout,
 )
 
 from .. import scene as S
@@ -312,9 +316,17 @@ class MainWindow(QMainWindow):
 
     def show_controls(self) -> None:
         """Help > Controls: made from the actions table, so it lists every shortcut."""
-        box = QMessageBox(QMessageBox.Icon.NoIcon, "Controls", controls_html(), parent=self)
-        box.setTextFormat(Qt.TextFormat.RichText)
-        box.exec()
+        dialog = QDialog(self)
+        dialog.setWindowTitle("Controls")
+        text = QTextBrowser(dialog)
+        text.setHtml(controls_html())
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Close, dialog)
+        buttons.rejected.connect(dialog.reject)
+        layout = QVBoxLayout(dialog)
+        layout.addWidget(text)
+        layout.addWidget(buttons)
+        dialog.resize(620, min(620, self.height()))  # scrolls on a small screen
+        dialog.exec()
 
     # ------------------------------------------------------------------ what is shown
 
