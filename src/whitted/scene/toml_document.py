@@ -123,10 +123,7 @@ def compact_toml(scene: Scene) -> str:
     for name in ("lights", "objects"):
         items = getattr(scene, name)
         if items:
-            aot = tomlkit.aot()
-            for it in items:
-                aot.append(_table(compact_data(it)))
-            doc[name] = aot
+            doc[name] = _aot(items)
     for name in _OTHER_FIELDS:  # e.g. the animation table
         value = getattr(scene, name, None)
         if value is not None and value != _scene_default(name):
@@ -172,8 +169,10 @@ def _set_field(table: Any, name: str, old: BaseModel, new: BaseModel) -> None:
             del table[name]
         return
     plain = _plain(new_value)
-    table[name] = _item(plain, inline=not isinstance(table, Table) or not isinstance(
-        new_value, BaseModel) or isinstance(node, InlineTable) or node is None)
+    # a sub-table only where the file has one: ``material = "glass"`` becoming an object's
+    # own material is written inline, on the line where the name was
+    table[name] = _item(plain, inline=not (isinstance(table, Table) and isinstance(
+        new_value, BaseModel) and isinstance(node, Table)))
 
 
 def _update_table(table: Any, old: BaseModel, new: BaseModel) -> None:
@@ -196,7 +195,7 @@ def _update_list(doc: Any, name: str, old: list, new: list) -> None:
         return
     inline = isinstance(node, Array)
     fresh = (lambda it: _item(compact_data(it))) if inline else (
-        lambda it: _table(compact_data(it)))
+        lambda it: _block(compact_data(it)))
     ops = difflib.SequenceMatcher(None, [_key(i) for i in old], [_key(i) for i in new],
                                   autojunk=False).get_opcodes()
     for tag, i1, i2, j1, j2 in reversed(ops):  # from the end: earlier indices stay valid
@@ -215,10 +214,17 @@ def _update_list(doc: Any, name: str, old: list, new: list) -> None:
             node.insert(i1 + paired, fresh(new[k]))
 
 
+def _block(data: dict[str, Any]) -> Table:
+    """A table of an array of tables (``[[objects]]``) with a blank line before it."""
+    table = _table(data)
+    table.trivia.indent = "\n"
+    return table
+
+
 def _aot(items: list) -> AoT:
     aot = tomlkit.aot()
     for it in items:
-        aot.append(_table(compact_data(it)))
+        aot.append(_block(compact_data(it)))
     return aot
 
 
