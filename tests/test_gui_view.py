@@ -80,6 +80,11 @@ def test_a_render_looks_through_the_scene_camera(window, qtbot):
     assert nav.camera_view  # the render is the camera's picture: camera view
     qtbot.waitUntil(lambda: not window.controller.rendering, timeout=SLOW)
     assert window.controller.last_image is not None
+    assert "Rendered" in window.statusBar().currentMessage()
+    # File > New: nothing said about the last scene's render stays
+    qtbot.keyClick(vp, Qt.Key.Key_N, Qt.KeyboardModifier.ControlModifier)
+    assert window.statusBar().currentMessage() == "" and window.eta.text() == ""
+    assert window.navigation.camera_view
 
 
 def test_the_preview_size_follows_the_picture_on_screen(make_window, qtbot):  # noqa: F811

@@ -259,6 +259,17 @@ class MainWindow(QMainWindow):
         box.exec()
         return "rewrite" if box.clickedButton() is rewrite else "cancel"
 
+    def ask_save_for_film(self) -> bool:
+        """The film is rendered from the scene's file: save the changes first? (True:
+        save; False: no film)."""
+        answer = QMessageBox.question(
+            self, "Save before the film?",
+            f"The film is rendered from the scene's file. Save the changes to "
+            f"{self.scene_name()} first?",
+            QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Cancel,
+            QMessageBox.StandardButton.Save)
+        return answer == QMessageBox.StandardButton.Save
+
     def ask_recover(self, autosave: Path) -> bool:
         answer = QMessageBox.question(
             self, "Recover unsaved changes?",
