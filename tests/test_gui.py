@@ -458,7 +458,8 @@ def test_render_then_stop_keeps_the_partial_picture(make_window, qtbot):
     assert window.viewport.image is not None and window.viewport.kind == "render"
     shown = window.viewport.image
     assert shown.width() == 320 and not shown.isNull()
-    assert "Stopped" in window.eta.text()
+    # said once, in the status bar (not again beside the hidden progress bar)
+    assert "Stopped" in window.statusBar().currentMessage() and window.eta.text() == ""
     assert window.act_render.isEnabled() and not window.act_stop.isEnabled()
     # the kept picture can be saved
     out = Path(window.settings.fileName()).parent / "partial.png"

@@ -100,8 +100,9 @@ class RenderControl(QObject):
         if self.viewport.caption == "Stopping…":
             self.viewport.caption = ""
             self.viewport.update()
-        self.window_.statusBar().showMessage(text, 8000)
-        self.progress.hide()  # (the last progress text stays beside it until the next)
+        self.window_.statusBar().showMessage(text, 8000)  # said once, not twice
+        self.progress.hide()
+        self.eta.setText("")
         self.update_actions()
 
     def _failed(self, kind: str, message: str) -> None:
