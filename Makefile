@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 # Compiled kernels are kept here between runs (see src/whitted/_cache.py).
 export WHITTED_CACHE_DIR ?= $(CURDIR)/.cache
 
-.PHONY: demo test lint install install-test bench clean
+.PHONY: demo test test-timing lint install install-test bench clean
 
 $(BIN)/whitted: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -30,6 +30,10 @@ demo: install
 test: install-test
 	$(BIN)/ruff check src tests
 	$(BIN)/python -m pytest -q
+
+## The tests whose outcome depends on the machine's speed (marker `timing`), run apart
+test-timing: install-test
+	$(BIN)/python -m pytest -q -m timing
 
 ## Render the benchmark scenes (benchmarks/) and print the timing table
 bench: install
