@@ -242,7 +242,7 @@ class MainWindow(QMainWindow):
         buttons = (QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
                    | QMessageBox.StandardButton.Cancel)
         answer = QMessageBox.question(
-            self, "Unsaved changes", f"Save the changes to {self.scene_name()}?", buttons,
+            self, "Unsaved changes", f"Save the changes to {self.files.scene_name()}?", buttons,
             QMessageBox.StandardButton.Save)
         return {QMessageBox.StandardButton.Save: "save",
                 QMessageBox.StandardButton.Discard: "discard"}.get(answer, "cancel")
@@ -265,7 +265,7 @@ class MainWindow(QMainWindow):
         answer = QMessageBox.question(
             self, "Save before the film?",
             f"The film is rendered from the scene's file. Save the changes to "
-            f"{self.scene_name()} first?",
+            f"{self.files.scene_name()} first?",
             QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Cancel,
             QMessageBox.StandardButton.Save)
         return answer == QMessageBox.StandardButton.Save
@@ -273,7 +273,7 @@ class MainWindow(QMainWindow):
     def ask_recover(self, autosave: Path) -> bool:
         answer = QMessageBox.question(
             self, "Recover unsaved changes?",
-            f"{autosave.name} holds changes to {self.scene_name()} that were never saved "
+            f"{autosave.name} holds changes to {self.files.scene_name()} that were never saved "
             "(the editor closed unexpectedly). Recover them?")
         return answer == QMessageBox.StandardButton.Yes
 
@@ -436,17 +436,11 @@ class MainWindow(QMainWindow):
         panel and the picture's outline all follow the document's one selection."""
         self.doc.select(key)
 
-    def scene_name(self) -> str:
-        return self.files.scene_name()
-
     def maybe_save(self) -> bool:
         return self.files.maybe_save()
 
     def new_scene(self) -> bool:
         return self.files.new_scene()
-
-    def open_dialog(self) -> bool:
-        return self.files.open_dialog()
 
     def open_path(self, path: Path, *, ask: bool = True) -> bool:
         return self.files.open_path(path, ask=ask)
@@ -487,23 +481,14 @@ class MainWindow(QMainWindow):
     def duplicate_selected(self):
         return self.editing.duplicate_selected()
 
-    def rename_selected(self) -> None:
-        self.editing.rename_selected()
-
     def start_tool(self, mode: str) -> bool:
         return self.editing.start_tool(mode)
 
     def pick(self, u: float, v: float, modifiers=None) -> tuple | None:
         return self.editing.pick(u, v, modifiers)
 
-    def light_at(self, u: float, v: float):
-        return self.overlays.light_at(u, v)
-
     def _light_marks(self):
         return self.overlays.light_marks()
-
-    def frame_selection(self) -> bool:
-        return self.navigation.frame_selection()
 
     def frame_all(self) -> bool:
         return self.navigation.frame_all()
