@@ -222,3 +222,37 @@ def test_shift_click_selects_more_and_g_and_delete_act_on_all_in_one_step(window
     qtbot.keyClick(vp, Qt.Key.Key_X)  # X deletes, as Delete does
     assert len(window.doc.scene.objects) == count - 2
     assert window.doc.undo_stack.count() == steps + 1 and window.doc.selection is None
+
+
+def test_ctrl_d_duplicates_every_selected_item_in_one_step_and_selects_the_copies(window,
+                                                                                  qtbot):
+    window.select([("objects", 2), ("objects", 3), ("lights", 1)])
+    count, lights = len(window.doc.scene.objects), len(window.doc.scene.lights)
+    steps = window.doc.undo_stack.count()
+    qtbot.keyClick(window.tree, Qt.Key.Key_D, Qt.KeyboardModifier.ControlModifier)
+    scene = window.doc.scene
+    assert len(scene.objects) == count + 2 and len(scene.lights) == lights + 1
+    assert [o.name for o in scene.objects[-2:]] == ["ball 1 copy", "ball 2 copy"]
+    assert scene.lights[-1].name == "lamp copy"
+    assert window.doc.undo_stack.count() == steps + 1
+    assert set(window.doc.selected_keys()) == {("lights", lights), ("objects", count),
+                                               ("objects", count + 1)}
+
+
+def test_overlays_stay_inside_the_picture(window, qtbot):
+    """The selection's box, partly outside the view, is drawn only over the picture: the
+    margin around it keeps the viewport's plain colour."""
+    from PySide6.QtGui import QColor
+
+    vp = window.viewport
+    window.select(("objects", 1))  # the big ball
+    for _ in range(6):  # the view closes in: the ball's box reaches past the picture
+        window.navigation.zoom(0.6)
+    image = vp.grab().toImage()
+    rect = vp.picture_rect().toAlignedRect()
+    plain = QColor(48, 48, 52).rgb()
+    ratio = image.width() / vp.width()
+    margin = [(x, y) for x in range(0, vp.width(), 3) for y in range(0, vp.height(), 3)
+              if not rect.adjusted(-3, -3, 3, 3).contains(x, y)]
+    assert margin  # the picture does not fill the viewport
+    assert all(image.pixel(int(x * ratio), int(y * ratio)) == plain for x, y in margin)
