@@ -57,19 +57,12 @@ def _load(case_path: Path):
     return case, case_path.read_text(encoding="utf-8")
 
 
-def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, size=(480, 360)):
+def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, size=(480, 360),
+           allow_large: bool = False):
     from ..stefan.case import CaseError
     from ..stefan.run import run_case
 
     case, text = _load(case_path)
-    if output.exists() and not output.is_dir():
-        raise _fail(f"{output}: exists and is not a folder")
-    if output.resolve() == case_path.resolve().parent and fresh:
-        raise _fail(f"{output}: --fresh would clear the case file's own folder")
-    if fresh and output.exists():
-        for sub in ("fields", "surfaces", "scenes"):
-            for f in (output / sub).glob("*"):
-                f.unlink()
     from rich.progress import (
         BarColumn,
         Progress,
@@ -89,7 +82,8 @@ def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, size=(480, 3
 
         try:
             result = run_case(case, text, output, resume=not fresh, progress=progress,
-                              should_stop=stop.flag.is_set, scene_size=size)
+                              should_stop=stop.flag.is_set, scene_size=size,
+                              allow_large=allow_large, case_path=case_path)
         except CaseError as exc:
             raise _fail(str(exc)) from None
     return case, result
@@ -100,13 +94,18 @@ def run(
     case_path: Annotated[Path, typer.Argument(metavar="CASE", help="Case file (TOML)")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Output folder")] = Path(
         "stefan-out"),
-    fresh: Annotated[bool, typer.Option("--fresh", help="Start over, do not resume")] = False,
+    fresh: Annotated[bool, typer.Option("--fresh", help="Start over, do not resume (removes "
+                                        "only the files whitted wrote there)")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
+    allow_large: Annotated[bool, typer.Option(
+        "--allow-large", help="Go beyond the soft limits on steps, cell updates, saved times "
+        "and disk (never beyond the machine's memory or free disk)")] = False,
 ) -> None:
     """Compute the melt of CASE: fields (.npz), surfaces (.ply) per saved time, a time series
     (CSV and plots) and a scene per saved time. Ctrl-C keeps what was saved; run again to
-    resume from the last saved time."""
-    case, result = _solve(case_path, output, fresh, quiet)
+    resume from the last saved time. The folder must be new, empty of the run's names, or
+    one whitted made (its .whitted-stefan-run marker): nothing else is written over."""
+    case, result = _solve(case_path, output, fresh, quiet, allow_large=allow_large)
     _report(result)
     if result.interrupted:
         err.print(f"interrupted at t = {result.end_time:.1f} s: kept the saved times up to "
@@ -225,7 +224,6 @@ def film(
     time with 'whitted animate' (the piece on a table, backlit; ice 1.31, water 1.333,
     absorption exaggerated and said so) and encode the film with the simulated time in each
     frame. Ctrl-C keeps the solved times and the finished frames; run again to continue."""
-    import csv
 
     from ..output.video import encode_film, video_format
     from ..stefan.scene import ABSORPTION_BOOST, still_life_scene, write_scene
@@ -247,23 +245,32 @@ def film(
         err.print(f"interrupted while solving: kept every saved time in {work}; run the same "
                   "command again to continue")
         raise typer.Exit(EXIT_INTERRUPTED)
-    with (work / "series.csv").open(newline="") as fh:
-        times = [float(row["time_s"]) for row in csv.DictReader(fh)]
-    count = 0  # frames: saved times from 0 on where both surfaces exist
-    while (count < len(times) and (work / "surfaces" / f"outer_{count:04d}.ply").exists()
-           and (work / "surfaces" / f"inner_{count:04d}.ply").exists()):
-        count += 1
+    from ..stefan.run import film_frames
+
+    shown = film_frames(work)  # to the end of the run (drain: the outer surface alone)
+    count = len(shown)
+    times = [f.time for f in shown]
     if count == 0:
-        raise _fail(f"{work}: no saved time has both surfaces to film")
-    scene_path = work / "film.toml"
-    write_scene(scene_path, still_life_scene(
-        "surfaces/outer_{frame:04d}.ply", "surfaces/inner_{frame:04d}.ply", None,
-        width=width, height=height, size_cm=100 * max(case.block.size), frames=count, fps=fps))
+        raise _fail(f"{work}: no saved time has a surface to film")
     frames = work / "frames"
     render_start = time.perf_counter()
-    animate_command(scene_path=scene_path, output=frames, frames=None, fps=None, width=None,
-                    height=None, samples=None, max_depth=None, threads=None, seed=None,
-                    set_values=None, crf=18, force=False, quiet=quiet)
+    if all(f.inner is not None for f in shown):
+        scene_path = work / "film.toml"
+        write_scene(scene_path, still_life_scene(
+            "surfaces/outer_{frame:04d}.ply", "surfaces/inner_{frame:04d}.ply", None,
+            width=width, height=height, size_cm=100 * max(case.block.size), frames=count,
+            fps=fps))
+        animate_command(scene_path=scene_path, output=frames, frames=None, fps=None,
+                        width=None, height=None, samples=None, max_depth=None, threads=None,
+                        seed=None, set_values=None, crf=18, force=False, quiet=quiet)
+    else:  # some frames have no cavity: each frame's own still life (scenes/frame_NNNN)
+        from ..render import render as render_scene
+
+        frames.mkdir(exist_ok=True)
+        for f in shown:
+            image = render_scene(work / "scenes" / f"frame_{f.index:04d}.toml", width=width,
+                                 height=height)
+            image.save(frames / f"{f.index:04d}.png")
     render_seconds = time.perf_counter() - render_start
     stamped = [_stamp(frames / f"{k:04d}.png",
                       f"t = {times[k] / 60:5.1f} min   (absorption x{ABSORPTION_BOOST:g})")
