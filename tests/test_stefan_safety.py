@@ -23,7 +23,7 @@ from whitted.stefan.case import Case, CaseError, case_from_dict, load_case
 from whitted.stefan.geometry import initial_state
 from whitted.stefan.measures import measure
 from whitted.stefan.run import _latest_state, film_frames, run_case, state_files
-from whitted.stefan.solver import Air, EnthalpySolver
+from whitted.stefan.solver import EnthalpySolver
 
 REPO = Path(__file__).resolve().parents[1]
 TINY = "[grid]\ncells = 12\n[time]\nend = 300.0\nsave_every = 300.0\n[surfaces]\nsmoothing = 2\n"
@@ -210,7 +210,7 @@ def test_shell_thins_and_cavity_grows_steadily_to_the_breach():
     case = case_from_dict(data)
     H, kind, cavity, _ = initial_state(case)
     solver = EnthalpySolver(H, kind, case.dx, case.properties, faces=case.solver_faces(),
-                            air=Air(case.air.temperature, case.air.h))
+                            air=case.solver_air())
     initial = float(cavity.sum()) * case.dx ** 3
     rows = []
     t = 0.0

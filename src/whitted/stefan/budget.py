@@ -65,12 +65,12 @@ def grid_shape(case: Case) -> tuple[int, int, int]:
 
 
 def time_step(case: Case) -> float:
-    from .solver import Air, stability_limit
+    from .solver import stability_limit
 
     if case.time.dt is not None:
         return case.time.dt
     limit = stability_limit(case.properties, case.dx, 3, case.solver_faces(),
-                            Air(case.air.temperature, case.air.h))
+                            case.solver_air())
     return case.time.cfl * limit
 
 

@@ -97,11 +97,17 @@ class Cavity(_Strict):
 
 
 class Air(_Strict):
-    """The room: air temperature (°C) and the heat transfer coefficient h (W/m²K: about
-    5-10 still air, 10-25 a gentle draught)."""
+    """The room: air temperature (°C) and the convective heat transfer coefficient h (W/m²K:
+    about 5-10 still air, 10-25 a gentle draught); radiation with surroundings at
+    ``surroundings`` °C (default: the air's) for ice of ``emissivity`` (0 turns it off); and
+    condensation of the air's vapour at ``relative_humidity`` (0-1; 0 turns it off). See
+    :mod:`whitted.stefan.room` and docs/stefan.md."""
 
     temperature: _num(ge=-80.0, le=200.0) = 25.0
     h: _num(gt=0.0, le=1.0e4) = 20.0
+    surroundings: _num(ge=-80.0, le=200.0) | None = None
+    emissivity: _num(ge=0.0, le=1.0) = 0.97
+    relative_humidity: _num(ge=0.0, le=1.0) = 0.3
 
 
 class Table(_Strict):
@@ -198,11 +204,10 @@ class Case(_Strict):
             problems.append(("air.temperature", "nothing melts: the air, the cavity water and "
                              "the table are all at or below 0 °C"))
         if self.time.dt is not None:
-            from .solver import Air as SolverAir
             from .solver import stability_limit
 
             limit = stability_limit(self.properties, dx, 3, self.solver_faces(),
-                                    SolverAir(self.air.temperature, self.air.h))
+                                    self.solver_air())
             if self.time.dt > limit:
                 problems.append(("time.dt", f"{self.time.dt:g} s is over the stability limit "
                                  f"{limit:.4g} s of {dx * 1e3:.3g} mm cells"))
@@ -210,6 +215,17 @@ class Case(_Strict):
             problems.append(("time.save_every", f"{self.time.save_every:g} s is longer than "
                              f"time.end ({self.time.end:g} s)"))
         return problems
+
+    def solver_air(self):
+        """The solver's air: convection, radiation and condensation as one effective film
+        (:func:`whitted.stefan.room.outer_film`)."""
+        from .room import outer_film
+        from .solver import Air as SolverAir
+
+        a = self.air
+        film = outer_film(a.temperature, a.h, t_sur=a.surroundings, emissivity=a.emissivity,
+                          relative_humidity=a.relative_humidity)
+        return SolverAir(film.temperature, film.h)
 
     def solver_faces(self):
         from .solver import Faces

@@ -35,7 +35,7 @@ from .case import Case, CaseError, case_digest
 from .geometry import GridFrame, grid_frame, initial_state
 from .measures import measure
 from .scene import still_life_scene, write_scene
-from .solver import Air, EnthalpySolver
+from .solver import EnthalpySolver
 from .surfaces import extract_surfaces, write_ply
 
 _STATE_NAME = re.compile(r"state_(\d+)\.npz")
@@ -196,7 +196,7 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
     props = case.properties
     frame = grid_frame(case)
     result = RunResult(out, cells=frame.shape)
-    air = Air(case.air.temperature, case.air.h)
+    air = case.solver_air()
     latest = _latest_state(out / "fields", digest) if resume else None
     rows: list[dict]
     if latest is not None:
