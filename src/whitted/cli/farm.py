@@ -8,8 +8,6 @@ before the end (frames, bands) is kept."""
 
 from __future__ import annotations
 
-import signal
-import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager, nullcontext
@@ -19,6 +17,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from ..errors import WhittedError
+from .interrupt import InterruptGuard
 
 if TYPE_CHECKING:
     from rich.progress import Progress
@@ -37,7 +36,7 @@ SchedulerOption = Annotated[
 
 def farm_module():
     """``whitted.farm``, or the one-line error saying what to install."""
-    from .main import fail
+    from .app import fail
 
     try:
         from .. import farm
@@ -48,37 +47,10 @@ def farm_module():
 
 def cluster_fail(message: str) -> typer.Exit:
     """One line, exit status :data:`EXIT_CLUSTER`."""
-    from .main import fail
+    from .app import fail
 
     fail(message)
     return typer.Exit(EXIT_CLUSTER)
-
-
-@contextmanager
-def stop_on_signals() -> Iterator[tuple[threading.Event, list[int]]]:
-    """While the farm works: the first Ctrl-C (SIGINT) or SIGTERM sets the event (the job
-    stops after writing what arrived), a second Ctrl-C stops at once."""
-    stop = threading.Event()
-    signals: list[int] = []
-    if threading.current_thread() is not threading.main_thread():
-        yield stop, signals
-        return
-
-    def on_signal(signum, frame) -> None:
-        if stop.is_set() and signum == signal.SIGINT:
-            raise KeyboardInterrupt
-        signals.append(signum)
-        stop.set()
-
-    handled = (signal.SIGINT, signal.SIGTERM)
-    previous = {sig: signal.getsignal(sig) for sig in handled}
-    for sig in handled:
-        signal.signal(sig, on_signal)
-    try:
-        yield stop, signals
-    finally:
-        for sig in handled:
-            signal.signal(sig, previous[sig])
 
 
 @contextmanager
@@ -100,16 +72,8 @@ def quiet_dask_logs() -> Iterator[None]:
             log.setLevel(level)
 
 
-def _stopped_status(signals: list[int]) -> tuple[str, int]:
-    from .main import EXIT_INTERRUPTED, EXIT_TERMINATED
-
-    if signal.SIGTERM in signals:
-        return "terminated", EXIT_TERMINATED
-    return "interrupted", EXIT_INTERRUPTED
-
-
 def bar(label: str, quiet: bool) -> Progress | None:
-    from .main import err
+    from .app import err
 
     if quiet or not err.is_terminal:
         return None
@@ -132,36 +96,37 @@ def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
     (with ``frame``, an 8-bit PNG is the film's frame file, record included, as locally).
     Stopped part way, the bands that arrived are written, as a local render keeps its
     tiles."""
-    from .main import _note, _save_npy, err, fail, out
+    from .app import err, fail, out, save_npy
 
     farm = farm_module()
     start = time.perf_counter()
-    note = None if quiet else (lambda line: err.print(line, markup=False, highlight=False))
+    tell = None if quiet else (lambda line: err.print(line, markup=False, highlight=False))
+    # Ctrl-C, SIGTERM (cli/interrupt.py): while the cluster starts, at once (nothing to keep);
+    # while bands render, after writing the bands that arrived, as a local render keeps tiles
+    starting, rendering = InterruptGuard(at_once=True), InterruptGuard()
     try:
-        # Ctrl-C while the cluster starts stops at once; later, after the bands that arrived
-        with quiet_dask_logs(), \
-                farm.farm_client(cluster, scheduler, threads=threads, note=note) as client, \
-                stop_on_signals() as (stop, signals):
+        with quiet_dask_logs(), starting, \
+                farm.farm_client(cluster, scheduler, threads=threads, note=tell) as client, \
+                rendering:
             progress = bar("rendering bands", quiet)
             with progress if progress is not None else nullcontext():
                 task = progress.add_task("bands", total=None) if progress else None
                 image = farm.render_still(
-                    client, scene, cancel=stop, note=note,
+                    client, scene, cancel=rendering.event, note=tell,
                     progress=None if progress is None else (
                         lambda done, total: progress.update(task, completed=done,
                                                             total=total)))
-    except KeyboardInterrupt:  # a second Ctrl-C, or one while the cluster started
-        _note(f"interrupted: nothing written ({output} is unchanged)")
-        raise typer.Exit(130) from None
+    except KeyboardInterrupt:  # while the cluster started, or a second signal
+        guard = rendering if rendering.interrupted else starting
+        raise guard.exit(f"nothing written ({output} is unchanged)") from None
     except farm.ClusterLost as exc:
         raise cluster_fail(str(exc)) from None
     except WhittedError as exc:  # a bad option, a bad model file
         raise fail(str(exc)) from None
     stats = image.meta["stats"]
     if stats.cancelled and stats.tiles_done == 0:
-        what, code = _stopped_status(signals)
-        _note(f"{what} before any band was finished: nothing written ({output} is unchanged)")
-        raise typer.Exit(code)
+        raise rendering.exit(f"before any band was finished: nothing written ({output} is "
+                             "unchanged)")
     for warning in stats.warnings:
         err.print(f"warning: {warning}", markup=False, highlight=False)
     from ..output.encode import image_format
@@ -184,16 +149,14 @@ def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
         planes = render_aovs(scene)
         for name in aovs:
             path = output.with_name(f"{output.stem}.{name}.npy")
-            _save_npy(path, planes[name])
+            save_npy(path, planes[name])
             written.append(str(path))
     stats.wall_seconds = time.perf_counter() - start
     if not quiet or stats.cancelled:
         out.print(f"{stats.summary()} on {image.meta['workers']} workers "
                   f"({image.meta['bands']} bands) -> {', '.join(written)}", highlight=False)
     if stats.cancelled:
-        what, code = _stopped_status(signals)
-        _note(f"{what}: kept {stats.tiles_done}/{stats.tiles_total} bands in {output}")
-        raise typer.Exit(code)
+        raise rendering.exit(f"kept {stats.tiles_done}/{stats.tiles_total} bands in {output}")
     raise typer.Exit(0)
 
 
@@ -202,20 +165,20 @@ def animate_on_farm(scene: Scene, frames: range, folder: Path, film: Path | None
                     scheduler: str | None, threads: int | None) -> None:
     """``whitted animate`` on a cluster: frames as tasks, each written here as it arrives
     (resumable, as the local command), then the film encoded from the whole sequence."""
-    from .main import err, fail, out
+    from .app import err, fail, out
 
     farm = farm_module()
     start = time.perf_counter()
     note = None if quiet else (lambda line: err.print(line, markup=False, highlight=False))
     finished: list[int | None] = []
-    signals: list[int] = []
+    # Ctrl-C, SIGTERM (cli/interrupt.py): while the cluster starts, at once; while frames
+    # render, after writing every frame that arrived (a second signal: at once)
+    starting, rendering = InterruptGuard(at_once=True), InterruptGuard()
 
-    def stopped(extra: str = "") -> typer.Exit:
-        what, code = _stopped_status(signals)
-        err.print(f"{what}: {len(finished)} of {len(frames)} frames finished in {folder}"
-                  f"{extra}; run the same command again to continue", markup=False,
-                  highlight=False)
-        return typer.Exit(code)
+    def stopped() -> typer.Exit:
+        guard = rendering if rendering.interrupted else starting
+        return guard.exit(f"{len(finished)} of {len(frames)} frames finished in {folder}; "
+                          "run the same command again to continue")
 
     try:
         farm.check_farm_options(cluster, scheduler)
@@ -223,8 +186,7 @@ def animate_on_farm(scene: Scene, frames: range, folder: Path, film: Path | None
         # a cluster only when frames are missing: a finished film is only encoded
         connect = (farm.farm_client(cluster, scheduler, threads=threads, note=note)
                    if plan.todo else nullcontext())
-        with quiet_dask_logs(), connect as client, stop_on_signals() as (stop, caught):
-            signals = caught
+        with quiet_dask_logs(), starting, connect as client, rendering:
             progress = bar("frames", quiet)
 
             def frame_done(done: int, total: int, frame: int | None) -> None:
@@ -237,9 +199,9 @@ def animate_on_farm(scene: Scene, frames: range, folder: Path, film: Path | None
             with progress if progress is not None else nullcontext():
                 task = progress.add_task("frames", total=len(frames)) if progress else None
                 result = farm.render_film(client, scene, folder, film=film, fps=fps, crf=crf,
-                                          progress=frame_done, plan=plan, cancel=stop,
-                                          note=note)
-    except KeyboardInterrupt:  # a second Ctrl-C (or one while the cluster started)
+                                          progress=frame_done, plan=plan,
+                                          cancel=rendering.event, note=note)
+    except KeyboardInterrupt:  # while the cluster started, or a second signal
         raise stopped() from None
     except farm.ClusterLost as exc:
         kept = f" ({len(finished)} of {len(frames)} frames are in {folder})" if finished else ""

@@ -74,12 +74,6 @@ class FilmResult:
     threads: int = 0  # the cluster's Dask threads when the tasks were sized
 
 
-def frame_file_name(frame: int, count: int) -> str:
-    """``0007.png``: four digits at least, more when the film has more frames (the names
-    ``whitted animate`` gives)."""
-    return f"{frame:0{max(4, len(str(count - 1)))}d}.png"
-
-
 def chunk_size(frames: int, threads: int, frame_seconds: float | None) -> int:
     """Frames per task for ``frames`` frames on ``threads`` render threads in all (the Dask
     threads of every worker) when a frame takes ``frame_seconds`` (measured; None: not yet,
@@ -109,6 +103,7 @@ def plan_film(scene: Scene, frames_dir: str | Path, *, frames: Sequence[int] | N
               force: bool = False, **settings: Any) -> FilmPlan:
     """Each frame's still, hash and file; the frames whose PNG already holds their hash are
     kept (unless ``force``)."""
+    from ..animation.film import frame_name
     from ..animation.frames import frame_digest, frame_is_current, still_for_frame
 
     folder = Path(frames_dir)
@@ -116,7 +111,7 @@ def plan_film(scene: Scene, frames_dir: str | Path, *, frames: Sequence[int] | N
     chosen = list(range(count) if frames is None else frames)
     stills = [still_for_frame(scene, k, **settings) for k in chosen]
     digests = [frame_digest(still, k) for still, k in zip(stills, chosen, strict=True)]
-    paths = [folder / frame_file_name(k, count) for k in chosen]
+    paths = [folder / frame_name(k, count) for k in chosen]
     todo, kept = [], []
     for i, (k, digest, path) in enumerate(zip(chosen, digests, paths, strict=True)):
         if not force and frame_is_current(path, digest):
@@ -161,7 +156,7 @@ def render_film(
     :class:`FrameFailed` for the first frame that failed, after all the others are saved, and
     :class:`~whitted.farm.watch.ClusterLost` when the cluster cannot go on (what arrived is
     written)."""
-    from ..output.encode import atomic_write
+    from ..files import atomic_write
 
     started = time.perf_counter()
     folder = Path(frames_dir)

@@ -18,8 +18,9 @@ from typing import Any
 
 from pydantic import BaseModel
 
-from ..animation.model import Animation, Interpolation, Track
-from ..animation.paths import (
+from ..scene import Scene
+from ..scene.animation import Animation, Interpolation, Track
+from ..scene.paths import (
     PathError,
     format_path,
     get_value,
@@ -27,8 +28,7 @@ from ..animation.paths import (
     resolve_path,
     set_value,
 )
-from ..animation.timeline import scene_at_frame, track_value
-from ..scene import Scene
+from ..scene.timeline import scene_at_frame, track_value
 from ..scene.types import Transform
 
 #: a new animation (made by the first key of a still scene): two seconds at 24 fps
@@ -117,7 +117,8 @@ def insert_keys(scene: Scene, targets: list[tuple[str, Any]], frame: int,
         else:
             tracks.append(Track(path, [[frame, value]], interpolation=interpolation))
     fields = {name: getattr(scene, name) for name in Scene.model_fields}
-    fields["animation"] = Animation(frames=anim.frames, fps=anim.fps, tracks=tracks)
+    # every other setting of the animation (cyclic, fps, frames...) stays as it is
+    fields["animation"] = anim.model_copy(update={"tracks": tracks})
     return Scene(**fields).with_base_dir(getattr(scene, "_base_dir", None))
 
 
