@@ -32,7 +32,7 @@ def test_render_on_a_local_cluster_writes_the_local_image(tmp_path, examples_dir
     result = whitted("render", scene_path, "-W", 80, "-H", 45, "-s", 2, "-o",
                      tmp_path / "farm.png", "--cluster", "local:2", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
-    assert "farm: 2 workers at tcp://127.0.0.1:" in result.stderr
+    assert "farm: 2 workers (2 Dask threads) at tcp://127.0.0.1:" in result.stderr
     assert "on 2 workers" in result.stdout
     scene = load_scene(scene_path).with_settings(width=80, height=45, samples=2)
     RenderJob(scene).run().save(tmp_path / "local.png")
@@ -152,3 +152,60 @@ print(numba.get_num_threads(), numba.config.NUMBA_NUM_THREADS)
                             text=True, timeout=120, env=dict(os.environ))
     assert result.returncode == 0, result.stderr
     assert result.stdout.split() == ["1", "1"]
+
+
+def test_help_names_the_farm_extra():
+    result = CliRunner().invoke(app, ["render", "--help"], env={"COLUMNS": "200"})
+    assert result.exit_code == 0
+    assert "(needs whitted[farm])" in " ".join(result.stdout.split())
+
+
+def test_a_frame_rendered_on_a_cluster_is_the_local_frame_file(tmp_path):
+    scene = tmp_path / "turn.toml"
+    scene.write_text(FILM)
+    local = CliRunner().invoke(app, ["render", str(scene), "-f", "4", "-o",
+                                     str(tmp_path / "local.png"), "-q"])
+    assert local.exit_code == 0, local.stderr
+    result = whitted("render", scene, "-f", 4, "-o", tmp_path / "farm.png", "-q",
+                     "--cluster", "local:1", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    # the record (frame hash, renderer) too: `whitted animate` takes it as its frame 4
+    assert (tmp_path / "farm.png").read_bytes() == (tmp_path / "local.png").read_bytes()
+    from whitted.animation.frames import read_frame_digest
+
+    assert read_frame_digest(tmp_path / "farm.png") is not None
+
+
+def test_ctrl_c_in_a_terminal_keeps_the_frames_and_the_workers_stop_quietly(tmp_path):
+    import signal
+    import time
+
+    scene = tmp_path / "long.toml"
+    scene.write_text(FILM.replace("frames = 6", "frames = 300"))
+    folder = tmp_path / "frames"
+    code = ("import sys; from whitted.cli.main import main; sys.argv[0] = 'whitted'; main()")
+    run = subprocess.Popen([sys.executable, "-c", code, "animate", str(scene), "-o",
+                            str(folder), "--cluster", "local:2", "-q"], cwd=tmp_path,
+                           env=dict(os.environ), stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        end = time.monotonic() + 240
+        while len(list(folder.glob("*.png"))) < 3 and run.poll() is None:
+            assert time.monotonic() < end, "no frames arrived"
+            time.sleep(0.05)
+        os.killpg(run.pid, signal.SIGINT)  # a terminal's Ctrl-C: every process of the group
+        _, stderr = run.communicate(timeout=120)
+    finally:
+        if run.poll() is None:
+            os.killpg(run.pid, signal.SIGKILL)
+    assert run.returncode == 130, stderr
+    assert "Traceback" not in stderr
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1, stderr
+    line = lines[0]
+    written = sorted(folder.glob("*.png"))
+    assert line == (f"interrupted: {len(written)} of 300 frames finished in {folder}; run the "
+                    "same command again to continue")
+    from whitted.animation.frames import read_frame_digest
+
+    assert all(read_frame_digest(p) is not None for p in written)  # whole frames only

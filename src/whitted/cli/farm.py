@@ -129,7 +129,7 @@ def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
                              "unchanged)")
     for warning in stats.warnings:
         err.print(f"warning: {warning}", markup=False, highlight=False)
-    from ..output.encode import image_format
+    from ..output.formats import image_format
 
     try:
         if frame is not None and not stats.cancelled and bit_depth == 8 \

@@ -7,6 +7,7 @@ that cannot be (another whitted, none at all) is named in one line and given no 
 from __future__ import annotations
 
 import importlib.util
+import logging
 import signal
 import socket
 import threading
@@ -89,7 +90,8 @@ def dashboard_link(client: Client) -> str | None:
 def local_cluster(workers: int, threads: int) -> LocalCluster:
     """``workers`` processes of one Dask thread each, each rendering with ``threads`` lanes.
     They start with Ctrl-C ignored (the client stops them itself: a terminal's Ctrl-C
-    reaches every process of its group, and each printed its traceback)."""
+    reaches every process of its group, and each printed its traceback), and log errors
+    only."""
     main = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
     try:
@@ -97,6 +99,7 @@ def local_cluster(workers: int, threads: int) -> LocalCluster:
             n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
             dashboard_address="127.0.0.1:0",  # a free port (a page only with bokeh)
             env={"NUMBA_NUM_THREADS": str(threads)},
+            silence_logs=logging.ERROR,  # a worker stopped mid-task says so as a WARNING
         )
     finally:
         if main:
