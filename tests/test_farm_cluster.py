@@ -390,3 +390,62 @@ def test_an_unreachable_scheduler_is_one_line_at_once(tmp_path):
     assert bad.returncode == 2
     assert bad.stderr.strip() == ("error: --scheduler head-node: not an address "
                                   "tcp://HOST:PORT")
+
+
+# ------------------------------------------------------------------------------ telling
+
+
+def test_a_cold_worker_says_it_is_compiling_with_progress(scheduler):
+    from whitted.farm import Watch
+    from whitted.farm.worker import EVENT_TOPIC
+
+    address, _, _ = scheduler
+    notes: list[str] = []
+    with distributed.Client(address) as client:
+        watch = Watch(client, notes.append)
+        try:
+            def compiling(fraction: float) -> None:  # what a compiling worker's plugin logs
+                client.log_event(EVENT_TOPIC, {"worker": "tcp://10.0.0.7:40000",
+                                               "status": "compiling", "fraction": fraction})
+
+            # the subscription travels apart from log_event: the first event until it is heard
+            wait_for(lambda: compiling(0.05) or notes, "the subscription")
+            for fraction in (0.08, 0.35, 0.99):
+                compiling(fraction)
+            wait_for(lambda: len(notes) == 3, "three notes")
+        finally:
+            watch.close()
+    assert notes == [f"farm: worker tcp://10.0.0.7:40000 is compiling the kernels (a cold "
+                     f"cache: first run of this whitted there): {p}%" for p in (0, 30, 90)]
+
+
+def test_a_still_stopped_part_way_keeps_the_bands_that_arrived(scheduler, film_scene):
+    import threading
+
+    import numpy as np
+
+    from whitted.farm import render_still
+    from whitted.render.api import RenderJob
+
+    address, worker, _ = scheduler
+    worker("--name", "w", pythonpath=str(SRC))
+    still = film_scene.at_frame(0).with_settings(width=40, height=64)
+    stop = threading.Event()
+    with distributed.Client(address) as client:
+        client.wait_for_workers(1)
+        ready_cluster(client, WhittedWorker(threads=1), None)
+        image = render_still(client, still, bands=4, cancel=stop,
+                             progress=lambda done, total: stop.set())
+    stats = image.meta["stats"]
+    local = RenderJob(still, threads=1).run().pixels
+    assert stats.tiles_total == 4 and stats.tiles_done >= 1
+    assert stats.cancelled == (stats.tiles_done < 4)
+    from whitted.farm import band_ranges
+
+    same = 0
+    for a, b in band_ranges(64, 4):  # each band is the local rows, or black (not arrived)
+        if np.array_equal(image.pixels[a:b], local[a:b]):
+            same += 1
+        else:
+            assert not image.pixels[a:b].any()
+    assert same >= stats.tiles_done

@@ -305,7 +305,8 @@ def run_tasks(watch: Watch, tasks: dict[Future, Any],
     it takes the result with ``watch.result(future)``). Work of a stalled worker, or whose
     finished result its worker does not hand over, is submitted again with ``submit(item,
     workers)``, the ready workers; ``between()`` runs after each step (it may add tasks).
-    Returns False when ``cancel`` was set (the tasks that had finished are handled first); on
+    Returns False when ``cancel`` was set and tasks were left (those that had finished are
+    handled first); on
     Ctrl-C (KeyboardInterrupt) the finished ones are handled too, then it is raised again."""
 
     def again(items: list[Any], ready: list[str]) -> None:
@@ -318,7 +319,7 @@ def run_tasks(watch: Watch, tasks: dict[Future, Any],
         while tasks:
             if cancel is not None and cancel.is_set():
                 _finish(watch, tasks, on_done)
-                return False
+                return not tasks  # stopped: False unless every task had finished
             for future in watch.wait(tasks):
                 item = tasks.pop(future)
                 try:
