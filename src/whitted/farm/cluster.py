@@ -87,8 +87,9 @@ def dashboard_link(client: Client) -> str | None:
     return client.dashboard_link if "dashboard" in info.get("services", {}) else None
 
 
-def local_cluster(workers: int, threads: int) -> LocalCluster:
-    """``workers`` processes of one Dask thread each, each rendering with ``threads`` lanes.
+def local_cluster(workers: int, threads: int, dask_threads: int = 1) -> LocalCluster:
+    """``workers`` processes of ``dask_threads`` Dask threads each (1: the command line's), each
+    task rendering with ``threads`` lanes.
     They start with Ctrl-C ignored (the client stops them itself: a terminal's Ctrl-C
     reaches every process of its group, and each printed its traceback), and log errors
     only."""
@@ -96,7 +97,8 @@ def local_cluster(workers: int, threads: int) -> LocalCluster:
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
     try:
         return LocalCluster(
-            n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+            n_workers=workers, threads_per_worker=dask_threads, processes=True,
+            host="127.0.0.1",
             dashboard_address="127.0.0.1:0",  # a free port (a page only with bokeh)
             env={"NUMBA_NUM_THREADS": str(threads)},
             silence_logs=logging.ERROR,  # a worker stopped mid-task says so as a WARNING

@@ -1,11 +1,12 @@
 """Measure the farm on this machine (the numbers behind docs/farm.md's scaling model)::
 
     python -m whitted.farm.measure [SCENE] [--frames 24] [--width 480 --height 270]
-        [--workers 1,2] [--rounds 3] [--hd] [--cold] [--json out.json]
+        [--workers 1x1,1x2,2x1] [--rounds 3] [--hd] [--cold] [--json out.json]
 
 A film of ``--frames`` frames (the scene's own animation, or a camera turn added to a still
-scene) rendered three ways: locally in one process with 2 render threads (what ``whitted
-animate`` does), and on LocalClusters of 1 and 2 worker processes with 1 render thread each.
+scene) rendered locally in one process with 2 render threads (what ``whitted animate`` does),
+and on LocalClusters given as ``PROCESSESxTHREADS``: 1x2 is one worker process with 2 Dask
+threads, 2x1 two processes of one (``--cluster local:2``); every task renders with 1 thread.
 Also: the time to start a cluster and warm a fresh worker (kernels loaded from the cache; with
 ``--cold`` compiled into an empty cache), the per-task overhead of Dask on this machine (empty
 tasks: the round trip of one, and the throughput of many), the bytes that travel (the scene,
@@ -67,15 +68,16 @@ def measure_local(scene, folder: Path, threads: int = 2) -> dict:
             "per_frame_cpu_s": cpu / n}
 
 
-def measure_cluster(scene, workers: int, folder: Path, overhead: bool) -> dict:
+def measure_cluster(scene, workers: int, folder: Path, overhead: bool,
+                    dask_threads: int = 1) -> dict:
     from . import render_film
     from ._dask import Client
     from .cluster import local_cluster
     from .worker import WhittedWorker, warm_seconds
 
-    row: dict = {"workers": workers, "threads_per_worker": 1}
+    row: dict = {"workers": workers, "threads_per_worker": dask_threads}
     start = time.perf_counter()
-    cluster = local_cluster(workers, 1)
+    cluster = local_cluster(workers, 1, dask_threads)
     client = Client(cluster)
     row["cluster_start_s"] = time.perf_counter() - start
     try:
@@ -89,6 +91,7 @@ def measure_cluster(scene, workers: int, folder: Path, overhead: bool) -> dict:
         row["per_frame_worker_s"] = result.render_seconds / max(1, len(result.rendered))
         row["per_frame_worker_cpu_s"] = result.render_cpu_seconds / max(1, len(result.rendered))
         row["tasks"] = result.tasks
+        row["chunk"] = result.chunk
         sizes = [p.stat().st_size for p in result.paths]
         row["png_bytes_mean"] = statistics.mean(sizes)
         row["asset_bytes"] = result.asset_bytes
@@ -125,7 +128,8 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--frames", type=int, default=24)
     parser.add_argument("--width", type=int, default=480)
     parser.add_argument("--height", type=int, default=270)
-    parser.add_argument("--workers", default="1,2")
+    parser.add_argument("--workers", default="1x1,2x1",
+                        help="cluster layouts PROCESSESxTHREADS, comma-separated (2 = 2x1)")
     parser.add_argument("--hd", action="store_true")
     parser.add_argument("--cold", action="store_true")
     parser.add_argument("--rounds", type=int, default=1,
@@ -140,14 +144,15 @@ def main(argv: list[str] | None = None) -> dict:
                     "scene_pickle_bytes": len(pickle.dumps(scene))}
     with tempfile.TemporaryDirectory(prefix="whitted-measure-") as tmp:
         root = Path(tmp)
-        counts = [int(n) for n in args.workers.split(",")]
+        layouts = [_layout(text) for text in args.workers.split(",")]
+        counts = [f"{p}x{t}" for p, t in layouts]
         local_rows, cluster_rows = [], {n: [] for n in counts}
         for round_ in range(args.rounds):  # interleaved: the machine's load hits all alike
             local_rows.append(measure_local(scene, _fresh(root / "local")))
             print(f"round {round_} local:", local_rows[-1], flush=True)
-            for n in counts:
-                row = measure_cluster(scene, n, _fresh(root / f"farm{n}"),
-                                      overhead=n == max(counts))
+            for n, (processes, threads) in zip(counts, layouts, strict=True):
+                row = measure_cluster(scene, processes, _fresh(root / f"farm{n}"),
+                                      overhead=n == counts[-1], dask_threads=threads)
                 cluster_rows[n].append(row)
                 print(f"round {round_} {n} worker(s):", row, flush=True)
         report["local"] = _medians(local_rows)
@@ -172,6 +177,11 @@ def main(argv: list[str] | None = None) -> dict:
     if args.json:
         Path(args.json).write_text(json.dumps(report, indent=2) + "\n")
     return report
+
+
+def _layout(text: str) -> tuple[int, int]:
+    processes, _, threads = text.partition("x")
+    return int(processes), int(threads or 1)
 
 
 def _medians(rows: list[dict]) -> dict:
