@@ -3,19 +3,22 @@
 The client works out, for every frame asked for, the still (``scene.at_frame``) and the hash
 the animation feature records in a frame's PNG (:func:`whitted.animation.frames.frame_digest`,
 computed here, where the files have the paths the hash names). A frame whose PNG already
-holds that hash is done (resume); the others go to the workers, one task per frame, or per
-run of consecutive frames when frames are short (so the per-task overhead stays small beside
-the work). Tasks are ``pure=False`` with ``retries``; a worker lost mid-task only costs its
-tasks a new run elsewhere (Dask reschedules them; the results it held are computed again).
+holds that hash, recorded by this renderer, is done (resume); the others go to the workers:
+first one frame a task for each Dask thread of the cluster, then, once a frame's time is
+measured, runs of consecutive frames sized by :func:`chunk_size`. Tasks are ``pure=False``
+with ``retries`` and ask for the ``whitted`` resource (only readied workers with the client's
+renderer take them); a worker lost mid-task only costs its tasks a new run elsewhere, and the
+client's watch (:mod:`.watch`) moves the tasks of a stalled worker and ends a run the cluster
+cannot finish with one line.
 
 A task renders its frames with the worker's :class:`~whitted.animation.frames.FrameRenderer`
 (kernels loaded once per worker, compiled geometry reused between consecutive frames) and
 returns each frame as the PNG the local ``whitted animate`` writes, byte for byte: the same
-writer, the same pixels, the client's hash. The client takes results in the order they finish
-(``as_completed``) and writes each frame atomically, once. A frame that fails (a bad model
-file, a kernel error) is reported, not retried: the run goes on, saves every other frame, and
-then ends with one line naming the frame and the reason. The film is encoded only when the
-whole numbered sequence is on disk, in frame order.
+writer, the same pixels, the client's hash, the worker's renderer fingerprint (the client's).
+The client takes results in the order they finish and writes each frame atomically, once. A
+frame that fails (a bad model file, a kernel error) is reported, not retried: the run goes
+on, saves every other frame, and then ends with one line naming the frame and the reason.
+The film is encoded only when the whole numbered sequence is on disk, in frame order.
 """
 
 from __future__ import annotations
