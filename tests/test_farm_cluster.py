@@ -449,3 +449,12 @@ def test_a_still_stopped_part_way_keeps_the_bands_that_arrived(scheduler, film_s
         else:
             assert not image.pixels[a:b].any()
     assert same >= stats.tiles_done
+
+
+@pytest.mark.parametrize("floor", [0, -1.0, float("nan"), float("inf"), "30"])
+def test_a_stall_floor_is_a_positive_number_of_seconds(scheduler, floor):
+    from whitted.farm import Watch
+
+    address, _, _ = scheduler
+    with distributed.Client(address) as client, pytest.raises(ValueError, match="stall_floor"):
+        Watch(client, stall_floor=floor)

@@ -33,6 +33,7 @@ what the farm had finished (frames written, bands) is kept.
 from __future__ import annotations
 
 import contextlib
+import math
 import threading
 import time
 from collections.abc import Callable, Iterable
@@ -62,6 +63,10 @@ class Watch:
 
     def __init__(self, client: Client, note: Callable[[str], None] | None = None, *,
                  stall_floor: float = STALL_FLOOR) -> None:
+        if not (isinstance(stall_floor, int | float) and math.isfinite(stall_floor)
+                and stall_floor > 0):
+            raise ValueError(f"stall_floor: {stall_floor!r} is not a positive number of "
+                             "seconds")
         self.client = client
         self.note = note or (lambda line: None)
         self.stall_floor = stall_floor
