@@ -89,10 +89,11 @@ def dashboard_link(client: Client) -> str | None:
 
 def local_cluster(workers: int, threads: int, dask_threads: int = 1) -> LocalCluster:
     """``workers`` processes of ``dask_threads`` Dask threads each (1: the command line's), each
-    task rendering with ``threads`` lanes.
-    They start with Ctrl-C ignored (the client stops them itself: a terminal's Ctrl-C
-    reaches every process of its group, and each printed its traceback), and log errors
-    only."""
+    task rendering with ``threads`` lanes. They ignore Ctrl-C's SIGINT (the client stops them
+    itself: a terminal's Ctrl-C reaches every process of its group, and each printed its
+    traceback): it is ignored here while they start, and a process started with SIGINT
+    ignored keeps it so (Python and asyncio then install no handler of their own). They log
+    errors only."""
     main = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
     try:
@@ -104,7 +105,7 @@ def local_cluster(workers: int, threads: int, dask_threads: int = 1) -> LocalClu
             silence_logs=logging.ERROR,  # a worker stopped mid-task says so as a WARNING
         )
     finally:
-        if main:
+        if main:  # the caller's handler (the interrupt guard's) again
             signal.signal(signal.SIGINT, previous)
 
 

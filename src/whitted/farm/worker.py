@@ -88,16 +88,6 @@ def warm_seconds() -> float | None:
     return _warm_seconds
 
 
-def quiet_interrupts() -> None:
-    """Ignore Ctrl-C's SIGINT in this worker process: a terminal's Ctrl-C reaches every
-    process of its group, and the client stops its workers itself (without this, each
-    worker of a ``--cluster local:N`` printed its own traceback)."""
-    import signal
-
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
 class WhittedWorker(WorkerPlugin):
     """Readies each worker: ``threads`` render threads (default 1: one worker per core is the
     usual layout), kernels loaded before the first task when ``warm``. ``fingerprint``: the
@@ -117,7 +107,6 @@ class WhittedWorker(WorkerPlugin):
     async def setup(self, worker) -> None:
         from ..fingerprint import renderer_fingerprint
 
-        quiet_interrupts()
         mine = renderer_fingerprint()
         if mine != self.fingerprint:
             worker.log_event(EVENT_TOPIC, {"worker": worker.address, "status": "mismatch",
