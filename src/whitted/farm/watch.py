@@ -77,7 +77,8 @@ class Watch:
         self.seconds: list[float] = []  # each finished frame's (band's) time
         self.first_seen: dict[str, float] = {}
         self.heartbeats: dict[str, tuple[float, float]] = {}  # worker -> (last_seen, since)
-        self.busy_since: dict[str, float] = {}
+        self.busy_since: dict[str, float] = {}  # worker -> when it got its newest task
+        self.given: dict[tuple[str, str], float] = {}
         self.excluded: set[str] = set()
         self.told: set[str] = set()
         self.no_worker_since: float | None = None
@@ -117,8 +118,28 @@ class Watch:
 
     def result(self, future: Future) -> Any:
         """``future.result()``, or TimeoutError when the worker holding it does not hand it
-        over within the floor of the stall limit (stopped, or gone without a word)."""
-        return future.result(timeout=self.result_seconds)
+        over within the floor of the stall limit (stopped, or gone without a word), or when
+        its result was lost with its worker and the task is on no worker for
+        :data:`KICK_SECONDS` (Dask would run it again only on a worker that joins)."""
+        start = time.monotonic()
+        orphan_since = None
+        while True:
+            try:
+                return future.result(timeout=1.0)
+            except TimeoutError:
+                now = time.monotonic()
+                if now - start > self.result_seconds:
+                    raise
+                key = future.key
+                held = self.client.who_has([future]).get(key)
+                running = any(str(key) in map(str, keys)
+                              for keys in self.client.processing().values())
+                if held or running:
+                    orphan_since = None
+                    continue
+                orphan_since = orphan_since or now
+                if now - orphan_since > KICK_SECONDS:
+                    raise
 
     def give_up_on(self, future: Future) -> list[str]:
         """Exclude the workers holding ``future``'s result (it did not come back)."""
@@ -195,6 +216,9 @@ class Watch:
             if worker in self.excluded:
                 moved |= ours
                 continue
+            for key in ours:  # when the worker got each of its tasks (as seen from here)
+                self.given.setdefault((worker, key), now)
+            self.busy_since[worker] = max(self.given[(worker, k)] for k in ours)
             stalled = self._stalled(worker, workers.get(worker, {}), now)
             if stalled:
                 self.excluded.add(worker)
@@ -232,7 +256,7 @@ class Watch:
 
     def _stalled(self, worker: str, identity: dict[str, Any], now: float) -> str:
         """Why ``worker`` (holding our tasks) is stalled, or ''."""
-        since = self.busy_since.setdefault(worker, now)
+        since = self.busy_since.get(worker, now)
         seen = identity.get("last_seen")
         last_seen, unchanged_since = self.heartbeats.get(worker, (None, now))
         if seen != last_seen:
