@@ -110,6 +110,7 @@ class RenderStats:
     cancelled: bool = False
     warnings: list[str] = field(default_factory=list)  # from the scene's compilation
     triangles: int = 0  # mesh triangles stored (each distinct mesh once)
+    photons: object = None  # compile.photon_map.PhotonStats of a render with caustics
 
     @property
     def total_rays(self) -> int:
@@ -277,6 +278,13 @@ class RenderJob:
         stats.warnings = list(compiled.warnings)
         stats.triangles = compiled.triangles
         params = render_params(self.scene, compiled, self.settings)
+        lights = compiled.lights
+        if self.settings.caustics.photons > 0:  # the photon map (compile/photon_map.py)
+            from ..compile.photon_map import PhotonStats, photon_lights
+
+            stats.photons = PhotonStats()
+            lights = photon_lights(compiled, params, self.settings.caustics, self.threads,
+                                   lambda: self.cancel_token.cancelled, stats.photons)
         tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size, self.rows)
         counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
         stats.tiles_total = len(tiles)
@@ -316,7 +324,7 @@ class RenderJob:
                 part = np.ascontiguousarray(tiles[idx])
                 part_counters = np.zeros((len(idx), N_RAY_KINDS), np.int64)
                 render_tiles(part, self.framebuffer, compiled.geometry, compiled.materials,
-                             compiled.lights, params, part_counters, work, 0, 1)
+                             lights, params, part_counters, work, 0, 1)
                 with lock:
                     counters[idx] = part_counters
                     done += len(idx)

@@ -1,0 +1,169 @@
+"""The caustics' side of the render kernel: the photon map's gather and the switch that
+compiles it in only for renders with caustics (docs/caustics.md).
+
+A render without caustics passes a ``LightArrays`` whose ``photons`` are float64 and empty
+(layout.NO_CAUSTICS_DTYPE); with caustics they are float32. The two are different Numba
+types, so the render kernel is compiled once per kind, and in the kind without caustics
+:func:`caustics_on` is the constant False (the integrator's shadow rays see the material
+table itself) and :func:`add_caustic` adds nothing: the integrator's machine code is exactly what it was before caustics existed (the
+same images, bit for bit), and the gather is never compiled for it (as features.py does for
+mesh instances).
+"""
+
+from __future__ import annotations
+
+import math
+
+from .jit import kernel, overload
+from .layout import (
+    GRID_INV_CELL,
+    GRID_MASK,
+    GRID_PASS,
+    GRID_R2_MAX,
+    MAT_KD,
+    PHOTON_DIRECTION,
+    PHOTON_PASS,
+    PHOTON_POWER,
+)
+
+#: a photon counts at a point only when it lies within this fraction of the gather radius
+#: of the point's tangent plane (no light leaks round corners onto walls)
+PLANE_FRACTION = 0.5
+
+
+def _photons_possible(lights_type) -> bool:
+    from numba import types
+
+    fields = dict(zip(lights_type.fields, lights_type.types, strict=True))
+    return fields["photons"].dtype == types.float32
+
+
+def caustics_on(lights):
+    """True when the render has a photon map (resolved when the kernel is compiled)."""
+    return lights.photons.dtype.name == "float32"
+
+
+@overload(caustics_on, inline="always")
+def _caustics_on(lights):
+    if not _photons_possible(lights):
+        return lambda lights: False
+    return lambda lights: True
+
+
+@kernel(inline="always")
+def cell_hash(ix, iy, iz, mask):
+    """Row of the photon grid's hash table for integer cell (ix, iy, iz)."""
+    return ((ix * 73856093) ^ (iy * 19349663) ^ (iz * 83492791)) & mask
+
+
+@kernel(inline="always")
+def cell_of(x, inv_cell):
+    return int(math.floor(x * inv_cell))
+
+
+@kernel
+def _cell_seen_before(k, hi, ix0, iy0, iz0, mask, h):
+    """Whether one of the cells 0..k-1 of the 2x2x2 block at (ix0, iy0, iz0), clipped to the
+    cells ``hi`` allows, hashes to ``h`` (its photons were gathered already)."""
+    for j in range(k):
+        dx = j & 1
+        dy = (j >> 1) & 1
+        dz = (j >> 2) & 1
+        if ix0 + dx > hi[0] or iy0 + dy > hi[1] or iz0 + dz > hi[2]:
+            continue
+        if cell_hash(ix0 + dx, iy0 + dy, iz0 + dz, mask) == h:
+            return True
+    return False
+
+
+@kernel
+def caustic_irradiance(lights, p, n):
+    """Irradiance (per channel) the photon map gives at point ``p`` of a surface whose unit
+    normal ``n`` faces the side being shaded: the photons of each pass within that pass's
+    radius of ``p``, arriving on that side and near the tangent plane, weighted by the
+    Epanechnikov kernel ``2 / (pi r^2) (1 - d^2 / r^2)``, averaged over the passes. The grid
+    cells are twice the largest radius, so the ball around ``p`` meets at most 2x2x2 of
+    them; a hash row shared by two of them is read once."""
+    grid = lights.photon_grid
+    photons = lights.photons
+    cells = lights.photon_cells
+    inv_cell = grid[GRID_INV_CELL]
+    mask = int(grid[GRID_MASK])
+    r2_max = grid[GRID_R2_MAX]
+    r = math.sqrt(r2_max)
+    ix0 = cell_of(p[0] - r, inv_cell)
+    iy0 = cell_of(p[1] - r, inv_cell)
+    iz0 = cell_of(p[2] - r, inv_cell)
+    hi = (cell_of(p[0] + r, inv_cell), cell_of(p[1] + r, inv_cell), cell_of(p[2] + r, inv_cell))
+    e0 = 0.0
+    e1 = 0.0
+    e2 = 0.0
+    for k in range(8):
+        dx = k & 1
+        dy = (k >> 1) & 1
+        dz = (k >> 2) & 1
+        if ix0 + dx > hi[0] or iy0 + dy > hi[1] or iz0 + dz > hi[2]:
+            continue
+        h = cell_hash(ix0 + dx, iy0 + dy, iz0 + dz, mask)
+        if k > 0 and _cell_seen_before(k, hi, ix0, iy0, iz0, mask, h):
+            continue
+        for q in range(cells[h], cells[h + 1]):
+            ox = photons[q, 0] - p[0]
+            oy = photons[q, 1] - p[1]
+            oz = photons[q, 2] - p[2]
+            d2 = ox * ox + oy * oy + oz * oz
+            if d2 >= r2_max:
+                continue
+            s = GRID_PASS + 2 * int(photons[q, PHOTON_PASS])
+            r2 = grid[s]
+            if d2 >= r2:
+                continue
+            if (photons[q, PHOTON_DIRECTION] * n[0] + photons[q, PHOTON_DIRECTION + 1] * n[1]
+                    + photons[q, PHOTON_DIRECTION + 2] * n[2]) >= 0.0:
+                continue  # it arrived on the other side
+            off = ox * n[0] + oy * n[1] + oz * n[2]
+            if off * off > PLANE_FRACTION * PLANE_FRACTION * r2:
+                continue
+            w = (1.0 - d2 / r2) * grid[s + 1]
+            e0 += w * photons[q, PHOTON_POWER]
+            e1 += w * photons[q, PHOTON_POWER + 1]
+            e2 += w * photons[q, PHOTON_POWER + 2]
+    return e0, e1, e2
+
+
+@kernel(inline="always")
+def with_caustic(lights, mats, m, albedo, p, n, local):
+    """``local`` (a hit's direct light) plus the caustic's diffuse term kd·albedo·E, E the
+    photon map's irradiance at ``p`` (exactly as a light's direct term enters)."""
+    kd = mats[m, MAT_KD]
+    if kd == 0.0:
+        return local
+    e = caustic_irradiance(lights, p, n)
+    return (local[0] + kd * albedo[0] * e[0], local[1] + kd * albedo[1] * e[1],
+            local[2] + kd * albedo[2] * e[2])
+
+
+@kernel(entry=True)  # called from Python: the photon map's estimate at given points
+def irradiance_at(lights, points, normals, out):
+    """:func:`caustic_irradiance` at each row of ``points`` (with unit ``normals``) into
+    ``out`` (tests, docs/caustics.md's validation)."""
+    for i in range(points.shape[0]):
+        e = caustic_irradiance(lights, (points[i, 0], points[i, 1], points[i, 2]),
+                               (normals[i, 0], normals[i, 1], normals[i, 2]))
+        out[i, 0] = e[0]
+        out[i, 1] = e[1]
+        out[i, 2] = e[2]
+
+
+def add_caustic(lights, mats, m, albedo, p, n, local):
+    """:func:`with_caustic` in renders with caustics; ``local`` unchanged, and nothing
+    compiled, without."""
+    return with_caustic(lights, mats, m, albedo, p, n, local)
+
+
+@overload(add_caustic, inline="always")
+def _add_caustic(lights, mats, m, albedo, p, n, local):
+    if not _photons_possible(lights):
+        return lambda lights, mats, m, albedo, p, n, local: local
+    return lambda lights, mats, m, albedo, p, n, local: with_caustic(lights, mats, m, albedo,
+                                                                     p, n, local)
