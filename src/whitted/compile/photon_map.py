@@ -344,3 +344,28 @@ def photon_lights(compiled: CompiledScene, params: RenderParams, settings: Caust
     stats.seconds = time.perf_counter() - start
     return compiled.lights._replace(photons=sorted_photons, photon_cells=cells,
                                     photon_grid=grid, shadow_materials=shadow_mats)
+
+
+def scene_photon_map(scene, threads: int = 1) -> tuple[CompiledScene, LightArrays, PhotonStats]:
+    """Compile ``scene`` and build the photon map of its ``[render.caustics]`` (tests, the
+    validation in docs/caustics.md): (compiled scene, lights with the map, stats)."""
+    from .params import render_params
+    from .scene import compile_scene
+
+    compiled = compile_scene(scene)
+    params = render_params(scene, compiled, scene.render)
+    stats = PhotonStats()
+    return compiled, photon_lights(compiled, params, scene.render.caustics, threads,
+                                   stats=stats), stats
+
+
+def irradiance(lights: LightArrays, points, normals) -> np.ndarray:
+    """The caustic irradiance (N, 3) the render kernel's gather finds at ``points`` (N, 3)
+    of surfaces with unit ``normals`` (N, 3) facing the side seen."""
+    from ..kernels.caustics import irradiance_at
+
+    points = np.ascontiguousarray(points, np.float64).reshape(-1, 3)
+    normals = np.ascontiguousarray(np.broadcast_to(normals, points.shape), np.float64)
+    out = np.zeros((len(points), 3))
+    irradiance_at(lights, points, normals, out)
+    return out

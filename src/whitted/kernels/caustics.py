@@ -5,9 +5,9 @@ A render without caustics passes a ``LightArrays`` whose ``photons`` are float64
 (layout.NO_CAUSTICS_DTYPE); with caustics they are float32. The two are different Numba
 types, so the render kernel is compiled once per kind, and in the kind without caustics
 :func:`caustics_on` is the constant False (the integrator's shadow rays see the material
-table itself) and :func:`add_caustic` adds nothing: the integrator's machine code is exactly what it was before caustics existed (the
-same images, bit for bit), and the gather is never compiled for it (as features.py does for
-mesh instances).
+table itself) and :func:`add_caustic` adds nothing: the integrator's machine code is what it
+was before caustics existed (the same images, bit for bit), and the gather is never
+compiled for it (as features.py does for mesh instances).
 """
 
 from __future__ import annotations

@@ -63,8 +63,25 @@ SET_EPSILON = 3
 SET_SLOTS = 4  # records one photon may store
 N_SET = 5
 
-R2_A1 = 0.7548776662466927  # 1 / g, g the plastic number: the R2 sequence's steps
-R2_A2 = 0.5698402909980532
+
+
+def _r_steps(dims: int) -> tuple[float, ...]:
+    """The steps of Roberts' R_d low-discrepancy sequence: 1 / g^k, g the root of
+    x^(d+1) = x + 1 (the plastic number for d = 2)."""
+    g = 2.0
+    for _ in range(64):
+        g = (1.0 + g) ** (1.0 / (dims + 1))
+    return tuple(g ** -k for k in range(1, dims + 1))
+
+
+#: a photon's emission is the point of its index in R_2 (the best spread in two
+#: dimensions), and its first LD_BOUNCES choices between reflection and refraction further
+#: coordinates of a low-discrepancy sequence (steps of R_6 that are not R_2's), so that
+#: the choices of many photons come out in proportion; later choices draw counter-based
+#: random numbers
+LD_BOUNCES = 4
+R_A1, R_A2 = _r_steps(2)
+_, _, R_B1, R_B2, R_B3, R_B4 = _r_steps(6)
 PHOTON_SAMPLE_BASE = 0x10000  # the random streams' "sample" of pass p: base + p
 DISK_DIM = 0x40000  # random dimension of a disk light's point (+ emitter); bounces use 1, 2, ...
 MIN_POWER = 1e-12  # a photon carrying less than this is dropped
@@ -129,8 +146,8 @@ def emit_photon(table, emitters, e, i, seed, pass_index):
     j = int(emitters[e, EMIT_LIGHT])
     kind = table[j, LIGHT_TYPE]
     shift = random_pair(seed, e, PHOTON_SAMPLE_BASE + pass_index, 0)
-    u1 = (shift[0] + (i + 1) * R2_A1) % 1.0
-    u2 = (shift[1] + (i + 1) * R2_A2) % 1.0
+    u1 = (shift[0] + (i + 1) * R_A1) % 1.0
+    u2 = (shift[1] + (i + 1) * R_A2) % 1.0
     radiance = vload(table, j, LIGHT_RADIANCE)
     c = vload(emitters, e, EMIT_CENTRE)
     r = emitters[e, EMIT_RADIUS]
@@ -165,6 +182,18 @@ def emit_photon(table, emitters, e, i, seed, pass_index):
         return o, d, (0.0, 0.0, 0.0), kind == LIGHT_DIRECTIONAL
     return o, d, (radiance[0] / density, radiance[1] / density,
                   radiance[2] / density), kind == LIGHT_DIRECTIONAL
+
+
+@kernel
+def _choice(seed, photon, index, emitter, pass_index, bounce):
+    """The number in [0, 1) that decides a photon's ``bounce``: a coordinate of its R_d point
+    (``index`` within its emitter) for the first LD_BOUNCES, else a random one."""
+    if bounce < LD_BOUNCES:
+        step = R_B1 if bounce == 0 else (R_B2 if bounce == 1 else (R_B3 if bounce == 2
+                                                                    else R_B4))
+        shift = random01(seed, emitter, PHOTON_SAMPLE_BASE + pass_index, 1 + bounce)
+        return (shift + (index + 1) * step) % 1.0
+    return random01(seed, photon, PHOTON_SAMPLE_BASE + pass_index, 1 + bounce)
 
 
 @kernel
@@ -211,7 +240,7 @@ def _interface(geo, mats, prim, m, entering, media, n_media, scratch):
 
 @kernel
 def trace_photon(geo, mats, shadow_mats, table, j, o, d, power, directional, settings, photon,
-                 out, slot0, stack, media, scratch):
+                 index, emitter, out, slot0, stack, media, scratch):
     """Follow one photon; store a record (layout.PHOTON_* columns) at each diffuse surface it
     reaches after a specular bounce, into ``out[slot0:]``. Returns the records stored. A
     refraction counts as specular where shadow rays stop (``shadow_mats``' kt is 0): where
@@ -286,7 +315,7 @@ def trace_photon(geo, mats, shadow_mats, table, j, o, d, power, directional, set
         total = kr_eff + b_mean
         if total <= 0.0:
             break
-        u = random01(seed, photon, PHOTON_SAMPLE_BASE + pass_index, 1 + bounce)
+        u = _choice(seed, photon, index, emitter, pass_index, bounce)
         if u * total < b_mean:  # refracted, with probability b_mean / total
             s = total / b_mean
             w = (w[0] * bt[0] * s, w[1] * bt[1] * s, w[2] * bt[2] * s)
@@ -329,6 +358,8 @@ def trace_photons(geo, mats, shadow_mats, table, emitters, settings, first, last
         counts[i] = 0
         if max(power[0], max(power[1], power[2])) <= 0.0:
             continue
-        counts[i] = trace_photon(geo, mats, shadow_mats, table, int(emitters[e, EMIT_LIGHT]), o, d, power,
-                                 directional, settings, i, out, i * slots, stack, media, scratch)
+        counts[i] = trace_photon(geo, mats, shadow_mats, table, int(emitters[e, EMIT_LIGHT]),
+                                 o, d, power, directional, settings, i,
+                                 i - int(emitters[e, EMIT_FIRST]), e, out, i * slots, stack,
+                                 media, scratch)
 
