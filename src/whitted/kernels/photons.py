@@ -167,15 +167,20 @@ def emit_photon(table, emitters, e, i, seed, pass_index):
             y = madd(madd(y, vload(table, j, LIGHT_DISK_U), px * rad),
                      vload(table, j, LIGHT_DISK_V), py * rad)
         cos_max, _, axis = _cone(emitters, e, y)
-        cos_t = 1.0 - u1 * (1.0 - cos_max)
+        # the disk's point (dx, dy) -> a direction in the cone: uniform in solid angle,
+        # with the sequence's even spread kept (equal areas of the disk, equal solid angles)
+        dx, dy = concentric_disk(u1, u2)
+        rho2 = dx * dx + dy * dy
+        cos_t = 1.0 - rho2 * (1.0 - cos_max)
         sin_t = math.sqrt(max(0.0, 1.0 - cos_t * cos_t))
-        phi = 2.0 * math.pi * u2
+        if rho2 > 0.0:
+            s = sin_t / math.sqrt(rho2)
+            dx *= s
+            dy *= s
         a, b = _frame(axis)
-        d = normalize((
-            cos_t * axis[0] + sin_t * (math.cos(phi) * a[0] + math.sin(phi) * b[0]),
-            cos_t * axis[1] + sin_t * (math.cos(phi) * a[1] + math.sin(phi) * b[1]),
-            cos_t * axis[2] + sin_t * (math.cos(phi) * a[2] + math.sin(phi) * b[2]),
-        ))
+        d = normalize((cos_t * axis[0] + dx * a[0] + dy * b[0],
+                       cos_t * axis[1] + dx * a[1] + dy * b[1],
+                       cos_t * axis[2] + dx * a[2] + dy * b[2]))
         o = y
         density = _density(emitters, j, o, d, False)
     if density <= 0.0:
