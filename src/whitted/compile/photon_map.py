@@ -66,7 +66,7 @@ from ..scene.scene import CausticsSettings
 from .scene import CompiledScene
 
 SLOTS = 4  # records one photon may store (diffuse surfaces that also reflect or refract)
-DEFAULT_NEIGHBOURS = 64  # photons the default radius gathers where light is not focused
+DEFAULT_NEIGHBOURS = 256  # photons the default radius gathers where light is not focused
 MAX_TARGETS = 64  # more bodies than this are aimed at as one bounding sphere
 PHOTON_BYTES = PHOTON_WIDTH * 4
 BVH_STACK = 128  # as kernels/tiles.py

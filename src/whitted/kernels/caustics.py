@@ -19,6 +19,7 @@ from .layout import (
     GRID_INV_CELL,
     GRID_MASK,
     GRID_PASS,
+    GRID_PASSES,
     GRID_R2_MAX,
     MAT_KD,
     PHOTON_DIRECTION,
@@ -29,6 +30,11 @@ from .layout import (
 #: a photon counts at a point only when it lies within this fraction of the gather radius
 #: of the point's tangent plane (no light leaks round corners onto walls)
 PLANE_FRACTION = 0.5
+#: an estimate made of fewer photons than this fades out (to 0 at FEWEST_PHOTONS): where
+#: photons are sparse (light spread thin by a convex mirror), lone photons would show as
+#: blotches of the gather disc's size (POV-Ray's ``gather`` minimum does the same)
+MIN_PHOTONS = 8
+FEWEST_PHOTONS = 2
 
 
 def _photons_possible(lights_type) -> bool:
@@ -81,7 +87,8 @@ def caustic_irradiance(lights, p, n):
     """Irradiance (per channel) the photon map gives at point ``p`` of a surface whose unit
     normal ``n`` faces the side being shaded: the photons of each pass within that pass's
     radius of ``p``, arriving on that side and near the tangent plane, weighted by the
-    Epanechnikov kernel ``2 / (pi r^2) (1 - d^2 / r^2)``, averaged over the passes. The grid
+    Epanechnikov kernel ``2 / (pi r^2) (1 - d^2 / r^2)``, averaged over the passes (and
+    faded out where fewer than MIN_PHOTONS per pass are found). The grid
     cells are twice the largest radius, so the ball around ``p`` meets at most 2x2x2 of
     them; a hash row shared by two of them is read once."""
     grid = lights.photon_grid
@@ -98,6 +105,7 @@ def caustic_irradiance(lights, p, n):
     e0 = 0.0
     e1 = 0.0
     e2 = 0.0
+    found = 0
     for k in range(8):
         dx = k & 1
         dy = (k >> 1) & 1
@@ -125,9 +133,15 @@ def caustic_irradiance(lights, p, n):
             if off * off > PLANE_FRACTION * PLANE_FRACTION * r2:
                 continue
             w = (1.0 - d2 / r2) * grid[s + 1]
+            found += 1
             e0 += w * photons[q, PHOTON_POWER]
             e1 += w * photons[q, PHOTON_POWER + 1]
             e2 += w * photons[q, PHOTON_POWER + 2]
+    passes = grid[GRID_PASSES]
+    if found < MIN_PHOTONS * passes:
+        fade = max(0.0, (found - FEWEST_PHOTONS * passes) / ((MIN_PHOTONS - FEWEST_PHOTONS)
+                                                              * passes))
+        return e0 * fade, e1 * fade, e2 * fade
     return e0, e1, e2
 
 
