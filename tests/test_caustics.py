@@ -200,3 +200,85 @@ def test_bad_caustics_settings_are_refused(key, value):
 def test_a_photon_map_too_big_for_memory_is_refused():
     with pytest.raises(SceneError, match=r"render\.caustics"):
         check_photon_memory(CausticsSettings(photons=50_000_000, passes=4096))
+
+
+def test_disk_light_casts_a_soft_caustic_of_the_same_power():
+    point = [{"type": "point", "position": [0, 6, 0], "intensity": 1.0,
+              "falloff": "inverse_square"}]
+    disk = [{"type": "disk", "center": [0, 6, 0], "radius": 1.0, "intensity": 1.0,
+             "falloff": "inverse_square"}]
+    ball = [{"type": "sphere", "center": [0, 2, 0], "radius": 1.0, "material": GLASS}]
+    _, sharp, _ = scene_photon_map(scene_of(ball, lights=point, radius=0.02), threads=2)
+    _, soft, _ = scene_photon_map(scene_of(ball, lights=disk, radius=0.02), threads=2)
+    power = [a.photons[:, PHOTON_POWER].astype(np.float64).sum() for a in (sharp, soft)]
+    # a disk of this size, 6 away, sends the ball nearly the point light's power (within
+    # the change of solid angle over the disk: 1 - ~1.5 %)
+    assert power[1] == pytest.approx(power[0], rel=0.03)
+    peak = [irradiance(a, [[0, 0, 0]], [0, 1, 0])[0, 0] for a in (sharp, soft)]
+    assert peak[1] < 0.5 * peak[0]  # the disk's focus is spread: a soft caustic
+
+
+def test_meshes_traced_as_instances_focus_like_flattened_ones():
+    from whitted.compile.params import render_params
+    from whitted.compile.photon_map import photon_lights
+    from whitted.compile.scene import compile_scene
+
+    # a glass icosphere-like mesh: a UV sphere of triangles
+    n_lat, n_lon = 16, 32
+    verts = [[0, 1, 0]]
+    for i in range(1, n_lat):
+        th = math.pi * i / n_lat
+        for j in range(n_lon):
+            ph = 2 * math.pi * j / n_lon
+            verts.append([math.sin(th) * math.cos(ph), math.cos(th), math.sin(th) * math.sin(ph)])
+    verts.append([0, -1, 0])
+    faces = [[0, 1 + (j + 1) % n_lon, 1 + j] for j in range(n_lon)]
+    for i in range(n_lat - 2):
+        for j in range(n_lon):
+            a, b = 1 + i * n_lon + j, 1 + i * n_lon + (j + 1) % n_lon
+            faces += [[a, b, b + n_lon], [a, b + n_lon, a + n_lon]]
+    last = len(verts) - 1
+    base = 1 + (n_lat - 2) * n_lon
+    faces += [[last, base + j, base + (j + 1) % n_lon] for j in range(n_lon)]
+    mesh = {"type": "mesh", "vertices": verts, "faces": faces, "material": GLASS,
+            "transform": {"translate": [0, 2.5, 0]}}
+    scene = scene_of([mesh], photons=50_000)
+    powers = []
+    for limit in (10**6, 0):  # flattened into the scene BVH, then instanced
+        compiled = compile_scene(scene, flatten_limit=limit)
+        params = render_params(scene, compiled, scene.render)
+        lights = photon_lights(compiled, params, scene.render.caustics, 2)
+        powers.append(lights.photons[:, PHOTON_POWER].astype(np.float64).sum())
+    assert powers[0] > 0.8 * math.pi  # the power through the cross-section, mostly
+    assert powers[1] == pytest.approx(powers[0], rel=1e-3)
+
+
+def test_water_inside_ice_passes_light_through_both_media():
+    ice = {"color": [1, 1, 1], "ka": 0.0, "kd": 0.0, "ks": 0.0, "kr": 0.0, "kt": 1.0,
+           "ior": 1.309, "fresnel": True}
+    water = dict(ice, ior=1.333, attenuation=[0.5, 0.5, 0.5])
+    objects = [{"type": "box", "min": [-2, 1, -2], "max": [2, 3, 2], "material": ice},
+               {"type": "box", "min": [-1.5, 1.5, -1.5], "max": [1.5, 2.5, 1.5],
+                "material": water}]
+    _, lights, _ = scene_photon_map(scene_of(objects, photons=200_000), threads=2)
+    e = irradiance(lights, floor_points(0.5, 5), [0, 1, 0])[:, 0].mean()
+    # straight down through four faces: ice (n 1.309) from air, water from ice, ice from
+    # water, air from ice; 1 of water absorbs exp(-0.5); internal reflections between the
+    # faces add (1 + F^2 ...) for each, less than 0.5 % here and left out
+    r = [((a - b) / (a + b)) ** 2 for a, b in ((1, 1.309), (1.309, 1.333), (1.333, 1.309),
+                                                (1.309, 1))]
+    expected = math.prod(1 - f for f in r) * math.exp(-0.5)
+    assert e == pytest.approx(expected, rel=0.02)
+
+
+def test_export_writes_photons_blocks():
+    from whitted.export.pov import scene_to_pov
+
+    scene = scene_of([{"type": "sphere", "center": [0, 2, 0], "radius": 1.0,
+                       "material": GLASS}], photons=1000, passes=3, radius=0.05)
+    text = scene_to_pov(scene)
+    assert "photons { count 3000 autostop 0 jitter 0.4" in text
+    assert "radius 0.05" in text
+    assert "photons { target reflection on refraction on collect off }" in text
+    plain = scene_to_pov(scene.with_settings(caustics=CausticsSettings()))
+    assert "photons" not in plain
