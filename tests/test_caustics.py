@@ -18,6 +18,7 @@ from whitted.compile.photon_map import (
 )
 from whitted.errors import SceneError
 from whitted.kernels.layout import PHOTON_POWER
+from whitted.render.api import RenderJob
 from whitted.scene.scene import CausticsSettings, Scene
 
 GLASS = {"color": [1, 1, 1], "ka": 0.0, "kd": 0.0, "ks": 0.0, "kr": 0.0, "kt": 1.0,
@@ -169,6 +170,9 @@ def test_render_with_caustics_shows_them_and_is_thread_independent():
     a = render(scene, threads=1).pixels
     b = render(scene, threads=2).pixels
     assert np.array_equal(a, b)
+    # a still split in bands of rows, as the render farm's workers render it
+    bands = [RenderJob(scene, threads=2, rows=rows).run().pixels for rows in ((0, 13), (13, 30))]
+    assert np.array_equal(np.concatenate([bands[0][:13], bands[1][13:]]), a)
     plain = render(scene.with_settings(caustics=CausticsSettings())).pixels
     # without caustics the floor under a clear ball is lit through it (kt·colour = 1): the
     # floor is 1 everywhere; with them the shadow ray stops at the ball and the light
@@ -282,3 +286,32 @@ def test_export_writes_photons_blocks():
     assert "photons { target reflection on refraction on collect off }" in text
     plain = scene_to_pov(scene.with_settings(caustics=CausticsSettings()))
     assert "photons" not in plain
+
+
+def test_fuzzed_caustics_tables_are_accepted_or_refused_in_one_line():
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    from whitted.scene.io import scene_from_dict
+
+    values = st.one_of(st.integers(-10, 10**9), st.floats(allow_nan=True, allow_infinity=True),
+                       st.text(max_size=5), st.booleans(), st.none(), st.lists(st.integers(),
+                                                                              max_size=2))
+    tables = st.dictionaries(st.sampled_from(["photons", "passes", "radius", "alpha",
+                                              "other"]), values, max_size=4)
+
+    @settings(max_examples=200, deadline=None)
+    @given(tables)
+    def check(table):
+        try:
+            made = scene_from_dict({"render": {"caustics": table}}, file="fuzz.toml")
+        except SceneError as exc:  # one line naming the file and the key
+            message = str(exc)
+            assert "\n" not in message.strip() and message.startswith("fuzz.toml")
+            assert "render.caustics" in message
+            return
+        c = made.render.caustics
+        assert 0 <= c.photons <= 50_000_000 and 1 <= c.passes <= 4096
+        assert 0 <= c.radius <= 1e6 and 0 < c.alpha <= 1 and math.isfinite(c.radius)
+
+    check()

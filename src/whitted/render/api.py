@@ -279,17 +279,27 @@ class RenderJob:
         stats.triangles = compiled.triangles
         params = render_params(self.scene, compiled, self.settings)
         lights = compiled.lights
+        photon_seconds = 0.0
         if self.settings.caustics.photons > 0:  # the photon map (compile/photon_map.py)
             from ..compile.photon_map import PhotonStats, photon_lights
 
             stats.photons = PhotonStats()
             lights = photon_lights(compiled, params, self.settings.caustics, self.threads,
                                    lambda: self.cancel_token.cancelled, stats.photons)
+            photon_seconds = stats.photons.seconds
+            # the render kernel's kind with caustics, compiled (first time) or loaded here,
+            # not in the first tile: its time is compile time
+            start = time.perf_counter()
+            render_tiles(np.zeros((0, 4), np.int32), self.framebuffer, compiled.geometry,
+                         compiled.materials, lights, params, np.zeros((0, N_RAY_KINDS),
+                                                                      np.int64),
+                         lane_workspace(params.max_depth), 0, 1)
+            stats.compile_seconds += time.perf_counter() - start
         tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size, self.rows)
         counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
         stats.tiles_total = len(tiles)
         lanes = self.threads
-        render_start = time.perf_counter()
+        render_start = time.perf_counter() - photon_seconds  # shooting photons is rendering
         done = 0
         lock = threading.Lock()
         self.rendering = True
