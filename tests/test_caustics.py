@@ -315,3 +315,30 @@ def test_fuzzed_caustics_tables_are_accepted_or_refused_in_one_line():
         assert 0 <= c.radius <= 1e6 and 0 < c.alpha <= 1 and math.isfinite(c.radius)
 
     check()
+
+
+def test_render_through_a_clear_body_of_ior_1_equals_the_render_without_it():
+    # ior 1, kt 1, no Fresnel, nothing of its own (ka = kd = ks = 0), seen straight down
+    # (orthographic: pixel (i, j) shows the floor point ((j + 0.5) / 6 - 2, ..)): with
+    # caustics the ball's shadow is filled by photons
+    clear = dict(GLASS, ior=1.0, fresnel=False)
+    camera = {"position": [0, 8, 0.0], "look_at": [0, 0, 0], "up": [0, 0, -1],
+              "projection": "orthographic", "ortho_height": 4.0}
+    ball = [{"type": "sphere", "center": [0, 2, 0], "radius": 1.0, "material": clear}]
+    with_ball = scene_of(ball, photons=200_000, size=(24, 24), camera=camera)
+    a = render(with_ball).pixels[..., 0]
+    b = render(scene_of([], photons=0, size=(24, 24), camera=camera)).pixels[..., 0]
+    assert np.all(b == 1.0)
+    centres = (np.arange(24) + 0.5) / 6 - 2
+    rho = np.hypot(*np.meshgrid(centres, centres))
+    r = with_ball.render.caustics.radius or 0.062  # the default radius here (docs)
+    inside = rho < 1 - 2 * r
+    assert inside.sum() > 60
+    assert a[inside].mean() == pytest.approx(1.0, rel=0.01)
+    assert np.all(np.abs(a[inside] - 1.0) < 0.05)
+    assert np.all(a[rho > 1 + 2 * r] == 1.0)  # directly lit: exactly as without
+    # within the gather radius of the shadow's edge the estimate blurs the edge: photons
+    # spill out (the kernel's half outside: up to 1 + 1/2) and are missed inside (down to
+    # 1/2): the estimator's resolution, which progressive passes shrink
+    rim = np.abs(rho - 1) <= 2 * r
+    assert np.all((a[rim] >= 0.5) & (a[rim] <= 1.5))

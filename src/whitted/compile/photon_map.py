@@ -71,6 +71,8 @@ MAX_TARGETS = 64  # more bodies than this are aimed at as one bounding sphere
 PHOTON_BYTES = PHOTON_WIDTH * 4
 BVH_STACK = 128  # as kernels/tiles.py
 MEMORY_SHARE = 0.5  # of the memory available, what a photon map may take
+CHUNK_MIN = 2048  # photons per kernel call: at least this many (calls cost little)...
+CHUNK_MAX = 1 << 18  # ...at most this many (a cancel waits for the calls under way)
 
 
 @dataclass
@@ -266,8 +268,10 @@ class PhotonStats:
 
 def shoot_pass(compiled: CompiledScene, rows: np.ndarray, shadow_mats: np.ndarray,
                params: RenderParams, photons: int, pass_index: int, threads: int,
-               pool: ThreadPoolExecutor | None) -> np.ndarray:
-    """The records the photons of one pass store, in photon order."""
+               pool: ThreadPoolExecutor | None,
+               cancelled: Callable[[], bool] = lambda: False) -> np.ndarray:
+    """The records the photons of one pass store, in photon order (chunks of photons not
+    started once ``cancelled()`` is true are left out: the render is being cancelled)."""
     from ..kernels.photons import trace_photons
 
     settings = np.zeros(N_SET)
@@ -278,10 +282,13 @@ def shoot_pass(compiled: CompiledScene, rows: np.ndarray, shadow_mats: np.ndarra
     settings[SET_SLOTS] = SLOTS
     out = np.empty((photons * SLOTS, PHOTON_WIDTH), np.float32)
     counts = np.zeros(photons, np.int32)
-    chunks = max(1, min(photons, 8 * threads))
+    # 8 calls a thread (they balance the load), each of CHUNK_MIN to CHUNK_MAX photons
+    chunks = max(1, min(8 * threads, -(-photons // CHUNK_MIN)), -(-photons // CHUNK_MAX))
     bounds = np.linspace(0, photons, chunks + 1).astype(np.int64)
 
     def run(k: int) -> None:
+        if cancelled():
+            return
         trace_photons(compiled.geometry, compiled.materials, shadow_mats,
                       compiled.lights.table, rows, settings, int(bounds[k]),
                       int(bounds[k + 1]), out, counts,
@@ -321,7 +328,7 @@ def photon_lights(compiled: CompiledScene, params: RenderParams, settings: Caust
                 break
             if len(rows):
                 parts.append(shoot_pass(compiled, rows, shadow_mats, params, settings.photons,
-                                        p, threads, pool))
+                                        p, threads, pool, cancelled))
     finally:
         if pool is not None:
             pool.shutdown()

@@ -122,11 +122,15 @@ class RenderStats:
 
     def summary(self) -> str:
         state = " (cancelled)" if self.cancelled else ""
+        caustics = ""
+        if self.photons is not None:
+            caustics = (f", caustics {self.photons.shot:,} photons ({self.photons.stored:,} "
+                        f"stored) in {self.photons.seconds:.2f} s")
         return (
             f"{self.width}x{self.height}{state}: wall {self.wall_seconds:.2f} s, "
             f"compile {self.compile_seconds:.2f} s, render {self.render_seconds:.3f} s, "
             f"{self.total_rays:,} rays, {self.mrays_per_second:.1f} Mrays/s, "
-            f"{self.threads} thread{'s' if self.threads != 1 else ''}"
+            f"{self.threads} thread{'s' if self.threads != 1 else ''}{caustics}"
         )
 
 
