@@ -23,8 +23,8 @@ from ..errors import SceneError
 from ..kernels.caustics import cell_hash, cell_of
 from ..kernels.jit import builder
 from ..kernels.layout import (
+    GRID_BITS,
     GRID_INV_CELL,
-    GRID_MASK,
     GRID_PASS,
     GRID_PASSES,
     GRID_R2_MAX,
@@ -202,10 +202,31 @@ def pass_radii(radius: float, passes: int, alpha: float) -> np.ndarray:
 
 
 def default_radius(targets: Targets, photons: int) -> float:
-    """A radius gathering about DEFAULT_NEIGHBOURS photons where the light is not focused:
-    the photons of a pass spread over the targets' cross-sections."""
+    """A first guess of the radius gathering DEFAULT_NEIGHBOURS photons: the photons of a
+    pass spread over the targets' cross-sections (:func:`fitted_radius` refines it)."""
     area = float(np.sum(math.pi * targets.radii ** 2)) if len(targets.radii) else 1.0
     return math.sqrt(DEFAULT_NEIGHBOURS * area / (math.pi * max(photons, 1)))
+
+
+def fitted_radius(positions: np.ndarray, guess: float,
+                  neighbours: int = DEFAULT_NEIGHBOURS) -> float:
+    """The radius at which the typical stored photon of a pass (``positions``) has about
+    ``neighbours`` others within it: the photons' density read off a grid of cells twice
+    the radius (photons lie on surfaces: a cell holds about (2r)^2 of surface), the median
+    over the photons of their cell's count, twice (from ``guess``, kept within 1/8 to 4
+    times it)."""
+    if len(positions) < neighbours:
+        return guess
+    r = guess
+    pos = positions.astype(np.float64)
+    for _ in range(2):
+        h = 2.0 * r
+        cells = np.floor(pos / h).astype(np.int64)
+        keys = (cells[:, 0] * 73856093) ^ (cells[:, 1] * 19349663) ^ (cells[:, 2] * 83492791)
+        _, inverse, counts = np.unique(keys, return_inverse=True, return_counts=True)
+        density = float(np.median(counts[inverse])) / (h * h)
+        r = min(4.0 * guess, max(guess / 8.0, math.sqrt(neighbours / (math.pi * density))))
+    return r
 
 
 def _available_memory() -> int | None:
@@ -231,19 +252,20 @@ def check_photon_memory(settings: CausticsSettings, threads: int = 1) -> int:
 
 
 @builder
-def build_grid(photons, inv_cell, mask):
-    """``photons`` sorted by the hash of their grid cell (stable: the order within a cell is
-    the order shot) and the hash table's row starts."""
+def build_grid(photons, inv_cell, bits):
+    """``photons`` sorted by the hash row of their grid cell (stable: the order within a
+    row is the order shot) and the hash table's row starts (2^(3 bits) rows)."""
     n = photons.shape[0]
+    rows = 1 << (3 * bits)
     keys = np.empty(n, np.int64)
-    cells = np.zeros(mask + 2, np.int32)
+    cells = np.zeros(rows + 1, np.int32)
     for q in range(n):
         h = cell_hash(cell_of(np.float64(photons[q, 0]), inv_cell),
                       cell_of(np.float64(photons[q, 1]), inv_cell),
-                      cell_of(np.float64(photons[q, 2]), inv_cell), mask)
+                      cell_of(np.float64(photons[q, 2]), inv_cell), bits)
         keys[q] = h
         cells[h + 1] += 1
-    for h in range(mask + 1):
+    for h in range(rows):
         cells[h + 1] += cells[h]
     fill = cells[:-1].copy()
     out = np.empty_like(photons)
@@ -252,6 +274,11 @@ def build_grid(photons, inv_cell, mask):
         out[fill[h]] = photons[q]
         fill[h] += 1
     return out, cells
+
+
+def grid_bits(photons: int) -> int:
+    """Bits per cell coordinate: at least two rows per photon, at least 4 cells a side."""
+    return max(2, -(-max(1, 2 * photons - 1).bit_length() // 3))
 
 
 @dataclass
@@ -317,8 +344,6 @@ def photon_lights(compiled: CompiledScene, params: RenderParams, settings: Caust
     targets = caustic_targets(compiled)
     rows = emitters(compiled, targets, settings.photons)
     shadow_mats = shadow_material_table(compiled)
-    radius = settings.radius or default_radius(targets, settings.photons)
-    radii = pass_radii(radius, settings.passes, settings.alpha)
     parts = []
     pool = ThreadPoolExecutor(threads, thread_name_prefix="whitted-photons") if threads > 1 \
         else None
@@ -334,15 +359,21 @@ def photon_lights(compiled: CompiledScene, params: RenderParams, settings: Caust
             pool.shutdown()
     photons = (np.concatenate(parts) if parts
                else np.zeros((0, PHOTON_WIDTH), np.float32))
+    radius = settings.radius
+    if radius == 0.0:  # fitted to the first pass's photons (the same on every machine)
+        radius = default_radius(targets, settings.photons)
+        if parts:
+            radius = fitted_radius(parts[0][:, :3], radius)
+    radii = pass_radii(radius, settings.passes, settings.alpha)
     grid = np.zeros(GRID_PASS + 2 * settings.passes)
-    grid[GRID_INV_CELL] = 1.0 / (2.0 * radius)
-    size = 1 << max(1, int(len(photons) * 2 - 1).bit_length())
-    grid[GRID_MASK] = size - 1
+    grid[GRID_INV_CELL] = 1.0 / radius
+    bits = grid_bits(len(photons))
+    grid[GRID_BITS] = bits
     grid[GRID_R2_MAX] = radius * radius
     grid[GRID_PASSES] = settings.passes
     grid[GRID_PASS::2] = (radii * radii)
     grid[GRID_PASS + 1::2] = 2.0 / (math.pi * radii * radii) / settings.passes
-    sorted_photons, cells = build_grid(photons, grid[GRID_INV_CELL], size - 1)
+    sorted_photons, cells = build_grid(photons, grid[GRID_INV_CELL], bits)
     stats.shot = settings.photons * settings.passes
     stats.stored = len(photons)
     stats.radius = float(radii[0])

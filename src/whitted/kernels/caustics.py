@@ -16,8 +16,8 @@ import math
 
 from .jit import kernel, overload
 from .layout import (
+    GRID_BITS,
     GRID_INV_CELL,
-    GRID_MASK,
     GRID_PASS,
     GRID_PASSES,
     GRID_R2_MAX,
@@ -57,9 +57,12 @@ def _caustics_on(lights):
 
 
 @kernel(inline="always")
-def cell_hash(ix, iy, iz, mask):
-    """Row of the photon grid's hash table for integer cell (ix, iy, iz)."""
-    return ((ix * 73856093) ^ (iy * 19349663) ^ (iz * 83492791)) & mask
+def cell_hash(ix, iy, iz, bits):
+    """Row of the photon grid's hash table for integer cell (ix, iy, iz): the cell's
+    coordinates modulo 2^bits, packed. Cells fewer than 2^bits apart on every axis never
+    share a row, so the 3x3x3 cells around a point are always distinct rows."""
+    m = (1 << bits) - 1
+    return (ix & m) | ((iy & m) << bits) | ((iz & m) << (2 * bits))
 
 
 @kernel(inline="always")
@@ -68,75 +71,58 @@ def cell_of(x, inv_cell):
 
 
 @kernel
-def _cell_seen_before(k, hi, ix0, iy0, iz0, mask, h):
-    """Whether one of the cells 0..k-1 of the 2x2x2 block at (ix0, iy0, iz0), clipped to the
-    cells ``hi`` allows, hashes to ``h`` (its photons were gathered already)."""
-    for j in range(k):
-        dx = j & 1
-        dy = (j >> 1) & 1
-        dz = (j >> 2) & 1
-        if ix0 + dx > hi[0] or iy0 + dy > hi[1] or iz0 + dz > hi[2]:
-            continue
-        if cell_hash(ix0 + dx, iy0 + dy, iz0 + dz, mask) == h:
-            return True
-    return False
-
-
-@kernel
 def caustic_irradiance(lights, p, n):
     """Irradiance (per channel) the photon map gives at point ``p`` of a surface whose unit
     normal ``n`` faces the side being shaded: the photons of each pass within that pass's
     radius of ``p``, arriving on that side and near the tangent plane, weighted by the
     Epanechnikov kernel ``2 / (pi r^2) (1 - d^2 / r^2)``, averaged over the passes (and
-    faded out where fewer than MIN_PHOTONS per pass are found). The grid
-    cells are twice the largest radius, so the ball around ``p`` meets at most 2x2x2 of
-    them; a hash row shared by two of them is read once."""
+    faded out where fewer than MIN_PHOTONS per pass are found). The grid's cells are the
+    largest radius: the ball around ``p`` meets at most 3x3x3 of them, each its own row of
+    the hash table (:func:`cell_hash`)."""
     grid = lights.photon_grid
     photons = lights.photons
     cells = lights.photon_cells
     inv_cell = grid[GRID_INV_CELL]
-    mask = int(grid[GRID_MASK])
+    bits = int(grid[GRID_BITS])
     r2_max = grid[GRID_R2_MAX]
     r = math.sqrt(r2_max)
     ix0 = cell_of(p[0] - r, inv_cell)
     iy0 = cell_of(p[1] - r, inv_cell)
     iz0 = cell_of(p[2] - r, inv_cell)
-    hi = (cell_of(p[0] + r, inv_cell), cell_of(p[1] + r, inv_cell), cell_of(p[2] + r, inv_cell))
+    ix1 = cell_of(p[0] + r, inv_cell)
+    iy1 = cell_of(p[1] + r, inv_cell)
+    iz1 = cell_of(p[2] + r, inv_cell)
     e0 = 0.0
     e1 = 0.0
     e2 = 0.0
     found = 0
-    for k in range(8):
-        dx = k & 1
-        dy = (k >> 1) & 1
-        dz = (k >> 2) & 1
-        if ix0 + dx > hi[0] or iy0 + dy > hi[1] or iz0 + dz > hi[2]:
-            continue
-        h = cell_hash(ix0 + dx, iy0 + dy, iz0 + dz, mask)
-        if k > 0 and _cell_seen_before(k, hi, ix0, iy0, iz0, mask, h):
-            continue
-        for q in range(cells[h], cells[h + 1]):
-            ox = photons[q, 0] - p[0]
-            oy = photons[q, 1] - p[1]
-            oz = photons[q, 2] - p[2]
-            d2 = ox * ox + oy * oy + oz * oz
-            if d2 >= r2_max:
-                continue
-            s = GRID_PASS + 2 * int(photons[q, PHOTON_PASS])
-            r2 = grid[s]
-            if d2 >= r2:
-                continue
-            if (photons[q, PHOTON_DIRECTION] * n[0] + photons[q, PHOTON_DIRECTION + 1] * n[1]
-                    + photons[q, PHOTON_DIRECTION + 2] * n[2]) >= 0.0:
-                continue  # it arrived on the other side
-            off = ox * n[0] + oy * n[1] + oz * n[2]
-            if off * off > PLANE_FRACTION * PLANE_FRACTION * r2:
-                continue
-            w = (1.0 - d2 / r2) * grid[s + 1]
-            found += 1
-            e0 += w * photons[q, PHOTON_POWER]
-            e1 += w * photons[q, PHOTON_POWER + 1]
-            e2 += w * photons[q, PHOTON_POWER + 2]
+    for ix in range(ix0, ix1 + 1):
+        for iy in range(iy0, iy1 + 1):
+            for iz in range(iz0, iz1 + 1):
+                h = cell_hash(ix, iy, iz, bits)
+                for q in range(cells[h], cells[h + 1]):
+                    ox = photons[q, 0] - p[0]
+                    oy = photons[q, 1] - p[1]
+                    oz = photons[q, 2] - p[2]
+                    d2 = ox * ox + oy * oy + oz * oz
+                    if d2 >= r2_max:
+                        continue
+                    s = GRID_PASS + 2 * int(photons[q, PHOTON_PASS])
+                    r2 = grid[s]
+                    if d2 >= r2:
+                        continue
+                    if (photons[q, PHOTON_DIRECTION] * n[0]
+                            + photons[q, PHOTON_DIRECTION + 1] * n[1]
+                            + photons[q, PHOTON_DIRECTION + 2] * n[2]) >= 0.0:
+                        continue  # it arrived on the other side
+                    off = ox * n[0] + oy * n[1] + oz * n[2]
+                    if off * off > PLANE_FRACTION * PLANE_FRACTION * r2:
+                        continue
+                    w = (1.0 - d2 / r2) * grid[s + 1]
+                    found += 1
+                    e0 += w * photons[q, PHOTON_POWER]
+                    e1 += w * photons[q, PHOTON_POWER + 1]
+                    e2 += w * photons[q, PHOTON_POWER + 2]
     passes = grid[GRID_PASSES]
     if found < MIN_PHOTONS * passes:
         fade = max(0.0, (found - FEWEST_PHOTONS * passes) / ((MIN_PHOTONS - FEWEST_PHOTONS)

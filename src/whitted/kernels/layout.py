@@ -187,8 +187,8 @@ PHOTON_PASS = 9
 PHOTON_WIDTH = 10
 # photon grid scalars (LightArrays.photon_grid, float64), then per pass its squared radius
 # at GRID_PASS + 2 p and its estimator's normalisation at GRID_PASS + 2 p + 1
-GRID_INV_CELL = 0  # 1 / cell side (the side is twice the largest gather radius)
-GRID_MASK = 1  # hash table size - 1 (a power of two)
+GRID_INV_CELL = 0  # 1 / cell side (the side is the largest gather radius)
+GRID_BITS = 1  # bits of each cell coordinate in the hash (kernels/caustics.py's cell_hash)
 GRID_R2_MAX = 2  # the largest squared radius (pass 0's)
 GRID_PASSES = 3
 GRID_PASS = 4
