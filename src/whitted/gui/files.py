@@ -10,11 +10,26 @@ from pathlib import Path
 from PySide6.QtCore import QObject
 from PySide6.QtWidgets import QApplication
 
+from .. import scene as S
 from ..errors import WhittedError
 from ..scene import Scene, load_scene, save_scene
 from ..scene.toml_document import edited_toml, save_scene_toml, scene_toml
 from ..scene.writing import rebase_files
 from .autosave import recovery_for
+
+
+def starter_scene() -> Scene:
+    """What File > New gives: a floor, a sphere, an ambient and a point light."""
+    return Scene(
+        render=S.RenderSettings(width=640, height=480),
+        camera=S.Camera(position=(0.0, 1.5, 6.0), look_at=(0.0, 0.6, 0.0), fov=40.0),
+        background=S.Background(gradient=S.Gradient(top=(0.3, 0.45, 0.75),
+                                                     bottom=(0.85, 0.88, 0.95))),
+        lights=[S.AmbientLight(name="ambient", intensity=0.2),
+                S.PointLight(name="lamp", position=(-4.0, 6.0, 5.0), intensity=0.9)],
+        objects=[S.Plane(name="floor", material="matte"),
+                 S.Sphere(name="ball", center=(0.0, 0.8, 0.0), radius=0.8, material="plastic")],
+    )
 
 
 class FileControl(QObject):
@@ -51,8 +66,6 @@ class FileControl(QObject):
         return False
 
     def new_scene(self) -> bool:
-        from .main_window import starter_scene
-
         if not self.maybe_save():
             return False
         self.window_.controller.stop()

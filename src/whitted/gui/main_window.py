@@ -28,7 +28,6 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
 )
 
-from .. import scene as S
 from ..scene import Scene
 from ..scene.default import default_scene
 from . import catalog
@@ -43,7 +42,7 @@ from .document import (
     set_path,
 )
 from .editing import Editing
-from .files import FileControl
+from .files import FileControl, starter_scene
 from .icons import icon_for
 from .navigation import Navigation
 from .overlays import Overlays
@@ -60,20 +59,6 @@ SCENE_FILTER = "Scene files (*.toml *.json);;TOML scene (*.toml);;JSON scene (*.
 IMAGE_FILTER = "PNG image (*.png);;OpenEXR HDR image (*.exr);;All images (*.png *.exr *.jpg *.pfm)"
 #: fits a 1366×768 screen with its panel and the title bar
 WINDOW_SIZE = (1280, 680)
-
-
-def starter_scene() -> Scene:
-    """What File > New gives: a floor, a sphere, an ambient and a point light."""
-    return Scene(
-        render=S.RenderSettings(width=640, height=480),
-        camera=S.Camera(position=(0.0, 1.5, 6.0), look_at=(0.0, 0.6, 0.0), fov=40.0),
-        background=S.Background(gradient=S.Gradient(top=(0.3, 0.45, 0.75),
-                                                     bottom=(0.85, 0.88, 0.95))),
-        lights=[S.AmbientLight(name="ambient", intensity=0.2),
-                S.PointLight(name="lamp", position=(-4.0, 6.0, 5.0), intensity=0.9)],
-        objects=[S.Plane(name="floor", material="matte"),
-                 S.Sphere(name="ball", center=(0.0, 0.8, 0.0), radius=0.8, material="plastic")],
-    )
 
 
 class MainWindow(QMainWindow):
