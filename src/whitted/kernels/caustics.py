@@ -158,6 +158,8 @@ def irradiance_at(lights, points, normals, out):
 def add_caustic(lights, mats, m, albedo, p, n, local):
     """:func:`with_caustic` in renders with caustics; ``local`` unchanged, and nothing
     compiled, without."""
+    if not caustics_on(lights):
+        return local
     return with_caustic(lights, mats, m, albedo, p, n, local)
 
 
