@@ -237,11 +237,12 @@ def _available_memory() -> int | None:
 
 
 def check_photon_memory(settings: CausticsSettings, threads: int = 1) -> int:
-    """The bytes a photon map of these settings may take (each pass's output slots, and the
-    photons stored, one per photon shot on average, twice while the grid is sorted);
+    """The bytes a photon map of these settings may take (each pass's output slots and
+    counts; the photons stored, one per photon shot on average, three copies while the grid
+    is sorted, their cell keys and two hash-table rows each);
     :class:`SceneError` naming the key when that is more than half the memory available."""
-    need = (settings.photons * (SLOTS * PHOTON_BYTES + 1)
-            + 3 * settings.photons * settings.passes * PHOTON_BYTES)
+    need = (settings.photons * (SLOTS * PHOTON_BYTES + 4)
+            + settings.photons * settings.passes * (3 * PHOTON_BYTES + 8 + 8))
     have = _available_memory()
     if have is not None and need > MEMORY_SHARE * have:
         raise SceneError(
