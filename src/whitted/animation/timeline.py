@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 from pydantic import BaseModel
 
-from ..errors import SceneError
+from ..errors import FrameError, SceneError, shorten
 from .interpolate import interpolate_tree, wrap_keys
 from .model import Track
 from .paths import PathError, Step, format_path, get_value, parse_path, resolve_path, set_value
@@ -199,15 +199,31 @@ def check_animation(scene: Scene) -> None:
                     f"between keys gives {exc}") from None
 
 
+def frame_number(frame: Any, frames: int) -> int:
+    """``frame`` as an int in 0 .. frames - 1 (a whole float such as ``3.0`` or a NumPy
+    integer is accepted); FrameError (one line) for anything else: None, text, true/false,
+    NaN, infinity, 2.5, a frame out of range."""
+    import numbers
+
+    span = f"0..{frames - 1}"
+    if isinstance(frame, bool) or not isinstance(frame, numbers.Real):
+        raise FrameError(f"frame {shorten(repr(frame))} is not a frame number (a whole number "
+                         f"{span})")
+    if not isinstance(frame, numbers.Integral) and (
+            not math.isfinite(frame) or int(frame) != frame):
+        raise FrameError(f"frame {frame!r} is not a whole number (the frames are {span})")
+    frame = int(frame)
+    if not 0 <= frame < frames:
+        plural = "s" if frames != 1 else ""
+        raise FrameError(f"frame {shorten(str(frame))} is outside {span} (the scene has "
+                         f"{frames} frame{plural})")
+    return frame
+
+
 def scene_at_frame(scene: Scene, frame: int) -> Scene:
     """The plain still of frame ``frame`` (0 .. frame_count - 1); ``scene`` is unchanged."""
     n = frame_count(scene)
-    if isinstance(frame, bool) or int(frame) != frame:
-        raise SceneError(f"frame {frame!r} is not a whole number")
-    frame = int(frame)
-    if not 0 <= frame < n:
-        raise SceneError(f"frame {frame} is outside 0..{n - 1} (the scene has {n} "
-                         f"frame{'s' if n != 1 else ''})")
+    frame = frame_number(frame, n)
     still = scene
     if scene.animation is not None:
         try:

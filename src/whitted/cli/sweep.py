@@ -24,6 +24,15 @@ from .main import (
 )
 
 
+def _sheet_columns(cells, columns: int | None) -> int:
+    """Cells per row of the sheet: the first axis's values for a grid, else --columns, else
+    one row up to 6 cells and a square-ish grid beyond."""
+    if len(cells.axes) == 2:
+        return cells.columns
+    n = len(cells)
+    return max(1, min(n, columns or (n if n <= 6 else math.ceil(math.sqrt(n)))))
+
+
 @app.command()
 def sweep(
     scene_path: SceneArgument = None,
@@ -53,8 +62,8 @@ def sweep(
     from pydantic import ValidationError
 
     from ..animation.frames import FrameRenderer
-    from ..animation.overrides import apply_overrides, parse_assignment, parse_values
-    from ..animation.sweep import contact_sheet, sweep_cells
+    from ..animation.overrides import apply_overrides, is_range, parse_assignment, parse_values
+    from ..animation.sweep import cell_size_bounds, check_sheet_size, contact_sheet, sweep_cells
     from ..output.encode import atomic_write
     from ..render.api import CancelToken
 
@@ -69,15 +78,21 @@ def sweep(
         for text in set_values or []:
             path, value_text = parse_assignment(text)
             values = parse_values(value_text)
-            if len(values) > 1:
+            if len(values) > 1 or is_range(value_text):  # a range of one value is an axis
                 axes.append((path, values))
             else:
                 fixed.append((path, value_text))
         scene = apply_overrides(scene, fixed)
         scene = scene.with_settings(width=width, height=height, samples=samples,
                                     max_depth=max_depth)
-        cells = sweep_cells(scene, axes)
-        stills = [cell.scene.at_frame(frame) for cell in cells]
+        cells = sweep_cells(scene, axes)  # counted and checked value by value, made lazily
+        scene.at_frame(frame)
+        ncols = _sheet_columns(cells, columns)
+        widths, heights = cell_size_bounds(cells)
+        if ncols != cells.columns:  # one axis wrapped onto several rows
+            widths = [max(widths)] * ncols
+            heights = [heights[0]] * math.ceil(len(cells) / ncols)
+        check_sheet_size(widths, heights, title != "")
     except WhittedError as exc:
         raise fail(str(exc)) from None
     except ValidationError as exc:
@@ -101,9 +116,13 @@ def sweep(
     rendered = 0
     digits = len(str(len(cells) - 1))
     try:
-        for cell, still in zip(cells, stills, strict=True):
+        for cell in cells:
             if interrupted.is_set():
                 break
+            try:
+                still = cell.scene.at_frame(frame)
+            except ValidationError as exc:
+                raise fail(_override_error(exc)) from None
             path = folder / f"{cell.index:0{digits}d}.png"
             result = renderer.render(still, frame, path, cancel=cancel)
             if result.cancelled:
@@ -127,10 +146,6 @@ def sweep(
     from PIL import Image as PILImage
 
     images = [np.asarray(PILImage.open(p).convert("RGB")) for p in paths]
-    if len(axes) == 2:
-        ncols = len(axes[0][1])
-    else:
-        ncols = columns or (len(cells) if len(cells) <= 6 else math.ceil(math.sqrt(len(cells))))
     heading = title if title is not None else " / ".join(path for path, _ in axes)
     sheet = contact_sheet(images, [c.label for c in cells], ncols, heading)
     atomic_write(output, lambda tmp: PILImage.fromarray(sheet).save(tmp, format="PNG"))
