@@ -14,6 +14,7 @@ included when the steps land on it: ``1:0:-0.2`` is 1, 0.8, 0.6, 0.4, 0.2, 0) or
 from __future__ import annotations
 
 import math
+import sys
 import tomllib
 from typing import TYPE_CHECKING, Any
 
@@ -139,11 +140,14 @@ def _range_values(text: str, pieces: list[str]) -> list[Any]:
         _check_count(where, math.inf if not math.isfinite(span) else math.floor(span) + 1)
     count = math.floor(span + 1e-9) + 1
     _check_count(where, count)
-    values = []
-    for k in range(count):
+    values = [start]
+    for k in range(1, count):
         v = start + k * step
-        # 0.1 * 3 is 0.30000000000000004: keep 12 significant digits (and an exact 0)
-        values.append(0.0 if abs(v) < abs(step) * 1e-9 else float(f"{v:.12g}"))
+        # 0.1 * 3 is 0.30000000000000004 and 1 - 5 * 0.2 may be 5e-17: within the rounding
+        # of the sum, take the shortest number (0.3, 0) instead
+        noise = 4 * sys.float_info.epsilon * (abs(start) + abs(k * step))
+        short = float(f"{v:.12g}")
+        values.append(0.0 if abs(v) <= noise else short if abs(short - v) <= noise else v)
     return values
 
 
