@@ -39,7 +39,14 @@ class Step:
     item: bool = False  # written in brackets
 
     def __str__(self) -> str:
-        return f"[{self.key}]" if self.item else f".{self.key}"
+        if not self.item:
+            return f".{self.key}"
+        key = self.key
+        if isinstance(key, str) and (re.fullmatch(r"\d+", key) or key != key.strip()
+                                     or any(c in key for c in "[]\"'")):
+            # quoted, so that the path reads back the same (a name "3" is not index 3)
+            return f"['{key}']" if '"' in key else f'["{key}"]'
+        return f"[{key}]"
 
 
 _TOKEN = re.compile(
