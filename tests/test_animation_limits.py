@@ -269,7 +269,13 @@ def test_a_sweep_is_counted_before_any_cell_is_made(tmp_path: Path, monkeypatch)
         cells[5000]
 
 
-def test_a_sheet_too_big_is_refused_before_rendering(tmp_path: Path):
+def test_a_sheet_too_big_is_refused_before_rendering(tmp_path: Path, monkeypatch):
+    from whitted.animation.frames import FrameRenderer
+
+    def no_render(*args, **kwargs):
+        raise TooManyChecks("a cell was rendered")
+
+    monkeypatch.setattr(FrameRenderer, "render", no_render)
     (tmp_path / "s.toml").write_text(SCENE)
     line = one_line_error(run_main("sweep", "s.toml", "--set", "render.width=8000:8002",
                                    "--set", "render.height=6000:6010", "-o", "x.png",
