@@ -66,7 +66,7 @@ def test_a_file_too_big_for_the_address_space_is_one_clear_line(tmp_path: Path):
 
 def test_reading_a_small_file_asks_for_its_size_not_the_limit(tmp_path: Path, monkeypatch):
     """The read is sized by the file (plus one byte to notice growth), never by the limit."""
-    from whitted.assets import files
+    from whitted.files import reading as files
 
     path = tmp_path / "a.mtl"
     path.write_bytes(b"newmtl a\nKd 1 0 0\n")
@@ -119,7 +119,7 @@ class TooManyChecks(Exception):
 
 
 def count_checks(monkeypatch, limit: int) -> list[int]:
-    from whitted.animation import timeline
+    from whitted.scene import timeline
 
     calls = [0]
     real = timeline.set_value
@@ -172,7 +172,7 @@ def test_a_spline_overshooting_in_a_million_frame_film_is_still_found(tmp_path, 
 def test_the_frames_tried_include_each_splines_turning_points():
     import numpy as np
 
-    from whitted.animation.interpolate import interpolate_scalar, spline_extremes
+    from whitted.scene.interpolate import interpolate_scalar, spline_extremes
 
     times, values = [0.0, 10.0, 30.0, 31.0, 40.0], [0.0, 1.0, 0.2, 5.0, -1.0]
     found = spline_extremes(times, values)
@@ -220,7 +220,7 @@ def test_sequence_patterns_are_bounded_and_named(tmp_path: Path, pattern: str, p
 
 
 def test_a_sequence_pattern_of_the_widest_allowed_format_works(tmp_path: Path):
-    from whitted.animation.timeline import MAX_FORMAT_WIDTH, sequence_file
+    from whitted.scene.timeline import MAX_FORMAT_WIDTH, sequence_file
 
     for k in range(2):
         (tmp_path / f"ice_{k:032d}.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
@@ -407,7 +407,7 @@ def test_set_a_path_whose_quoted_name_holds_brackets(tmp_path: Path):
 ])
 def test_parse_assignment_respects_quotes_in_brackets(text: str, path: str, value: str):
     from whitted.animation.overrides import parse_assignment
-    from whitted.animation.paths import parse_path
+    from whitted.scene.paths import parse_path
 
     assert parse_assignment(text) == (path, value)
     parse_path(path)  # and the path reader reads the same path
