@@ -434,3 +434,18 @@ def test_a_one_value_range_sweeps_one_value(tmp_path: Path):
     assert parse_values("9007199254740993:9007199254740995") == [
         9007199254740993, 9007199254740994, 9007199254740995]  # whole numbers stay exact
     assert parse_values("0:1e-12:2.5e-13") == [0.0, 2.5e-13, 5e-13, 7.5e-13, 1e-12]
+
+
+def test_a_range_given_to_render_says_ranges_are_for_sweeps(tmp_path: Path):
+    scene = SCENE.replace("radius = 1.0", "radius = 1.0\nmaterial = { kt = 0.5 }")
+    (tmp_path / "s.toml").write_text(scene)
+    line = one_line_error(run_main("render", "s.toml", "--set", "objects[0].material.kt=1:1:0.1",
+                                   "-o", "x.png", cwd=tmp_path))
+    assert line.startswith("error: --set: objects[0].material.kt: input should be a valid "
+                           "number")
+    assert line.endswith("(got '1:1:0.1'); a range START:STOP:STEP is for whitted sweep, "
+                         "here give one value")
+    # a text value that looks like a range is still text where text is wanted
+    code, out, err = run_main("render", "s.toml", "--set", "objects[0].name=1:2", "-q",
+                              "-o", "y.png", cwd=tmp_path)
+    assert code == 0, err

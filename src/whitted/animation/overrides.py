@@ -178,14 +178,17 @@ def apply_overrides(scene: Scene, assignments: list[tuple[str, Any]] | dict[str,
     (one line, ``--set PATH: problem``) when a path names nothing or a value is rejected."""
     items = list(assignments.items()) if isinstance(assignments, dict) else list(assignments)
     for path, value in items:
-        if isinstance(value, str):
-            value = parse_value(value)
+        text = value if isinstance(value, str) else None
+        if text is not None:
+            value = parse_value(text)
         try:
             written = parse_path(path)
             steps = resolve_path(scene, written)
             new = set_value(scene, written, value)  # errors name the path as written
         except PathError as exc:
-            raise SceneError(str(exc), where="--set") from None
+            hint = ("; a range START:STOP:STEP is for whitted sweep, here give one value"
+                    if text is not None and is_range(text) else "")
+            raise SceneError(f"{exc}{hint}", where="--set") from None
         if scene.animation is not None:
             kept = []
             for track in scene.animation.tracks:
