@@ -377,7 +377,7 @@ def animation_tables(draw):
     return table
 
 
-@fuzz(120)
+@fuzz(100)
 @given(table=animation_tables(), frame=st.one_of(st.none(), st.integers(-2, 12),
                                                   st.sampled_from(["x", "1e3", "2.5", "-0"])))
 def test_random_animation_tables_end_cleanly(tmp_path_factory, table, frame):
@@ -413,7 +413,7 @@ def set_options(draw):
     return out
 
 
-@fuzz(120)
+@fuzz(80)
 @given(options=set_options(), animated=st.booleans())
 def test_random_set_values_end_cleanly(tmp_path_factory, options: list[str], animated: bool):
     folder = tmp_path_factory.mktemp("set")
@@ -467,7 +467,7 @@ def test_sweep_values_are_a_bounded_list_or_one_clean_line(text: str):
                                        atol=abs(steps[0]) * 1e-6 + 1e-300)
 
 
-@fuzz(60)
+@fuzz(40)
 @given(first=sweep_texts(), second=st.one_of(st.none(), sweep_texts()),
        path=st.sampled_from(["render.samples", "objects[ball].material.kt", "render.width",
                              "camera.fov", "objects[ball].radius", "nope", "background"]))
@@ -499,7 +499,7 @@ def test_random_sweeps_end_cleanly_and_never_make_too_many_cells(tmp_path_factor
     assert not cells.exists() or len(list(cells.iterdir())) <= 12
 
 
-@fuzz(150)
+@fuzz(100)
 @given(frame=st.one_of(st.none(), st.integers(-2**70, 2**70), st.floats(allow_nan=True),
                        st.booleans(), st.text(max_size=4), st.lists(st.integers(), max_size=2),
                        st.sampled_from([np.int64(2), np.float32("nan"), np.float64(2.0),
