@@ -46,7 +46,8 @@ $(OLDEST_VENV)/.ready: pyproject.toml $(VENV)/.test-deps
 
 test-oldest-numba: $(OLDEST_VENV)/.ready
 	$(OLDEST_VENV)/bin/python -c 'import numba; print("oldest Numba:", numba.__version__)'
-	WHITTED_CACHE_DIR=$(CURDIR)/.cache-oldest-numba $(OLDEST_VENV)/bin/python -m pytest -q \
+	PYTHONPATH=$(CURDIR)/src WHITTED_CACHE_DIR=$(CURDIR)/.cache-oldest-numba \
+		$(OLDEST_VENV)/bin/python -m pytest -q \
 		-p no:cacheprovider tests/test_kernel_cache.py tests/test_jit.py \
 		tests/test_shapes.py -k 'not two_cold'
 

@@ -95,7 +95,6 @@ def upward_imports(found: dict[str, set[tuple[str, int]]],
     return sorted(wrong)
 
 
-@pytest.mark.xfail(strict=True, reason="gui/film_job.py imports cli/ until the film API lands")
 def test_imports_go_down_the_layers():
     wrong = upward_imports(imports(), layers())
     assert not wrong, "imports that do not go down a layer:\n" + "\n".join(wrong)

@@ -210,7 +210,7 @@ def test_a3_a4_signal_during_the_first_compile_stops_at_once_and_writes_nothing(
     finally:
         release.set()
     assert code == status, (code, out, err)
-    assert f"{word} before any tile was finished: nothing written" in err
+    assert f"{word}: before any tile was finished: nothing written" in err
     assert (tmp_path / "out.png").read_bytes() == good  # the good image is kept
 
 
@@ -236,7 +236,7 @@ def test_a3_ctrl_c_during_the_first_compile_ends_the_process_at_once(tmp_path: P
     result = subprocess.run([sys.executable, "-c", LONG_COMPILE], cwd=tmp_path,
                             capture_output=True, text=True, timeout=100)
     assert result.returncode == 130, result.stderr
-    assert "interrupted before any tile was finished: nothing written" in result.stderr
+    assert "interrupted: before any tile was finished: nothing written" in result.stderr
     assert not (tmp_path / "out.png").exists()
 
 

@@ -48,4 +48,7 @@ def gui(
 
 def main() -> None:
     """Console entry point of ``whitted`` (and ``python -m whitted``)."""
+    from .cli.interrupt import install_process_handlers
+
+    install_process_handlers()  # SIGINT, SIGTERM outside a command's guard: one line, at once
     _cli_main()

@@ -10,7 +10,7 @@ grid with a label under each and a title above.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any, overload
@@ -76,6 +76,13 @@ class SweepCells(Sequence[SweepCell]):
 
     def __len__(self) -> int:
         return self.columns * self.rows
+
+    def axis_scenes(self) -> Iterator[Scene]:
+        """The scene with each value of each axis set alone, one at a time (the files a
+        swept value names are among theirs)."""
+        for path, values in self.axes:
+            for value in values:
+                yield apply_overrides(self.scene, [(path, value)])
 
     @overload
     def __getitem__(self, index: int) -> SweepCell: ...

@@ -22,6 +22,7 @@ except ImportError:  # pragma: no cover - depends on the installed typer
 from ..errors import WhittedError, shorten
 from .console import Text, err, out
 from .farm import ClusterOption, SchedulerOption, render_still_on_farm
+from .interrupt import InterruptGuard, command_finished, exit_code_of, last_signal
 
 if TYPE_CHECKING:
     import numpy as np
@@ -47,8 +48,6 @@ SceneArgument = Annotated[
 
 AOV_NAMES = ("depth", "normal", "id")
 EXIT_USER_ERROR = 2
-EXIT_INTERRUPTED = 130
-EXIT_TERMINATED = 143  # 128 + SIGTERM
 #: After an interrupt during the first compile the render thread is abandoned; the process
 #: then ends at once (os._exit) instead of waiting for the compiler to let the interpreter
 #: shut down (seconds). A local ``render`` also ends at once once its files are written and
@@ -207,48 +206,33 @@ def render(
     except WhittedError as exc:
         raise fail(str(exc)) from None
     _ends_at_once.append(True)
-    interrupted = threading.Event()
-    signals: list[int] = []
-    handled = [signal.SIGINT, signal.SIGTERM]
-    previous = {sig: signal.getsignal(sig) for sig in handled}
-
-    def on_interrupt(signum, frame) -> None:  # Ctrl-C, SIGTERM: stop after the tiles in flight
-        if interrupted.is_set():  # the second one: stop now (a write in progress is undone)
-            raise KeyboardInterrupt
-        signals.append(signum)
-        interrupted.set()
-        job.cancel()
-
-    # the handlers stay until the image is written: a signal during the write lets it finish
-    for sig in handled:
-        signal.signal(sig, on_interrupt)
-    try:
-        _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
-                          interrupted, signals, process_start, frame)
-    finally:
-        for sig in handled:
-            signal.signal(sig, previous[sig])
+    # Ctrl-C, SIGTERM: stop after the tiles in flight (cli/interrupt.py); the handlers stay
+    # until the image is written: a signal during the write lets it finish
+    with InterruptGuard() as guard:
+        guard.on_interrupt(job.cancel)
+        _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet, guard,
+                          process_start, frame)
 
 
-def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet, interrupted,
-                      signals, process_start, frame: int | None) -> None:
+def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
+                      guard: InterruptGuard, process_start, frame: int | None) -> None:
     from ..output.formats import image_format
     from ..render.api import render_aovs
+
+    interrupted = guard.event
 
     try:
         _run_with_progress(job, quiet, interrupted)
     except WhittedError as exc:  # a model or texture file the scene names is unusable
         raise fail(_with_scene_key(exc, scene, name)) from None
-    exit_code = EXIT_TERMINATED if signal.SIGTERM in signals else EXIT_INTERRUPTED
     stats = job.stats
     if interrupted.is_set() and (job.running or stats.tiles_done == 0):
         # stopped while compiling, or before any tile was finished: there is nothing to keep,
         # and an existing file at the output path is left as it was
-        what = "terminated" if signal.SIGTERM in signals else "interrupted"
-        _note(f"{what} before any tile was finished: nothing written ({output} is unchanged)")
         if job.running:
             _abandoned.append(True)
-        raise typer.Exit(exit_code)
+        raise guard.exit(f"before any tile was finished: nothing written ({output} is "
+                         "unchanged)")
     image = job.image
     assert image is not None
     for warning in stats.warnings:
@@ -276,9 +260,7 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
     if not quiet or interrupted.is_set():
         out.line(f"{stats.summary()} -> {', '.join(written)}")
     if interrupted.is_set():  # (a signal may have come during the write)
-        what = "terminated" if signal.SIGTERM in signals else "interrupted"
-        _note(f"{what}: kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")
-        raise typer.Exit(EXIT_TERMINATED if signal.SIGTERM in signals else EXIT_INTERRUPTED)
+        raise guard.exit(f"kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")
 
 
 def _with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
@@ -628,6 +610,7 @@ def main() -> None:
     try:
         with only_the_command_named(sys.argv):
             code = app(standalone_mode=False)
+        command_finished()
         if (_abandoned or _ends_at_once) and EXIT_AT_ONCE_WHEN_ABANDONED:
             _exit_now(code if isinstance(code, int) else 0)
     except UsageError as exc:
@@ -638,10 +621,11 @@ def main() -> None:
         err.print(Text.assemble(("error:", "bold red"), " ",
                                 one_line(exc.format_message()) + hint), soft_wrap=True)
         sys.exit(EXIT_USER_ERROR)
-    except typer.Abort:
-        sys.exit(EXIT_INTERRUPTED)
-    except KeyboardInterrupt:
-        sys.exit(EXIT_INTERRUPTED)
+    except (typer.Abort, KeyboardInterrupt):  # a second signal: stopped at once
+        signum = last_signal()
+        err.line(f"{'terminated' if signum == signal.SIGTERM else 'interrupted'}: stopped at "
+                 "once (what was being written was not kept)")
+        sys.exit(exit_code_of(signum))
     except typer.Exit as exc:  # raised with standalone_mode=False only by an eager callback
         sys.exit(exc.exit_code)
     except WhittedError as exc:  # a user mistake a command did not catch itself

@@ -5,9 +5,7 @@ A thin client: the physics is :mod:`whitted.stefan`, the rendering the render AP
 
 from __future__ import annotations
 
-import signal
 import sys
-import threading
 import time
 from pathlib import Path
 from typing import Annotated
@@ -16,8 +14,9 @@ import typer
 
 from ..errors import WhittedError
 from .console import LazyConsole
-from .main import EXIT_INTERRUPTED, err, fail
+from .interrupt import InterruptGuard
 from .main import app as main_app
+from .main import err, fail
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="The Stefan problem: a hollow piece of ice with water inside, melting.")
@@ -31,22 +30,6 @@ def _fail(message: str) -> typer.Exit:
     return fail(message)
 
 
-class _Interrupt:
-    """Ctrl-C sets a flag the solver checks between chunks of steps."""
-
-    def __init__(self) -> None:
-        self.flag = threading.Event()
-        self.previous = None
-
-    def __enter__(self) -> _Interrupt:
-        self.previous = signal.getsignal(signal.SIGINT)
-        signal.signal(signal.SIGINT, lambda *_: self.flag.set())
-        return self
-
-    def __exit__(self, *exc) -> None:
-        signal.signal(signal.SIGINT, self.previous)
-
-
 def _load(case_path: Path):
     from ..stefan.case import load_case
 
@@ -57,13 +40,32 @@ def _load(case_path: Path):
     return case, case_path.read_text(encoding="utf-8")
 
 
-def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, size=(480, 360)):
+#: the files a run writes at the top of its folder (stefan/run.py)
+RUN_FILES = ("case.toml", "series.csv", "summary.json", "series.png")
+
+
+def _check_run_outputs(case_path: Path, output: Path) -> None:
+    """The output-safety check of ``render`` for a run's folder: its files can be written
+    there and none of them is the case file the run reads (one line)."""
+    from ..output.safety import check_outputs
+
+    if not output.is_dir():  # the run makes it
+        return
+    try:
+        check_outputs([output / name for name in RUN_FILES], inputs=[case_path])
+    except WhittedError as exc:
+        raise _fail(str(exc)) from None
+
+
+def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, guard: InterruptGuard,
+           size=(480, 360)):
     from ..stefan.case import CaseError
     from ..stefan.run import run_case
 
     case, text = _load(case_path)
     if output.exists() and not output.is_dir():
         raise _fail(f"{output}: exists and is not a folder")
+    _check_run_outputs(case_path, output)
     if output.resolve() == case_path.resolve().parent and fresh:
         raise _fail(f"{output}: --fresh would clear the case file's own folder")
     if fresh and output.exists():
@@ -80,8 +82,8 @@ def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, size=(480, 3
 
     columns = (TextColumn("[bold]{task.description}"), BarColumn(), TaskProgressColumn(),
                TextColumn("t = {task.fields[t]}"), TimeRemainingColumn())
-    with _Interrupt() as stop, Progress(*columns, console=err, transient=True,
-                                        disable=quiet or not err.is_terminal) as bar:
+    with Progress(*columns, console=err, transient=True,
+                  disable=quiet or not err.is_terminal) as bar:
         task = bar.add_task("melting", total=1.0, t="0 s")
 
         def progress(fraction: float, t: float, what: str) -> None:
@@ -89,7 +91,7 @@ def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, size=(480, 3
 
         try:
             result = run_case(case, text, output, resume=not fresh, progress=progress,
-                              should_stop=stop.flag.is_set, scene_size=size)
+                              should_stop=guard.is_set, scene_size=size)
         except CaseError as exc:
             raise _fail(str(exc)) from None
     return case, result
@@ -106,13 +108,13 @@ def run(
     """Compute the melt of CASE: fields (.npz), surfaces (.ply) per saved time, a time series
     (CSV and plots) and a scene per saved time. Ctrl-C keeps what was saved; run again to
     resume from the last saved time."""
-    case, result = _solve(case_path, output, fresh, quiet)
-    _report(result)
-    if result.interrupted:
-        err.print(f"interrupted at t = {result.end_time:.1f} s: kept the saved times up to "
-                  f"t = {result.last_saved:.0f} s in {output}; run the same command again to "
-                  "resume from there")
-        raise typer.Exit(EXIT_INTERRUPTED)
+    with InterruptGuard() as guard:
+        case, result = _solve(case_path, output, fresh, quiet, guard)
+        _report(result)
+        if result.interrupted:
+            raise guard.exit(f"at t = {result.end_time:.1f} s: kept the saved times up to "
+                             f"t = {result.last_saved:.0f} s in {output}; run the same "
+                             "command again to resume from there")
 
 
 def _report(result) -> None:
@@ -209,6 +211,43 @@ def _stamp(path: Path, text: str):
     return np.asarray(image)
 
 
+def _check_film_options(case_path: Path, output: Path, gif: Path | None, width: int,
+                        height: int, fps: float) -> None:
+    """What the film's options must be, checked before the solve (one line naming the
+    option): the image size, the frame rate each film's format takes, and films that can be
+    written where they go without writing over the case file or each other."""
+    from pydantic import ValidationError
+
+    from ..output.safety import check_outputs
+    from ..output.video import check_fps, video_format
+    from ..scene.scene import RenderSettings
+
+    try:
+        RenderSettings(width=width, height=height)
+    except ValidationError as exc:
+        from .main import _override_error
+
+        raise _fail(_override_error(exc)) from None
+    films = [output, *([gif] if gif is not None else [])]
+    formats = []
+    for option, path in zip(("-o", "--gif"), films, strict=False):
+        try:
+            formats.append(video_format(path))
+        except ValueError as exc:
+            raise _fail(f"{option}: {path}: {exc}") from None
+    for fmt in formats:
+        try:
+            check_fps(fps, fmt)
+        except ValueError as exc:
+            raise _fail(f"--fps: {exc}") from None
+    if gif is not None and output.resolve() == gif.resolve():
+        raise _fail(f"--gif: {gif} is the film -o names too")
+    try:
+        check_outputs(films, inputs=[case_path])
+    except WhittedError as exc:
+        raise _fail(str(exc)) from None
+
+
 @app.command()
 def film(
     case_path: Annotated[Path, typer.Argument(metavar="CASE", help="Case file (TOML)")],
@@ -222,54 +261,72 @@ def film(
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
 ) -> None:
     """Solve CASE (or resume it) into OUTPUT's folder NAME_stefan/, render one frame per saved
-    time with 'whitted animate' (the piece on a table, backlit; ice 1.31, water 1.333,
-    absorption exaggerated and said so) and encode the film with the simulated time in each
-    frame. Ctrl-C keeps the solved times and the finished frames; run again to continue."""
+    time (the piece on a table, backlit; ice 1.31, water 1.333, absorption exaggerated and
+    said so) and encode the film with the simulated time in each frame. Ctrl-C or SIGTERM
+    keeps the solved times and the finished frames; run again to continue."""
     import csv
 
-    from ..output.video import encode_film, video_format
+    from ..animation.film import FilmPaths, render_film
+    from ..output.video import encode_film
+    from ..render.api import CancelToken
+    from ..scene import load_scene
     from ..stefan.scene import ABSORPTION_BOOST, still_life_scene, write_scene
-    from .animate import animate as animate_command
 
     started = time.perf_counter()
-    try:
-        video_format(output)
-        if gif is not None:
-            video_format(gif)
-    except ValueError as exc:
-        raise _fail(f"{output}: {exc}") from None
-    if not output.parent.exists():
-        raise _fail(f"{output}: the folder {output.parent} does not exist")
+    _check_film_options(case_path, output, gif, width, height, fps)
     work = output.with_name(output.stem + "_stefan")
-    case, result = _solve(case_path, work, fresh, quiet, size=(width, height))
-    _report(result)
-    if result.interrupted:
-        err.print(f"interrupted while solving: kept every saved time in {work}; run the same "
-                  "command again to continue")
-        raise typer.Exit(EXIT_INTERRUPTED)
-    with (work / "series.csv").open(newline="") as fh:
-        times = [float(row["time_s"]) for row in csv.DictReader(fh)]
-    count = 0  # frames: saved times from 0 on where both surfaces exist
-    while (count < len(times) and (work / "surfaces" / f"outer_{count:04d}.ply").exists()
-           and (work / "surfaces" / f"inner_{count:04d}.ply").exists()):
-        count += 1
-    if count == 0:
-        raise _fail(f"{work}: no saved time has both surfaces to film")
-    scene_path = work / "film.toml"
-    write_scene(scene_path, still_life_scene(
-        "surfaces/outer_{frame:04d}.ply", "surfaces/inner_{frame:04d}.ply", None,
-        width=width, height=height, size_cm=100 * max(case.block.size), frames=count, fps=fps))
-    frames = work / "frames"
-    render_start = time.perf_counter()
-    animate_command(scene_path=scene_path, output=frames, frames=None, fps=None, width=None,
-                    height=None, samples=None, max_depth=None, threads=None, seed=None,
-                    set_values=None, crf=18, force=False, quiet=quiet)
-    render_seconds = time.perf_counter() - render_start
-    stamped = [_stamp(frames / f"{k:04d}.png",
-                      f"t = {times[k] / 60:5.1f} min   (absorption x{ABSORPTION_BOOST:g})")
-               for k in range(count)]
-    for path in [output, *([gif] if gif is not None else [])]:
-        encode_film(stamped, path, fps)
+    with InterruptGuard() as guard:
+        case, result = _solve(case_path, work, fresh, quiet, guard, size=(width, height))
+        _report(result)
+        if result.interrupted:
+            raise guard.exit(f"while solving: kept every saved time in {work}; run the same "
+                             "command again to continue")
+        with (work / "series.csv").open(newline="") as fh:
+            times = [float(row["time_s"]) for row in csv.DictReader(fh)]
+        count = 0  # frames: saved times from 0 on where both surfaces exist
+        while (count < len(times) and (work / "surfaces" / f"outer_{count:04d}.ply").exists()
+               and (work / "surfaces" / f"inner_{count:04d}.ply").exists()):
+            count += 1
+        if count == 0:
+            raise _fail(f"{work}: no saved time has both surfaces to film")
+        scene_path = work / "film.toml"
+        write_scene(scene_path, still_life_scene(
+            "surfaces/outer_{frame:04d}.ply", "surfaces/inner_{frame:04d}.ply", None,
+            width=width, height=height, size_cm=100 * max(case.block.size), frames=count,
+            fps=fps))
+        cancel = CancelToken()
+        guard.on_interrupt(cancel.cancel)
+        render_start = time.perf_counter()
+        try:
+            scene = load_scene(scene_path)
+            frames = render_film(scene, FilmPaths(None, work / "frames"), fps=fps,
+                                 scene_path=scene_path, cancel=cancel,
+                                 progress=None if quiet else _frame_line)
+        except WhittedError as exc:
+            raise _fail(str(exc)) from None
+        if frames.cancelled:
+            raise guard.exit(f"{len(frames.files)} of {count} frames finished in "
+                             f"{work / 'frames'}; run the same command again to continue")
+        render_seconds = time.perf_counter() - render_start
+        stamped = [_stamp(path, f"t = {times[k] / 60:5.1f} min   "
+                                f"(absorption x{ABSORPTION_BOOST:g})")
+                   for k, path in zip(frames.plan.frames, frames.files, strict=True)]
+        for path in [output, *([gif] if gif is not None else [])]:
+            try:
+                encode_film(stamped, path, fps, cancel=cancel)
+            except WhittedError:  # cancelled: ffmpeg stopped, the film as it was
+                raise guard.exit(f"every frame is in {work / 'frames'}; {path} was not "
+                                 "written") from None
+            except (ValueError, OSError) as exc:
+                raise _fail(f"{path}: cannot encode: "
+                            f"{getattr(exc, 'strerror', None) or exc}") from None
     out.print(f"{count} frames ({render_seconds / count:.2f} s a frame, wall) -> {output}"
               + (f", {gif}" if gif is not None else "")
               + f"; total {time.perf_counter() - started:.1f} s")
+
+
+def _frame_line(p) -> None:
+    """One line per frame finished (render_film's progress), on stdout."""
+    if p.event == "done":
+        state = f"{p.result.seconds:.2f} s" if p.result.rendered else "already done"
+        out.line(f"frame {p.frame} ({p.done}/{p.total}): {state}")
