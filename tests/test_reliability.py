@@ -445,6 +445,8 @@ def test_b1_scene_link_to_a_device_is_refused(tmp_path: Path):
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
 def test_b1_fifo_scene_and_texture_do_not_hang(tmp_path: Path):
+    from whitted.assets.images import load_image
+
     os.mkfifo(tmp_path / "pipe.toml")
     result = subprocess.run([*WHITTED, "info", "pipe.toml"], cwd=tmp_path,
                             capture_output=True, text=True, timeout=60)
@@ -453,7 +455,7 @@ def test_b1_fifo_scene_and_texture_do_not_hang(tmp_path: Path):
     write(tmp_path / "scene.toml", TEXTURED)
     one_line_error(run_main("info", "scene.toml", cwd=tmp_path), "objects[1]", "named pipe")
     with pytest.raises(SceneError, match="named pipe"):
-        whitted.assets.images.load_image(tmp_path / "tex.png")
+        load_image(tmp_path / "tex.png")
     with pytest.raises(ArgumentError, match="named pipe"):
         whitted.Image.load(tmp_path / "tex.png")
 

@@ -10,7 +10,7 @@ from typing import Annotated
 
 import typer
 
-from .cli.main import app, fail
+from .cli.app import app, fail
 from .cli.main import main as _cli_main
 from .errors import WhittedError
 

@@ -10,18 +10,18 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from ..errors import WhittedError
-from .farm import ClusterOption, SchedulerOption, animate_on_farm
-from .interrupt import InterruptGuard
-from .main import (
+from .app import (
     SceneArgument,
-    _load,
-    _override_error,
     app,
     apply_set_options,
     err,
     fail,
+    load_scene_argument,
     out,
+    override_error,
 )
+from .farm import ClusterOption, SchedulerOption, animate_on_farm
+from .interrupt import InterruptGuard
 
 if TYPE_CHECKING:
     from rich.progress import Progress
@@ -64,7 +64,7 @@ def animate(
 
     started = time.perf_counter()
     try:
-        scene, name = _load(scene_path)
+        scene, name = load_scene_argument(scene_path)
         scene = apply_set_options(scene, set_values)
         scene = scene.with_settings(width=width, height=height, samples=samples,
                                     max_depth=max_depth, threads=threads, seed=seed)
@@ -75,7 +75,7 @@ def animate(
     except WhittedError as exc:
         raise fail(str(exc)) from None
     except ValidationError as exc:
-        raise fail(_override_error(exc)) from None
+        raise fail(override_error(exc)) from None
     if cluster is not None or scheduler is not None:  # frames on a Dask cluster (cli/farm.py)
         plan.paths.frames.mkdir(exist_ok=True)
         animate_on_farm(scene, chosen, plan.paths.frames, plan.paths.film, fps=plan.fps,

@@ -28,7 +28,7 @@ SchedulerOption = Annotated[
 
 def farm_module():
     """``whitted.farm``, or the one-line error saying what to install."""
-    from .main import fail
+    from .app import fail
 
     try:
         from .. import farm
@@ -38,7 +38,7 @@ def farm_module():
 
 
 def bar(label: str, quiet: bool) -> Progress | None:
-    from .main import err
+    from .app import err
 
     if quiet or not err.is_terminal:
         return None
@@ -58,7 +58,7 @@ def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
                          scheduler: str | None, threads: int | None, quiet: bool,
                          bit_depth: int, aovs: list[str]) -> None:
     """``whitted render`` on a cluster: bands across the workers, one image written here."""
-    from .main import _save_npy, err, fail, out
+    from .app import err, fail, out, save_npy
 
     farm = farm_module()
     start = time.perf_counter()
@@ -92,7 +92,7 @@ def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
         planes = render_aovs(scene)
         for name in aovs:
             path = output.with_name(f"{output.stem}.{name}.npy")
-            _save_npy(path, planes[name])
+            save_npy(path, planes[name])
             written.append(str(path))
     stats.wall_seconds = time.perf_counter() - start
     if not quiet:
@@ -106,7 +106,7 @@ def animate_on_farm(scene: Scene, frames: range, folder: Path, film: Path | None
                     scheduler: str | None, threads: int | None) -> None:
     """``whitted animate`` on a cluster: frames as tasks, each written here as it arrives
     (resumable, as the local command), then the film encoded from the whole sequence."""
-    from .main import err, fail, out
+    from .app import err, fail, out
 
     farm = farm_module()
     start = time.perf_counter()

@@ -13,10 +13,10 @@ from typing import Annotated
 import typer
 
 from ..errors import WhittedError
+from .app import app as main_app
+from .app import err, fail
 from .console import LazyConsole
 from .interrupt import InterruptGuard
-from .main import app as main_app
-from .main import err, fail
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="The Stefan problem: a hollow piece of ice with water inside, melting.")
@@ -30,7 +30,7 @@ def _fail(message: str) -> typer.Exit:
     return fail(message)
 
 
-def _load(case_path: Path):
+def load_scene_argument(case_path: Path):
     from ..stefan.case import load_case
 
     try:
@@ -58,20 +58,14 @@ def _check_run_outputs(case_path: Path, output: Path) -> None:
 
 
 def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, guard: InterruptGuard,
-           size=(480, 360)):
+           size=(480, 360), allow_large: bool = False):
     from ..stefan.case import CaseError
     from ..stefan.run import run_case
 
-    case, text = _load(case_path)
+    case, text = load_scene_argument(case_path)
     if output.exists() and not output.is_dir():
         raise _fail(f"{output}: exists and is not a folder")
     _check_run_outputs(case_path, output)
-    if output.resolve() == case_path.resolve().parent and fresh:
-        raise _fail(f"{output}: --fresh would clear the case file's own folder")
-    if fresh and output.exists():
-        for sub in ("fields", "surfaces", "scenes"):
-            for f in (output / sub).glob("*"):
-                f.unlink()
     from rich.progress import (
         BarColumn,
         Progress,
@@ -91,7 +85,8 @@ def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, guard: Inter
 
         try:
             result = run_case(case, text, output, resume=not fresh, progress=progress,
-                              should_stop=guard.is_set, scene_size=size)
+                              should_stop=guard.is_set, scene_size=size,
+                              allow_large=allow_large, case_path=case_path)
         except CaseError as exc:
             raise _fail(str(exc)) from None
     return case, result
@@ -102,14 +97,19 @@ def run(
     case_path: Annotated[Path, typer.Argument(metavar="CASE", help="Case file (TOML)")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Output folder")] = Path(
         "stefan-out"),
-    fresh: Annotated[bool, typer.Option("--fresh", help="Start over, do not resume")] = False,
+    fresh: Annotated[bool, typer.Option("--fresh", help="Start over, do not resume (removes "
+                                        "only the files whitted wrote there)")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
+    allow_large: Annotated[bool, typer.Option(
+        "--allow-large", help="Go beyond the soft limits on steps, cell updates, saved times "
+        "and disk (never beyond the machine's memory or free disk)")] = False,
 ) -> None:
     """Compute the melt of CASE: fields (.npz), surfaces (.ply) per saved time, a time series
     (CSV and plots) and a scene per saved time. Ctrl-C keeps what was saved; run again to
-    resume from the last saved time."""
+    resume from the last saved time. The folder must be new, empty of the run's names, or
+    one whitted made (its .whitted-stefan-run marker): nothing else is written over."""
     with InterruptGuard() as guard:
-        case, result = _solve(case_path, output, fresh, quiet, guard)
+        case, result = _solve(case_path, output, fresh, quiet, guard, allow_large=allow_large)
         _report(result)
         if result.interrupted:
             raise guard.exit(f"at t = {result.end_time:.1f} s: kept the saved times up to "
@@ -161,6 +161,17 @@ def validate(
                       f"{r['front_mm']:.4f}", f"{r['exact_mm']:.4f}", f"{r['error_pct']:+.2f} %",
                       "" if r["order"] is None else f"{r['order']:.2f}",
                       f"{r['far_change']:.1e}", f"{r['energy_rel']:.1e}")
+    out.print(table)
+
+    table = Table(title=f"Three more 1-D cases (issue 30) after {t_end:.0f} s")
+    for col in ("case", "dx (mm)", "steps", "front (mm)", "exact (mm)", "error", "order",
+                "energy (rel.)"):
+        table.add_column(col, justify="right")
+    for r in v.more_case_rows(t_end=t_end, cells_mm=(0.5, 0.25, 0.125) if full else (0.5, 0.25)):
+        table.add_row(r["case"], f"{r['dx_mm']:g}", str(r["steps"]), f"{r['front_mm']:.4f}",
+                      f"{r['exact_mm']:.4f}", f"{r['error_pct']:+.2f} %",
+                      "" if r["order"] is None else f"{r['order']:.2f}",
+                      f"{r['energy_rel']:.1e}")
     out.print(table)
 
     table = Table(title="The 1-D case along each axis and in 3-D (0.5 mm, 600 s, same dt)")
@@ -225,9 +236,9 @@ def _check_film_options(case_path: Path, output: Path, gif: Path | None, width: 
     try:
         RenderSettings(width=width, height=height)
     except ValidationError as exc:
-        from .main import _override_error
+        from .app import override_error
 
-        raise _fail(_override_error(exc)) from None
+        raise _fail(override_error(exc)) from None
     films = [output, *([gif] if gif is not None else [])]
     formats = []
     for option, path in zip(("-o", "--gif"), films, strict=False):
@@ -261,15 +272,14 @@ def film(
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
 ) -> None:
     """Solve CASE (or resume it) into OUTPUT's folder NAME_stefan/, render one frame per saved
-    time (the piece on a table, backlit; ice 1.31, water 1.333, absorption exaggerated and
-    said so) and encode the film with the simulated time in each frame. Ctrl-C or SIGTERM
+    time (the piece on a table, backlit; ice 1.31, water 1.333, measured absorption, 4 samples
+    per pixel) and encode the film with the simulated time in each frame. Ctrl-C or SIGTERM
     keeps the solved times and the finished frames; run again to continue."""
-    import csv
-
-    from ..animation.film import FilmPaths, render_film
+    from ..animation.film import FilmPaths, frame_name, render_film
     from ..output.video import encode_film
     from ..render.api import CancelToken
     from ..scene import load_scene
+    from ..stefan.run import film_frames
     from ..stefan.scene import ABSORPTION_BOOST, still_life_scene, write_scene
 
     started = time.perf_counter()
@@ -281,36 +291,39 @@ def film(
         if result.interrupted:
             raise guard.exit(f"while solving: kept every saved time in {work}; run the same "
                              "command again to continue")
-        with (work / "series.csv").open(newline="") as fh:
-            times = [float(row["time_s"]) for row in csv.DictReader(fh)]
-        count = 0  # frames: saved times from 0 on where both surfaces exist
-        while (count < len(times) and (work / "surfaces" / f"outer_{count:04d}.ply").exists()
-               and (work / "surfaces" / f"inner_{count:04d}.ply").exists()):
-            count += 1
+        shown = film_frames(work)  # to the end of the run (drain: the outer surface alone)
+        count = len(shown)
+        times = [f.time for f in shown]
         if count == 0:
-            raise _fail(f"{work}: no saved time has both surfaces to film")
-        scene_path = work / "film.toml"
-        write_scene(scene_path, still_life_scene(
-            "surfaces/outer_{frame:04d}.ply", "surfaces/inner_{frame:04d}.ply", None,
-            width=width, height=height, size_cm=100 * max(case.block.size), frames=count,
-            fps=fps))
+            raise _fail(f"{work}: no saved time has a surface to film")
         cancel = CancelToken()
         guard.on_interrupt(cancel.cancel)
         render_start = time.perf_counter()
-        try:
-            scene = load_scene(scene_path)
-            frames = render_film(scene, FilmPaths(None, work / "frames"), fps=fps,
-                                 scene_path=scene_path, cancel=cancel,
-                                 progress=None if quiet else _frame_line)
-        except WhittedError as exc:
-            raise _fail(str(exc)) from None
-        if frames.cancelled:
-            raise guard.exit(f"{len(frames.files)} of {count} frames finished in "
-                             f"{work / 'frames'}; run the same command again to continue")
+        if all(f.inner is not None for f in shown):  # one animated still life: render_film
+            scene_path = work / "film.toml"
+            write_scene(scene_path, still_life_scene(
+                "surfaces/outer_{frame:04d}.ply", "surfaces/inner_{frame:04d}.ply", None,
+                width=width, height=height, size_cm=100 * max(case.block.size), frames=count,
+                fps=fps))
+            try:
+                scene = load_scene(scene_path)
+                frames = render_film(scene, FilmPaths(None, work / "frames"), fps=fps,
+                                     scene_path=scene_path, cancel=cancel,
+                                     progress=None if quiet else _frame_line)
+            except WhittedError as exc:
+                raise _fail(str(exc)) from None
+            if frames.cancelled:
+                raise guard.exit(f"{len(frames.files)} of {count} frames finished in "
+                                 f"{work / 'frames'}; run the same command again to continue")
+            files = list(frames.files)
+        else:  # after the breach (drain) there is no cavity: each saved time's own still life
+            files = _render_saved_times(work, shown, width, height, cancel, quiet, guard,
+                                        frame_name)
         render_seconds = time.perf_counter() - render_start
-        stamped = [_stamp(path, f"t = {times[k] / 60:5.1f} min   "
-                                f"(absorption x{ABSORPTION_BOOST:g})")
-                   for k, path in zip(frames.plan.frames, frames.files, strict=True)]
+        label = ("measured absorption" if ABSORPTION_BOOST == 1.0
+                 else f"absorption x{ABSORPTION_BOOST:g}")
+        stamped = [_stamp(path, f"t = {times[k] / 60:5.1f} min   ({label})")
+                   for k, path in enumerate(files)]
         for path in [output, *([gif] if gif is not None else [])]:
             try:
                 encode_film(stamped, path, fps, cancel=cancel)
@@ -323,6 +336,38 @@ def film(
     out.print(f"{count} frames ({render_seconds / count:.2f} s a frame, wall) -> {output}"
               + (f", {gif}" if gif is not None else "")
               + f"; total {time.perf_counter() - started:.1f} s")
+
+
+def _render_saved_times(work: Path, shown, width: int, height: int, cancel, quiet: bool,
+                        guard: InterruptGuard, frame_name) -> list[Path]:
+    """Each saved time's own scene (``scenes/frame_NNNN.toml``, written by the run) rendered
+    to ``frames/``: the film of a run whose later times have no cavity. A cancel keeps the
+    frames finished (each written atomically)."""
+    from ..render import render as render_scene
+
+    folder = work / "frames"
+    folder.mkdir(exist_ok=True)
+    files = []
+    for k, f in enumerate(shown):
+        if cancel.cancelled:
+            raise guard.exit(f"{k} of {len(shown)} frames finished in {folder}; run the same "
+                             "command again to continue")
+        path = folder / frame_name(k, len(shown))
+        try:
+            image = render_scene(work / "scenes" / f"frame_{f.index:04d}.toml", width=width,
+                                 height=height, cancel=cancel)
+            if not cancel.cancelled:
+                image.save(path)
+        except WhittedError as exc:
+            raise _fail(str(exc)) from None
+        if not cancel.cancelled:
+            files.append(path)
+            if not quiet:
+                out.line(f"frame {k} ({k + 1}/{len(shown)}): rendered")
+    if cancel.cancelled:
+        raise guard.exit(f"{len(files)} of {len(shown)} frames finished in {folder}; run the "
+                         "same command again to continue")
+    return files
 
 
 def _frame_line(p) -> None:

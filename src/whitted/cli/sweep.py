@@ -10,15 +10,15 @@ from typing import Annotated
 import typer
 
 from ..errors import WhittedError
-from .interrupt import InterruptGuard
-from .main import (
+from .app import (
     SceneArgument,
-    _load,
-    _override_error,
     app,
     fail,
+    load_scene_argument,
     out,
+    override_error,
 )
+from .interrupt import InterruptGuard
 
 
 def _sheet_columns(cells, columns: int | None) -> int:
@@ -70,7 +70,7 @@ def sweep(
     if output.suffix.lower() != ".png":
         raise fail(f"{output}: the sheet is a PNG (use a .png name)")
     try:
-        scene, name = _load(scene_path)
+        scene, name = load_scene_argument(scene_path)
         axes, fixed = [], []
         for text in set_values or []:
             path, value_text = parse_assignment(text)
@@ -106,7 +106,7 @@ def sweep(
     except WhittedError as exc:
         raise fail(str(exc)) from None
     except ValidationError as exc:
-        raise fail(_override_error(exc)) from None
+        raise fail(override_error(exc)) from None
     except OSError as exc:
         raise fail(f"{output}: cannot write: {exc.strerror or exc}") from None
 
