@@ -123,7 +123,7 @@ def sweep(
                 try:
                     still = cell.scene.at_frame(frame)  # each cell's scene made when its turn
                 except ValidationError as exc:
-                    raise fail(_override_error(exc)) from None
+                    raise fail(override_error(exc)) from None
                 result = renderer.render(still, frame, path, cancel=cancel)
                 if result.cancelled:
                     break
