@@ -467,3 +467,17 @@ def test_a_range_given_to_render_says_ranges_are_for_sweeps(tmp_path: Path):
     code, out, err = run_main("render", "s.toml", "--set", "objects[0].name=1:2", "-q",
                               "-o", "y.png", cwd=tmp_path)
     assert code == 0, err
+
+
+def test_a_combination_of_good_values_that_does_not_fit_is_one_line_at_its_cell(tmp_path):
+    """Each value is checked alone up front; a cell whose values clash (the camera on its
+    look-at point) is made at its turn: one line, the cells before it kept."""
+    (tmp_path / "s.toml").write_text(SCENE)
+    line = one_line_error(run_main(
+        "sweep", "s.toml", "--set", "camera.position=[0, 0, 5],[0, 0, 1]",
+        "--set", "camera.look_at=[0, 0, 0],[0, 0, 1]", "-W", "4", "-H", "3", "-q",
+        "-o", "c.png", cwd=tmp_path))
+    assert line == "error: --set: camera.look_at: look_at coincides with position"
+    assert sorted(p.name for p in (tmp_path / "c_cells").iterdir()) == [
+        "0.png", "1.png", "2.png"]
+    assert not (tmp_path / "c.png").exists()
