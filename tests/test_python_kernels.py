@@ -33,6 +33,9 @@ SCENES = [
     ("examples/textured.toml", 8, 6, {}),  # image, checker and gradient textures
     ("examples/soft_shadows.toml", 6, 5, {"shadow_samples": 2}),  # disk lights
     ("tests/scenes/cows_instanced.toml", 8, 6, {}),  # a mesh stored once, instanced
+    # caustics: photons traced, the grid built and gathered (docs/caustics.md)
+    ("examples/ice_water.toml", 6, 6, {"caustics": {"photons": 3000, "passes": 2,
+                                                  "radius": 0.3}}),
 ]
 
 RENDER = """
@@ -62,7 +65,8 @@ def _render_other_mode(path, width, height, extra, tmp_path) -> np.ndarray:
 
 
 @pytest.mark.parametrize(("path", "width", "height", "extra"), SCENES,
-                         ids=[Path(s[0]).stem if s[0] else "default" for s in SCENES])
+                         ids=[(Path(s[0]).stem if s[0] else "default")
+                              + ("_caustics" if "caustics" in s[3] else "") for s in SCENES])
 def test_python_and_compiled_kernels_give_the_same_image(tmp_path, path, width, height,
                                                          extra):
     here = _render_here(path, width, height, extra)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 
@@ -10,7 +11,7 @@ import pytest
 from PIL import Image as PILImage
 
 import whitted
-from whitted.animation.sweep import contact_sheet, short_name, sweep_cells
+from whitted.animation.sweep import _font, contact_sheet, draw_length, short_name, sweep_cells
 from whitted.errors import SceneError
 
 SCENE = """\
@@ -57,16 +58,16 @@ def test_cells_cover_every_combination(tmp_path):
 
 
 def test_contact_sheet_places_each_image_in_its_cell():
-    images = [np.full((10, 16, 3), 40 * k, np.uint8) for k in range(5)]
+    images = [np.full((10, 24, 3), 40 * k, np.uint8) for k in range(5)]  # labels fit in 24
     sheet = contact_sheet(images, [f"v{k}" for k in range(5)], columns=3, title="t", gap=6)
     rows, cols = 2, 3
-    size = max(11, min(24, 16 // 14))
+    size = max(11, min(24, 24 // 14))
     label_h, title_h = size + 12, size + 18
-    assert sheet.shape == (title_h + rows * (10 + label_h) + 6, cols * 16 + 4 * 6, 3)
+    assert sheet.shape == (title_h + rows * (10 + label_h) + 6, cols * 24 + 4 * 6, 3)
     for k in range(5):
         r, c = divmod(k, cols)
-        y, x = title_h + 6 + r * (10 + label_h), 6 + c * (16 + 6)
-        assert np.all(sheet[y:y + 10, x:x + 16] == 40 * k)
+        y, x = title_h + 6 + r * (10 + label_h), 6 + c * (24 + 6)
+        assert np.all(sheet[y:y + 10, x:x + 24] == 40 * k)
 
 
 def test_sweep_command_writes_one_image_per_value_and_a_sheet(tmp_path):
@@ -84,8 +85,10 @@ def test_sweep_command_writes_one_image_per_value_and_a_sheet(tmp_path):
     assert labels == ["kt = 1", "kt = 0.8", "kt = 0.6", "kt = 0.4", "kt = 0.2", "kt = 0"]
     first, last = (np.asarray(PILImage.open(cells[k])) for k in (0, 5))
     assert not np.array_equal(first, last)  # transparency shows
-    with PILImage.open(sheet) as im:  # six cells of 20 px in one row, 6 px apart
-        assert im.size[0] == 6 * 20 + 7 * 6
+    font = _font(11)  # six cells of 20 px in one row, 6 px apart, each as wide as its label
+    columns = [max(20, math.ceil(draw_length(font, label)) + 6) for label in labels]
+    with PILImage.open(sheet) as im:
+        assert im.size[0] == sum(columns) + 7 * 6
     # each cell is the still a render with the same --set gives
     still = tmp_path / "still.png"
     subprocess.run([sys.executable, "-m", "whitted", "render", str(path), "-o", str(still),

@@ -8,6 +8,12 @@ into a single ``error:`` line and exit status 2. The subclasses:
 * :class:`SceneValidationError`: a value the scene model rejects (``Sphere(radius=-1)``,
   ``Scene.model_validate(...)``). It is a :class:`SceneError` and also pydantic's
   ``ValidationError`` (``.errors()`` lists every problem), so both ``except`` clauses work.
+* :class:`PathError`: a path to a scene value (a track's, a ``--set``'s, the argument of
+  ``animation.get_value``/``set_value``) that names nothing, or a value its target rejects;
+  a :class:`SceneError` and also a ``ValueError``.
+* :class:`FrameError`: a frame a scene does not have (``scene.at_frame(None | nan | inf |
+  2.5 | 99)``): not a whole number, or outside ``0 .. frames - 1``; a :class:`SceneError`
+  and also a ``ValueError``.
 * :class:`ArgumentError`: a bad argument to a public function (``RenderJob(tile_size=0)``);
   also a ``ValueError``.
 * :class:`JobStateError`: a render job used out of order (``wait()`` before ``start()``,
@@ -64,6 +70,15 @@ class SceneError(WhittedError):
             head = f"line {self.line}: "
         place = f"{self.where}: " if self.where else ""
         return f"{head}{place}{self.message}"
+
+
+class PathError(SceneError, ValueError):
+    """A path to a scene value that names nothing, or a value its target rejects (one line:
+    ``objects[bal]: unknown name 'bal' (did you mean 'ball'?)``)."""
+
+
+class FrameError(SceneError, ValueError):
+    """A frame number a scene does not have: not a whole number, or out of its range."""
 
 
 class ArgumentError(WhittedError, ValueError):

@@ -14,16 +14,18 @@ included when the steps land on it: ``1:0:-0.2`` is 1, 0.8, 0.6, 0.4, 0.2, 0) or
 from __future__ import annotations
 
 import math
+import sys
 import tomllib
 from typing import TYPE_CHECKING, Any
 
-from ..errors import SceneError
+from ..errors import SceneError, shorten
 from ..scene.paths import PathError, parse_path, resolve_path, set_value
 
 if TYPE_CHECKING:
     from ..scene.scene import Scene
 
-__all__ = ["apply_overrides", "parse_assignment", "parse_value", "parse_values"]
+__all__ = ["MAX_VALUES", "apply_overrides", "is_range", "parse_assignment", "parse_value",
+           "parse_values"]
 
 
 def parse_value(text: str) -> Any:
@@ -36,14 +38,21 @@ def parse_value(text: str) -> Any:
 
 
 def parse_assignment(text: str) -> tuple[str, str]:
-    """``"PATH=VALUE"`` -> (PATH, VALUE text). SceneError when there is no ``=``."""
-    depth = 0
+    """``"PATH=VALUE"`` -> (PATH, VALUE text). SceneError when there is no ``=``. The ``=``
+    is the first one outside the path's brackets and the quotes in them
+    (``objects["a=b]"].radius=0.2``), as the path reader (:func:`parse_path`) reads them."""
+    depth, quote = 0, ""
     for i, ch in enumerate(text):
-        if ch == "[":
+        if quote:
+            if ch == quote:
+                quote = ""
+        elif ch in "\"'" and depth > 0 and text[:i].rstrip().endswith("["):
+            quote = ch  # a quoted name: brackets and '=' in it are part of the name
+        elif ch == "[":
             depth += 1
         elif ch == "]":
             depth -= 1
-        elif ch == "=" and depth == 0:
+        elif ch == "=" and depth <= 0:
             path, value = text[:i].strip(), text[i + 1:].strip()
             if not path:
                 break
@@ -73,31 +82,94 @@ def _split_top_level(text: str) -> list[str]:
     return [p.strip() for p in parts if p.strip()]
 
 
+#: The most values one range or list of a sweep may have.
+MAX_VALUES = 10_000
+
+
+def _range_pieces(text: str) -> list[str] | None:
+    """The numbers of ``START:STOP`` or ``START:STOP:STEP`` as text, or None when ``text``
+    is not written as a range."""
+    pieces = [p.strip() for p in text.split(":")]
+    if len(pieces) not in (2, 3) or text.strip().startswith(("[", "{", '"', "'")):
+        return None
+    try:
+        for p in pieces:
+            float(p)
+    except ValueError:
+        return None
+    return pieces
+
+
+def is_range(text: str) -> bool:
+    """Whether ``text`` is written as a range of a sweep (``1:0:-0.2``, ``1:1:0.1``)."""
+    return _range_pieces(text) is not None
+
+
+def _whole(piece: str) -> int | None:
+    try:
+        return int(piece)  # exact, however large (no float rounding)
+    except ValueError:
+        return None
+
+
+def _range_values(text: str, pieces: list[str]) -> list[Any]:
+    where = f"range {shorten(text)!r}"
+    whole = [_whole(p) for p in pieces]
+    if all(w is not None for w in whole):  # whole numbers: exact integer steps
+        start, stop = whole[0], whole[1]
+        step = whole[2] if len(whole) == 3 else (1 if stop >= start else -1)
+        if step == 0:
+            raise SceneError(f"{where}: the step must not be 0", where="--set")
+        if (stop - start) * step < 0:
+            raise SceneError(f"{where}: the step {step} goes away from {shorten(str(stop))}",
+                             where="--set")
+        count = (stop - start) // step + 1
+        _check_count(where, count)
+        return [start + k * step for k in range(count)]
+    nums = [float(p) for p in pieces]
+    if not all(math.isfinite(v) for v in nums):
+        raise SceneError(f"{where}: START, STOP and STEP must be finite numbers", where="--set")
+    start, stop = nums[0], nums[1]
+    step = nums[2] if len(nums) == 3 else (1.0 if stop >= start else -1.0)
+    if step == 0:
+        raise SceneError(f"{where}: the step must not be 0", where="--set")
+    span = (stop - start) / step  # may overflow to infinity: then far too many values
+    if span < 0:
+        raise SceneError(f"{where}: the step {step:g} goes away from {stop:g}", where="--set")
+    if not math.isfinite(span) or span >= MAX_VALUES:
+        _check_count(where, math.inf if not math.isfinite(span) else math.floor(span) + 1)
+    count = math.floor(span + 1e-9) + 1
+    _check_count(where, count)
+    values = [start]
+    for k in range(1, count):
+        v = start + k * step
+        # 0.1 * 3 is 0.30000000000000004 and 1 - 5 * 0.2 may be 5e-17: within the rounding
+        # of the sum, take the shortest number (0.3, 0) instead
+        noise = 4 * sys.float_info.epsilon * (abs(start) + abs(k * step))
+        short = float(f"{v:.12g}")
+        values.append(0.0 if abs(v) <= noise else short if abs(short - v) <= noise else v)
+    return values
+
+
+def _check_count(where: str, count: float) -> None:
+    if count > MAX_VALUES:
+        shown = f"{count:.3g}" if count >= 1e6 else f"{count}"
+        raise SceneError(f"{where} has {shown} values (at most {MAX_VALUES})", where="--set")
+
+
 def parse_values(text: str) -> list[Any]:
-    """The values of a sweep: ``START:STOP:STEP`` or ``a,b,c`` (each a TOML value)."""
-    pieces = text.split(":")
-    if len(pieces) in (2, 3) and not text.strip().startswith(("[", "{", '"', "'")):
-        try:
-            nums = [float(p) for p in pieces]
-        except ValueError:
-            nums = None
-        if nums is not None:
-            start, stop = nums[0], nums[1]
-            step = nums[2] if len(nums) == 3 else (1.0 if stop >= start else -1.0)
-            if step == 0 or not all(math.isfinite(v) for v in nums):
-                raise SceneError(f"range {text!r}: the step must be a non-zero number",
-                                 where="--set")
-            if (stop - start) * step < 0:
-                raise SceneError(f"range {text!r}: the step {step:g} goes away from {stop:g}",
-                                 where="--set")
-            count = math.floor((stop - start) / step + 1e-9) + 1
-            if count > 10_000:
-                raise SceneError(f"range {text!r} has {count} values (at most 10000)",
-                                 where="--set")
-            whole = all(float(p).is_integer() and "." not in p for p in pieces)
-            values = [round(start + k * step, 10) for k in range(count)]
-            return [int(v) for v in values] if whole else [v + 0.0 for v in values]
-    return [parse_value(p) for p in _split_top_level(text)]
+    """The values of a sweep: ``START:STOP:STEP`` (STOP included when a step lands on it,
+    as near as 1e-9 of a step; whole numbers stay whole and exact) or ``a,b,c`` (each a TOML
+    value). SceneError (one line) for a range with a zero or wrong-way step, numbers that
+    are not finite, or more than :data:`MAX_VALUES` values."""
+    pieces = _range_pieces(text)
+    if pieces is not None:
+        return _range_values(text, pieces)
+    values = [parse_value(p) for p in _split_top_level(text)]
+    if len(values) > MAX_VALUES:
+        raise SceneError(f"the list {shorten(text)!r} has {len(values)} values (at most "
+                         f"{MAX_VALUES})", where="--set")
+    return values
 
 
 def apply_overrides(scene: Scene, assignments: list[tuple[str, Any]] | dict[str, Any]) -> Scene:
@@ -106,14 +178,17 @@ def apply_overrides(scene: Scene, assignments: list[tuple[str, Any]] | dict[str,
     (one line, ``--set PATH: problem``) when a path names nothing or a value is rejected."""
     items = list(assignments.items()) if isinstance(assignments, dict) else list(assignments)
     for path, value in items:
-        if isinstance(value, str):
-            value = parse_value(value)
+        text = value if isinstance(value, str) else None
+        if text is not None:
+            value = parse_value(text)
         try:
             written = parse_path(path)
             steps = resolve_path(scene, written)
             new = set_value(scene, written, value)  # errors name the path as written
         except PathError as exc:
-            raise SceneError(str(exc), where="--set") from None
+            hint = ("; a range START:STOP:STEP is for whitted sweep, here give one value"
+                    if text is not None and is_range(text) else "")
+            raise SceneError(f"{exc}{hint}", where="--set") from None
         if scene.animation is not None:
             kept = []
             for track in scene.animation.tracks:

@@ -58,6 +58,9 @@ SCENES: dict[str, BenchScene] = {
                    mesh_bench=True),
         BenchScene("instances100", "instances100.toml",
                    "100 instances of a 100,000-triangle torus, shadows", mesh_bench=True),
+        BenchScene("caustics", "caustics.toml",
+                   "a glass ball and a glass slab on a floor, a directional and a point "
+                   "light: caustics by photon mapping (100,000 photons)"),
     )
 }
 

@@ -21,6 +21,15 @@ from .app import (
 from .interrupt import InterruptGuard
 
 
+def _sheet_columns(cells, columns: int | None) -> int:
+    """Cells per row of the sheet: the first axis's values for a grid, else --columns, else
+    one row up to 6 cells and a square-ish grid beyond."""
+    if len(cells.axes) == 2:
+        return cells.columns
+    n = len(cells)
+    return max(1, min(n, columns or (n if n <= 6 else math.ceil(math.sqrt(n)))))
+
+
 @app.command()
 def sweep(
     scene_path: SceneArgument = None,
@@ -51,8 +60,8 @@ def sweep(
 
     from ..animation.film import check_frame_files
     from ..animation.frames import FrameRenderer
-    from ..animation.overrides import apply_overrides, parse_assignment, parse_values
-    from ..animation.sweep import sweep_cells
+    from ..animation.overrides import apply_overrides, is_range, parse_assignment, parse_values
+    from ..animation.sweep import cell_size_bounds, check_sheet_size, sweep_cells
     from ..files import atomic_write
     from ..output.safety import check_memory, check_outputs, input_files
     from ..render.api import CancelToken
@@ -66,26 +75,33 @@ def sweep(
         for text in set_values or []:
             path, value_text = parse_assignment(text)
             values = parse_values(value_text)
-            if len(values) > 1:
+            if len(values) > 1 or is_range(value_text):  # a range of one value is an axis
                 axes.append((path, values))
             else:
                 fixed.append((path, value_text))
         scene = apply_overrides(scene, fixed)
         scene = scene.with_settings(width=width, height=height, samples=samples,
                                     max_depth=max_depth)
-        cells = sweep_cells(scene, axes)
-        stills = [cell.scene.at_frame(frame) for cell in cells]
+        cells = sweep_cells(scene, axes)  # counted and checked value by value, made lazily
+        scene.at_frame(frame)
+        ncols = _sheet_columns(cells, columns)
+        widths, heights = cell_size_bounds(cells)
+        if ncols != cells.columns:  # one axis wrapped onto several rows
+            widths = [max(widths)] * ncols
+            heights = [heights[0]] * math.ceil(len(cells) / ncols)
+        check_sheet_size(widths, heights, title != "")
         # before anything is written: the sheet and the cells can be written, none is a file
-        # the sweep reads, and no file in the cells' way was written by anyone but whitted
-        inputs = list(dict.fromkeys(  # a swept value may name other files
-            f for cell in cells for f in input_files(cell.scene, scene_path)))
+        # the sweep reads, and no file in the cells' way was written by anyone but whitted.
+        # A swept value may name other files: those of the scene with each value alone set
+        # (one scene per value, not one per cell).
+        inputs = list(dict.fromkeys(
+            f for each in [scene, *cells.axis_scenes()] for f in input_files(each, scene_path)))
         check_outputs([output], inputs=inputs)
         folder = output.with_name(f"{output.stem}_cells")
         digits = len(str(len(cells) - 1))
-        cell_files = [folder / f"{cell.index:0{digits}d}.png" for cell in cells]
+        cell_files = [folder / f"{k:0{digits}d}.png" for k in range(len(cells))]
         check_frame_files(folder, cell_files, inputs)
-        for still in stills:
-            check_memory(still.render.width, still.render.height, "png")
+        check_memory(max(widths), max(heights), "png")  # the largest cell, at most
         folder.mkdir(exist_ok=True)
     except WhittedError as exc:
         raise fail(str(exc)) from None
@@ -101,9 +117,13 @@ def sweep(
     with InterruptGuard() as guard:
         guard.on_interrupt(cancel.cancel)
         try:
-            for cell, still, path in zip(cells, stills, cell_files, strict=True):
+            for cell, path in zip(cells, cell_files, strict=True):
                 if cancel.cancelled:
                     break
+                try:
+                    still = cell.scene.at_frame(frame)  # each cell's scene made when its turn
+                except ValidationError as exc:
+                    raise fail(override_error(exc)) from None
                 result = renderer.render(still, frame, path, cancel=cancel)
                 if result.cancelled:
                     break
@@ -119,14 +139,14 @@ def sweep(
         if len(paths) < len(cells):
             raise guard.exit(f"{len(paths)} of {len(cells)} images finished in {folder}; "
                              "run the same command again to continue")
-        _write_sheet(output, paths, cells, axes, columns, title, guard, atomic_write)
+        _write_sheet(output, paths, cells, axes, ncols, title, guard, atomic_write)
     if not quiet:
         out.print(f"{len(cells)} images ({rendered} rendered) -> {folder}; sheet "
                   f"{_sheet_size(output)} -> {output}; "
                   f"{time.perf_counter() - started:.1f} s", highlight=False)
 
 
-def _write_sheet(output, paths, cells, axes, columns, title, guard, atomic_write) -> None:
+def _write_sheet(output, paths, cells, axes, ncols, title, guard, atomic_write) -> None:
     """The contact sheet, written atomically (a signal during the write lets it finish: the
     cells are all there, and the sheet is whole or not written)."""
     import numpy as np
@@ -135,10 +155,6 @@ def _write_sheet(output, paths, cells, axes, columns, title, guard, atomic_write
     from ..animation.sweep import contact_sheet
 
     images = [np.asarray(PILImage.open(p).convert("RGB")) for p in paths]
-    if len(axes) == 2:
-        ncols = len(axes[0][1])
-    else:
-        ncols = columns or (len(cells) if len(cells) <= 6 else math.ceil(math.sqrt(len(cells))))
     heading = title if title is not None else " / ".join(path for path, _ in axes)
     sheet = contact_sheet(images, [c.label for c in cells], ncols, heading)
     try:

@@ -108,15 +108,44 @@ def read_limited(path: str | os.PathLike[str], limit: int, what: str = "file",
                  name: str | None = None) -> bytes:
     """The bytes of the regular file ``path`` (at most ``limit`` bytes, else SceneError)."""
     fd = open_regular(path, limit, what, name)
+    size = 0
     try:
         with os.fdopen(fd, "rb", closefd=True) as f:
-            data = f.read(limit + 1)
+            size = os.fstat(f.fileno()).st_size
+            data = _read_at_most(f, size, limit)
     except OSError as exc:
         raise SceneError(_os_problem(exc), file=os.fspath(path) if name is None else name) from None
+    except MemoryError:
+        raise SceneError(_no_room(what, size), file=os.fspath(path) if name is None else name
+                         ) from None
     if len(data) > limit:  # grew while we read it
         raise SceneError(f"{what} too large (the limit is {_size_text(limit)})",
                          file=os.fspath(path) if name is None else name)
     return data
+
+
+def _no_room(what: str, size: int) -> str:
+    return (f"{what} too large for the memory this process may use: {_size_text(size)} "
+            "could not be read (a memory or address-space limit such as ulimit -v)")
+
+
+def _read_at_most(f, size: int, limit: int) -> bytes:
+    """The bytes of the open file ``f`` whose size was ``size``, read in one call of that
+    size (not of ``limit``: a buffer as large as the limit would be asked for up front, which
+    fails under an address-space limit such as ``ulimit -v``), then more only if the file grew
+    meanwhile; at most ``limit + 1`` bytes in all (more than ``limit`` means too large)."""
+    data = f.read(min(size, limit) + 1)
+    if len(data) <= size or len(data) > limit:
+        return data
+    parts = [data]  # it grew while we read it: go on in bounded pieces up to limit + 1
+    total = len(data)
+    while total <= limit:
+        piece = f.read(min(limit + 1 - total, 64 * MiB))
+        if not piece:
+            break
+        parts.append(piece)
+        total += len(piece)
+    return b"".join(parts)
 
 
 def map_limited(path: str | os.PathLike[str], limit: int, what: str = "file",
@@ -125,13 +154,20 @@ def map_limited(path: str | os.PathLike[str], limit: int, what: str = "file",
     pages touched) instead of read whole: a reader that stops at the first bad byte of a huge
     file touches only the start of it."""
     fd = open_regular(path, limit, what, name)
+    size = 0
     try:
         size = os.fstat(fd).st_size
         if size < 16 * MiB:
             with os.fdopen(fd, "rb", closefd=False) as f:
-                return f.read(limit + 1)
+                return _read_at_most(f, size, limit)
         return mmap.mmap(fd, size, access=mmap.ACCESS_READ)
+    except MemoryError:
+        raise SceneError(_no_room(what, size), file=os.fspath(path) if name is None else name
+                         ) from None
     except OSError as exc:
+        if exc.errno == errno.ENOMEM:  # mmap beyond the address-space limit
+            raise SceneError(_no_room(what, size),
+                             file=os.fspath(path) if name is None else name) from None
         raise SceneError(_os_problem(exc), file=os.fspath(path) if name is None else name) from None
     finally:
         os.close(fd)

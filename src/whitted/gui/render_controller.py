@@ -33,6 +33,7 @@ INTERACTIVE_TARGET_S = 0.04
 REFINE_FACTOR = 4  # each idle refinement step has this many times the pixels
 PREVIEW_DEPTH = 2
 PREVIEW_SHADOW_SAMPLES = 4
+PREVIEW_PHOTONS = 20_000  # caustic photons per pass of a preview
 
 
 def qimage_of(rgb: np.ndarray) -> QImage:
@@ -55,9 +56,13 @@ def preview_scene(scene: Scene, pixels: int) -> Scene:
     scale = min(1.0, math.sqrt(pixels / (s.width * s.height)))
     width = max(1, round(s.width * scale))
     height = max(1, round(s.height * scale))
+    # caustics with fewer photons (their default radius grows to match): the same light
+    caustics = s.caustics.model_copy(update={"photons": min(s.caustics.photons,
+                                                            PREVIEW_PHOTONS)})
     return scene.with_settings(width=width, height=height, samples=1,
                                max_depth=min(s.max_depth, PREVIEW_DEPTH),
-                               shadow_samples=min(s.shadow_samples, PREVIEW_SHADOW_SAMPLES))
+                               shadow_samples=min(s.shadow_samples, PREVIEW_SHADOW_SAMPLES),
+                               caustics=caustics)
 
 
 @dataclass

@@ -35,7 +35,8 @@ INTERPOLATIONS = ("step", "linear", "smooth", "spline")
 
 __all__ = [
     "INTERPOLATIONS", "euler_to_quaternion", "interpolate_rotation", "interpolate_scalar",
-    "interpolate_tree", "quaternion_to_euler", "slerp", "wrap_keys",
+    "interpolate_tree", "quaternion_to_euler", "scalar_leaves", "slerp", "spline_extremes",
+    "wrap_keys",
 ]
 
 
@@ -283,3 +284,47 @@ def wrap_keys(times: Sequence[float], values: Sequence[Any], period: float
 
 def _step_index(times: Sequence[float], t: float) -> int:
     return max(0, bisect.bisect_right(times, t) - 1)
+
+
+def scalar_leaves(values: Sequence[Any], name: str | None = None) -> list[list[float]]:
+    """The keys of every number :func:`interpolate_tree` interpolates on its own (one list
+    per leaf, one number per key), in the order it walks them; rotations and leaves that
+    step are left out."""
+    if len(values) < 2:
+        return []
+    if all(_is_number(v) for v in values):
+        return [[float(v) for v in values]]
+    if all(isinstance(v, list | tuple) for v in values) and len({len(v) for v in values}) == 1:
+        n = len(values[0])
+        if (name in ROTATION_FIELDS and n == 3
+                and all(_is_number(c) for v in values for c in v)):
+            return []
+        return [leaf for k in range(n) for leaf in scalar_leaves([v[k] for v in values])]
+    if all(isinstance(v, dict) for v in values) and len({tuple(v) for v in values}) == 1:
+        return [leaf for k in values[0] for leaf in scalar_leaves([v[k] for v in values], k)]
+    return []
+
+
+def spline_extremes(times: Sequence[float], values: Sequence[float]) -> list[float]:
+    """The times strictly inside the segments where the ``spline`` through the keys turns
+    (its slope is zero): where it can overshoot the keys. Exact for each segment's cubic."""
+    out: list[float] = []
+    for i in range(len(times) - 1):
+        h = times[i + 1] - times[i]
+        p0, p1 = float(values[i]), float(values[i + 1])
+        m0, m1 = h * _slope(times, values, i), h * _slope(times, values, i + 1)
+        # d/ds of the Hermite cubic: a s^2 + b s + c
+        a = 6 * p0 + 3 * m0 - 6 * p1 + 3 * m1
+        b = -6 * p0 - 4 * m0 + 6 * p1 - 2 * m1
+        c = m0
+        roots: list[float] = []
+        if abs(a) < 1e-300:
+            if abs(b) > 1e-300:
+                roots.append(-c / b)
+        else:
+            disc = b * b - 4 * a * c
+            if disc >= 0 and math.isfinite(disc):
+                r = math.sqrt(disc)
+                roots += [(-b - r) / (2 * a), (-b + r) / (2 * a)]
+        out += [times[i] + s * h for s in roots if 0.0 < s < 1.0]
+    return out

@@ -25,12 +25,10 @@ from typing import Any
 
 from pydantic import BaseModel, TypeAdapter, ValidationError
 
+from ..errors import PathError, shorten
+
 __all__ = ["PathError", "Step", "format_path", "get_value", "parse_path", "resolve_path",
            "set_value"]
-
-
-class PathError(ValueError):
-    """A path that names nothing, or a value its target rejects (message is one line)."""
 
 
 @dataclass(frozen=True)
@@ -41,7 +39,14 @@ class Step:
     item: bool = False  # written in brackets
 
     def __str__(self) -> str:
-        return f"[{self.key}]" if self.item else f".{self.key}"
+        if not self.item:
+            return f".{self.key}"
+        key = self.key
+        if isinstance(key, str) and (re.fullmatch(r"\d+", key) or key != key.strip()
+                                     or any(c in key for c in "[]\"'")):
+            # quoted, so that the path reads back the same (a name "3" is not index 3)
+            return f"['{key}']" if '"' in key else f'["{key}"]'
+        return f"[{key}]"
 
 
 _TOKEN = re.compile(
@@ -51,6 +56,8 @@ _TOKEN = re.compile(
 
 def parse_path(text: str) -> tuple[Step, ...]:
     """``"objects[glass sphere].material.kt"`` -> its steps. PathError when malformed."""
+    if not isinstance(text, str):
+        raise PathError(f"a path is text such as 'camera.position', got {_kind(text)}")
     text = text.strip()
     if not text:
         raise PathError("empty path")
@@ -60,20 +67,20 @@ def parse_path(text: str) -> tuple[Step, ...]:
     while pos < len(text):
         m = _TOKEN.match(text, pos)
         if m is None:
-            raise PathError(f"cannot read path {text!r} at {text[pos:]!r}")
+            raise PathError(f"cannot read path {shorten(text)!r} at {shorten(text[pos:])!r}")
         if m.group("dot"):
             if after_dot:
-                raise PathError(f"cannot read path {text!r}: a name is missing before '.'")
+                raise PathError(f"cannot read path {shorten(text)!r}: a name is missing before '.'")
             after_dot = True
         elif m.group("field") is not None:
             if not after_dot:
-                raise PathError(f"cannot read path {text!r}: '.' missing before "
+                raise PathError(f"cannot read path {shorten(text)!r}: '.' missing before "
                                 f"{m.group('field')!r}")
             steps.append(Step(m.group("field")))
             after_dot = False
         else:
             if after_dot:
-                raise PathError(f"cannot read path {text!r}: '[' must follow a name")
+                raise PathError(f"cannot read path {shorten(text)!r}: '[' must follow a name")
             raw = m.group("item")
             if len(raw) >= 2 and raw[0] == raw[-1] and raw[0] in "\"'":
                 key: str | int = raw[1:-1]
@@ -82,12 +89,19 @@ def parse_path(text: str) -> tuple[Step, ...]:
             else:
                 key = raw
             if key == "":
-                raise PathError(f"cannot read path {text!r}: empty []")
+                raise PathError(f"cannot read path {shorten(text)!r}: empty []")
             steps.append(Step(key, item=True))
         pos = m.end()
     if after_dot:
-        raise PathError(f"cannot read path {text!r}: it ends with '.'")
+        raise PathError(f"cannot read path {shorten(text)!r}: it ends with '.'")
     return tuple(steps)
+
+
+def _steps(steps: Any) -> tuple[Step, ...]:
+    """A path given as text or as parsed steps; PathError for anything else."""
+    if isinstance(steps, tuple) and all(isinstance(s, Step) for s in steps):
+        return steps
+    return parse_path(steps)
 
 
 def format_path(steps: tuple[Step, ...]) -> str:
@@ -113,7 +127,7 @@ def _unknown(key: object, known: list[str], where: str, what: str = "key") -> Pa
     close = difflib.get_close_matches(str(key), known, n=1, cutoff=0.6)
     hint = (f" (did you mean {close[0]!r}?)" if close
             else f" (known: {', '.join(known)})" if known and len(known) <= 16 else "")
-    return PathError(f"{where}: unknown {what} {key!r}{hint}")
+    return PathError(f"{shorten(where)}: unknown {what} {shorten(str(key))!r}{hint}")
 
 
 def _item_index(items: list, key: str | int, where: str) -> int:
@@ -133,8 +147,7 @@ def _item_index(items: list, key: str | int, where: str) -> int:
 def resolve_path(scene: Any, steps: tuple[Step, ...] | str) -> tuple[Step, ...]:
     """The same path with names of list items replaced by their index, checked against
     ``scene``: PathError (one line) when it names nothing."""
-    if isinstance(steps, str):
-        steps = parse_path(steps)
+    steps = _steps(steps)
     out: list[Step] = []
     _walk(scene, steps, out)
     return tuple(out)
@@ -178,6 +191,8 @@ def _child(scene: Any, node: Any, step: Step, where: str, parent: tuple[Step, ..
 
 
 def _kind(value: Any) -> str:
+    if value is None:
+        return "nothing (None)"
     if isinstance(value, bool):
         return "true/false"
     if isinstance(value, int | float):
@@ -216,8 +231,7 @@ def _expand(scene: Any, owner: BaseModel, key: str, value: Any, parent: tuple[St
 
 def get_value(scene: Any, steps: tuple[Step, ...] | str) -> Any:
     """The value a path names (a model, a tuple, a number, ...)."""
-    if isinstance(steps, str):
-        steps = parse_path(steps)
+    steps = _steps(steps)
     return _walk(scene, steps)
 
 
@@ -243,8 +257,7 @@ def set_value(scene: Any, steps: tuple[Step, ...] | str, value: Any) -> Any:
     """A copy of ``scene`` with the value at ``steps`` replaced by ``value`` (validated where
     it lands). The original is unchanged. PathError (one line) when the path names nothing
     or the value is rejected."""
-    if isinstance(steps, str):
-        steps = parse_path(steps)
+    steps = _steps(steps)
     if not steps:
         raise PathError("empty path")
     return _set(scene, scene, steps, 0, value, None)

@@ -20,9 +20,9 @@ from typing import TYPE_CHECKING, Any
 
 from pydantic import BaseModel
 
-from ..errors import SceneError
+from ..errors import FrameError, SceneError, shorten
 from .animation import Track
-from .interpolate import interpolate_tree, wrap_keys
+from .interpolate import interpolate_tree, scalar_leaves, spline_extremes, wrap_keys
 from .paths import PathError, Step, format_path, get_value, parse_path, resolve_path, set_value
 
 if TYPE_CHECKING:
@@ -56,19 +56,50 @@ def is_sequence(name: str | None) -> bool:
     return bool(name) and "{" in name  # type: ignore[operator]
 
 
+#: The widest a sequence pattern's ``{frame:...}`` may make the number (width or precision):
+#: ``{frame:>300000000}`` would be a name of 300 million characters.
+MAX_FORMAT_WIDTH = 32
+
+_SPEC_RE = re.compile(
+    r"(?:.?[<>=^])?[-+ ]?z?#?0?(?P<width>\d+)?[,_]?(?:\.(?P<precision>\d+))?[bdoxXneEfFgG%]?")
+
+
+def _check_spec(pattern: str, spec: str, conversion: str | None) -> None:
+    shown = shorten(pattern)
+    if conversion is not None:
+        raise ValueError(f"file pattern {shown!r}: {{frame!{conversion}}} is not a number "
+                         "format (use for example {frame:04d})")
+    m = _SPEC_RE.fullmatch(spec)
+    if m is None:
+        raise ValueError(f"file pattern {shown!r}: {{frame:{shorten(spec, 20)}}} is not a "
+                         "number format (use for example {frame:04d})")
+    for part in ("width", "precision"):
+        digits = m.group(part)
+        if digits is not None and (len(digits) > 3 or int(digits) > MAX_FORMAT_WIDTH):
+            raise ValueError(f"file pattern {shown!r}: the {part} "
+                             f"{shorten(digits.lstrip('0') or '0', 20)} is more than "
+                             f"{MAX_FORMAT_WIDTH} characters")
+
+
 def sequence_file(pattern: str, frame: int) -> str:
-    """The file of ``frame`` in a numbered sequence; ValueError for a malformed pattern."""
+    """The file of ``frame`` in a numbered sequence; ValueError for a malformed pattern
+    (a field other than ``{frame}``, a format that is not a number's, or one wider than
+    :data:`MAX_FORMAT_WIDTH`)."""
     try:
-        fields = [f for _, f, _, _ in string.Formatter().parse(pattern) if f is not None]
+        parsed = list(string.Formatter().parse(pattern))
     except ValueError as exc:
-        raise ValueError(f"file pattern {pattern!r}: {exc}") from None
-    if any(f != "frame" for f in fields):
-        raise ValueError(f"file pattern {pattern!r}: only {{frame}} may be used "
-                         "(for example ice_{frame:04d}.ply)")
+        raise ValueError(f"file pattern {shorten(pattern)!r}: {exc}") from None
+    for _, name, spec, conversion in parsed:
+        if name is None:
+            continue
+        if name != "frame":
+            raise ValueError(f"file pattern {shorten(pattern)!r}: only {{frame}} may be used "
+                             "(for example ice_{frame:04d}.ply)")
+        _check_spec(pattern, spec or "", conversion)
     try:
         return pattern.format(frame=int(frame))
     except (ValueError, IndexError) as exc:
-        raise ValueError(f"file pattern {pattern!r}: {exc}") from None
+        raise ValueError(f"file pattern {shorten(pattern)!r}: {exc}") from None
 
 
 def _sequences(scene: Scene) -> list[int]:
@@ -171,11 +202,45 @@ def track_value(scene: Scene, track: Track | int, frame: float) -> Any:
     return _value_at(ready, frame)
 
 
+#: A track whose keys span at most this many frames is checked at every frame between its
+#: keys; a longer one (a film may have a million frames) at its keys, the frames next to
+#: them, the frames where a spline turns (where it can overshoot) and this many frames
+#: spread evenly: a cost that grows with the keys, not with the frames.
+CHECK_EVERY_FRAME_UP_TO = 512
+
+
+def _frames_to_check(ready: _Ready, frames: int) -> list[int]:
+    """The frames :func:`check_animation` tries for one track's in-between values."""
+    first = max(0, math.ceil(ready.times[0]))
+    last = min(frames - 1, math.floor(ready.times[-1]))
+    if last < first:
+        return []
+    if last - first < CHECK_EVERY_FRAME_UP_TO:
+        return list(range(first, last + 1))
+    picked: set[int] = set()
+    for t in ready.times:  # on both sides of every key
+        picked.update((math.floor(t) - 1, math.floor(t), math.ceil(t), math.ceil(t) + 1))
+    if ready.interpolation == "spline":
+        for leaf in scalar_leaves(ready.values, ready.name):
+            for t in spline_extremes(ready.times, leaf):
+                picked.update((math.floor(t), math.ceil(t)))
+    step = (last - first) / CHECK_EVERY_FRAME_UP_TO
+    picked.update(first + round(k * step) for k in range(CHECK_EVERY_FRAME_UP_TO + 1))
+    return sorted(f for f in picked if first <= f <= last)
+
+
 def check_animation(scene: Scene) -> None:
     """ValueError (one line, starting with the place: ``animation.tracks[2].keys[1]: ...``)
     for a track whose path names nothing, a key outside the frames, a key value its target
     rejects, or an interpolation that leaves what the target accepts between keys (a spline
-    overshooting ``kt = 1``); or a mesh sequence with a malformed file pattern."""
+    overshooting ``kt = 1``); or a mesh sequence with a malformed file pattern.
+
+    The keys are checked once each; in-between values at the frames
+    :func:`_frames_to_check` picks (every frame of a track spanning up to
+    :data:`CHECK_EVERY_FRAME_UP_TO` frames), so a million-frame film is checked as fast as
+    its keys. A frame not tried here whose value is still rejected (a value rule that is
+    not a range, such as a camera position on its look-at point) is reported, one line
+    naming the frame and the track, when that frame is made (:func:`scene_at_frame`)."""
     for i in _sequences(scene):
         try:
             sequence_file(scene.objects[i].file, 0)
@@ -187,9 +252,7 @@ def check_animation(scene: Scene) -> None:
         ready = _prepare(scene, i, track)
         if ready.interpolation == "step" or len(ready.times) < 2:
             continue
-        first = max(0, math.ceil(ready.times[0]))
-        last = min(scene.animation.frames - 1, math.floor(ready.times[-1]))
-        for frame in range(first, last + 1):
+        for frame in _frames_to_check(ready, scene.animation.frames):
             value = _value_at(ready, frame)
             try:
                 set_value(scene, ready.written, value)
@@ -199,15 +262,31 @@ def check_animation(scene: Scene) -> None:
                     f"between keys gives {exc}") from None
 
 
+def frame_number(frame: Any, frames: int) -> int:
+    """``frame`` as an int in 0 .. frames - 1 (a whole float such as ``3.0`` or a NumPy
+    integer is accepted); FrameError (one line) for anything else: None, text, true/false,
+    NaN, infinity, 2.5, a frame out of range."""
+    import numbers
+
+    span = f"0..{frames - 1}"
+    if isinstance(frame, bool) or not isinstance(frame, numbers.Real):
+        raise FrameError(f"frame {shorten(repr(frame))} is not a frame number (a whole number "
+                         f"{span})")
+    if not isinstance(frame, numbers.Integral) and (
+            not math.isfinite(frame) or int(frame) != frame):
+        raise FrameError(f"frame {frame!r} is not a whole number (the frames are {span})")
+    frame = int(frame)
+    if not 0 <= frame < frames:
+        plural = "s" if frames != 1 else ""
+        raise FrameError(f"frame {shorten(str(frame))} is outside {span} (the scene has "
+                         f"{frames} frame{plural})")
+    return frame
+
+
 def scene_at_frame(scene: Scene, frame: int) -> Scene:
     """The plain still of frame ``frame`` (0 .. frame_count - 1); ``scene`` is unchanged."""
     n = frame_count(scene)
-    if isinstance(frame, bool) or int(frame) != frame:
-        raise SceneError(f"frame {frame!r} is not a whole number")
-    frame = int(frame)
-    if not 0 <= frame < n:
-        raise SceneError(f"frame {frame} is outside 0..{n - 1} (the scene has {n} "
-                         f"frame{'s' if n != 1 else ''})")
+    frame = frame_number(frame, n)
     still = scene
     if scene.animation is not None:
         try:
