@@ -89,14 +89,19 @@ class Scene(Strict):
 
     @model_validator(mode="after")
     def _material_names_resolve(self) -> Scene:
-        for i, obj in enumerate(self.objects):
-            name = obj.material
-            if isinstance(name, str) and name not in self.materials and name not in PRESETS:
-                known = sorted(set(self.materials) | set(PRESETS))
-                raise ValueError(
-                    f"objects[{i}].material: unknown material {name!r}"
-                    f" (known: {', '.join(known)})"
-                )
+        def check(objects, where: str) -> None:
+            for i, obj in enumerate(objects):
+                name = obj.material
+                if isinstance(name, str) and name not in self.materials and name not in PRESETS:
+                    known = sorted(set(self.materials) | set(PRESETS))
+                    raise ValueError(
+                        f"{where}[{i}].material: unknown material {name!r}"
+                        f" (known: {', '.join(known)})"
+                    )
+                if obj.type == "csg":  # the children of a CSG object, to any depth
+                    check(obj.objects, f"{where}[{i}].objects")
+
+        check(self.objects, "objects")
         return self
 
     @model_validator(mode="after")
