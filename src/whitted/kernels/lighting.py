@@ -21,10 +21,10 @@ from .intersect import INF
 from .jit import kernel, overload
 from .layout import (
     CELL_COUNT,
-    CSG_MAX_LEAVES,
-    FIRST_EXTRA_SHAPE,
     CELL_FIRST,
     CELL_OPAQUE,
+    CSG_MAX_LEAVES,
+    FIRST_EXTRA_SHAPE,
     LIGHT_BUFFER,
     LIGHT_BUFFER_SIDE,
     LIGHT_DIRECTION,

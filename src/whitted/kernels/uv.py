@@ -18,13 +18,12 @@ import math
 
 from .accel import to_object
 from .extras import extra_uv_if_extras
-from .features import has_extras
-from .features import instances_possible
+from .features import has_extras, instances_possible
 from .intersect import _box_local, triangle_barycentric
 from .jit import kernel, overload
 from .layout import (
-    FIRST_EXTRA_SHAPE,
     DISK_TANGENT,
+    FIRST_EXTRA_SHAPE,
     FRUSTUM_TANGENT,
     PLANE_TANGENT,
     PRIM_TYPE,

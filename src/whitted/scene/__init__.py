@@ -13,6 +13,7 @@ __all__ = [
     "CSG", "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera", "CheckerTexture",
     "Cone", "Cylinder", "DirectionalLight", "Disk", "DiskLight", "Gradient", "GradientTexture",
     "ImageTexture", "Material", "Mesh", "Plane", "PointLight",
-    "Rectangle", "RenderSettings", "Scene", "Sphere", "Torus", "Transform", "Triangle", "load_scene",
+    "Rectangle", "RenderSettings", "Scene", "Sphere", "Torus", "Transform", "Triangle",
+    "load_scene",
     "save_scene",
 ]
