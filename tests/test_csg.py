@@ -1,0 +1,233 @@
+"""CSG: union, intersection, difference and merge, nested, checked against worked values and
+against an exact interval computation; POV-Ray's material rule; one body for the media;
+errors for children that bound no volume."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from pydantic import ValidationError
+
+from whitted.compile.scene import compile_scene
+from whitted.kernels.accel import closest_hit, hit_material, surface_normals
+from whitted.kernels.layout import PRIM_FLIP, PRIM_MEDIUM, PRIM_OBJECT
+from whitted.scene import CSG, Box, Cylinder, Material, Plane, Scene, Sphere, Torus, Transform
+
+CUBE = Box(min=(-1, -1, -1), max=(1, 1, 1))
+
+
+class Compiled:
+    def __init__(self, *shapes, materials=None):
+        self.compiled = compile_scene(Scene(objects=list(shapes), materials=materials or {}))
+        self.geo = self.compiled.geometry
+        self.stack = np.empty(128, np.int32)
+
+    def hit(self, o, d, tmin=0.0):
+        o = tuple(map(float, o))
+        d = tuple(map(float, d))
+        t, prim, tri, b1, b2 = closest_hit(self.geo, o, d, float(tmin), math.inf, self.stack)
+        if prim < 0:
+            return None
+        p = tuple(a + t * b for a, b in zip(o, d, strict=True))
+        n, _ = surface_normals(self.geo, prim, tri, b1, b2, p)
+        return t, np.array(n), int(prim)
+
+    def hits(self, o, d):
+        out = []
+        tmin = 0.0
+        while (h := self.hit(o, d, tmin)) is not None:
+            out.append(h)
+            tmin = h[0]
+        return out
+
+    def ts(self, o, d):
+        return [h[0] for h in self.hits(o, d)]
+
+
+def test_difference_of_a_box_and_a_sphere_is_a_hollow_block():
+    c = Compiled(CSG(operation="difference", objects=[CUBE, Sphere(radius=0.5)]))
+    # along x from -5: box face at -1, the cavity from -0.5 to 0.5, the far face at 1
+    hits = c.hits((-5, 0, 0), (1, 0, 0))
+    assert [h[0] for h in hits] == pytest.approx([4.0, 4.5, 5.5, 6.0], rel=1e-12)
+    # the cavity's walls face into the cavity (the sphere's normals turned over)
+    np.testing.assert_allclose([h[1] for h in hits],
+                               [[-1, 0, 0], [1, 0, 0], [-1, 0, 0], [1, 0, 0]], atol=1e-12)
+    # above the cavity only the block's faces show
+    assert c.ts((-5, 0.7, 0), (1, 0, 0)) == pytest.approx([4.0, 6.0], rel=1e-12)
+
+
+def test_intersection_of_a_box_and_a_sphere_rounds_the_corners():
+    c = Compiled(CSG(operation="intersection", objects=[CUBE, Sphere(radius=1.3)]))
+    assert c.ts((-5, 0, 0), (1, 0, 0)) == pytest.approx([4.0, 6.0], rel=1e-12)
+    # through a corner region: y = z = 0.9 -> the sphere at x = -sqrt(1.69 - 1.62)
+    x = math.sqrt(1.69 - 1.62)
+    assert c.ts((-5, 0.9, 0.9), (1, 0, 0)) == pytest.approx([5 - x, 5 + x], rel=1e-12)
+    # past the rounded corner: nothing
+    assert c.hit((-5, 1.0 - 1e-9, 0.95), (1, 0, 0)) is None
+
+
+def test_merge_has_no_inner_surfaces_and_union_keeps_them():
+    pair = [Sphere(radius=1.0), Sphere(center=(1, 0, 0), radius=1.0)]
+    # along x from -5: the first sphere from -1 to 1, the second from 0 to 2
+    assert Compiled(CSG(operation="merge", objects=pair)).ts((-5, 0, 0), (1, 0, 0)) == \
+        pytest.approx([4.0, 7.0], rel=1e-12)
+    assert Compiled(CSG(operation="union", objects=pair)).ts((-5, 0, 0), (1, 0, 0)) == \
+        pytest.approx([4.0, 5.0, 6.0, 7.0], rel=1e-12)
+
+
+def test_nested_trees_and_difference_of_many():
+    # a cube minus (the union of two spheres) minus a cylinder along y
+    holes = CSG(operation="union", objects=[Sphere(center=(-1, 0, 0), radius=0.5),
+                                            Sphere(center=(1, 0, 0), radius=0.5)])
+    drill = Cylinder(base=(0, -2, 0), top=(0, 2, 0), radius=0.25)
+    c = Compiled(CSG(operation="difference", objects=[CUBE, holes, drill]))
+    # along x: the hemispherical dents take the faces' centres: -0.5, the drill -0.25..0.25
+    assert c.ts((-5, 0, 0), (1, 0, 0)) == pytest.approx([4.5, 4.75, 5.25, 5.5], rel=1e-12)
+    # along z through the drill: faces at -1, drill wall -0.25 .. 0.25, face at 1
+    assert c.ts((0.0, 0.5, -5), (0, 0, 1)) == pytest.approx([4.0, 4.75, 5.25, 6.0],
+                                                             rel=1e-12)
+
+
+def test_a_difference_of_a_difference_turns_twice():
+    # (cube - big sphere) - ... no: cube - (sphere r=0.8 - sphere r=0.4): a shell cut out,
+    # leaving a ball of radius 0.4 floating in the cavity; its surface faces outward again
+    inner = CSG(operation="difference", objects=[Sphere(radius=0.8), Sphere(radius=0.4)])
+    c = Compiled(CSG(operation="difference", objects=[CUBE, inner]))
+    hits = c.hits((-5, 0, 0), (1, 0, 0))
+    assert [h[0] for h in hits] == pytest.approx([4, 4.2, 4.6, 5.4, 5.8, 6], rel=1e-12)
+    np.testing.assert_allclose([h[1][0] for h in hits], [-1, 1, -1, 1, -1, 1], atol=1e-12)
+
+
+def test_transform_of_the_whole_and_of_a_child():
+    c = Compiled(CSG(operation="difference", objects=[
+        CUBE, Sphere(radius=0.5, transform=Transform(translate=(0.0, 0.0, 1.0)))],
+        transform=Transform(scale=2.0, translate=(0.0, 0.0, -10.0))))
+    # the scaled cube spans z -12..-8; the dent (radius 1 at z = -8) takes its front face's
+    # centre: from z = 0 down -z the first surface is the dent's bottom at z = -9
+    h = c.hit((0, 0, 0), (0, 0, -1))
+    assert h[0] == pytest.approx(9.0, rel=1e-12)
+    np.testing.assert_allclose(h[1], [0, 0, 1], atol=1e-12)
+
+
+def test_surfaces_keep_their_childs_material_and_the_cut_shows_the_cutters():
+    red = Material(color=(1, 0, 0))
+    blue = Material(color=(0, 0, 1))
+    glass = Material(preset="glass")
+    c = Compiled(CSG(operation="difference", material=glass, objects=[
+        Box(min=(-1, -1, -1), max=(1, 1, 1), material=red),
+        Sphere(radius=0.5, material=blue),
+        Sphere(center=(0, 0.9, 0), radius=0.05)]))  # no material: the object's
+    mats = c.compiled.materials
+    geo = c.geo
+
+    def colour(o, d, tmin=0.0):
+        h = c.hit(o, d, tmin)
+        return tuple(mats[hit_material(geo, h[2], -1), 0:3]), h[2]
+
+    assert colour((-5, 0, 0), (1, 0, 0))[0] == (1, 0, 0)
+    cut, prim = colour((-5, 0, 0), (1, 0, 0), 4.0)
+    assert cut == (0, 0, 1)
+    assert geo.prim_info[prim, PRIM_FLIP] == 1
+    assert geo.prim_info[prim, PRIM_OBJECT] == 0
+    small, _ = colour((0, 0.9, -5), (0, 0, 1))
+    assert small == (1, 0, 0)  # the box's face first
+    # every leaf's medium is the whole object's material (glass)
+    leaves = [i for i in range(len(geo.prim_info)) if geo.prim_info[i, PRIM_MEDIUM] >= 0]
+    assert len(leaves) == 3
+    assert len({int(geo.prim_info[i, PRIM_MEDIUM]) for i in leaves}) == 1
+    assert tuple(mats[int(geo.prim_info[leaves[0], PRIM_MEDIUM]), 0:3]) == glass.color
+
+
+def _interval(lo, hi):
+    return (lo, hi) if lo < hi else None
+
+
+def _box_interval(o, d):
+    lo, hi = -math.inf, math.inf
+    for k in range(3):
+        if abs(d[k]) < 1e-300:
+            if abs(o[k]) > 1.0:
+                return None
+            continue
+        a, b = (-1 - o[k]) / d[k], (1 - o[k]) / d[k]
+        lo, hi = max(lo, min(a, b)), min(hi, max(a, b))
+    return _interval(lo, hi)
+
+
+def _sphere_interval(o, d, c, r):
+    oc = np.subtract(o, c)
+    a = np.dot(d, d)
+    b = np.dot(oc, d)
+    disc = b * b - a * (np.dot(oc, oc) - r * r)
+    if disc <= 0:
+        return None
+    s = math.sqrt(disc)
+    return (-b - s) / a, (-b + s) / a
+
+
+SCULPT = Compiled(CSG(operation="difference", objects=[
+    CSG(operation="intersection", objects=[CUBE, Sphere(radius=1.35)]),
+    Sphere(center=(0.3, 0.2, 0.1), radius=0.6)]))
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.tuples(*[st.floats(-3, 3)] * 3), st.tuples(*[st.floats(-1, 1)] * 3))
+def test_first_surface_matches_the_exact_intervals(origin, target):
+    # (cube ∩ ball) − small ball: the solid along the ray is ([box] ∩ [ball]) minus (cut);
+    # its first boundary point past 0 is the first hit
+    d = np.subtract(target, origin)
+    if np.linalg.norm(d) < 1e-3:
+        return
+    o = np.array(origin)
+    if any(abs(d[k]) < 1e-9 and abs(abs(o[k]) - 1) < 1e-9 for k in range(3)):
+        return  # a ray in the plane of a face: which side it is on is not defined
+    box = _box_interval(o, d)
+    ball = _sphere_interval(o, d, (0, 0, 0), 1.35)
+    cut = _sphere_interval(o, d, (0.3, 0.2, 0.1), 0.6)
+    pieces = []
+    if box and ball:
+        lo, hi = max(box[0], ball[0]), min(box[1], ball[1])
+        if lo < hi:
+            pieces = [(lo, hi)]
+            if cut:
+                pieces = [p for p in ((lo, min(hi, cut[0])), (max(lo, cut[1]), hi))
+                          if p[0] < p[1]]
+    ends = sorted(x for p in pieces for x in p if x > 1e-9)
+    h = SCULPT.hit(o, d)
+    if not ends:
+        assert h is None
+        return
+    assert h is not None
+    assert h[0] == pytest.approx(ends[0], rel=1e-9, abs=1e-9)
+
+
+def test_csg_children_must_bound_a_volume():
+    with pytest.raises(ValidationError, match=r"objects\[1\] \(plane\).*no volume"):
+        CSG(operation="difference", objects=[CUBE, Plane()])
+    with pytest.raises(ValidationError, match="uncapped cylinder is open"):
+        CSG(operation="union", objects=[CUBE, Cylinder(radius=1, capped=False)])
+    with pytest.raises(ValidationError, match="at most 63 solids"):
+        CSG(operation="union", objects=[Sphere(center=(k, 0, 0), radius=0.4)
+                                        for k in range(64)])
+
+
+def test_unknown_material_inside_a_csg_names_its_place():
+    with pytest.raises(ValidationError, match=r"objects\[0\]\.objects\[1\]\.material"):
+        Scene(objects=[CSG(operation="union", objects=[CUBE, Sphere(radius=1,
+                                                                       material="nope")])])
+
+
+def test_torus_in_a_csg():
+    # a ring cut in half by a box: along x at y = 0 the left half is gone
+    c = Compiled(CSG(operation="difference", objects=[
+        Torus(major_radius=2, minor_radius=0.5), Box(min=(-3, -1, -1), max=(0, 1, 1))]))
+    assert c.ts((-10, 0, 0), (1, 0, 0)) == pytest.approx([11.5, 12.5], rel=1e-12)
+
+
+def test_scenes_without_extras_keep_the_lean_kernels():
+    assert Compiled(Sphere(radius=1)).geo.unbounded.dtype == np.int32
+    assert Compiled(Torus(major_radius=1, minor_radius=0.2)).geo.unbounded.dtype == np.int64
