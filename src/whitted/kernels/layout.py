@@ -232,3 +232,8 @@ class RenderParams(NamedTuple):
     camera_up: tuple[float, float, float]  # scaled by the half height
     camera_forward: tuple[float, float, float]
     orthographic: int
+    # focal blur: the lens's half axes (unit right and up times its radius; zero: a pinhole)
+    # and the distance along camera_forward of the plane in focus (0: no focal blur)
+    lens_u: tuple[float, float, float]
+    lens_v: tuple[float, float, float]
+    focal_distance: float
