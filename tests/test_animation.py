@@ -25,13 +25,13 @@ from whitted.animation import (
     set_value,
 )
 from whitted.animation.frames import read_frame_digest, render_frame
-from whitted.animation.interpolate import (
+from whitted.errors import SceneError
+from whitted.scene.interpolate import (
     euler_to_quaternion,
     interpolate_rotation,
     interpolate_scalar,
     quaternion_matrix,
 )
-from whitted.errors import SceneError
 from whitted.scene.types import Transform
 
 SCENE = """\
@@ -452,7 +452,7 @@ _names = st.text(st.characters(whitelist_categories=("L", "N"), whitelist_charac
 @settings(max_examples=60, deadline=None)
 @given(_names, st.integers(0, 999), st.sampled_from(["kt", "color", "rotate"]))
 def test_paths_read_back_as_written(name, index, leaf):
-    from whitted.animation.paths import format_path
+    from whitted.scene.paths import format_path
 
     for text in (f"objects[{name}].material.{leaf}", f"lights[{index}].{leaf}"):
         steps = parse_path(text)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import time
 
 import numpy as np
 import pytest
@@ -55,13 +56,20 @@ def test_quick_bench_table_and_json(tmp_path):
 
 
 def test_fresh_process_run_measures_every_stage():
+    """The stages are measured inside the child process and its wall time from outside: the
+    stages measured inside fit within the wall time, and the wall time within the time this
+    test saw pass around the whole call (startup_s is what is left over, never negative)."""
+    start = time.perf_counter()
     result = run_bench(BenchOptions(scenes=["lecture"], runs=1, threads=[1], size=(16, 16),
                                     warmup=False), log=lambda line: None)
+    elapsed = time.perf_counter() - start
     (row,) = result.rows
     assert row["mode"] == "process" and row["width"] == 16
     assert row["rays"]["primary"] == 256 and row["rays"]["shadow"] > 0
-    parts = row["startup_s"] + row["compile_s"] + row["build_s"] + row["render_s"]
-    assert row["wall_s"] == pytest.approx(parts, rel=1e-6)
+    inside = row["compile_s"] + row["build_s"] + row["render_s"]
+    assert row["render_s"] > 0 and row["build_s"] > 0 and row["compile_s"] >= 0
+    assert inside < row["wall_s"] <= elapsed
+    assert row["startup_s"] == pytest.approx(row["wall_s"] - inside, abs=1e-9)
     assert row["startup_s"] > 0 and row["peak_mib"] > 10
 
 

@@ -25,12 +25,12 @@ from PySide6.QtGui import QMouseEvent  # noqa: E402
 from typer.testing import CliRunner  # noqa: E402
 
 import whitted  # noqa: E402
-from whitted.cli.main import app as cli_app  # noqa: E402
 from whitted.gui import camera_ops  # noqa: E402
 from whitted.gui.autosave import autosave_path  # noqa: E402
 from whitted.gui.catalog import HAS_MESH, LIGHT_KINDS, OBJECT_KINDS  # noqa: E402
 from whitted.gui.document import CAMERA, RENDER  # noqa: E402
 from whitted.gui.main_window import WINDOW_SIZE, MainWindow, starter_scene  # noqa: E402
+from whitted.program import app as cli_app  # noqa: E402
 
 SLOW = 120_000  # ms: the first render in a fresh process compiles or loads the kernels
 

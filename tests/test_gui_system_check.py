@@ -41,7 +41,7 @@ def test_the_command_stops_before_qt(tmp_path):
         "from whitted.gui import system_check as c\n"
         f"c.library_cache = lambda: {cache_without('libxcb-cursor.so.0')!r}\n"
         "from typer.testing import CliRunner\n"
-        "from whitted.cli.main import app\n"
+        "from whitted.program import app\n"
         "r = CliRunner().invoke(app, ['gui'])\n"
         "print(repr(r.output)); print(r.exit_code)\n"
         "print(any(m.startswith('PySide6.QtWidgets') for m in sys.modules))\n"

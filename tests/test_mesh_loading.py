@@ -479,7 +479,7 @@ def test_cache_returns_the_same_object_and_reads_once(tmp_path, monkeypatch):
     path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     clear_mesh_cache()
     reads = []
-    from whitted.assets import files
+    from whitted import files
 
     original = files.map_limited
 

@@ -20,7 +20,7 @@ from whitted.output import (
     read_image,
     srgb_to_linear,
 )
-from whitted.output.encode import encode_ldr, quantize, tonemap
+from whitted.output.colour import encode_ldr, quantize, tonemap
 
 RNG = np.random.default_rng(1234)
 
@@ -555,7 +555,7 @@ def test_8bit_srgb_table_gives_the_exact_curves_codes():
     """encode_ldr's 8-bit sRGB table look-up equals the float64 curve then rounding, at every
     step of the table (and three float32 values either side), on a million float32 values
     spread over [0, 1], on values outside it, and after every tone map."""
-    from whitted.output import encode as e
+    from whitted.output import colour as e
 
     def reference(v, tonemap="clamp"):
         return e.quantize(e.linear_to_srgb(e.tonemap(v, tonemap)), 8)

@@ -35,7 +35,7 @@ from whitted.errors import (
     SceneValidationError,
     WhittedError,
 )
-from whitted.output import encode
+from whitted.output import colour, formats
 
 WHITTED = [sys.executable, "-m", "whitted"]
 cli_main.EXIT_AT_ONCE_WHEN_ABANDONED = False  # in-process runs must not end the test process
@@ -261,13 +261,13 @@ def test_a3_interrupt_before_the_first_tile_keeps_the_old_image(tmp_path: Path, 
 
 def test_a4_sigterm_during_the_write_lets_it_finish(tmp_path: Path, monkeypatch):
     write(tmp_path / "scene.toml", SCENE)
-    original = encode._write_png
+    original = formats._write_png
 
     def write_and_terminate(tmp, *args):
         os.kill(os.getpid(), signal.SIGTERM)  # arrives while the file is being written
         original(tmp, *args)
 
-    monkeypatch.setattr(encode, "_write_png", write_and_terminate)
+    monkeypatch.setattr(formats, "_write_png", write_and_terminate)
     code, out, err = run_main("render", "scene.toml", "-o", "out.png", cwd=tmp_path)
     assert code == 143, err
     assert "terminated: kept 1/1 tiles" in err
@@ -286,7 +286,7 @@ def test_a4_a_second_ctrl_c_stops_at_once_and_undoes_the_write(tmp_path: Path, m
         time.sleep(1)
         pytest.fail("the second Ctrl-C did not stop the write")
 
-    monkeypatch.setattr(encode, "_write_png", slow_write)
+    monkeypatch.setattr(formats, "_write_png", slow_write)
     code, _out, _err = run_main("render", "scene.toml", "-o", "out.png", cwd=tmp_path)
     assert code == 130
     assert (tmp_path / "out.png").read_bytes() == good
@@ -329,7 +329,7 @@ def test_a4_sigterm_during_the_render_keeps_the_finished_tiles(tmp_path: Path):
 
 KILLED_WRITER = """
 import os, signal, sys
-from whitted.output.encode import atomic_write
+from whitted.files import atomic_write
 def die(tmp):
     open(tmp, "wb").write(b"partial")
     os.kill(os.getpid(), signal.SIGKILL)
@@ -348,7 +348,7 @@ def test_a4_temporary_files_of_a_killed_write_are_removed_by_the_next(tmp_path: 
     # a live writer's temporary file (this process) is not touched
     live = tmp_path / f".out.png.tmp-{os.getpid()}.abcdef.png"
     live.write_bytes(b"live")
-    encode.write_image(target, np.zeros((2, 2, 3), np.float32))
+    formats.write_image(target, np.zeros((2, 2, 3), np.float32))
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["out.png", live.name])
 
 
@@ -356,21 +356,21 @@ def test_a5_png_and_jpeg_encode_in_strips(tmp_path: Path):
     """An 8-bit image costs a few bytes per pixel at the encoder, not ~130 (float64 copies of
     the whole image): measured with tracemalloc (NumPy's allocations)."""
     pixels = np.random.default_rng(1).random((1000, 1000, 3), dtype=np.float32) * 1.5
-    expected = encode.encode_ldr(pixels, bits=8, transfer="srgb", tonemap="reinhard")
+    expected = colour.encode_ldr(pixels, bits=8, transfer="srgb", tonemap="reinhard")
     for name in ("a.png", "a.jpg"):
         tracemalloc.start()
-        encode.write_image(tmp_path / name, pixels, tonemap="reinhard")
+        formats.write_image(tmp_path / name, pixels, tonemap="reinhard")
         peak = tracemalloc.get_traced_memory()[1]
         tracemalloc.stop()
         # ~8 MB for the strips (one of 65,536 pixels at a time); whole-image: ~130 MB
         assert peak < 24 * pixels.shape[0] * pixels.shape[1], (name, peak)
     # strips change nothing: the PNG holds exactly the whole-image encoding
     assert np.array_equal(np.asarray(PILImage.open(tmp_path / "a.png")), expected)
-    encode.write_image(tmp_path / "b.png", pixels, bit_depth=16)
+    formats.write_image(tmp_path / "b.png", pixels, bit_depth=16)
     reader = png.Reader(filename=str(tmp_path / "b.png"))
     w, h, rows, _info = reader.asDirect()
     stored = np.vstack([np.asarray(r, np.uint16) for r in rows]).reshape(h, w, 3)
-    assert np.array_equal(stored, encode.encode_ldr(pixels, bits=16))
+    assert np.array_equal(stored, colour.encode_ldr(pixels, bits=16))
 
 
 def test_a5_memory_need_is_checked_before_the_render(tmp_path: Path, monkeypatch, no_render):

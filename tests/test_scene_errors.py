@@ -14,7 +14,7 @@ from pydantic import ValidationError
 
 import whitted
 from whitted import SceneError, load_scene
-from whitted.scene.io import rebase_files
+from whitted.scene.writing import rebase_files
 
 # A small valid scene. Each bad case below changes one thing in it. The comments after the
 # [[objects]] headers make those lines easy to find (and check that comments are allowed there).

@@ -369,7 +369,7 @@ def test_a_missing_extra_is_one_line_naming_it(tmp_path, blocked, args, extra):
         importlib.util.find_spec = lambda name, *a: (
             None if name.split(".")[0] == {blocked!r} else real_find_spec(name, *a))
         sys.argv = ["whitted", *{args!r}]
-        from whitted.cli.main import main
+        from whitted.program import main
         main()
     """)
     env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"))

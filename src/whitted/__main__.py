@@ -1,5 +1,5 @@
-"""``python -m whitted`` runs the command line."""
+"""``python -m whitted`` runs the ``whitted`` program."""
 
-from .cli.main import main
+from .program import main
 
 main()

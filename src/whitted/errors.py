@@ -98,16 +98,14 @@ def _scene_validation_error_class() -> type:
             self.line = None
 
         @classmethod
-        def wrap(cls, exc: ValidationError, model: type | None = None) -> SceneValidationError:
-            """The same problems as ``exc`` (a pydantic ValidationError), as this class;
-            ``model`` is the class that raised it (named in the message)."""
-            from .scene.io import describe_validation_error
-
+        def wrap(cls, exc: ValidationError, where: str | None,
+                 message: str) -> SceneValidationError:
+            """The same problems as ``exc`` (a pydantic ValidationError), as this class, with
+            the one line ``where: message`` (scene/messages.py words it)."""
             new = cls.from_exception_data(exc.title, exc.errors())  # type: ignore[arg-type]
-            where, message = describe_validation_error(exc, model)
             new.message = message
             new.file = None
-            new.where = ".".join(p for p in (getattr(model, "__name__", None), where) if p) or None
+            new.where = where or None
             new.line = None
             return new
 

@@ -6,13 +6,10 @@ renders like any other scene. :func:`render_frame` (in :mod:`whitted.animation.f
 renders one frame to a PNG that records what it is a picture of, so a film can resume.
 """
 
-# The scene models first: scene.Scene holds an Animation, and animation.model builds on
-# scene.types, so importing this package before whitted.scene must not start in the middle.
-from .. import scene as _scene  # noqa: F401  (import order only)
-from .model import Animation, Track
+from ..scene.animation import Animation, Track
+from ..scene.paths import PathError, get_value, parse_path, resolve_path, set_value
+from ..scene.timeline import frame_count, frame_seed, scene_at_frame, sequence_file
 from .overrides import apply_overrides, parse_assignment, parse_value, parse_values
-from .paths import PathError, get_value, parse_path, resolve_path, set_value
-from .timeline import frame_count, frame_seed, scene_at_frame, sequence_file
 
 __all__ = [
     "Animation", "PathError", "Track", "apply_overrides", "frame_count", "frame_seed",

@@ -130,7 +130,7 @@ def _write_frame_png(path: Path, image: Any, digest: str, frame: int) -> None:
     from PIL import Image as PILImage
     from PIL.PngImagePlugin import PngInfo
 
-    from ..output.encode import atomic_write
+    from ..files import atomic_write
 
     data = image.to_srgb8()
     info = PngInfo()

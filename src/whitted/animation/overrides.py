@@ -3,7 +3,7 @@
 ``VALUE`` is written as in a TOML file (``0.5``, ``[0, 2, 9]``, ``"glass"``, ``true``,
 ``{ top = "#336699", bottom = "#ffffff" }``); a bare word that is not TOML is taken as text
 (``--set render.tonemap=aces``). The path is the same as a track's
-(:mod:`whitted.animation.paths`). An override applies to the scene before its frames are
+(:mod:`whitted.scene.paths`). An override applies to the scene before its frames are
 made; a track animating the same value is dropped (the command line wins).
 
 For sweeps, :func:`parse_values` reads several values: a range ``START:STOP:STEP`` (STOP
@@ -18,7 +18,7 @@ import tomllib
 from typing import TYPE_CHECKING, Any
 
 from ..errors import SceneError
-from .paths import PathError, parse_path, resolve_path, set_value
+from ..scene.paths import PathError, parse_path, resolve_path, set_value
 
 if TYPE_CHECKING:
     from ..scene.scene import Scene
@@ -128,7 +128,7 @@ def apply_overrides(scene: Scene, assignments: list[tuple[str, Any]] | dict[str,
                 new = new.model_copy(update={"animation": animation})
         scene = new
     if scene.animation is not None:
-        from .timeline import check_animation
+        from ..scene.timeline import check_animation
 
         try:
             check_animation(scene)

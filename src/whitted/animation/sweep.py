@@ -18,8 +18,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import SceneError
+from ..scene.paths import PathError, parse_path
 from .overrides import apply_overrides
-from .paths import PathError, parse_path
 
 if TYPE_CHECKING:
     from ..scene.scene import Scene

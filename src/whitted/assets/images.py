@@ -82,7 +82,7 @@ def load_image(path: str | os.PathLike[str], colorspace: str = "srgb") -> np.nda
         raise SceneError("image file not found", file=name) from None
     except OSError as exc:
         raise SceneError(f"cannot read image file: {_one_line(exc)}", file=name) from None
-    from .files import kind_of
+    from ..files import kind_of
 
     kind = kind_of(status.st_mode)
     if kind is not None:
@@ -95,7 +95,7 @@ def load_image(path: str | os.PathLike[str], colorspace: str = "srgb") -> np.nda
             _cache.move_to_end(key)
             return pixels
 
-    from .files import read_limited
+    from ..files import read_limited
 
     data = read_limited(resolved, MAX_IMAGE_BYTES, "image file", name)
     pixels = _decode(data, colorspace, name)

@@ -28,7 +28,6 @@ import codecs
 import os
 import threading
 from collections import OrderedDict
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -36,30 +35,13 @@ import numpy as np
 from ..errors import SceneError
 from ..scene.materials import Material
 from . import obj_scan
+from .mesh_data import MeshData
 from .mtl import MtlRecord, read_mtl_file, split_escaped, to_material
 
 OBJ_SUFFIXES = (".obj",)
 TRIMESH_SUFFIXES = (".ply", ".stl", ".off", ".gltf", ".glb")
 SUPPORTED_SUFFIXES = OBJ_SUFFIXES + TRIMESH_SUFFIXES
 _CACHE_ENTRIES = 16
-
-
-@dataclass(frozen=True, eq=False)
-class MeshData:
-    """A triangle mesh read from a file (see the module docstring for the conventions)."""
-
-    vertices: np.ndarray  # (V, 3) float64 positions
-    faces: np.ndarray  # (T, 3) int32, 0-based, fan-triangulated in file order
-    normals: np.ndarray | None  # (V, 3) float64 per-vertex normals from the file, or None
-    uvs: np.ndarray | None  # (V, 2) float64 per-vertex texture coordinates, or None
-    face_material: np.ndarray  # (T,) int32 index into materials
-    materials: list[Material]  # at least one
-    warnings: list[str]  # "path:line: problem"
-    vertex_records: int  # vertices as written in the file (OBJ: `v` records)
-    triangle_records: int  # triangles after fan triangulation, degenerate ones included
-    source: str  # the path
-    texture_files: list[str]  # the existing texture images the materials use
-    library_files: list[str] = field(default_factory=list)  # the MTL files read (OBJ)
 
 
 _cache: OrderedDict[tuple[str, int, int], MeshData] = OrderedDict()
@@ -79,7 +61,7 @@ def load_mesh(path: str | Path) -> MeshData:
     Raises :class:`~whitted.errors.SceneError` (``path:line: problem``) for a missing,
     unreadable, unsupported or malformed file.
     """
-    from .files import path_problem
+    from ..files import path_problem
 
     name = os.fspath(path)
     file_path = Path(name)
@@ -149,7 +131,7 @@ def _check_obj_head(head: bytes, name: str) -> None:
 
 def _read_model(file_path: Path, name: str, suffix: str) -> MeshData:
     if suffix in OBJ_SUFFIXES:
-        from .files import head_bytes, map_limited
+        from ..files import head_bytes, map_limited
 
         _check_obj_head(head_bytes(file_path, 65536, MAX_OBJ_BYTES, "OBJ file", name), name)
         data = map_limited(file_path, MAX_OBJ_BYTES, "OBJ file", name)

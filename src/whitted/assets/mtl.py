@@ -324,7 +324,7 @@ def to_material(
 def read_mtl_file(path: Path, warnings: list[str]) -> dict[str, MtlRecord] | None:
     """The records of an MTL file, or None when it cannot be read."""
     from ..errors import SceneError
-    from .files import read_limited
+    from ..files import read_limited
 
     try:
         data = read_limited(path, MAX_MTL_BYTES, "material library")

@@ -27,7 +27,7 @@ from .._cache import cache_dir
 from ..errors import SceneError
 from ..scene.materials import Material
 from ..scene.textures import ImageTexture
-from .mesh import MeshData
+from .mesh_data import MeshData
 
 
 def _external_base_colour_images(path: Path) -> dict[str, Path]:
@@ -125,7 +125,7 @@ MAX_TRIMESH_BYTES = 2 << 30
 def check_header(path: Path, name: str) -> None:
     """Refuse at once, from its first bytes, a file that is not of the format its extension
     says (before trimesh reads all of it)."""
-    from .files import head_bytes
+    from ..files import head_bytes
 
     suffix = path.suffix.lower()
     kind = suffix[1:].upper()

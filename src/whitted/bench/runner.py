@@ -300,7 +300,7 @@ def markdown_table(rows: list[dict[str, Any]]) -> str:
 
 
 def write_json(rows: list[dict[str, Any]], path: Path) -> Path:
-    from ..output.encode import atomic_write
+    from ..files import atomic_write
 
     text = json.dumps(rows, indent=2) + "\n"
     atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))

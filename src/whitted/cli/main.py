@@ -161,7 +161,7 @@ def render(
     An animated scene renders frame 0, or the frame --frame names."""
     from pydantic import ValidationError
 
-    from ..output.encode import check_bit_depth, image_format
+    from ..output.formats import check_bit_depth, image_format
     from ..render.api import RenderJob
 
     process_start = time.perf_counter()
@@ -232,7 +232,7 @@ def render(
 
 def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet, interrupted,
                       signals, process_start, frame: int | None) -> None:
-    from ..output.encode import image_format
+    from ..output.formats import image_format
     from ..render.api import render_aovs
 
     try:
@@ -283,7 +283,7 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
 
 def _with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
     """A model or texture error from the render, with the scene file and key that name it."""
-    from ..scene.io import named_files
+    from ..scene.writing import named_files
 
     file = getattr(exc, "file", None)
     if not file or file == name:
@@ -293,7 +293,7 @@ def _with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
             target = scene.resolve_path(named)
         except (OSError, RuntimeError, ValueError):
             continue
-        from ..assets.files import same_file
+        from ..files import same_file
 
         if same_file(target, file) or str(target) == file:
             where = "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in keys).lstrip(".")
@@ -304,14 +304,14 @@ def _with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
 def _save_npy(path: Path, array: np.ndarray) -> None:
     import numpy as np
 
-    from ..output.encode import atomic_write
+    from ..files import atomic_write
 
     atomic_write(path, lambda tmp: np.save(tmp, array))
 
 
 def _override_error(exc: ValidationError) -> str:
     """One line for a command-line value the render settings reject."""
-    from ..scene.io import _clean_message
+    from ..scene.messages import clean_message as _clean_message
 
     e = exc.errors()[0]
     if e["loc"]:
@@ -510,39 +510,6 @@ def info(
     primary = r.width * r.height * r.samples
     out.print(f"work: {primary:,} primary rays, up to {shadow} shadow ray(s) per hit, "
               f"secondary rays up to depth {r.max_depth}")
-
-
-@app.command()
-def gui(
-    scene_path: Annotated[
-        Path | None, typer.Argument(metavar="[SCENE]", help="Scene file; a new one if missing")
-    ] = None,
-) -> None:
-    """Open the scene editor (a desktop window) on SCENE, or on the built-in default scene."""
-    from ..scene import load_scene
-
-    scene = None
-    try:
-        exists = scene_path is not None and scene_path.exists()
-    except (OSError, ValueError) as exc:
-        raise fail(f"{scene_path}: {getattr(exc, 'strerror', None) or exc}") from None
-    if exists:
-        try:
-            scene = load_scene(scene_path)
-        except WhittedError as exc:
-            raise fail(str(exc)) from None
-    elif scene_path is not None and scene_path.suffix.lower() not in (".toml", ".json"):
-        raise fail(f"{scene_path}: unknown scene format {scene_path.suffix!r} (use .toml or .json)")
-    import importlib.util
-
-    # Qt is imported by the editor only, after its check of the system libraries Qt needs
-    if importlib.util.find_spec("PySide6") is None:
-        raise fail("the editor needs PySide6, which is not installed: pip install 'whitted[gui]'")
-    try:
-        from ..gui.app import run_editor
-    except ImportError as exc:
-        raise fail(f"the editor needs PySide6 ({exc}): pip install 'whitted[gui]'") from None
-    raise typer.Exit(run_editor(scene, scene_path))
 
 
 @app.command()

@@ -55,7 +55,7 @@ def sweep(
     from ..animation.frames import FrameRenderer
     from ..animation.overrides import apply_overrides, parse_assignment, parse_values
     from ..animation.sweep import contact_sheet, sweep_cells
-    from ..output.encode import atomic_write
+    from ..files import atomic_write
     from ..render.api import CancelToken
 
     started = time.perf_counter()

@@ -482,7 +482,7 @@ def export_pov(
     """Write the scene as a POV-Ray 3.7 file at ``path`` (atomically). Returns the path.
     :class:`~whitted.errors.OutputError` when ``path`` is the scene file (``source``) or a
     file the scene reads, or cannot be written."""
-    from ..output.encode import atomic_write
+    from ..files import atomic_write
     from ..output.safety import check_outputs
 
     path = Path(path)

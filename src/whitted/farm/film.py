@@ -143,7 +143,7 @@ def render_film(
     :func:`plan_film` when the caller made it already (then ``client`` may be None when no
     frame is left to render). Raises :class:`FrameFailed` for the first frame that failed,
     after all the others are saved."""
-    from ..output.encode import atomic_write
+    from ..files import atomic_write
 
     started = time.perf_counter()
     folder = Path(frames_dir)

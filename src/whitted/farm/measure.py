@@ -45,7 +45,7 @@ def film_scene(path: str | None, frames: int):
 
         c, s = math.cos(turn), math.sin(turn)
         keys.append([k, [target[0] + c * dx + s * dz, eye[1], target[2] - s * dx + c * dz]])
-    from ..animation.model import Track
+    from ..scene.animation import Track
 
     return scene.with_animation(frames, 24.0, [Track("camera.position", keys)])
 

@@ -18,8 +18,9 @@ from typing import Any
 
 from pydantic import BaseModel
 
-from ..animation.model import Animation, Interpolation, Track
-from ..animation.paths import (
+from ..scene import Scene
+from ..scene.animation import Animation, Interpolation, Track
+from ..scene.paths import (
     PathError,
     format_path,
     get_value,
@@ -27,8 +28,7 @@ from ..animation.paths import (
     resolve_path,
     set_value,
 )
-from ..animation.timeline import scene_at_frame, track_value
-from ..scene import Scene
+from ..scene.timeline import scene_at_frame, track_value
 from ..scene.types import Transform
 
 #: a new animation (made by the first key of a still scene): two seconds at 24 fps

@@ -26,8 +26,8 @@ from .. import scene as S
 from ..errors import WhittedError
 from ..scene import Scene, load_scene, save_scene
 from ..scene.default import default_scene
-from ..scene.io import rebase_files
 from ..scene.toml_document import save_scene_toml
+from ..scene.writing import rebase_files
 from . import camera_ops, catalog
 from .autosave import Autosave, recovery_for
 from .document import (

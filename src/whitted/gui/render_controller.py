@@ -16,7 +16,7 @@ from PySide6.QtCore import QObject, QTimer, Signal
 from PySide6.QtGui import QImage
 
 from ..compile.scene import compile_scene  # built here once, reused by the previews of a drag
-from ..output.encode import encode_ldr
+from ..output.colour import encode_ldr
 from ..output.image import Image
 from ..render.api import Progress, RenderJob, available_threads, warm_up_kernels
 from ..scene import Scene

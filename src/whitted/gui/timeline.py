@@ -42,9 +42,9 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from ..animation.model import Animation
 from ..errors import WhittedError
 from ..scene import Scene, load_scene
+from ..scene.animation import Animation
 from .document import EditRefused, label_of, rebuild_scene
 from .film_job import FilmJob
 from .keyframes import (

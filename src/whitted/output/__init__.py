@@ -5,15 +5,9 @@ default) and quantized; HDR formats (.exr, .pfm, .npy) store the raw linear floa
 are written atomically.
 """
 
-from whitted.output.encode import (
-    atomic_write,
-    linear_to_srgb,
-    quantize,
-    read_image,
-    srgb_to_linear,
-    tonemap,
-    write_image,
-)
+from whitted.files import atomic_write
+from whitted.output.colour import linear_to_srgb, quantize, srgb_to_linear, tonemap
+from whitted.output.formats import read_image, write_image
 from whitted.output.image import Image
 
 __all__ = [

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from whitted.output import encode
+from whitted.output import colour, formats
 
 
 class Image:
@@ -31,9 +31,9 @@ class Image:
         tonemap: str = "clamp",
         meta: dict | None = None,
     ) -> None:
-        self._pixels = encode.check_pixels(pixels)
-        self.transfer = encode.check_transfer(transfer)
-        self.tonemap = encode.check_tonemap(tonemap)
+        self._pixels = colour.check_pixels(pixels)
+        self.transfer = colour.check_transfer(transfer)
+        self.tonemap = colour.check_tonemap(tonemap)
         self.meta: dict = {} if meta is None else dict(meta)
 
     # ---------------------------------------------------------------- properties
@@ -45,7 +45,7 @@ class Image:
 
     @pixels.setter
     def pixels(self, value: np.ndarray) -> None:
-        self._pixels = encode.check_pixels(value)
+        self._pixels = colour.check_pixels(value)
 
     @property
     def width(self) -> int:
@@ -59,11 +59,11 @@ class Image:
 
     def to_srgb8(self) -> np.ndarray:
         """uint8 (H, W, 3) display values: this image's tonemap, then its transfer."""
-        return encode.encode_ldr(self._pixels, bits=8, transfer=self.transfer, tonemap=self.tonemap)
+        return colour.encode_ldr(self._pixels, bits=8, transfer=self.transfer, tonemap=self.tonemap)
 
     def to_uint16(self) -> np.ndarray:
         """uint16 (H, W, 3) display values: this image's tonemap, then its transfer."""
-        return encode.encode_ldr(
+        return colour.encode_ldr(
             self._pixels, bits=16, transfer=self.transfer, tonemap=self.tonemap
         )
 
@@ -103,7 +103,7 @@ class Image:
         transfer or tonemap, or a bit depth other than 8 (16 is accepted for .png only).
         Returns the path written.
         """
-        return encode.write_image(
+        return formats.write_image(
             path,
             self._pixels,
             bit_depth=bit_depth,
@@ -113,8 +113,8 @@ class Image:
 
     @classmethod
     def load(cls, path: str | os.PathLike[str], *, transfer: str = "srgb") -> Image:
-        """Read an image file (see :func:`whitted.output.encode.read_image`).
+        """Read an image file (see :func:`whitted.output.formats.read_image`).
 
         LDR files are decoded with ``transfer``, which also becomes the image's transfer.
         """
-        return cls(encode.read_image(path, transfer=transfer), transfer=transfer)
+        return cls(formats.read_image(path, transfer=transfer), transfer=transfer)

@@ -10,12 +10,12 @@ import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 
-from ..assets.files import kind_of, same_file
 from ..errors import OutputError
+from ..files import kind_of, same_file
 
 #: Bytes per pixel held while rendering (the float32 RGB framebuffer).
 FRAMEBUFFER_BYTES = 12
-#: Bytes per pixel the encoders add on top of the framebuffer (see encode.write_image;
+#: Bytes per pixel the encoders add on top of the framebuffer (see formats.write_image;
 #: measured 4.4 for 8-bit PNG and JPEG at 25 megapixels).
 ENCODER_BYTES = {"png": 5, "jpeg": 5, "exr": 12, "pfm": 0, "npy": 0}
 
@@ -56,7 +56,7 @@ def input_files(scene: object, scene_path: str | os.PathLike[str] | None) -> lis
     and texture images."""
     from ..assets.mesh import load_mesh
     from ..errors import WhittedError
-    from ..scene.io import named_files
+    from ..scene.writing import named_files
 
     files: list[Path] = []
     if scene_path is not None:

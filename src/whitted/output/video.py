@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .encode import atomic_write
+from ..files import atomic_write
 
 __all__ = ["DEFAULT_CRF", "VIDEO_FORMATS", "encode_film", "even_size", "pad_to_even",
            "video_format"]

@@ -7,12 +7,14 @@ from typing import Literal
 
 from pydantic import Field, PrivateAttr, model_validator
 
-from ..animation.model import Animation
+from .animation import Animation
 from .camera import Camera
 from .lights import Light
 from .materials import PRESETS, Material
 from .shapes import Shape
+from .timeline import check_animation, is_sequence, scene_at_frame
 from .types import Background, Strict
+from .writing import save_scene
 
 MAX_PIXELS = 100_000_000
 MAX_DEPTH = 64
@@ -106,7 +108,6 @@ class Scene(Strict):
 
     @model_validator(mode="after")
     def _animation_targets(self) -> Scene:
-        from ..animation.timeline import check_animation
 
         check_animation(self)
         return self
@@ -119,7 +120,6 @@ class Scene(Strict):
     @property
     def is_animated(self) -> bool:
         """Whether frames differ: an animation, or a mesh file naming a numbered sequence."""
-        from ..animation.timeline import is_sequence
 
         return self.animation is not None or any(
             is_sequence(getattr(obj, "file", None)) for obj in self.objects)
@@ -127,7 +127,6 @@ class Scene(Strict):
     def at_frame(self, frame: int) -> Scene:
         """The plain still of frame ``frame`` (0 .. frame_count - 1): tracks applied, mesh
         sequences named, the frame's seed derived; this scene is unchanged."""
-        from ..animation.timeline import scene_at_frame
 
         return scene_at_frame(self, frame)
 
@@ -154,8 +153,6 @@ class Scene(Strict):
 
     def save(self, path: str | Path) -> Path:
         """Write the scene as TOML or JSON (by extension), atomically."""
-        from .io import save_scene
-
         return save_scene(self, path)
 
     def with_settings(self, **overrides: object) -> Scene:

@@ -9,6 +9,8 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BeforeValidator, Field, PlainSerializer, model_validator
 
+from ..errors import SceneError
+from ..files import path_problem
 from .materials import Material
 from .types import MAX_MAGNITUDE, Direction, Finite, Strict, Transform, Vec3
 
@@ -277,10 +279,12 @@ class Mesh(_Shape):
 
     @classmethod
     def from_file(cls, path: str | Path, **fields: Any) -> Mesh:
-        """A mesh object for the model at ``path``, loaded now so a bad file fails here."""
-        from ..assets import load_mesh
-
-        load_mesh(path)
+        """A mesh object for the model file at ``path``. A path that is not a readable regular
+        file fails here; the model itself is read when the scene is compiled (or by
+        :func:`whitted.assets.load_mesh`, which reads and checks it now)."""
+        problem = path_problem(path)
+        if problem is not None:
+            raise SceneError(problem, file=str(path))
         return cls(file=str(path), **fields)
 
     @model_validator(mode="after")

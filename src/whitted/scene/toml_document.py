@@ -22,9 +22,11 @@ from pydantic import BaseModel
 from tomlkit.items import AoT, Array, InlineTable, Table
 
 from ..errors import SceneError
-from .io import parse_scene_text, rebase_files, scene_from_dict
+from ..files import atomic_write
+from .io import parse_scene_text, scene_from_dict
 from .materials import Material
 from .scene import Scene
+from .writing import rebase_files, scene_to_dict
 
 # ---------------------------------------------------------------------- compact data
 
@@ -400,8 +402,6 @@ def scene_toml(scene: Scene, *, text: str | None = None, loaded: Scene | None = 
         return compact
     import tomli_w
 
-    from .io import scene_to_dict
-
     return tomli_w.dumps(scene_to_dict(scene))  # every value spelt out: always loads back
 
 
@@ -409,8 +409,6 @@ def save_scene_toml(scene: Scene, path: str | Path, *, text: str | None = None,
                     loaded: Scene | None = None) -> str:
     """Write ``scene`` to the TOML file ``path`` atomically (see :func:`scene_toml`); relative
     model and texture names are rewritten when the folder changes. Returns the text written."""
-    from ..output.encode import atomic_write
-
     path = Path(path)
     if path.parent.resolve() != scene.base_dir.resolve():
         scene = rebase_files(scene, path.parent)

@@ -21,9 +21,18 @@ from pydantic import (
 )
 
 from ..errors import SceneValidationError
+from .messages import describe_validation_error
 
 _strict: ContextVar[bool] = ContextVar("whitted_strict_validation", default=False)
 _depth: ContextVar[int] = ContextVar("whitted_validation_depth", default=0)
+
+
+
+def _wrap(exc: ValidationError, model: type) -> Exception:
+    """``exc`` as a :class:`SceneValidationError` whose line names ``model`` and the key."""
+    where, message = describe_validation_error(exc, model)
+    where = ".".join(p for p in (getattr(model, "__name__", None), where) if p)
+    return SceneValidationError.wrap(exc, where, message)
 
 
 class Strict(BaseModel):
@@ -49,7 +58,7 @@ class Strict(BaseModel):
         except ValidationError as exc:
             if _depth.get() > 1 or isinstance(exc, SceneValidationError):
                 raise
-            raise SceneValidationError.wrap(exc, type(self)) from None
+            raise _wrap(exc, type(self)) from None
         finally:
             _depth.reset(depth)
 
@@ -59,7 +68,7 @@ class Strict(BaseModel):
         except SceneValidationError:
             raise
         except ValidationError as exc:
-            raise SceneValidationError.wrap(exc, type(self)) from None
+            raise _wrap(exc, type(self)) from None
 
     @classmethod
     def model_validate(cls, obj: Any, *, strict: bool | None = None, **kwargs: Any) -> Any:
@@ -70,7 +79,7 @@ class Strict(BaseModel):
         except ValidationError as exc:
             if _depth.get() > 1 or isinstance(exc, SceneValidationError):
                 raise
-            raise SceneValidationError.wrap(exc, cls) from None
+            raise _wrap(exc, cls) from None
         finally:
             _depth.reset(depth)
             _strict.reset(strictness)

@@ -189,18 +189,18 @@ class Case(_Strict):
 
 
 def _error_from_validation(exc: ValidationError, file: str | None, text: str | None) -> CaseError:
-    from ..scene.io import _clean_loc, _clean_message, _format_path, _toml_line
+    from ..scene.messages import clean_loc, clean_message, format_path, toml_line
 
     best = max(exc.errors(), key=lambda e: len(e["loc"]))
-    keys = _clean_loc(best["loc"])
-    message = "unknown key" if best["type"] == "extra_forbidden" else _clean_message(best)
-    line = _toml_line(text, keys) if text and keys else None
-    return CaseError(message, file=file, where=_format_path(keys) or None, line=line)
+    keys = clean_loc(best["loc"])
+    message = "unknown key" if best["type"] == "extra_forbidden" else clean_message(best)
+    line = toml_line(text, keys) if text and keys else None
+    return CaseError(message, file=file, where=format_path(keys) or None, line=line)
 
 
 def case_from_dict(data: dict, *, file: str | None = None, text: str | None = None) -> Case:
     """Validate a case; raises :class:`CaseError` on the first problem."""
-    from ..scene.io import _parse_path, _toml_line
+    from ..scene.messages import parse_path, toml_line
 
     try:
         case = Case.model_validate(data)
@@ -209,7 +209,7 @@ def case_from_dict(data: dict, *, file: str | None = None, text: str | None = No
     problems = case.check()
     if problems:
         where, message = problems[0]
-        line = _toml_line(text, _parse_path(where)) if text else None
+        line = toml_line(text, parse_path(where)) if text else None
         raise CaseError(message, file=file, where=where, line=line)
     return case
 

@@ -234,7 +234,7 @@ def _adapter(annotation: Any) -> TypeAdapter:
 
 
 def _message(exc: ValidationError) -> str:
-    from ..scene.io import validation_message
+    from .messages import validation_message
 
     return validation_message(exc)
 

@@ -21,12 +21,12 @@ from typing import TYPE_CHECKING, Any
 from pydantic import BaseModel
 
 from ..errors import SceneError
+from .animation import Track
 from .interpolate import interpolate_tree, wrap_keys
-from .model import Track
 from .paths import PathError, Step, format_path, get_value, parse_path, resolve_path, set_value
 
 if TYPE_CHECKING:
-    from ..scene.scene import Scene
+    from .scene import Scene
 
 __all__ = ["check_animation", "frame_count", "frame_seed", "is_sequence", "scene_at_frame",
            "sequence_file", "track_value"]

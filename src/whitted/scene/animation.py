@@ -1,6 +1,6 @@
 """The ``[animation]`` table of a scene: frames, frames per second and tracks (pure data).
 
-A track names one value of the scene by a path (:mod:`whitted.animation.paths`) and gives
+A track names one value of the scene by a path (:mod:`whitted.scene.paths`) and gives
 keys, pairs ``[frame, value]``, with an interpolation. Frames are numbered from 0 to
 ``frames - 1``; a key may sit between frames (``12.5``).
 
@@ -14,7 +14,7 @@ from typing import Any, Literal
 
 from pydantic import Field, field_validator
 
-from ..scene.types import Strict
+from .types import Strict
 
 Interpolation = Literal["step", "linear", "smooth", "spline"]
 MAX_FRAMES = 1_000_000

@@ -1,0 +1,51 @@
+"""The ``whitted`` program: the command line (``cli/``) and the editor's ``whitted gui``
+(``gui/``). The two are clients on one layer that never import each other; this module, above
+both, puts the editor's command into the command line."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from .cli.main import app, fail
+from .cli.main import main as _cli_main
+from .errors import WhittedError
+
+
+@app.command()
+def gui(
+    scene_path: Annotated[
+        Path | None, typer.Argument(metavar="[SCENE]", help="Scene file; a new one if missing")
+    ] = None,
+) -> None:
+    """Open the scene editor (a desktop window) on SCENE, or on the built-in default scene."""
+    from .scene import load_scene
+
+    scene = None
+    try:
+        exists = scene_path is not None and scene_path.exists()
+    except (OSError, ValueError) as exc:
+        raise fail(f"{scene_path}: {getattr(exc, 'strerror', None) or exc}") from None
+    if exists:
+        try:
+            scene = load_scene(scene_path)
+        except WhittedError as exc:
+            raise fail(str(exc)) from None
+    elif scene_path is not None and scene_path.suffix.lower() not in (".toml", ".json"):
+        raise fail(f"{scene_path}: unknown scene format {scene_path.suffix!r} (use .toml or .json)")
+    # Qt is imported by the editor only, after its check of the system libraries Qt needs
+    if importlib.util.find_spec("PySide6") is None:
+        raise fail("the editor needs PySide6, which is not installed: pip install 'whitted[gui]'")
+    try:
+        from .gui.app import run_editor
+    except ImportError as exc:
+        raise fail(f"the editor needs PySide6 ({exc}): pip install 'whitted[gui]'") from None
+    raise typer.Exit(run_editor(scene, scene_path))
+
+
+def main() -> None:
+    """Console entry point of ``whitted`` (and ``python -m whitted``)."""
+    _cli_main()
