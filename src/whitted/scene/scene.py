@@ -20,6 +20,17 @@ MAX_PIXELS = 100_000_000
 MAX_DEPTH = 64
 
 
+class Antialias(Strict):
+    """Adaptive anti-aliasing (``[render.antialias]``, POV-Ray's method 2: ``+A0.3 +AM2
+    +R3`` is ``threshold = 0.3, max_samples = 81``): a pixel's corners are traced, and a
+    pixel (then each of its quarters) whose corners differ by more than ``threshold`` (the
+    sum of the red, green and blue differences, 0..3) is split, while a square of it may
+    still take (2^k + 1)^2 <= ``max_samples`` samples."""
+
+    threshold: float = Field(default=0.3, ge=0.0, le=3.0)
+    max_samples: int = Field(default=81, ge=4, le=1089)
+
+
 class RenderSettings(Strict):
     """How to render. ``threads = 0`` uses every core. ``epsilon = 0`` picks the ray offset
     from the scene's size. ``transfer``: ``srgb`` (display images) or ``linear`` (raw values,
@@ -40,9 +51,13 @@ class RenderSettings(Strict):
     transfer: Literal["srgb", "linear"] = "srgb"
     tonemap: Literal["clamp", "reinhard", "aces"] = "clamp"
     mesh_tracer: Literal["auto", "whitted", "embree"] = "auto"
+    antialias: Antialias | None = None
 
     @model_validator(mode="after")
     def _size(self) -> RenderSettings:
+        if self.antialias is not None and self.samples > 1:
+            raise ValueError("antialias chooses the samples of each pixel: leave samples "
+                             "at 1 with [render.antialias]")
         if self.width * self.height > MAX_PIXELS:
             raise ValueError(
                 f"{self.width}x{self.height} is over {MAX_PIXELS // 1_000_000} megapixels"
