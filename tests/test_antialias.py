@@ -8,8 +8,7 @@ import pytest
 from pydantic import ValidationError
 
 import whitted
-from whitted.kernels.adaptive import levels_for
-from whitted.scene import Scene
+from whitted.scene.scene import Antialias, Scene
 
 
 def _edge_scene(**antialias):
@@ -30,7 +29,7 @@ def _edge_scene(**antialias):
 
 
 def test_levels_follow_the_sample_cap():
-    assert [levels_for(n) for n in (4, 8, 9, 24, 25, 81, 288, 289, 1089)] == \
+    assert [Antialias(max_samples=n).levels for n in (4, 8, 9, 24, 25, 81, 288, 289, 1089)] == \
         [0, 0, 1, 1, 2, 3, 3, 4, 5]
 
 

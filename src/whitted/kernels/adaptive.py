@@ -25,18 +25,6 @@ from .layout import RAY_PRIMARY
 from .tiles import camera_ray, lens_ray
 
 geometry_ref_if_instances = numba_object(".geometry_ref", "geometry_ref_if_instances")
-MAX_LEVELS = 5  # splits of a pixel: up to 33 x 33 samples
-
-
-def levels_for(max_samples: int) -> int:
-    """Splits allowed when a pixel may take at most ``max_samples`` samples: the most whose
-    grid, (2^levels + 1)^2 points, fits."""
-    levels = 0
-    while levels < MAX_LEVELS and ((1 << (levels + 1)) + 1) ** 2 <= max_samples:
-        levels += 1
-    return levels
-
-
 def adaptive_workspace(tile_width: int, tile_height: int, levels: int):
     """Scratch memory of one lane: the corners of a tile's pixels, one pixel's sample grid
     and its marks, and the stack of squares to visit (three per level and the first)."""

@@ -289,13 +289,9 @@ class RenderJob:
         antialias = self.settings.antialias
         levels = 0
         if antialias is not None:
-            from ..kernels.adaptive import (
-                adaptive_workspace,
-                levels_for,
-                render_tiles_adaptive,
-            )
+            from ..kernels.adaptive import adaptive_workspace, render_tiles_adaptive
 
-            levels = levels_for(antialias.max_samples)
+            levels = antialias.levels
 
         next_tile = 0
         most_per_call = max(1, -(-len(tiles) // (64 * lanes)))  # ~64 progress updates a lane

@@ -30,6 +30,15 @@ class Antialias(Strict):
     threshold: float = Field(default=0.3, ge=0.0, le=3.0)
     max_samples: int = Field(default=81, ge=4, le=1089)
 
+    @property
+    def levels(self) -> int:
+        """Splits a pixel may take: the most whose grid, (2^levels + 1)^2 points, stays
+        within ``max_samples`` (POV-Ray's ``+R``)."""
+        levels = 0
+        while ((1 << (levels + 1)) + 1) ** 2 <= self.max_samples:
+            levels += 1
+        return levels
+
 
 class RenderSettings(Strict):
     """How to render. ``threads = 0`` uses every core. ``epsilon = 0`` picks the ray offset
