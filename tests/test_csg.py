@@ -231,3 +231,62 @@ def test_torus_in_a_csg():
 def test_scenes_without_extras_keep_the_lean_kernels():
     assert Compiled(Sphere(radius=1)).geo.unbounded.dtype == np.int32
     assert Compiled(Torus(major_radius=1, minor_radius=0.2)).geo.unbounded.dtype == np.int64
+
+
+CLI_SCENE = """
+[[objects]]
+type = "csg"
+operation = "difference"
+name = "die"
+[[objects.objects]]
+type = "csg"
+operation = "intersection"
+[[objects.objects.objects]]
+type = "box"
+min = [-1.0, -1.0, -1.0]
+max = [1.0, 1.0, 1.0]
+[[objects.objects.objects]]
+type = "sphere"
+radius = 1.35
+[[objects.objects]]
+type = "sphere"
+name = "pip"
+center = [0.0, 0.0, 1.0]
+radius = 0.2
+material = "mirror"
+"""
+
+
+def test_info_shows_the_tree(tmp_path):
+    from typer.testing import CliRunner
+
+    from whitted.cli.main import app
+
+    path = tmp_path / "die.toml"
+    path.write_text(CLI_SCENE)
+    result = CliRunner().invoke(app, ["info", str(path)])
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    start = next(i for i, line in enumerate(lines) if "csg difference 'die'" in line)
+    assert [line.strip() for line in lines[start + 1:start + 5]] == [
+        "objects[0] csg intersection material=inherited",
+        "objects[0].objects[0] box material=inherited",
+        "objects[0].objects[1] sphere material=inherited",
+        "objects[1] sphere 'pip' material=mirror",
+    ]
+
+
+def test_a_plane_in_a_csg_is_a_one_line_error(tmp_path):
+    from typer.testing import CliRunner
+
+    from whitted.cli.main import app
+
+    path = tmp_path / "bad.toml"
+    path.write_text(CLI_SCENE.split('type = "sphere"\nname = "pip"')[0]
+                    + 'type = "plane"\nname = "floor"\n')
+    result = CliRunner().invoke(app, ["render", str(path), "-o", str(tmp_path / "x.png")])
+    assert result.exit_code == 2
+    message = result.output.strip()
+    assert len(message.splitlines()) == 1
+    assert "bad.toml" in message and "objects[0]" in message and "no volume" in message
+    assert not (tmp_path / "x.png").exists()

@@ -351,6 +351,25 @@ class CSG(_Shape):
         """Solids and operations in the tree (its compiled rows after the object's own)."""
         return 1 + sum(c.rows() if isinstance(c, CSG) else 1 for c in self.objects)
 
+    def tree_lines(self, indent: str = "    ") -> list[str]:
+        """The tree under this object, one line per child (nested children indented
+        further): its index path, type, name and material."""
+        lines = []
+
+        def walk(node: CSG, prefix: str, depth: int) -> None:
+            for k, child in enumerate(node.objects):
+                mat = (child.material if isinstance(child.material, str)
+                       else "inline" if child.material is not None else "inherited")
+                label = f" '{child.name}'" if child.name else ""
+                extra = f" {child.operation}" if isinstance(child, CSG) else ""
+                lines.append(f"{indent * depth}{prefix}[{k}] {child.type}{extra}{label} "
+                             f"material={mat}")
+                if isinstance(child, CSG):
+                    walk(child, f"{prefix}[{k}].objects", depth + 1)
+
+        walk(self, "objects", 1)
+        return lines
+
     def leaves(self) -> int:
         """Solids at the bottom of the tree (every nested CSG opened)."""
         return sum(c.leaves() if isinstance(c, CSG) else 1 for c in self.objects)
