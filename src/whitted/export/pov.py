@@ -225,8 +225,12 @@ class _PovWriter:
             return f"pigment {{ {_colour(cd, kt)} }}"
         mapping = "uv_mapping " if uv else ""
         if isinstance(tex, CheckerTexture):
+            # POV-Ray's checker is three-dimensional: the surface (pattern z = 0) is moved to
+            # the middle of a layer of cubes, not onto the boundary between two, where
+            # rounding picked the colour point by point
             body = (f"checker {_colour(cd * np.asarray(tex.color1), kt)}, "
-                    f"{_colour(cd * np.asarray(tex.color2), kt)} scale {num(1.0 / tex.checks)}")
+                    f"{_colour(cd * np.asarray(tex.color2), kt)} translate <0, 0, -0.5> "
+                    f"scale {num(1.0 / tex.checks)}")
         elif isinstance(tex, GradientTexture):
             body = (f"gradient {'x' if tex.axis == 'u' else 'y'} color_map {{ "
                     f"[0 {_colour(cd * np.asarray(tex.color1), kt)}] "
@@ -531,9 +535,15 @@ def _labelled(index: int, obj) -> str:
 
 
 def _planar_placement(normal, point) -> str:
-    """A texture transform that lays POV-Ray's x/y pattern plane onto the given plane."""
-    u, v = _perpendicular_basis(normal)
+    """A texture transform that lays POV-Ray's x/y pattern plane onto the given plane, x
+    along whitted's u direction there (compile/geometry.py ``tangent``: world x made
+    perpendicular to the normal, or -z for surfaces facing along x) and y along v = n x u."""
     n = np.asarray(normal, dtype=np.float64) / np.linalg.norm(normal)
+    helper = (np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9
+              else np.array([0.0, 0.0, -np.sign(n[0])]))
+    u = helper - np.dot(helper, n) * n
+    u /= np.linalg.norm(u)
+    v = np.cross(n, u)
     m = np.eye(4)
     m[:3, 0], m[:3, 1], m[:3, 2] = u, v, n
     m[:3, 3] = point
