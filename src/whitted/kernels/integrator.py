@@ -203,6 +203,11 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
                 else:
                     n_out = media_leave(scratch, n_out, body)
                     n1 = mats[body, MAT_IOR]
+                    if n_out < n_media and media[n_media - 1] != body:
+                        # leaving a body that is not the innermost (overlapping bodies: a
+                        # water ball reaching a hair into the ice around it): the ray travels
+                        # in the innermost one, on both sides
+                        n1 = mats[media[n_media - 1], MAT_IOR]
                     if outside >= 0:
                         n_out = media_enter(scratch, n_out, outside)
                         n2 = mats[outside, MAT_IOR]
