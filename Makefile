@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 # Compiled kernels are kept here between runs (see src/whitted/_cache.py).
 export WHITTED_CACHE_DIR ?= $(CURDIR)/.cache
 
-.PHONY: demo test lint install install-test bench clean
+.PHONY: demo test test-oldest-numba test-timing coverage lint install install-test bench clean
 
 $(BIN)/whitted: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -31,6 +31,39 @@ test: install-test
 	$(BIN)/ruff check src tests
 	$(BIN)/python -m pytest -q
 
+## The render smoke tests again with the oldest Numba pyproject.toml allows (stock Numba:
+## kernels/dispatcher.py verifies its tuning on newer ones), in a second virtual environment
+## that holds only that Numba, its llvmlite and a NumPy it supports, and takes everything else
+## from $(VENV)
+OLDEST_NUMBA := $(shell sed -n 's/.*"numba>=\([0-9.]*\),.*/\1/p' pyproject.toml)
+OLDEST_VENV ?= .venv-oldest-numba
+$(OLDEST_VENV)/.ready: pyproject.toml $(VENV)/.test-deps
+	$(PYTHON) -m venv $(OLDEST_VENV)
+	$(OLDEST_VENV)/bin/python -m pip install --quiet 'numba==$(OLDEST_NUMBA).*' 'numpy<2.1'
+	$(BIN)/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])' \
+		> $$($(OLDEST_VENV)/bin/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')/whitted-main-venv.pth
+	@touch $@
+
+test-oldest-numba: $(OLDEST_VENV)/.ready
+	$(OLDEST_VENV)/bin/python -c 'import numba; print("oldest Numba:", numba.__version__)'
+	WHITTED_CACHE_DIR=$(CURDIR)/.cache-oldest-numba $(OLDEST_VENV)/bin/python -m pytest -q \
+		-p no:cacheprovider tests/test_kernel_cache.py tests/test_jit.py \
+		tests/test_shapes.py -k 'not two_cold'
+
+## The tests whose outcome depends on the machine's speed (marker `timing`), run apart
+test-timing: install-test
+	$(BIN)/python -m pytest -q -m timing
+
+## Line coverage of the whole suite, subprocesses included, plus the kernels as plain Python
+coverage: install-test
+	rm -rf .cache/coverage && mkdir -p .cache/coverage
+	$(BIN)/python -m coverage run -m pytest -q -x
+	NUMBA_DISABLE_JIT=1 $(BIN)/python -m coverage run -m pytest -q -x -m python_kernels
+	$(BIN)/python -m coverage combine -q
+	$(BIN)/python -m coverage report --sort=cover
+	$(BIN)/python -m coverage report --omit='*/gui/*,*/cli/*,*/program.py,*/__main__.py' \
+	  --format=total | sed 's/^/non-interface code (without cli\/, gui\/): /; s/$$/ %/'
+
 ## Render the benchmark scenes (benchmarks/) and print the timing table
 bench: install
 	$(BIN)/whitted bench
@@ -39,4 +72,4 @@ lint: install-test
 	$(BIN)/ruff check src tests
 
 clean:
-	rm -rf $(VENV) .cache build *.egg-info src/*.egg-info
+	rm -rf $(VENV) $(OLDEST_VENV) .cache .cache-oldest-numba build *.egg-info src/*.egg-info

@@ -241,6 +241,7 @@ def test_usage_mistake_is_one_line_error(args: list[str], needle: str, tmp_path:
 # ------------------------------------------------------------------------------------ Ctrl-C
 
 
+@pytest.mark.timing  # sends SIGINT after a sleep sized to the machine
 @pytest.mark.skipif(os.name != "posix", reason="sends SIGINT to a child process (POSIX only)")
 def test_ctrl_c_keeps_the_part_rendered_so_far(tmp_path: Path):
     # A tiny render first, so that the kernels are compiled and cached: the interrupt must land

@@ -17,6 +17,7 @@ from gui_input import SLOW, make_window, mouse, type_into  # noqa: E402, F401
 from whitted.gui.document import CAMERA  # noqa: E402
 
 
+@pytest.mark.timing  # counts updates in a 2 s drag: depends on the machine's speed
 def test_preview_is_coarse_while_dragging_and_refines_when_idle(make_window, qtbot):  # noqa: F811
     window = make_window(whitted.default_scene().with_settings(width=480, height=360))
     vp = window.viewport
@@ -63,6 +64,7 @@ def test_preview_is_coarse_while_dragging_and_refines_when_idle(make_window, qtb
           f"release -> full size ({vp.image.width()}x{vp.image.height()}) {1000 * refine:.0f} ms")
 
 
+@pytest.mark.timing  # counts updates in a 2 s drag: depends on the machine's speed
 def test_g_move_drag_rate_is_logged(make_window, qtbot):  # noqa: F811
     """A G move changes the geometry, so every preview compiles the scene again: its rate
     (written to the log) is the slowest kind of drag."""

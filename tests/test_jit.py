@@ -1,12 +1,23 @@
-"""The kernel decorator: one compiled variant per real argument type, not per integer constant."""
+"""The kernel decorator: one compiled variant per real argument type, not per integer constant
+(the tuned dispatcher of kernels/dispatcher.py), and stock Numba where that is not verified."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+
 import numpy as np
+import pytest
 from numba import types
 
+from whitted.kernels import dispatcher
 from whitted.kernels.dispatcher import widen_integer
-from whitted.kernels.jit import kernel
+from whitted.kernels.jit import kernel, load_numba
+
+load_numba()
+tuned_only = pytest.mark.skipif(not dispatcher.tuned(),
+                                reason="stock Numba here (kernels/dispatcher.py VERIFIED)")
 
 
 @kernel(cache=False)
@@ -30,6 +41,7 @@ def _sum_rows_per_constant(a):
     return _row_sum_per_constant(a, 0) + _row_sum_per_constant(a, 1)
 
 
+@tuned_only
 def test_integer_constants_and_int32_share_one_int64_variant():
     a = np.arange(6.0).reshape(3, 2)
     small = np.array([2], np.int32)
@@ -38,6 +50,7 @@ def test_integer_constants_and_int32_share_one_int64_variant():
     assert [sig[1] for sig in _row_sum.callee.signatures] == [types.int64]
 
 
+@tuned_only
 def test_specialise_constants_keeps_a_variant_per_constant():
     a = np.arange(6.0).reshape(3, 2)
     assert _sum_rows_per_constant(a) == 6.0
@@ -64,6 +77,7 @@ def _twice_scaled(a):
     return _scaled(a, 2.0) + _scaled(a, 3.0)
 
 
+@tuned_only
 def test_calls_from_kernels_compile_the_twin_without_a_python_wrapper():
     assert _twice_scaled(1.5) == 7.5
     assert _scaled.signatures == []  # nothing compiled the Python-callable version
@@ -86,6 +100,7 @@ def _sum_of_squares(x, y):
     return _inlined_square(x) + _inlined_square(y)
 
 
+@tuned_only
 def test_inline_always_is_left_to_llvm():
     """Numba's IR inliner is not used (its copies grow with the square of the callee's
     size): the callee is compiled once and LLVM inlines it (``alwaysinline``)."""
@@ -109,6 +124,7 @@ def _inlined_caller(x):
     return _plain_callee(x) * 2.0
 
 
+@tuned_only
 def test_a_callee_of_an_inlined_kernel_is_not_inlined_by_inheritance():
     """Numba passes ``forceinline`` on to callees compiled while an alwaysinline kernel
     compiles, unless they set it: a kernel would then be inlined or not depending on which
@@ -120,62 +136,66 @@ def test_a_callee_of_an_inlined_kernel_is_not_inlined_by_inheritance():
     assert callee.fndesc.inline is False
 
 
-def test_a_twin_gets_no_machine_code_and_its_callers_link_its_bitcode():
-    """kernels/cache_load.py: a twin's library is finalised without going into the JIT (its
-    callers link its LLVM module; its own machine code was never run) and is cached as its
-    bitcode beside an empty object code; its caller still runs it."""
-    assert _twice_scaled(2.0) == 10.0
-    (twin,) = _scaled.callee.overloads.values()
-    library = twin.library
-    assert library.name.endswith("__whitted_twin")
-    assert library._finalized
-    engine = library.codegen._engine
-    assert engine.get_function_address(twin.fndesc.mangled_name) == 0  # not in the JIT
-    name, kind, (obj, bitcode) = library.serialize_using_object_code()
-    assert (name, kind, obj) == (library.name, "object", b"") and len(bitcode) > 0
-    (caller,) = _twice_scaled.overloads.values()
-    assert caller.library.get_pointer_to_function(
-        caller.fndesc.llvm_cpython_wrapper_name) != 0
-
-
-CACHED_TWIN = '''
-import sys
+STOCK = """
 import numpy as np
-from whitted.kernels.jit import kernel
-from cached_twin_kernels import double_it, quadruple
+from numba.core.registry import CPUDispatcher
+from whitted.kernels import dispatcher
+from whitted.kernels.jit import kernel, load_numba
+
+load_numba()
+assert dispatcher.tuned() is False
 
 
-@kernel(cache=False)
-def octuple(x):  # compiled in every run, calling the twin (from the cache in the second)
-    return double_it(double_it(double_it(x)))
+@kernel(cache=False, inline="always")
+def inlined_square(x):
+    return x * x
 
 
-assert quadruple(np.float64(1.5)) == 6.0
-assert octuple(np.float64(1.5)) == 12.0
-twin = next(iter(double_it.callee.overloads.values())).library
-print({None: "LOADED", "x": "COMPILED"}.get(getattr(twin, "_unparsed_bitcode", "x"), "UNPARSED"))
-'''
+@kernel(cache=False, specialise_constants=True, numba_inline=True)
+def row_sum(a, i):
+    return a[i, 0] + a[i, 1]
 
 
-def test_a_twin_from_the_cache_links_into_a_new_caller(tmp_path):
-    """A twin written to the cache by one process (bitcode, no machine code) is loaded by the
-    next for linking only, and a kernel compiled there calls it."""
-    import os
-    import subprocess
-    import sys
+@kernel(entry=True)
+def total(a, small):
+    return inlined_square(a[0, 0]) + row_sum(a, 1) + row_sum(a, small[0])
 
-    (tmp_path / "cached_twin_kernels.py").write_text(
-        "from whitted.kernels.jit import kernel\n\n\n"
-        "@kernel\ndef double_it(x):\n    return 2.0 * x\n\n\n"
-        "@kernel\ndef quadruple(x):\n    return double_it(double_it(x))\n")
-    (tmp_path / "run.py").write_text(CACHED_TWIN)
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"),
-               PYTHONPATH=os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")]))
-    runs = [subprocess.run([sys.executable, "run.py"], cwd=tmp_path, env=env,
-                           capture_output=True, text=True, timeout=600) for _ in range(2)]
-    for run in runs:
-        assert run.returncode == 0, run.stderr
-    # the first run compiled the twin, the second loaded it and parsed its bitcode to link it
-    assert [run.stdout.strip() for run in runs] == ["COMPILED", "LOADED"]
-    cached = list((tmp_path / "cache").rglob("*double_it__whitted_twin*.nbc"))
-    assert cached, list((tmp_path / "cache").rglob("*"))
+
+a = np.arange(6.0).reshape(3, 2)
+print("RESULT", total(a, np.array([2], np.int32)), type(total.dispatcher).__name__)
+"""
+
+
+@pytest.mark.parametrize("why", [{"WHITTED_NUMBA_TUNING": "0"}, "unverified"])
+def test_stock_numba_runs_the_same_kernels(tmp_path, why):
+    """Where the tuned dispatcher is off (asked, or Numba outside the verified versions),
+    kernels are plain ``numba.njit`` functions taking the same decorator options (the
+    tuned-only ones dropped), cached, with the same results."""
+    script = STOCK
+    env = dict(os.environ, WHITTED_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("NUMBA_CACHE_DIR", None)
+    if why == "unverified":
+        script = script.replace("load_numba()\n", "dispatcher.VERIFIED['numba'] = ((0, 0), "
+                                "(0, 1))\nload_numba()\n", 1)
+    else:
+        env.update(why)
+    (tmp_path / "run.py").write_text(script)
+    for _ in range(2):  # compiled, then loaded from the cache
+        run = subprocess.run([sys.executable, "run.py"], cwd=tmp_path, env=env,
+                             capture_output=True, text=True, timeout=600)
+        assert run.returncode == 0, run.stderr[-2000:]
+        assert "RESULT 14.0 CPUDispatcher" in run.stdout  # 0 + (2+3) + (4+5)
+        assert run.stderr == ""
+    assert list((tmp_path / "cache").rglob("*total*.nbc"))
+
+
+def test_private_names_are_listed_and_checked():
+    """Every private name the tuned dispatcher uses is listed; a Numba outside the verified
+    versions turns it off."""
+    assert dispatcher.PRIVATE_NAMES and dispatcher.VERIFIED["numba"][0] < (
+        dispatcher.VERIFIED["numba"][1])
+    with open(dispatcher.__file__) as f:
+        source = f.read()
+    for name in ("get_call_template", "_load_overload", "rtsys.initialize", "_nrt",
+                 "no_cpython_wrapper", "forceinline", "UserProvidedCacheLocator"):
+        assert name in source.split("PRIVATE_NAMES = (", 1)[1].split(")\n", 1)[0], name

@@ -176,19 +176,23 @@ def test_a2_export_names_the_output_from_the_whole_stem(tmp_path: Path):
     assert not (tmp_path / "scene.pov").exists()
 
 
-def _slow_compile(monkeypatch, signum: int, release: threading.Event) -> None:
+def _slow_compile(monkeypatch, signum: int, release: threading.Event) -> threading.Event:
     """The first compile, standing in for Numba's 30 s: sends ``signum`` to this process and
-    then takes long (until ``release``)."""
+    then takes long (until ``release``). Returns the event set when the stand-in ends."""
     from whitted.render import api
+
+    ended = threading.Event()
 
     def warm_up(compiled=None) -> float:
         if compiled is None:
             os.kill(os.getpid(), signum)
             release.wait(30)
+            ended.set()
             raise RuntimeError("the stand-in compile ends the abandoned job here")
         return 0.0
 
     monkeypatch.setattr(api, "warm_up_kernels", warm_up)
+    return ended
 
 
 @pytest.mark.parametrize(("signum", "status", "word"), [
@@ -198,13 +202,13 @@ def test_a3_a4_signal_during_the_first_compile_stops_at_once_and_writes_nothing(
     write(tmp_path / "scene.toml", SCENE)
     good = png_bytes(tmp_path / "out.png")
     release = threading.Event()
-    _slow_compile(monkeypatch, signum, release)
-    start = time.perf_counter()
+    compile_ended = _slow_compile(monkeypatch, signum, release)
     try:
         code, out, err = run_main("render", "scene.toml", "-o", "out.png", cwd=tmp_path)
+        # the command returned while the stand-in compile was still running: it did not wait
+        assert not compile_ended.is_set()
     finally:
         release.set()
-    assert time.perf_counter() - start < 5.0
     assert code == status, (code, out, err)
     assert f"{word} before any tile was finished: nothing written" in err
     assert (tmp_path / "out.png").read_bytes() == good  # the good image is kept
@@ -228,10 +232,9 @@ main()
 @pytest.mark.skipif(os.name != "posix", reason="POSIX signals")
 def test_a3_ctrl_c_during_the_first_compile_ends_the_process_at_once(tmp_path: Path):
     write(tmp_path / "scene.toml", SCENE)
-    start = time.perf_counter()
+    # the stand-in compile sleeps 120 s: a process that waited for it would pass the timeout
     result = subprocess.run([sys.executable, "-c", LONG_COMPILE], cwd=tmp_path,
                             capture_output=True, text=True, timeout=100)
-    assert time.perf_counter() - start < 60  # not the 120 s of the compile
     assert result.returncode == 130, result.stderr
     assert "interrupted before any tile was finished: nothing written" in result.stderr
     assert not (tmp_path / "out.png").exists()
@@ -810,3 +813,38 @@ def test_f_aov_files_are_as_documented(tmp_path: Path):
     # a corner misses the sphere, the centre hits it at distance 5 - 1 = 4 facing the camera
     assert depth[0, 0] == np.inf and ids[0, 0] == -1 and not normal[0, 0].any()
     assert ids[6, 8] == 0 and abs(depth[6, 8] - 4.0) < 0.05 and normal[6, 8, 2] > 0.95
+
+
+@pytest.mark.skipif(os.name != "posix", reason="POSIX signals")
+@pytest.mark.parametrize(("signum", "status", "word"), [
+    (signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")])
+def test_a_signal_after_the_first_tiles_keeps_them(tmp_path: Path, monkeypatch, signum: int,
+                                                   status: int, word: str):
+    """The signal arrives when the first tiles are done (an event, not a sleep): the image
+    is written with them, at full size, the rest black, and the status says which signal."""
+    from whitted.render import api
+
+    write(tmp_path / "scene.toml", 'background = "#808080"\n' + SCENE.replace(
+        "width = 16", "width = 256").replace("height = 12", "height = 192"))
+    original = api.RenderJob._report
+    sent = []
+
+    def report_then_signal(self, *args, **kwargs):
+        original(self, *args, **kwargs)
+        if not sent:
+            sent.append(True)
+            os.kill(os.getpid(), signum)
+            # the handler (main thread) cancels the job: go on only once it has
+            assert self.cancel_token._event.wait(30)
+
+    monkeypatch.setattr(api.RenderJob, "_report", report_then_signal)
+    code, out, err = run_main("render", "scene.toml", "-o", "out.png", "--threads", "1",
+                              cwd=tmp_path)
+    assert code == status, (out, err)
+    assert word in err and "Traceback" not in err
+    with PILImage.open(tmp_path / "out.png") as image:
+        assert image.size == (256, 192)
+        pixels = np.asarray(image.convert("RGB"))
+    # 16-pixel tiles (render/api.py DEFAULT_TILE) on a grey background: rendered or black
+    lit = pixels.reshape(12, 16, 16, 16, 3).max(axis=(1, 3, 4))
+    assert 0 < (lit > 0).sum() < lit.size  # some tiles kept, not all rendered

@@ -18,9 +18,7 @@ import types
 from typing import TYPE_CHECKING
 
 from . import _lean_numba
-from ._cache import configure_kernel_cache
 
-configure_kernel_cache()  # before any kernel module imports numba
 _lean_numba.install()  # Numba's import without its SciPy and PyYAML probes
 
 #: public name -> the module that defines it

@@ -1,22 +1,63 @@
-"""Where compiled kernels are kept between runs.
+"""Where compiled kernels are kept between runs, and how whitted checks them before use.
 
-Numba's ``cache=True`` keys each cached function on its own source file only, so a change in
-a helper it calls would leave a stale machine-code copy behind. whitted therefore puts its
-cache in a folder named after a hash of all kernel sources: any change to any kernel starts a
-fresh cache, and different whitted versions never share one.
+**The folder.** Numba's ``cache=True`` keys each cached function on its own source file only,
+so a change in a helper it calls would leave a stale machine-code copy behind. whitted
+therefore puts its cache in a folder named after a hash of all kernel sources: any change to
+any kernel starts a fresh cache, and different whitted versions never share one. The folder
+is ``$WHITTED_CACHE_DIR/numba-<hash>`` (default ``~/.cache/whitted``; ``numba-<hash>-stock``
+with ``WHITTED_NUMBA_TUNING=0``); an explicit ``NUMBA_CACHE_DIR`` set by the user wins.
 
-The folder is ``$WHITTED_CACHE_DIR/numba-<hash>`` (default ``~/.cache/whitted``). An explicit
-``NUMBA_CACHE_DIR`` set by the user wins.
+**A folder that cannot be used** (read-only, a file, ``/proc``, ``/dev/null``): whitted says so
+in one ``warning:`` line and uses the per-user folder instead, or, when that cannot be used
+either, compiles in memory (every run compiles again). Never an error.
+
+**Checked before use.** Numba's cache files (``.nbi`` indexes, ``.nbc`` machine code) carry no
+checksum: one flipped bit can crash the process that loads them or give a wrong image. whitted
+keeps a list of their SHA-256 sums (:data:`SUMS`, written by whitted under a lock, whole or not
+at all) and, before Numba first loads anything in a process (:func:`prepare`), checks every
+cache file against it:
+
+- a file whose sum differs from its entry was damaged (or replaced by hand): it is deleted
+  (Numba then compiles that kernel again and caches it anew) and one ``warning:`` line says
+  how many were;
+- a file the list does not name (written by a process that was stopped before it sealed
+  it, or put there by hand) is not trusted either: in whitted's own folder it is deleted
+  silently (it is compiled again); in a folder the user named with ``NUMBA_CACHE_DIR``, which
+  may hold other programs' cache files, it is taken as found;
+- a damaged list is a list of nothing: every file is then compiled again, with one warning.
+
+After Numba wrote files (a compile of a kernel called from Python, the warm-up), whitted
+:func:`seal` s them: the files that are new since this process last looked, or were replaced
+by a new file (a new inode: Numba writes a file whole and renames it into place), get their
+entries; a file changed in place keeps its old entry, so damage is not sealed. A list that
+names files by content only survives copying the folder elsewhere (a container image). Two
+processes compiling at once take turns through a lock file (``whitted.lock``); the
+cold compile of the render kernels holds it throughout (render/warm_up.py), so a second cold
+render waits and then loads what the first compiled.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import json
 import os
 import sys
+import tempfile
+import threading
+import time
 from pathlib import Path
 
 KERNEL_DIRS = ("kernels", "compile", "assets")
+#: the list of sums in the cache folder
+SUMS = "whitted-sums.json"
+LOCK = "whitted.lock"
+#: what Numba writes into the cache folder
+CACHE_SUFFIXES = (".nbi", ".nbc")
+#: set in the environment of the compile helper (render/warm_up.py): its parent checked the
+#: folder and holds the lock; the helper neither checks nor seals
+HELPER_ENV = "WHITTED_KERNEL_CACHE_HELPER"
+LOCK_WAIT_SECONDS = 900.0  # a process holding the lock longer than this is not waited for
 
 
 def kernel_source_hash() -> str:
@@ -29,21 +70,281 @@ def kernel_source_hash() -> str:
     return h.hexdigest()[:16]
 
 
+def _user_base() -> str:
+    return os.path.join(os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"),
+                        "whitted")
+
+
+def _folder_name() -> str:
+    # stock Numba's code (WHITTED_NUMBA_TUNING=0, kernels/dispatcher.py) is kept apart from
+    # the tuned dispatcher's: the same kernel and types, compiled with other options
+    stock = "-stock" if os.environ.get("WHITTED_NUMBA_TUNING", "1") == "0" else ""
+    return f"numba-{kernel_source_hash()}{stock}"
+
+
 def cache_dir() -> Path:
-    base = os.environ.get("WHITTED_CACHE_DIR") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "whitted"
-    )
-    return Path(base) / f"numba-{kernel_source_hash()}"
+    base = os.environ.get("WHITTED_CACHE_DIR") or _user_base()
+    return Path(base) / _folder_name()
+
+
+def _warn(message: str) -> None:
+    print(f"warning: {message}", file=sys.stderr, flush=True)
+
+
+def _usable(folder: str) -> str | None:
+    """None when Numba can keep files in ``folder`` (made if missing), else why not."""
+    try:
+        os.makedirs(folder, exist_ok=True)
+        if not os.path.isdir(folder):
+            return "not a folder"
+        tempfile.TemporaryFile(dir=folder).close()
+    except OSError as exc:
+        return exc.strerror or type(exc).__name__
+    return None
+
+
+class KernelCache:
+    """The kernel cache folder this process uses (``folder``; None: compiling in memory)."""
+
+    def __init__(self, folder: str | None, own: bool, helper: bool) -> None:
+        self.folder = folder
+        self.own = own  # whitted's folder (not one the user named with NUMBA_CACHE_DIR)
+        self.helper = helper
+        self._seen: dict[str, tuple[int, int, int]] = {}  # file -> (inode, size, mtime)
+        self._lock = threading.RLock()
+        self._lock_fd: int | None = None
+        self._lock_depth = 0
+        self.unsealed = False  # Numba compiled something since the last seal
+
+    # ---------------------------------------------------------------- lock
+    @contextlib.contextmanager
+    def locked(self):
+        """Held by one process at a time (and one thread of it), for checking, sealing and
+        a cold compile. Without a lock file (it cannot be made) it does nothing."""
+        if self.folder is None or self.helper:
+            yield
+            return
+        with self._lock:
+            if self._lock_depth == 0:
+                self._acquire()
+            self._lock_depth += 1
+            try:
+                yield
+            finally:
+                self._lock_depth -= 1
+                if self._lock_depth == 0:
+                    self._release()
+
+    def _acquire(self) -> None:
+        import fcntl
+
+        try:
+            fd = os.open(os.path.join(self.folder, LOCK), os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError:
+            return
+        deadline = time.monotonic() + LOCK_WAIT_SECONDS
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                if time.monotonic() > deadline:
+                    break  # a process holding it this long is not waited for
+                time.sleep(0.05)
+            except OSError:  # a file system without locks
+                break
+        self._lock_fd = fd
+
+    def _release(self) -> None:
+        fd, self._lock_fd = self._lock_fd, None
+        if fd is not None:
+            os.close(fd)  # releases the lock
+
+    # ---------------------------------------------------------------- sums
+    def _files(self) -> dict[str, os.stat_result]:
+        found: dict[str, os.stat_result] = {}
+        root = self.folder
+        try:
+            folders = [e for e in os.scandir(root) if e.is_dir(follow_symlinks=False)]
+        except OSError:
+            return found
+        for sub in folders:
+            try:
+                entries = list(os.scandir(sub.path))
+            except OSError:
+                continue
+            for entry in entries:
+                if entry.name.endswith(CACHE_SUFFIXES):
+                    with contextlib.suppress(OSError):
+                        found[f"{sub.name}/{entry.name}"] = entry.stat(follow_symlinks=False)
+        return found
+
+    def _read_sums(self) -> tuple[dict, bool]:
+        """The list of sums, and whether it was damaged (then empty)."""
+        try:
+            with open(os.path.join(self.folder, SUMS), "rb") as f:
+                data = json.loads(f.read())
+        except FileNotFoundError:
+            return {}, False
+        except (OSError, ValueError):
+            return {}, True
+        if not isinstance(data, dict) or not all(
+                isinstance(v, list) and len(v) == 2 and isinstance(v[0], str)
+                and isinstance(v[1], int) for v in data.values()):
+            return {}, True
+        return data, False
+
+    def _write_sums(self, sums: dict) -> None:
+        path = os.path.join(self.folder, SUMS)
+        tmp = f"{path}.{os.getpid()}.tmp"
+        try:
+            with open(tmp, "w") as f:
+                json.dump(sums, f, sort_keys=True)
+            os.replace(tmp, path)
+        except OSError:  # full or read-only: the files stay unsealed, compiled again later
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+
+    @staticmethod
+    def _digest(path: str) -> str | None:
+        try:
+            with open(path, "rb") as f:
+                return hashlib.sha256(f.read()).hexdigest()
+        except OSError:
+            return None
+
+    def verify(self) -> int:
+        """Check every cache file against the list (module docstring); delete what fails.
+        Returns how many damaged files were deleted."""
+        if self.folder is None or self.helper:
+            return 0
+        with self.locked():
+            sums, damaged_list = self._read_sums()
+            damaged = 0
+            deleted = False
+            files = self._files()
+            for name, st in files.items():
+                path = os.path.join(self.folder, name)
+                entry = sums.get(name)
+                good = entry is not None and entry[1] == st.st_size \
+                    and self._digest(path) == entry[0]
+                if good:
+                    self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
+                    continue
+                if entry is None and not damaged_list and not self.own:
+                    continue  # another program's file in the user's NUMBA_CACHE_DIR
+                if entry is not None:
+                    damaged += 1
+                if entry is not None or self.own or damaged_list:
+                    with contextlib.suppress(OSError):
+                        os.unlink(path)
+                    deleted = True
+                sums.pop(name, None)
+            stale = [name for name in sums if name not in files]
+            for name in stale:
+                del sums[name]
+            if damaged or damaged_list:
+                self._write_sums(sums)
+                self._clear_markers()
+            elif stale:
+                self._write_sums(sums)
+            if deleted:
+                self._clear_markers()
+            if damaged_list:
+                _warn(f"the kernel cache's list of checksums in {self.folder} was damaged; "
+                      "its kernels are compiled again")
+            elif damaged:
+                _warn(f"{damaged} damaged kernel cache file{'s' * (damaged > 1)} in "
+                      f"{self.folder} deleted; compiling {'them' if damaged > 1 else 'it'} "
+                      "again")
+            if not self.own and not damaged_list:  # files found in the user's folder: as found
+                self.unsealed = True
+                self.seal()
+            return damaged
+
+    def _clear_markers(self) -> None:
+        for marker in Path(self.folder).glob("whitted-ready-*"):
+            with contextlib.suppress(OSError):
+                marker.unlink()
+
+    def seal(self) -> None:
+        """Enter in the list the cache files written since this process last looked: new
+        ones, and ones replaced by a new file (module docstring)."""
+        if self.folder is None or self.helper:
+            self.unsealed = False
+            return
+        with self.locked():
+            self.unsealed = False
+            sums, damaged_list = self._read_sums()
+            changed = False
+            for name, st in self._files().items():
+                seen = self._seen.get(name)
+                entry = sums.get(name)
+                if seen is not None and seen[0] == st.st_ino and entry is not None:
+                    continue  # as checked (or changed in place: not sealed)
+                digest = self._digest(os.path.join(self.folder, name))
+                if digest is None:
+                    continue
+                sums[name] = [digest, st.st_size]
+                self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
+                changed = True
+            if changed or damaged_list:
+                self._write_sums(sums)
+
+
+_state: KernelCache | None = None
+_state_lock = threading.Lock()
+
+
+def _set_numba_cache_dir(folder: str) -> None:
+    os.environ["NUMBA_CACHE_DIR"] = folder
+    if "numba" in sys.modules:  # numba already read its settings: tell it directly
+        import numba
+
+        numba.config.CACHE_DIR = folder
+
+
+def prepare() -> KernelCache:
+    """Choose the kernel cache folder, point Numba at it, and check its files (once per
+    process, before Numba loads any kernel)."""
+    global _state
+    if _state is not None:
+        return _state
+    with _state_lock:
+        if _state is not None:
+            return _state
+        helper = os.environ.get(HELPER_ENV) == "1"
+        chosen = os.environ.get("NUMBA_CACHE_DIR")
+        own = not chosen or helper
+        if not chosen:
+            chosen = str(cache_dir())
+        folder: str | None = chosen
+        problem = _usable(chosen)
+        if problem is not None:
+            fallback = str(Path(_user_base()) / _folder_name())
+            if fallback != chosen and _usable(fallback) is None:
+                _warn(f"kernel cache folder {chosen} cannot be used ({problem}); "
+                      f"using {fallback}")
+                folder, own = fallback, True
+            else:
+                _warn(f"kernel cache folder {chosen} cannot be used ({problem}); kernels are "
+                      "compiled in memory (every run compiles them again)")
+                folder = None
+        if folder is None:
+            os.environ.pop("NUMBA_CACHE_DIR", None)
+            if "numba" in sys.modules:
+                import numba
+
+                numba.config.CACHE_DIR = ""
+        else:
+            _set_numba_cache_dir(folder)
+        state = KernelCache(folder, own, helper)
+        state.verify()
+        _state = state
+        return state
 
 
 def configure_kernel_cache() -> str:
-    """Point Numba's on-disk cache at whitted's folder (unless the user chose one)."""
-    chosen = os.environ.get("NUMBA_CACHE_DIR")
-    if not chosen:
-        chosen = str(cache_dir())
-        os.environ["NUMBA_CACHE_DIR"] = chosen
-        if "numba" in sys.modules:  # numba already read its settings: tell it directly
-            import numba
-
-            numba.config.CACHE_DIR = chosen
-    return chosen
+    """Point Numba's on-disk cache at whitted's checked folder (:func:`prepare`) and return
+    it ("" when kernels are compiled in memory)."""
+    return prepare().folder or ""

@@ -5,19 +5,19 @@ Numba compiles a kernel's callees one after another, depth first, in the process
 compiles it. On a cold cache the render API starts a second process that compiles these
 (and then the builders) into the on-disk cache while the first compiles ``render_tiles``;
 when the first reaches one of them it waits for the helper and loads it instead of compiling
-it too (``render/warm_up.py``, ``jit.KernelCache.wait_for_helper``). The types must be
+it too (``render/warm_up.py``, ``dispatcher.KernelCache.wait_for_helper``; only with the tuned
+dispatcher of kernels/dispatcher.py). The types must be
 exactly the ones the callers ask for, or the helper's work is wasted: ``tests/test_warm_up.py``
-checks them. Integers are int64 everywhere (``jit.KernelDispatcher`` widens them); what is
+checks them. Integers are int64 everywhere (``dispatcher.KernelDispatcher`` widens them); what is
 compiled is each kernel's twin for calls from kernels (``callee``).
 
-The share is chosen by measured compile times (CPU, one process, 2-core EPYC, Zen 4): for
-scenes without mesh instances the helper also compiles all the builders and the OBJ loader
-(about 9 s), so it takes only ``surface_normals`` (0.9 s of the 10.9 s render kernel), the
-first callee ``render_tiles`` reaches after ``closest_hit``; for scenes with mesh instances
-(the builders are already cached) it takes the shadow rays (``shadow_transmittance``, about
-4 s of 12.3 s), the deepest part of ``direct_light``: what remains here is ``closest_hit``,
-normals, colour, then ``direct_light`` and ``render_tiles``, each inlining the one below
-(work only this process can do, as it needs everything below it).
+The share is chosen by measured compile times (docs/performance.md): for scenes without mesh
+instances the helper also compiles all the builders and the OBJ loader, so it takes only
+``surface_normals``, the first callee ``render_tiles`` reaches after ``closest_hit``; for
+scenes with mesh instances (the builders are already cached) it takes the shadow rays
+(``shadow_transmittance``), the deepest part of ``direct_light``: what remains here is
+``closest_hit``, normals, colour, then ``direct_light`` and ``render_tiles``, each inlining
+the one below (work only this process can do, as it needs everything below it).
 """
 
 from __future__ import annotations

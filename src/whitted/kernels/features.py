@@ -38,9 +38,9 @@ def instances_possible(geo_type) -> bool:
     kind without, whose ``inst_box`` is float32)."""
     from numba import types
 
-    from .geometry_ref import geometry_type
-
-    geo_type = geometry_type(geo_type)
+    # a GeometryRef (kernels/geometry_ref.py) names the tuple type it points to as
+    # ``geometry``; the tuple type itself has no such attribute
+    geo_type = getattr(geo_type, "geometry", geo_type)
     field_type = dict(zip(geo_type.fields, geo_type.types, strict=True))["inst_box"]
     return field_type.dtype != types.float32
 

@@ -2,24 +2,42 @@
 
 ``@kernel`` (render kernels: fast-math, no runtime), ``@builder`` (the kernels that build a
 scene's arrays and parse files: Numba's defaults, with the runtime), and the two Numba
-extensions kernels use, ``@overload`` and :func:`numba_object`. The options, and what each
-is for, are documented in kernels/dispatcher.py, which holds Numba's side of a kernel.
+extensions kernels use, ``@overload`` and :func:`numba_object`.
 
 A decorated kernel is a :class:`Kernel`: its Python function and its options. Its Numba
-dispatcher is made, and Numba imported (0.13 s), only when something needs it: a kernel is
-compiled, a call from Python finds no machine code in the native index (kernels/native.py),
-or code asks for a dispatcher's attributes (``signatures``, ``overloads``, ``callee``, ...,
-which a Kernel passes on to its dispatcher). A warm render of a scene seen before calls its
-entry points (the kernels that Python calls: ``@builder``, ``@kernel(entry=True)``) through
-kernels/native.py and never imports Numba.
+dispatcher is made, and Numba imported, only when something needs it: a kernel is called or
+compiled, or code asks for a dispatcher's attributes (``signatures``, ``overloads``, ...,
+which a Kernel passes on to its dispatcher). So ``import whitted`` and the commands that
+never render never import Numba.
 
-When Numba comes in (:func:`load_numba`) the deferred extensions are registered, and in the
-globals of whitted's modules (and of any module that defined a kernel) each Kernel that is
-not an entry point, and each :func:`numba_object`, is replaced by the real thing: kernels
-call kernels through their module globals, and Numba's compiler must find its own objects
-there (its inliner recognises only its dispatchers). An entry point stays a Kernel, so calls
-from Python keep going through the native index; Numba types any Kernel as its dispatcher
-(``_numba_type_``). A non-entry kernel defined after Numba came in is its dispatcher at once.
+The dispatcher is Numba's own (``numba.njit`` with the options below), or, on the Numba
+versions kernels/dispatcher.py was verified with, that module's tuned one (integer widening,
+twins without Python wrappers, no runtime in render kernels): the one module that uses
+names Numba does not document. Options:
+
+- ``error_model="numpy"``: 1/0 gives inf instead of raising; ``nogil=True``: the editor's UI
+  thread runs while a render is in flight;
+- ``fastmath``: the flags that let LLVM reorder and fuse arithmetic (``reassoc``,
+  ``contract``, ``arcp``, ``nsz``, ``afn``) but not ``nnan`` or ``ninf``: kernels use inf as
+  the "no hit" sentinel. The watertight triangle test opts out (``fastmath=False``);
+- ``inline="always"``: inlined by LLVM where the tuned dispatcher is used (its
+  ``forceinline``), not inlined otherwise; ``numba_inline=True``: Numba's own IR inliner
+  (``inline="always"`` of ``numba.njit``);
+- ``specialise_constants=True``: a variant per integer constant (what stock Numba always
+  does; the tuned dispatcher otherwise compiles one int64 variant);
+- ``entry=True``: a kernel Python calls (its calls seal the cache files a compile wrote,
+  whitted/_cache.py);
+- ``cache`` (default True): kept in the kernel cache (whitted/_cache.py; in memory when no
+  folder can be used).
+
+When Numba comes in (:func:`load_numba`) the kernel cache is prepared and checked, the
+deferred extensions are registered, and in the globals of whitted's modules (and of any
+module that defined a kernel) each Kernel that is not an entry point, and each
+:func:`numba_object`, is replaced by the real thing: kernels call kernels through their
+module globals, and Numba's compiler must find its own objects there. An entry point stays a
+Kernel, so calls from Python seal what they compiled; Numba types any Kernel as its
+dispatcher (``_numba_type_``, which a Kernel passes on). A non-entry kernel defined after
+Numba came in is its dispatcher at once.
 """
 
 from __future__ import annotations
@@ -30,7 +48,7 @@ import os
 import sys
 import threading
 
-#: the fast-math flags of render kernels (see kernels/dispatcher.py)
+#: the fast-math flags of render kernels (module docstring)
 FAST_MATH = frozenset({"reassoc", "contract", "arcp", "nsz", "afn"})
 
 _lock = threading.RLock()
@@ -53,17 +71,30 @@ def _jit_disabled() -> bool:
 
 
 def load_numba() -> None:
-    """Import Numba with whitted's settings (kernels/dispatcher.py), register the deferred
-    extensions, and put dispatchers where kernels will look for them (module docstring).
-    Does nothing the second time."""
+    """Prepare and check the kernel cache (whitted/_cache.py), import Numba with whitted's
+    settings, register the deferred extensions, and put dispatchers where kernels will look
+    for them (module docstring). Does nothing the second time."""
     global _numba_loaded, _numba_imported
     if _numba_loaded:
         return
     with _lock:  # another thread waits here until the swap is done
         if _numba_loaded or _numba_imported:  # done, or this thread is swapping (re-entry)
             return
-        from . import dispatcher  # noqa: F401 - Numba, SLP, the cache, faster loading
+        from .._cache import prepare
 
+        prepare()  # NUMBA_CACHE_DIR set, the files checked, before Numba reads any
+        if "NUMBA_SLP_VECTORIZE" not in os.environ:
+            # LLVM's SLP vectoriser packs the three lanes of vector arithmetic into SIMD
+            # instructions (docs/performance.md); set in the environment, as Numba reads its
+            # settings from there again whenever the environment has changed
+            os.environ["NUMBA_SLP_VECTORIZE"] = "1"
+            if "numba" in sys.modules:
+                from numba import config
+
+                config.SLP_VECTORIZE = 1
+        from numba.core import event
+
+        event.register("numba:compile", _compile_listener())
         while _deferred:
             _deferred.pop(0)()
         _numba_imported = True
@@ -71,6 +102,33 @@ def load_numba() -> None:
             _swap_in_globals()
         finally:
             _numba_loaded = True
+
+
+def _compile_listener():
+    """A listener of Numba's compile events (``numba.core.event``, Numba's documented event
+    API): after a compile, the cache files it wrote are sealed when the call from Python
+    returns (Kernel.__call__)."""
+    from numba.core import event
+
+    from .._cache import prepare
+
+    class CompileSeen(event.Listener):
+        def on_start(self, ev) -> None:
+            pass
+
+        def on_end(self, ev) -> None:
+            prepare().unsealed = True
+
+    return CompileSeen()
+
+
+def seal_cache() -> None:
+    """Enter the cache files compiles wrote in the list of checksums (whitted/_cache.py)."""
+    from .._cache import prepare
+
+    state = prepare()
+    if state.unsealed:
+        state.seal()
 
 
 def _swap_in_globals() -> None:
@@ -101,7 +159,7 @@ class Kernel:
         self.options = options
         self.specialise_constants = specialise_constants
         self.cache = cache
-        #: called from Python: its calls go through the native index (kernels/native.py)
+        #: called from Python: its calls seal the cache files their compiles wrote
         self.entry = entry
         self._dispatcher = None
 
@@ -111,23 +169,22 @@ class Kernel:
             load_numba()
             with _lock:
                 if self._dispatcher is None:
+                    from .._cache import prepare
                     from .dispatcher import make_dispatcher
 
+                    cache = self.cache and prepare().folder is not None
                     self._dispatcher = make_dispatcher(self.py_func, self.options,
-                                                       self.specialise_constants, self.cache)
+                                                       self.specialise_constants, cache)
         return self._dispatcher
 
     def __call__(self, *args, **kwargs):
-        if self.entry and not kwargs:
-            from . import native
+        result = self.dispatcher(*args, **kwargs)
+        if self.entry:
+            from .._cache import _state
 
-            call = native.machine_code(self, args)
-            if call is not None:
-                return call(args)
-            result = self.dispatcher(*args)
-            native.remember(self, args)
-            return result
-        return self.dispatcher(*args, **kwargs)
+            if _state is not None and _state.unsealed:
+                _state.seal()
+        return result
 
     def __getattr__(self, name: str):
         if name.startswith("__"):  # copy, pickle, inspect: not the dispatcher's business
@@ -160,12 +217,6 @@ class NumbaObject:
     def resolve(self):
         load_numba()
         return getattr(importlib.import_module(self.module), self.name)
-
-    @property
-    def _numba_type_(self):
-        from numba.core.registry import cpu_target
-
-        return cpu_target.typing_context.resolve_value_type(self.resolve())
 
     def __call__(self, *args, **kwargs):
         return self.resolve()(*args, **kwargs)
@@ -203,8 +254,8 @@ def overload(function, **options):
 
 
 def kernel(fn=None, *, entry: bool = False, **options):
-    """A render kernel (see kernels/dispatcher.py for the options); ``entry=True`` for one
-    that Python calls (its calls go through the native index, kernels/native.py)."""
+    """A render kernel (the options: the module docstring); ``entry=True`` for one that
+    Python calls."""
     opts = {"nopython": True, "error_model": "numpy", "nogil": True, "_nrt": False,
             "fastmath": set(FAST_MATH), "no_cfunc_wrapper": True}
     opts.update(options)
@@ -212,7 +263,7 @@ def kernel(fn=None, *, entry: bool = False, **options):
     # the flag, so a kernel would be inlined or not depending on which caller compiled it
     # first (in this process, or in another from whose cache it loads)
     opts["forceinline"] = False
-    if opts.get("inline") == "always":  # inlined by LLVM, not by Numba (dispatcher.py)
+    if opts.get("inline") == "always":  # inlined by LLVM, not by Numba (module docstring)
         del opts["inline"]
         opts["forceinline"] = True
     if opts.pop("numba_inline", False):  # inlined by Numba into its one caller

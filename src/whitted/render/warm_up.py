@@ -6,9 +6,11 @@ shared with a second process (``python -m whitted.render.warm_up``) when there a
 or more. While this process compiles ``render_tiles`` (and its callees on the way, depth
 first), the helper compiles a share of the render kernel's callees (``kernels/callees.py``),
 then the scene builders and the OBJ loader, into the cache. When this process reaches one of
-the helper's callees it waits for it (``jit.KernelCache.wait_for_helper``) and loads it
-instead of compiling it a second time. Then it waits for the helper (which by then is on the
-builders and loader, work this process would do next) and loads what it made. Whatever the
+the helper's callees it waits for it (``KernelCache.wait_for_helper``, kernels/dispatcher.py)
+and loads it instead of compiling it a second time (with stock Numba, which has neither the
+twins nor the wait, the helper compiles only the builders and the loader). Then it waits for the
+helper (which by then is on the builders and loader, work this process would do next) and
+loads what it made. Whatever the
 helper did not finish is compiled here, so the result never depends on the helper: it only
 saves time. The AOV kernel (depth, normal and object-id images) is compiled when first used.
 
@@ -39,7 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._cache import configure_kernel_cache
+from .._cache import HELPER_ENV, prepare
 from ..assets.mesh import load_obj_bytes
 from ..compile.params import render_params
 from ..compile.scene import CompiledScene, compile_scene
@@ -128,9 +130,18 @@ def _compile_render_kernels(compiled: CompiledScene, aovs: bool = False) -> None
                 lane_workspace(0), 0, 1)
 
 
-def _marker(instances: bool) -> Path:
-    return Path(configure_kernel_cache()) / (
-        "whitted-ready-instances" if instances else "whitted-ready-plain")
+def _marker(instances: bool) -> Path | None:
+    folder = prepare().folder
+    if folder is None:
+        return None
+    return Path(folder) / ("whitted-ready-instances" if instances else "whitted-ready-plain")
+
+
+def _mark(marker: Path | None) -> None:
+    """Record a complete variant (nothing where the folder cannot take it)."""
+    if marker is not None:
+        with contextlib.suppress(OSError):
+            marker.touch()
 
 
 class _CompileCount:
@@ -222,16 +233,18 @@ def compile_progress() -> float | None:
 def _start_helper(instances: bool) -> subprocess.Popen | None:
     from numba import config
 
+    folder = prepare().folder
     if (config.DISABLE_JIT or os.environ.get("WHITTED_COMPILE_HELPER", "1") == "0"
-            or len(os.sched_getaffinity(0)) < 2):
+            or folder is None or len(os.sched_getaffinity(0)) < 2):
         return None
-    configure_kernel_cache()  # the helper inherits NUMBA_CACHE_DIR
+    # the helper uses this folder (checked here, and locked while it runs)
+    env = dict(os.environ, NUMBA_CACHE_DIR=folder, **{HELPER_ENV: "1"})
     try:
         return subprocess.Popen(
             [sys.executable, "-m", "whitted.render.warm_up",
              "instances" if instances else "plain", str(os.getpid())],
             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-            text=True)
+            text=True, env=env)
     except OSError:  # no interpreter to start (frozen app, exotic platform): compile alone
         return None
 
@@ -264,16 +277,25 @@ def warm_up_kernels(compiled: CompiledScene | None = None) -> float:
         if instances in _ready:
             return 0.0
         start = time.perf_counter()
+        cache = prepare()
         marker = _marker(instances)
-        if marker.exists():
+        if marker is not None and marker.exists():
             # warm: load the render kernel only; the builders, the model loaders and the AOV
             # kernel load from the cache when first called (a scene without OBJ files never
             # loads the OBJ reader, a plain render never the AOV kernel)
             _compile_render_kernels(compiled if compiled is not None
                                     else stand_in_scene(instances), aovs=False)
         else:
-            _cold_compile(instances, compiled)
-        marker.touch()
+            with cache.locked():  # a second cold render waits here, then loads
+                if marker is not None and marker.exists():  # another process compiled it
+                    _compile_render_kernels(compiled if compiled is not None
+                                            else stand_in_scene(instances), aovs=False)
+                else:
+                    _cold_compile(instances, compiled)
+                cache.seal()
+                _mark(marker)
+        if cache.unsealed:
+            cache.seal()
         _ready.add(instances)
         return time.perf_counter() - start
 
@@ -300,7 +322,14 @@ def _interrupt_at_safe_points(count: _CompileCount):
 
 
 def _delegated(instances: bool) -> list:
-    """The helper's share of the render kernel's callees: (twin dispatcher, types) pairs."""
+    """The helper's share of the render kernel's callees: (twin dispatcher, types) pairs;
+    none with stock Numba (no twins to compile, nothing to wait for: kernels/dispatcher.py)."""
+    from ..kernels.dispatcher import tuned
+    from ..kernels.jit import load_numba
+
+    load_numba()
+    if not tuned():
+        return []
     from ..kernels.callees import render_callees
 
     stand_in = stand_in_scene(instances)
@@ -314,30 +343,36 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
     builders, counting both for :func:`compile_progress`; on any exception (Ctrl-C) the
     helper is stopped at once rather than waited for."""
     global _progress
-    from ..kernels.dispatcher import KernelCache  # Numba, with whitted's settings
+    from ..kernels.dispatcher import kernel_cache_class
+    from ..kernels.jit import load_numba
 
+    load_numba()  # Numba, with whitted's settings
+    KernelCache = kernel_cache_class()  # noqa: N806 - None with stock Numba
     helper = _start_helper(instances)
     delegated = ()
     if helper is not None and helper.stdout is not None:
         delegated = tuple(d.py_func.__qualname__ for d, _ in _delegated(instances))
     count = _CompileCount(EXPECTED_COMPILES[instances], delegated)
-    if delegated:
+    if helper is not None and helper.stdout is not None:
         threading.Thread(target=count.read_helper, args=(helper.stdout,),
                          name="whitted-compile-helper-output", daemon=True).start()
+    if delegated and KernelCache is not None:
         KernelCache.wait_for_helper = count.wait_for_helper
     _progress = count
     try:
         with _CountCompiles(count), _interrupt_at_safe_points(count):
             _compile_render_kernels(compiled if compiled is not None
                                     else stand_in_scene(instances))
-            KernelCache.wait_for_helper = None
+            if KernelCache is not None:
+                KernelCache.wait_for_helper = None
             _finish_helper(helper)
             _compile_builders()
     except BaseException:
         _stop_helper(helper)
         raise
     finally:
-        KernelCache.wait_for_helper = None
+        if KernelCache is not None:
+            KernelCache.wait_for_helper = None
         _progress = None
 
 

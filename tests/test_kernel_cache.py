@@ -1,0 +1,307 @@
+"""The kernel cache heals itself (whitted/_cache.py): damaged files are dropped and compiled
+again with one warning line, an unusable folder falls back with one warning line, two cold
+renders share one folder; never a crash, a wrong image or an internal error."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import whitted
+from whitted import _cache
+from whitted.render.warm_up import warm_up_kernels
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+SIZE = (12, 9)
+
+
+# ------------------------------------------------------------------ the list of sums alone
+
+def _fake_cache(tmp_path: Path, own: bool = True) -> _cache.KernelCache:
+    folder = tmp_path / "numba-x"
+    for sub, names in (("kernels_1", ("a-1.py311.nbi", "a-1.py311.0.nbc")),
+                       ("compile_2", ("b-2.py311.nbi", "b-2.py311.0.nbc", "b-2.py311.1.nbc"))):
+        (folder / sub).mkdir(parents=True)
+        for k, name in enumerate(names):
+            (folder / sub / name).write_bytes(bytes(range(256)) * (k + 3))
+    state = _cache.KernelCache(str(folder), own=own, helper=False)
+    state.seal()
+    return state
+
+
+def _names(state) -> set[str]:
+    return set(state._files())
+
+
+def _flip(path: Path, bit: int) -> None:
+    with open(path, "r+b") as f:
+        f.seek(bit // 8)
+        byte = f.read(1)[0]
+        f.seek(bit // 8)
+        f.write(bytes([byte ^ (1 << bit % 8)]))
+
+
+def test_a_sealed_folder_checks_clean(tmp_path, capsys):
+    state = _fake_cache(tmp_path)
+    again = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert again.verify() == 0
+    assert len(_names(again)) == 5 and capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize("bit", [0, 7, 800, 8 * 767 + 3])
+def test_a_flipped_bit_in_any_file_drops_that_file_with_one_warning(tmp_path, capsys, bit):
+    state = _fake_cache(tmp_path)
+    names = sorted(_names(state))
+    for name in names:  # every file, one at a time
+        _flip(Path(state.folder, name), bit)
+        again = _cache.KernelCache(state.folder, own=True, helper=False)
+        assert again.verify() == 1, name
+        assert name not in _names(again)
+        err = capsys.readouterr().err.splitlines()
+        assert len(err) == 1 and err[0].startswith("warning: 1 damaged kernel cache file")
+        again.seal()  # the others are still sealed and check clean
+        assert _cache.KernelCache(state.folder, own=True, helper=False).verify() == 0
+
+
+def test_truncated_files_are_dropped_with_one_warning_for_all(tmp_path, capsys):
+    state = _fake_cache(tmp_path)
+    for name in ("kernels_1/a-1.py311.nbi", "compile_2/b-2.py311.1.nbc"):
+        os.truncate(Path(state.folder, name), 10)
+    Path(state.folder, "compile_2/b-2.py311.0.nbc").write_bytes(b"")
+    again = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert again.verify() == 3
+    assert _names(again) == {"kernels_1/a-1.py311.0.nbc", "compile_2/b-2.py311.nbi"}
+    err = capsys.readouterr().err.splitlines()
+    assert err == [f"warning: 3 damaged kernel cache files in {state.folder} deleted; "
+                   "compiling them again"]
+
+
+def test_files_nobody_sealed_are_not_trusted_in_whitteds_folder(tmp_path, capsys):
+    """A file written by a process that stopped before sealing, or put there by hand, is
+    deleted (compiled again) without a warning; a file replaced by other content is
+    damaged."""
+    state = _fake_cache(tmp_path)
+    Path(state.folder, "kernels_1/c-9.py311.nbi").write_bytes(b"\x80\x04unsealed")
+    replaced = Path(state.folder, "kernels_1/a-1.py311.nbi")
+    new = replaced.with_suffix(".new")
+    new.write_bytes(b"rewritten elsewhere")
+    os.replace(new, replaced)
+    again = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert again.verify() == 1
+    assert _names(again) == _names(state) - {"kernels_1/a-1.py311.nbi"}
+    assert capsys.readouterr().err.startswith("warning: 1 damaged")
+
+
+def test_a_copied_folder_checks_clean(tmp_path, capsys):
+    """The list names files by content: a copy (new inodes, times) is as good."""
+    state = _fake_cache(tmp_path)
+    copy = tmp_path / "copy" / "numba-x"
+    shutil.copytree(state.folder, copy)
+    again = _cache.KernelCache(str(copy), own=True, helper=False)
+    assert again.verify() == 0 and len(_names(again)) == 5
+    assert capsys.readouterr().err == ""
+
+
+def test_a_file_numba_rewrote_in_this_process_is_sealed_anew(tmp_path):
+    state = _fake_cache(tmp_path)
+    index = Path(state.folder, "kernels_1/a-1.py311.nbi")
+    tmp = index.with_suffix(".tmp")
+    tmp.write_bytes(b"a new signature added")
+    os.replace(tmp, index)  # as Numba writes: a new file renamed over the old
+    _flip(Path(state.folder, "compile_2/b-2.py311.0.nbc"), 5)  # in place: never sealed
+    state.seal()
+    again = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert again.verify() == 1  # the flipped one only
+    assert "kernels_1/a-1.py311.nbi" in _names(again)
+
+
+def test_a_damaged_list_of_sums_drops_everything_with_one_warning(tmp_path, capsys):
+    state = _fake_cache(tmp_path)
+    sums = Path(state.folder, _cache.SUMS)
+    sums.write_bytes(sums.read_bytes()[:-7])
+    Path(state.folder, "whitted-ready-plain").touch()
+    again = _cache.KernelCache(state.folder, own=True, helper=False)
+    again.verify()
+    assert _names(again) == set()
+    assert not Path(state.folder, "whitted-ready-plain").exists()  # compiled again, helper too
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "list of checksums" in err[0] and err[0].startswith("warning:")
+
+
+def test_other_programs_files_in_a_users_numba_cache_dir_are_kept(tmp_path):
+    state = _fake_cache(tmp_path, own=False)
+    other = Path(state.folder, "elsewhere_3/theirs-4.py311.nbi")
+    other.parent.mkdir()
+    other.write_bytes(b"someone else's")
+    again = _cache.KernelCache(state.folder, own=False, helper=False)
+    assert again.verify() == 0
+    assert other.exists()
+    _flip(other, 3)  # sealed as found: damage after that is caught like any other
+    assert _cache.KernelCache(state.folder, own=False, helper=False).verify() == 1
+
+
+@pytest.mark.parametrize("problem", ["file", "readonly"])
+def test_an_unusable_folder_falls_back_with_one_warning(tmp_path, monkeypatch, capsys,
+                                                        problem):
+    """A folder that cannot be written (here made so by refusing its temporary file: the
+    tests may run as root, who writes anywhere) or that is a file: the per-user folder."""
+    chosen = tmp_path / "chosen"
+    if problem == "file":
+        chosen.write_text("not a folder")
+    else:
+        chosen.mkdir()
+        real = _cache.tempfile.TemporaryFile
+
+        def refuse(*args, dir=None, **kwargs):
+            if dir is not None and str(dir).startswith(str(chosen)):
+                raise PermissionError(13, "Permission denied")
+            return real(*args, dir=dir, **kwargs)
+
+        monkeypatch.setattr(_cache.tempfile, "TemporaryFile", refuse)
+    monkeypatch.setenv("WHITTED_CACHE_DIR", str(chosen))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "user"))
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.setattr(_cache, "_state", None)
+    monkeypatch.setattr(_cache, "_set_numba_cache_dir", lambda folder: None)
+    state = _cache.prepare()
+    assert state.folder == str(tmp_path / "user" / "whitted" / _cache._folder_name())
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith(f"warning: kernel cache folder {chosen}")
+
+
+# ------------------------------------------------------------------ renders
+
+
+@pytest.fixture(scope="module")
+def reference() -> np.ndarray:
+    warm_up_kernels()
+    return whitted.render(whitted.default_scene(), width=SIZE[0], height=SIZE[1],
+                          threads=1).to_srgb8()
+
+
+@pytest.fixture(scope="module")
+def warm_folder(reference) -> Path:
+    """This test session's warm kernel cache folder (the render kernels and builders)."""
+    folder = Path(_cache.prepare().folder)
+    assert (folder / "whitted-ready-plain").exists()
+    return folder
+
+
+def _render(tmp_path: Path, name: str, **settings: str) -> tuple[subprocess.CompletedProcess,
+                                                                  np.ndarray | None]:
+    from PIL import Image as PILImage
+
+    out = tmp_path / f"{name}.png"
+    env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"), WHITTED_COMPILE_HELPER="0")
+    env.pop("NUMBA_CACHE_DIR", None)
+    env.update(settings)
+    run = subprocess.run([sys.executable, "-m", "whitted", "render", "-W", str(SIZE[0]), "-H",
+                          str(SIZE[1]), "-t", "1", "-q", "-o", str(out)],
+                         capture_output=True, text=True, env=env, cwd=tmp_path, timeout=900)
+    image = np.asarray(PILImage.open(out)) if out.exists() else None
+    return run, image
+
+
+def _warnings(run) -> list[str]:
+    return [line for line in run.stderr.splitlines() if line.strip()]
+
+
+def _copy_warm(warm_folder: Path, base: Path) -> Path:
+    copy = base / warm_folder.name
+    shutil.copytree(warm_folder, copy, ignore=shutil.ignore_patterns("whitted.lock"))
+    return copy
+
+
+def test_damaged_numba_files_give_the_right_image_and_one_warning(tmp_path, warm_folder,
+                                                                  reference):
+    """A flipped bit in machine code (.nbc) and a truncated index (.nbi), of kernels the
+    render loads (the BVH builder, called from Python): the render drops them, compiles
+    those kernels again, and gives the reference image; the next run is clean."""
+    copy = _copy_warm(warm_folder, tmp_path / "cache")
+    files = sorted(copy.rglob("*.nb[ic]"))
+    builder = [f for f in files if f.name.startswith("bvh._build-")]
+    assert builder, [f.name for f in files][:20]
+    data = [f for f in builder if f.suffix == ".nbc"]
+    index = [f for f in builder if f.suffix == ".nbi"]
+    _flip(data[0], 8 * (data[0].stat().st_size // 2))
+    os.truncate(index[0], index[0].stat().st_size // 3)
+    run, image = _render(tmp_path, "damaged", WHITTED_CACHE_DIR=str(tmp_path / "cache"))
+    assert run.returncode == 0, run.stderr
+    lines = _warnings(run)
+    assert len(lines) == 1 and lines[0].startswith("warning: 2 damaged kernel cache files")
+    assert np.array_equal(image, reference)
+    again, image = _render(tmp_path, "again", WHITTED_CACHE_DIR=str(tmp_path / "cache"))
+    assert again.returncode == 0 and _warnings(again) == [], again.stderr
+    assert np.array_equal(image, reference)
+
+
+@pytest.mark.parametrize("chosen", ["file", "/proc", "/dev/null"])
+def test_a_cache_folder_that_cannot_be_used_falls_back_with_one_warning(tmp_path, warm_folder,
+                                                                        reference, chosen):
+    """WHITTED_CACHE_DIR naming a file, /proc or /dev/null: the per-user folder is used (a
+    warm copy here, so nothing compiles), one warning line says so."""
+    if chosen == "file":
+        chosen = str(tmp_path / "a-file")
+        Path(chosen).write_text("x")
+    _copy_warm(warm_folder, tmp_path / "user" / "whitted")
+    run, image = _render(tmp_path, "fallback", WHITTED_CACHE_DIR=chosen,
+                         XDG_CACHE_HOME=str(tmp_path / "user"))
+    assert run.returncode == 0, run.stderr
+    lines = _warnings(run)
+    assert len(lines) == 1 and lines[0].startswith(f"warning: kernel cache folder {chosen}")
+    assert str(tmp_path / "user") in lines[0]
+    assert np.array_equal(image, reference)
+
+
+def test_no_usable_folder_at_all_compiles_in_memory(tmp_path):
+    """Neither the chosen nor the per-user folder can be used: kernels compile in memory
+    (cache=False), with one warning line, and still run."""
+    script = textwrap.dedent("""
+        import numpy as np
+        from whitted.kernels.jit import kernel
+
+        @kernel(entry=True)
+        def twice(a):
+            return 2.0 * a[0]
+
+        print("RESULT", twice(np.array([1.5])), twice.dispatcher._cache.__class__.__name__)
+    """)
+    env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"), WHITTED_CACHE_DIR="/dev/null",
+               XDG_CACHE_HOME="/proc")
+    env.pop("NUMBA_CACHE_DIR", None)
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         env=env, cwd=tmp_path, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert "RESULT 3.0 NullCache" in run.stdout
+    lines = _warnings(run)
+    assert len(lines) == 1 and "compiled in memory" in lines[0], run.stderr
+
+
+def test_two_cold_renders_at_once_into_one_folder(tmp_path, reference):
+    """Both succeed, with the reference image and no warning: the second waits for the
+    first's compile (the folder's lock) and loads what it sealed."""
+    from PIL import Image as PILImage
+
+    env = dict(os.environ, PYTHONPATH=str(REPO_ROOT / "src"),
+               WHITTED_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("NUMBA_CACHE_DIR", None)
+    runs = [subprocess.Popen([sys.executable, "-m", "whitted", "render", "-W", str(SIZE[0]),
+                              "-H", str(SIZE[1]), "-t", "1", "-q", "-o",
+                              str(tmp_path / f"{k}.png")],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             env=env, cwd=tmp_path) for k in range(2)]
+    for k, run in enumerate(runs):
+        out, err = run.communicate(timeout=1200)
+        assert run.returncode == 0, err
+        assert err.strip() == "", err
+        assert np.array_equal(np.asarray(PILImage.open(tmp_path / f"{k}.png")), reference)
+    folder = next((tmp_path / "cache").glob("numba-*"))
+    assert _cache.KernelCache(str(folder), own=True, helper=False).verify() == 0
+    assert (folder / _cache.SUMS).exists()
