@@ -290,3 +290,39 @@ def test_a_plane_in_a_csg_is_a_one_line_error(tmp_path):
     assert len(message.splitlines()) == 1
     assert "bad.toml" in message and "objects[0]" in message and "no volume" in message
     assert not (tmp_path / "x.png").exists()
+
+
+def _cube_mesh(lo=-0.5, hi=0.5, drop=0):
+    from whitted.scene import Mesh
+
+    v = [[x, y, z] for x in (lo, hi) for y in (lo, hi) for z in (lo, hi)]
+    # corners indexed 4x + 2y + z (0/1); two triangles per face, counter-clockwise outside
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4),
+             (1, 5, 7, 3)]
+    faces = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
+    return Mesh(vertices=v, faces=faces[drop:])
+
+
+def test_a_closed_mesh_takes_part():
+    # the unit cube minus a mesh cube of side 1 around (0.5, 0, 0): the cut at x = 0
+    c = Compiled(CSG(operation="difference", objects=[CUBE, _cube_mesh(0.0, 1.0)
+                                                      .model_copy(update={"transform": None})]))
+    hits = c.hits((-5, 0.2, 0.3), (1, 0, 0))
+    assert [h[0] for h in hits] == pytest.approx([4.0, 5.0], rel=1e-12)
+    np.testing.assert_allclose(hits[1][1], [1, 0, 0], atol=1e-12)  # the cut faces +x
+    # a mesh intersected with a ball, rays through its edges and corners included
+    c = Compiled(CSG(operation="intersection", objects=[_cube_mesh(), Sphere(radius=0.6)]))
+    assert c.ts((-5, 0, 0), (1, 0, 0)) == pytest.approx([4.5, 5.5], rel=1e-12)
+    # y = z = 0.1 meets the faces x = -0.5 and 0.5 on the diagonal edges of their triangles
+    assert c.ts((-5, 0.1, 0.1), (1, 0, 0)) == pytest.approx([4.5, 5.5], rel=1e-12)
+    # at y = 0.45 the ball is inside the cube: its surface at x = -+sqrt(0.36 - 0.2025)
+    x = math.sqrt(0.36 - 0.2025)
+    assert c.ts((-5, 0.45, 0.0), (1, 0, 0)) == pytest.approx([5 - x, 5 + x], rel=1e-9)
+
+
+def test_an_open_mesh_in_a_csg_is_a_one_line_error():
+    from whitted.errors import SceneError
+
+    with pytest.raises(SceneError, match=r"objects\[0\]\.objects\[1\] \(mesh\): the mesh is "
+                                         r"open \(3 edges"):
+        Compiled(CSG(operation="difference", objects=[CUBE, _cube_mesh(drop=1)]))

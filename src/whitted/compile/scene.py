@@ -125,8 +125,18 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
             instanced += stored.triangles
             continue
         if isinstance(shape, CSG):
+            def emit_mesh(src, child, cm, mat, obj_index=obj_index):
+                own = child.material is None and child.file is not None and src.materials
+                rows = np.array([materials.add(x) for x in src.materials], np.int32)
+                first = b.rows
+                count = add_flat_mesh(b, meshes, src, rows, child, cm,
+                                      -1 if own else materials.add(mat), obj_index)
+                return first, count
+
             add_csg(b, shape, m, materials.add, scene.resolve_material, obj_index,
-                    scene.material_of(obj_index))
+                    scene.material_of(obj_index),
+                    lambda child, where, i=obj_index: mesh_source(scene, i, child, warnings),
+                    emit_mesh)
             continue
         add_shape(b, shape, m, materials.add(scene.material_of(obj_index)), obj_index)
     warnings.extend(meshes.warnings)

@@ -169,7 +169,10 @@ def surface_normals(geo, prim, tri, b1, b2, p):
         n = world_normal(geo, prim, p)
         smooth = geo.prim_params[prim, TRIANGLE_NORMALS] >= 0
         if geo.prim_info[prim, PRIM_TYPE] == SHAPE_TRIANGLE and smooth:
-            return n, _triangle_shading_normal(geo, prim, p, n)
+            ns = _triangle_shading_normal(geo, prim, p, n)
+            if has_extras(geo):  # a smooth mesh cutting a CSG difference: turned too
+                ns = flipped_if_extras(geo, prim, ns)
+            return n, ns
         return n, n
     ng, ns = mesh_normals_if_instances(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
     xf = geo.prim_info[prim, PRIM_XFORM]

@@ -2,8 +2,11 @@
 
 A CSG object is a row ``SHAPE_CSG`` (in the scene BVH, with the box of the whole) followed by
 its tree in postfix order: leaves are ordinary solid rows (sphere, box, frustum, torus; the
-object's transform baked in or kept as their own ``PRIM_XFORM``), operations are
-``SHAPE_CSG_OP`` rows with their code and number of operands. Leaf rows are in no BVH.
+object's transform baked in or kept as their own ``PRIM_XFORM``) or ``SHAPE_CSG_MESH`` rows
+naming the triangle rows of a closed mesh (after the tree, each tested in turn), operations
+are ``SHAPE_CSG_OP`` rows with their code and number of operands. These rows are in no BVH;
+a visible surface is reported as the row it belongs to (a mesh's triangle), so shading reads
+its material and normal as anywhere else.
 
 The walk follows the ray through the leaves' crossings in order, keeping each leaf's inside
 state as one bit of an int64: a leaf's state where the ray starts is whether its first
@@ -30,7 +33,7 @@ import math
 
 import numpy as np
 
-from .intersect import INF, intersect_local, normal_local
+from .intersect import INF, intersect_local, intersect_triangle, normal_local
 from .jit import kernel
 from .layout import (
     CSG_DIFFERENCE,
@@ -38,6 +41,7 @@ from .layout import (
     CSG_MERGE,
     PRIM_TYPE,
     PRIM_XFORM,
+    SHAPE_CSG_MESH,
     SHAPE_CSG_OP,
     SHAPE_TORUS,
 )
@@ -49,15 +53,33 @@ GRAZING = 1e-9  # |cos| between ray and normal below which a crossing is only a 
 
 
 @kernel
+def _mesh_t(geo, j, o, d, tmin, tmax):
+    """Nearest crossing in (tmin, tmax) with the triangles of mesh leaf ``j``, and the
+    triangle's row (each tested: a CSG mesh is small)."""
+    first = int(geo.prim_params[j, 0])
+    best_t = INF
+    best = np.int64(-1)
+    for r in range(first, first + int(geo.prim_params[j, 1])):
+        t = intersect_triangle(geo.prim_params, r, o, d, tmin, min(tmax, best_t))
+        if t < best_t:
+            best_t = t
+            best = np.int64(r)
+    return best_t, best
+
+
+@kernel
 def leaf_t(geo, j, o, d, tmin, tmax):
-    """Nearest crossing in (tmin, tmax) of the world ray with leaf row ``j`` (INF: none)."""
+    """Nearest crossing in (tmin, tmax) of the world ray with leaf row ``j`` (INF: none), and
+    the row whose surface it is (``j``, or a mesh leaf's triangle)."""
+    typ = geo.prim_info[j, PRIM_TYPE]
+    if typ == SHAPE_CSG_MESH:
+        return _mesh_t(geo, j, o, d, tmin, tmax)
     xf = geo.prim_info[j, PRIM_XFORM]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
-    typ = geo.prim_info[j, PRIM_TYPE]
     if typ == SHAPE_TORUS:
-        return intersect_torus(geo.prim_params, j, o, d, tmin, tmax)
-    return intersect_local(typ, geo.prim_params, j, o, d, tmin, tmax)
+        return intersect_torus(geo.prim_params, j, o, d, tmin, tmax), np.int64(j)
+    return intersect_local(typ, geo.prim_params, j, o, d, tmin, tmax), np.int64(j)
 
 
 @kernel
@@ -157,30 +179,30 @@ def csg_hit(geo, root, o, d, tmin, tmax):
     for r in range(root + 1, root + 1 + n_rows):
         if geo.prim_info[r, PRIM_TYPE] == SHAPE_CSG_OP:
             continue
-        t = leaf_t(geo, r, o, d, tmin, INF)
+        t, part = leaf_t(geo, r, o, d, tmin, INF)
         if t < INF:
             if t < tmax:
                 alive = _with_bit(alive, leaf, 1)
-            if dot(d, leaf_normal(geo, r, madd(o, d, t))) > 0.0:
+            if dot(d, leaf_normal(geo, part, madd(o, d, t))) > 0.0:
                 inside = _with_bit(inside, leaf, 1)  # its first crossing leaves it
         leaf += 1
     d_len = math.sqrt(dot(d, d))
     t_cur = tmin
     while alive != 0:
         best_t = INF
-        best_row = -1
+        best_row = np.int64(-1)
         best_leaf = -1
         leaf = 0
         for r in range(root + 1, root + 1 + n_rows):
             if geo.prim_info[r, PRIM_TYPE] == SHAPE_CSG_OP:
                 continue
             if _bit(alive, leaf):
-                t = leaf_t(geo, r, o, d, t_cur, tmax)
+                t, part = leaf_t(geo, r, o, d, t_cur, tmax)
                 if t == INF:
                     alive = _with_bit(alive, leaf, 0)
                 elif t < best_t:
                     best_t = t
-                    best_row = r
+                    best_row = part
                     best_leaf = leaf
             leaf += 1
         if best_row < 0:
@@ -192,4 +214,4 @@ def csg_hit(geo, root, o, d, tmin, tmax):
         if surface_shows(geo, root, best_leaf, inside):
             return best_t, best_row
         inside = _with_bit(inside, best_leaf, 1 if cos < 0.0 else 0)
-    return INF, -1
+    return INF, np.int64(-1)

@@ -32,6 +32,9 @@ SHAPE_TORUS = 8
 # (leaves: ordinary solid rows; operations: SHAPE_CSG_OP rows); leaves 1
 SHAPE_CSG = 9
 SHAPE_CSG_OP = 10  # an operation of a CSG tree: CSG_* code 0, number of operands 1
+# a closed mesh in a CSG tree: its triangles are the rows first 0 .. first + count 1 - 1
+# (flattened, in no BVH, after the tree's rows)
+SHAPE_CSG_MESH = 11
 FIRST_EXTRA_SHAPE = SHAPE_TORUS
 
 # CSG operation codes (SHAPE_CSG_OP rows)

@@ -317,7 +317,9 @@ class CSG(_Shape):
     """Constructive solid geometry (POV-Ray's ``union``, ``intersection``, ``difference`` and
     ``merge``) of solid ``objects``: spheres, boxes, capped cylinders and cones, tori and
     other CSG objects, to any depth. ``difference`` is the first object minus all the others;
-    ``merge`` is a union without its inner surfaces (for glass). ``material`` is used by the
+    ``merge`` is a union without its inner surfaces (for glass). Meshes take part when they
+    are closed (every edge shared by two triangles; checked when the scene is compiled) and
+    small (at most 65,536 triangles: each is tested in turn). ``material`` is used by the
     children that have none; ``transform`` places the whole. Each surface keeps its child's
     material (a difference's cut shows the material of the object that cut it), and the
     solid is one body for refraction and absorption: its medium is its own ``material`` (or,
@@ -337,9 +339,9 @@ class CSG(_Shape):
             if isinstance(child, Cylinder | Cone) and not child.capped:
                 raise ValueError(f"objects[{k}] ({what}): an uncapped {child.type} is open, "
                                  "so it cannot take part in CSG")
-            if isinstance(child, Mesh):
-                raise ValueError(f"objects[{k}] ({what}): meshes cannot take part in CSG yet "
-                                 "(analytic solids and CSG only)")
+            if isinstance(child, Mesh) and not child.solid:
+                raise ValueError(f"objects[{k}] ({what}): a mesh with solid = false bounds "
+                                 "no volume, so it cannot take part in CSG")
         leaves, rows = self.leaves(), self.rows()
         if leaves > CSG_MAX_SOLIDS or rows > CSG_MAX_SOLIDS:
             raise ValueError(f"a CSG object holds at most {CSG_MAX_SOLIDS} solids and "
