@@ -326,3 +326,36 @@ def test_an_open_mesh_in_a_csg_is_a_one_line_error():
     with pytest.raises(SceneError, match=r"objects\[0\]\.objects\[1\] \(mesh\): the mesh is "
                                          r"open \(3 edges"):
         Compiled(CSG(operation="difference", objects=[CUBE, _cube_mesh(drop=1)]))
+
+
+_SOLIDS = st.one_of(
+    st.builds(lambda c, r: {"type": "sphere", "center": c, "radius": r},
+              st.tuples(*[st.floats(-1, 1)] * 3), st.floats(0.05, 1.5)),
+    st.builds(lambda a, b: {"type": "box", "min": [min(x, y) - 0.01 for x, y in zip(a, b)],
+                            "max": [max(x, y) + 0.01 for x, y in zip(a, b)]},
+              st.tuples(*[st.floats(-1, 1)] * 3), st.tuples(*[st.floats(-1, 1)] * 3)),
+    st.builds(lambda r1, r2: {"type": "torus", "major_radius": r1, "minor_radius": r2},
+              st.floats(0.2, 1.5), st.floats(0.05, 0.5)),
+)
+_TREES = st.recursive(
+    _SOLIDS,
+    lambda children: st.builds(
+        lambda op, objs: {"type": "csg", "operation": op, "objects": objs},
+        st.sampled_from(["union", "intersection", "difference", "merge"]),
+        st.lists(children, min_size=1, max_size=4)),
+    max_leaves=12,
+)
+
+
+@settings(max_examples=60, deadline=None)
+@given(_TREES.filter(lambda t: t["type"] == "csg"), st.tuples(*[st.floats(-1, 1)] * 3))
+def test_random_trees_compile_and_answer_every_ray(tree, aim):
+    # any tree the model accepts compiles, and a ray at it gets a hit in front of it or none;
+    # the hit's surface is one of the tree's own rows (a leaf of this object)
+    c = Compiled(Scene.model_validate({"objects": [tree]}).objects[0])
+    d = np.subtract(aim, (0.3, 0.2, 6.0))
+    h = c.hit((0.3, 0.2, 6.0), d)
+    if h is not None:
+        assert 0 < h[0] < math.inf
+        assert c.geo.prim_info[h[2], PRIM_OBJECT] == 0
+        assert abs(np.linalg.norm(h[1]) - 1) < 1e-9
