@@ -331,8 +331,8 @@ def test_an_open_mesh_in_a_csg_is_a_one_line_error():
 _SOLIDS = st.one_of(
     st.builds(lambda c, r: {"type": "sphere", "center": c, "radius": r},
               st.tuples(*[st.floats(-1, 1)] * 3), st.floats(0.05, 1.5)),
-    st.builds(lambda a, b: {"type": "box", "min": [min(x, y) - 0.01 for x, y in zip(a, b, strict=True)],
-                            "max": [max(x, y) + 0.01 for x, y in zip(a, b, strict=True)]},
+    st.builds(lambda a, b: {"type": "box", "min": list(np.minimum(a, b) - 0.01),
+                            "max": list(np.maximum(a, b) + 0.01)},
               st.tuples(*[st.floats(-1, 1)] * 3), st.tuples(*[st.floats(-1, 1)] * 3)),
     st.builds(lambda r1, r2: {"type": "torus", "major_radius": r1, "minor_radius": r2},
               st.floats(0.2, 1.5), st.floats(0.05, 0.5)),
