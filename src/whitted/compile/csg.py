@@ -45,7 +45,7 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
     ``emit_mesh(source, child, matrix, material)`` appends its triangles as rows and returns
     (first row, count). An open mesh, or one too big, is a SceneError naming it."""
     root = b.rows
-    b.add(SHAPE_CSG, [0.0, 0.0], np.zeros(3), np.zeros(3), material=0, obj=obj, solid=True)
+    b.add(SHAPE_CSG, [0.0] * 8, np.zeros(3), np.zeros(3), material=0, obj=obj, solid=True)
     root_block = len(b.blocks) - 1
     leaves: list[tuple[int, object, int]] = []  # (row, Material, flip)
 
@@ -105,6 +105,8 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
     typ, params, xf, _, objs, solid, _, _ = b.blocks[root_block]
     params[0, 0] = b.rows - root - 1
     params[0, 1] = len(leaves)
+    params[0, 2:5] = lo  # the box of the whole: rays that miss it skip the walk
+    params[0, 5:8] = hi
     material = np.array([material_row(clear[0]) if clear else body], np.int32)
     b.blocks[root_block] = (typ, params, xf, material, objs, solid, lo.reshape(1, 3),
                             hi.reshape(1, 3))

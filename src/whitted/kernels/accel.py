@@ -46,10 +46,11 @@ from .xform import to_object
 MESH_STACK_BASE = 64  # traversal stack entries [0, 64) for the scene BVH, the rest for meshes
 
 
-@kernel
+@kernel(inline="always")
 def hit_analytic(geo, i, o, d, tmin, tmax):
-    """t of the ray with analytic primitive ``i`` (INF on a miss). Kept small so the compiler
-    inlines it into the traversal loops."""
+    """t of the ray with analytic primitive ``i`` (INF on a miss). Inlined into the traversal
+    loops (in kernels for scenes with tori or CSG it would otherwise be a call per candidate,
+    and the torus and the CSG walk stay calls behind it, made only for them)."""
     xf = geo.prim_info[i, PRIM_XFORM]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)

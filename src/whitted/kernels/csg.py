@@ -46,6 +46,7 @@ from .layout import (
     SHAPE_TORUS,
 )
 from .torus import intersect_torus, torus_normal
+from .traverse import inverse_direction, slab_entry
 from .vec import dot, madd
 from .xform import normal_to_world, to_object
 
@@ -172,7 +173,11 @@ def surface_shows(geo, root, hit_leaf, inside):
 def csg_hit(geo, root, o, d, tmin, tmax):
     """(t, leaf row) of the nearest visible surface of CSG object ``root`` in (tmin, tmax),
     or (INF, -1)."""
-    n_rows = int(geo.prim_params[root, 0])
+    P = geo.prim_params
+    if slab_entry(P[root, 2], P[root, 3], P[root, 4], P[root, 5], P[root, 6], P[root, 7], o,
+                  inverse_direction(d), tmin, tmax) == INF:
+        return INF, np.int64(-1)  # (shadow rays test listed objects without their boxes)
+    n_rows = int(P[root, 0])
     inside = np.int64(0)
     alive = np.int64(0)
     leaf = 0

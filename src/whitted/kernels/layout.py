@@ -29,7 +29,8 @@ SHAPE_MESH = 7  # an instance of a triangle mesh: mesh index 0 (a row of mesh_in
 # 3:12, major radius 12, minor radius 13
 SHAPE_TORUS = 8
 # a CSG object (kernels/csg.py): the rows after it, count 0, are its tree in postfix order
-# (leaves: ordinary solid rows; operations: SHAPE_CSG_OP rows); leaves 1
+# (leaves: ordinary solid rows; operations: SHAPE_CSG_OP rows); leaves 1; its box: lower
+# corner 2:5, upper corner 5:8
 SHAPE_CSG = 9
 SHAPE_CSG_OP = 10  # an operation of a CSG tree: CSG_* code 0, number of operands 1
 # a closed mesh in a CSG tree: its triangles are the rows first 0 .. first + count 1 - 1
