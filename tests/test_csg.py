@@ -359,3 +359,13 @@ def test_random_trees_compile_and_answer_every_ray(tree, aim):
         assert 0 < h[0] < math.inf
         assert c.geo.prim_info[h[2], PRIM_OBJECT] == 0
         assert abs(np.linalg.norm(h[1]) - 1) < 1e-9
+
+
+def test_csg_scene_is_the_same_on_any_number_of_threads():
+    import whitted
+
+    scene = whitted.load_scene("benchmarks/csg.toml").with_settings(width=64, height=48)
+    one = whitted.render(scene, threads=1).pixels
+    two = whitted.render(scene, threads=2).pixels
+    assert np.array_equal(one, two)
+    assert one.std() > 0.05  # a picture, not a blank
