@@ -46,7 +46,8 @@ $(OLDEST_VENV)/.ready: pyproject.toml $(VENV)/.test-deps
 
 test-oldest-numba: $(OLDEST_VENV)/.ready
 	$(OLDEST_VENV)/bin/python -c 'import numba; print("oldest Numba:", numba.__version__)'
-	WHITTED_CACHE_DIR=$(CURDIR)/.cache-oldest-numba $(OLDEST_VENV)/bin/python -m pytest -q \
+	PYTHONPATH=$(CURDIR)/src WHITTED_CACHE_DIR=$(CURDIR)/.cache-oldest-numba \
+		$(OLDEST_VENV)/bin/python -m pytest -q \
 		-p no:cacheprovider tests/test_kernel_cache.py tests/test_jit.py \
 		tests/test_shapes.py -k 'not two_cold'
 
@@ -54,11 +55,11 @@ test-oldest-numba: $(OLDEST_VENV)/.ready
 test-timing: install-test
 	$(BIN)/python -m pytest -q -m timing
 
-## Line coverage of the whole suite, subprocesses included, plus the kernels as plain Python
+## Line coverage of the whole suite, the commands it runs as subprocesses included, and the
+## kernels run as plain Python (tests/test_python_kernels.py runs them with NUMBA_DISABLE_JIT=1)
 coverage: install-test
 	rm -rf .cache/coverage && mkdir -p .cache/coverage
-	$(BIN)/python -m coverage run -m pytest -q -x
-	NUMBA_DISABLE_JIT=1 $(BIN)/python -m coverage run -m pytest -q -x -m python_kernels
+	$(BIN)/python -m coverage run -m pytest -q -p no:cacheprovider
 	$(BIN)/python -m coverage combine -q
 	$(BIN)/python -m coverage report --sort=cover
 	$(BIN)/python -m coverage report --omit='*/gui/*,*/cli/*,*/program.py,*/__main__.py' \

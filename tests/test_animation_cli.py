@@ -68,12 +68,12 @@ def _whitted(*args: str, **kw) -> subprocess.CompletedProcess:
                           text=True, **kw)
 
 
-def _rendered(stderr: str) -> list[int]:
-    return [int(m) for m in re.findall(r"^frame (\d+) \(\d+/\d+\): [\d.]+ s$", stderr, re.M)]
+def _rendered(stdout: str) -> list[int]:
+    return [int(m) for m in re.findall(r"^frame (\d+) \(\d+/\d+\): [\d.]+ s$", stdout, re.M)]
 
 
-def _kept(stderr: str) -> list[int]:
-    return [int(m) for m in re.findall(r"^frame (\d+) \(\d+/\d+\): already done$", stderr,
+def _kept(stdout: str) -> list[int]:
+    return [int(m) for m in re.findall(r"^frame (\d+) \(\d+/\d+\): already done$", stdout,
                                        re.M)]
 
 
@@ -85,7 +85,7 @@ def test_animate_writes_frames_and_an_mp4_then_resumes(tmp_path):
     assert result.returncode == 0, result.stderr
     frames = sorted((tmp_path / "out" / "film_frames").iterdir())
     assert [f.name for f in frames] == [f"{k:04d}.png" for k in range(5)]
-    assert _rendered(result.stderr) == [0, 1, 2, 3, 4]
+    assert _rendered(result.stdout) == [0, 1, 2, 3, 4]
     reader = imageio.get_reader(film, format="FFMPEG")
     assert reader.get_meta_data()["fps"] == 8.0 and reader.get_meta_data()["size"] == (24, 16)
     assert len([f for f in reader]) == 5  # noqa: C416 - list(reader) asks len(): inf
@@ -99,10 +99,10 @@ def test_animate_writes_frames_and_an_mp4_then_resumes(tmp_path):
     frames[3].write_bytes(frames[3].read_bytes()[:100])
     again = _whitted("animate", str(scene), "-o", str(film), "--threads", "1")
     assert again.returncode == 0, again.stderr
-    assert _rendered(again.stderr) == [2, 3] and _kept(again.stderr) == [0, 1, 4]
+    assert _rendered(again.stdout) == [2, 3] and _kept(again.stdout) == [0, 1, 4]
     # a changed setting renders everything
     bigger = _whitted("animate", str(scene), "-o", str(film), "--frames", "1:2", "-W", "26")
-    assert _rendered(bigger.stderr) == [1, 2]
+    assert _rendered(bigger.stdout) == [1, 2]
 
 
 def test_render_frame_equals_the_films_frame_at_any_thread_count(tmp_path):
@@ -127,7 +127,7 @@ def test_animate_errors_are_one_line(tmp_path):
         (["-o", str(tmp_path / "x.avi")], "unsupported film format '.avi'"),
         (["--set", "objects[ball].radius=-1"], "error: --set: objects[ball].radius: input "
                                                "should be greater than 0"),
-        (["--fps", "0"], "error: --fps: must be > 0, got 0"),
+        (["--fps", "0"], "error: --fps: must be 0.01 .. 1000 frames a second for MP4, got 0"),
     ]:
         result = _whitted("animate", str(scene), *args)
         assert result.returncode == 2
@@ -155,7 +155,7 @@ def test_ctrl_c_keeps_finished_frames_and_the_next_run_continues(tmp_path):
     assert all(read_frame_digest(folder / name) for name in done)  # every file is whole
     rest = _whitted("animate", str(scene), "-o", str(film), "--threads", "2")
     assert rest.returncode == 0, rest.stderr
-    assert _kept(rest.stderr) == list(range(len(done)))
-    assert _rendered(rest.stderr) == list(range(len(done), 12))
+    assert _kept(rest.stdout) == list(range(len(done)))
+    assert _rendered(rest.stdout) == list(range(len(done), 12))
     with PILImage.open(film) as im:
         assert im.n_frames == 12

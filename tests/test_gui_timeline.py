@@ -277,10 +277,15 @@ def test_render_animation_saves_then_makes_the_film_that_whitted_animate_makes(
     timeline.ask_film_path = lambda: film
     click_tree(qtbot, window.tree, BALL)
     click_frame(qtbot, timeline, 4)
-    qtbot.keyClick(window.tree, Qt.Key.Key_I)  # unsaved: saved before the film
+    qtbot.keyClick(window.tree, Qt.Key.Key_I)  # unsaved: saved before the film, once asked
+    asked = []
+    window.ask_save_for_film = lambda: asked.append("no") and False
+    qtbot.mouseClick(timeline.film_button, LEFT)
+    assert asked == ["no"] and window.doc.dirty and not timeline.film_running
+    window.ask_save_for_film = lambda: asked.append("yes") or True
     with qtbot.waitSignal(timeline.film_done, timeout=SLOW) as done:
         qtbot.mouseClick(timeline.film_button, LEFT)
-        assert not window.doc.dirty and timeline.film_running
+        assert asked == ["no", "yes"] and not window.doc.dirty and timeline.film_running
     job = done.args[0]
     assert job.error is None and not job.stopped and job.rendered == 8
     assert "Wrote" in timeline.film_status.text() and timeline.film_progress.value() == 1000

@@ -150,3 +150,27 @@ def test_the_editor_saves_only_what_was_typed(make_window, hand_written, qtbot):
     assert len(added) < 10 and "+[[lights]]" in added
     assert whitted.load_scene(hand_written) == window.doc.scene.with_base_dir(
         hand_written.parent)
+
+
+def test_a_named_material_made_the_objects_own_stays_inline_and_new_blocks_are_apart():
+    """Issue 27, section 4: ``material = "glass"`` becoming an object's own material is
+    written on its line (not as a sub-table), and new ``[[objects]]`` blocks are separated
+    by a blank line, as people write them."""
+    text = ('[materials.glass]\npreset = "glass"\n\n[[objects]]\ntype = "sphere"\n'
+            'radius = 1\nmaterial = "glass"\n')
+    from whitted.scene.io import parse_scene_text, scene_from_dict
+
+    scene = scene_from_dict(parse_scene_text(text, ".toml"))
+    own = scene.materials["glass"].model_copy(update={"ior": 1.6})
+    objects = [scene.objects[0].model_copy(update={"material": own}),
+               S.Sphere(name="a", center=(0, 1, 0), radius=0.5),
+               S.Sphere(name="b", center=(1, 1, 0), radius=0.5)]
+    edited = scene.model_copy(update={"objects": objects})
+    out = scene_toml(edited, text=text, loaded=scene)
+    assert out.startswith(text.replace('material = "glass"\n', ""))
+    assert 'material = {preset = "glass", ior = 1.6}\n' in out
+    assert "[objects.material]" not in out
+    assert out.endswith('\n\n[[objects]]\ntype = "sphere"\nname = "a"\ncenter = [0.0, 1.0, 0.0]\n'
+                       'radius = 0.5\n\n[[objects]]\ntype = "sphere"\nname = "b"\n'
+                       'center = [1.0, 1.0, 0.0]\nradius = 0.5\n')
+    assert "\n\n[[objects]]" in compact_toml(edited)

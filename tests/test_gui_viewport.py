@@ -70,16 +70,17 @@ def test_g_moves_the_selection_on_the_ground_and_typed_values_along_an_axis(wind
         mouse(vp, "move", QPointF(start) + QPointF(dx, 0), Qt.MouseButton.NoButton)
     qtbot.mouseClick(vp, Qt.MouseButton.LeftButton, pos=start + QPoint(30, 0))
     assert vp.tool is None
-    t = window.doc.item(("objects", 1)).transform
-    assert t.translate[0] > 0.05 and t.translate[1] == 0.0  # right, and not off the ground
+    c = window.doc.item(("objects", 1)).center  # a sphere: G moves its centre
+    assert c[0] > 0.05 and c[1] == 0.8  # right, and not off the ground
+    assert window.doc.item(("objects", 1)).transform is None
     assert window.doc.undo_stack.count() == steps + 1  # the whole move is one step
     # G, Z, a typed value, Enter: exactly that far along z
-    before = t.translate
+    before = c
     qtbot.keyClick(vp, Qt.Key.Key_G)
     qtbot.keyClick(vp, Qt.Key.Key_Z)
     qtbot.keyClicks(vp, "-1.5")
     qtbot.keyClick(vp, Qt.Key.Key_Return)
-    after = window.doc.item(("objects", 1)).transform.translate
+    after = window.doc.item(("objects", 1)).center
     assert after == pytest.approx((before[0], before[1], before[2] - 1.5))
     # R with a typed angle turns it about y; Esc during S cancels, leaving nothing to redo
     qtbot.keyClicks(vp, "r90")
@@ -96,35 +97,40 @@ def test_g_moves_the_selection_on_the_ground_and_typed_values_along_an_axis(wind
 def test_turntable_orbit_keeps_the_horizon_level(window, qtbot):
     vp = window.viewport
     c = QPointF(vp.rect().center())
-    up = window.doc.scene.camera.up
+    camera = window.doc.scene.camera
+    up = window.navigation.camera().up
     drag(vp, c, [c + QPointF(20 * i, 7 * i) for i in range(1, 8)])
-    cam = window.doc.scene.camera
+    cam = window.navigation.camera()
     assert cam.up == up
     right, _, forward = cam.basis()
     assert abs(float(np.dot(right, up))) < 1e-9  # no roll: the horizon stays level
     assert forward[1] != 0
+    # the view moved, not the scene's camera: nothing to save, nothing to undo
+    assert window.doc.scene.camera == camera and not window.doc.dirty
+    assert not window.navigation.camera_view
 
 
 def test_frame_selection_home_and_the_numpad_views(window, qtbot):
     vp = window.viewport
     qtbot.mouseClick(vp, Qt.MouseButton.LeftButton, pos=pixel_of(window, 1))
     qtbot.keyClick(vp, Qt.Key.Key_F)
-    cam = window.doc.scene.camera
+    cam = window.navigation.camera()
     assert cam.look_at == pytest.approx((0.0, 0.8, 0.0))  # the ball's centre
     qtbot.keyClick(vp, Qt.Key.Key_7, Qt.KeyboardModifier.KeypadModifier)  # top
-    cam = window.doc.scene.camera
+    cam = window.navigation.camera()
     assert cam.position[0] == pytest.approx(cam.look_at[0])
     assert cam.position[2] == pytest.approx(cam.look_at[2], abs=0.01)  # a hair to the front
     assert cam.position[1] > cam.look_at[1] and cam.up == (0.0, 1.0, 0.0)
     qtbot.keyClick(vp, Qt.Key.Key_3, Qt.KeyboardModifier.KeypadModifier)  # right side
-    cam = window.doc.scene.camera
+    cam = window.navigation.camera()
     assert cam.position[0] > cam.look_at[0] and cam.position[1] == pytest.approx(cam.look_at[1])
     qtbot.keyClick(vp, Qt.Key.Key_1, Qt.KeyboardModifier.KeypadModifier)  # front
-    cam = window.doc.scene.camera
+    cam = window.navigation.camera()
     assert cam.position[2] > cam.look_at[2] and cam.position[0] == pytest.approx(cam.look_at[0])
     qtbot.keyClick(vp, Qt.Key.Key_Home)  # everything bounded (the ball; the floor is endless)
-    assert window.doc.scene.camera.look_at == pytest.approx((0.0, 0.8, 0.0))
+    assert window.navigation.camera().look_at == pytest.approx((0.0, 0.8, 0.0))
     assert window.doc.selection == ("objects", 1)  # moving the view keeps the selection
+    assert not window.doc.dirty  # and the scene's camera stays where it is
 
 
 def test_a_light_is_drawn_picked_and_moved_with_g(make_window, qtbot):  # noqa: F811

@@ -398,13 +398,14 @@ def test_the_command_starts_no_blas_thread_pool_unless_asked(tmp_path):
 
 def test_progress_bar_appears_only_for_a_render_still_running_after_the_delay(tmp_path,
                                                                                monkeypatch):
-    """On a terminal the bar appears once a render has run PROGRESS_DELAY seconds (cli/main.py):
+    """On a terminal the bar appears once a render has run PROGRESS_DELAY seconds (cli/render.py):
     a render that ends sooner never shows it (nor imports rich's progress display)."""
     import io
 
     from rich.console import Console
 
     from whitted.cli import main as cli
+    from whitted.cli import render as render_command
     from whitted.cli.console import err
 
     shown = {}
@@ -412,7 +413,7 @@ def test_progress_bar_appears_only_for_a_render_still_running_after_the_delay(tm
         screen = io.StringIO()
         monkeypatch.setattr(err, "_made", Console(file=screen, force_terminal=True,
                                                   width=100))
-        monkeypatch.setattr(cli, "PROGRESS_DELAY", delay)
+        monkeypatch.setattr(render_command, "PROGRESS_DELAY", delay)
         out = tmp_path / f"delay{delay:g}.png"
         cli.app(["render", str(REPO_ROOT / "examples" / "glass_cube.toml"), "-W", "32",
                  "-H", "24", "-o", str(out)], standalone_mode=False)
@@ -456,19 +457,20 @@ def test_terminal_check_without_rich_agrees_with_rich(monkeypatch):
 
 def test_render_pauses_the_garbage_collector_only_for_its_set_up(tmp_path):
     """``whitted render`` runs its imports and scene reading with the cyclic collector paused
-    (cli/main.py ``_resume_collector``), and the job with it on, the set-up's objects frozen;
+    (cli/app.py ``resume_collector``), and the job with it on, the set-up's objects frozen;
     a render that ends in a usage error leaves it on too, and other commands never touch it."""
     out = tmp_path / "x.png"
     _modules_after(f"""
         import gc, sys
         import whitted.cli.main as cli
+        import whitted.cli.render as render_command
         cli.EXIT_AT_ONCE_WHEN_ABANDONED = False
         seen = []
-        job_run = cli._render_and_write
+        job_run = render_command._render_and_write
         def watched(*args, **kwargs):
             seen.append((gc.isenabled(), gc.get_freeze_count() > 0))
             return job_run(*args, **kwargs)
-        cli._render_and_write = watched
+        render_command._render_and_write = watched
         for argv in (["render", "-W", "16", "-H", "12", "-o", {str(out)!r}],
                      ["render", "-W", "-5", "-o", {str(out)!r}], ["--version"]):
             sys.argv = ["whitted", *argv]

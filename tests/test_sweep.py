@@ -80,7 +80,7 @@ def test_sweep_command_writes_one_image_per_value_and_a_sheet(tmp_path):
     assert result.returncode == 0, result.stderr
     cells = sorted((tmp_path / "sheet_cells").iterdir())
     assert [c.name for c in cells] == [f"{k}.png" for k in range(6)]
-    labels = [line.split(" (")[0] for line in result.stderr.strip().splitlines()]
+    labels = [line.split(" (")[0] for line in result.stdout.strip().splitlines()[:-1]]
     assert labels == ["kt = 1", "kt = 0.8", "kt = 0.6", "kt = 0.4", "kt = 0.2", "kt = 0"]
     first, last = (np.asarray(PILImage.open(cells[k])) for k in (0, 5))
     assert not np.array_equal(first, last)  # transparency shows

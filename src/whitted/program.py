@@ -10,7 +10,7 @@ from typing import Annotated
 
 import typer
 
-from .cli.main import app, fail
+from .cli.app import app, fail
 from .cli.main import main as _cli_main
 from .errors import WhittedError
 
@@ -48,4 +48,7 @@ def gui(
 
 def main() -> None:
     """Console entry point of ``whitted`` (and ``python -m whitted``)."""
+    from .cli.interrupt import install_process_handlers
+
+    install_process_handlers()  # SIGINT, SIGTERM outside a command's guard: one line, at once
     _cli_main()

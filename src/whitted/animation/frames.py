@@ -1,17 +1,17 @@
 """Render frames of an animated scene to PNG files that say what they are a picture of.
 
-Each frame PNG carries, in a text chunk, a hash of everything its pixels depend on: the
-still of that frame (every scene value, its seed, image size, samples, ...), the frame
-number, the renderer's kernel sources, and the size and modification time of every model and
-texture file the still names. A later run compares that hash with the one it would write and
-skips the frame when they match: films resume where they stopped, and a change to the scene
-renders again exactly the frames it changes. Thread counts are not part of the hash (images
-do not depend on them).
+Each frame PNG carries, in a text chunk, a hash of everything its pixels depend on: the still of
+that frame (every scene value, its seed, image size, samples, ...), the frame number, the
+renderer's kernel sources, and the size and modification time of every file the frame reads: the
+model and texture files the still names, and each model's own material libraries (MTL) and the
+textures those name (:func:`model_files`). A later run compares that hash with the one it would
+write and skips the frame when they match: films resume where they stopped, and a change to the
+scene renders again exactly the frames it changes. Thread counts are not part of the hash
+(images do not depend on them).
 
 :func:`render_frame` is the plain function a render farm calls per frame; a
-:class:`FrameRenderer` renders many frames in one process and reuses what it can between
-them (kernels, and compiled geometry when only camera, lights or material values change).
-"""
+:class:`FrameRenderer` renders many frames in one process and reuses what it can between them
+(kernels, and compiled geometry when only camera, lights or material values change)."""
 
 from __future__ import annotations
 
@@ -33,11 +33,12 @@ if TYPE_CHECKING:
     from ..scene.scene import Scene
 
 __all__ = ["FRAME_HASH_KEY", "FrameRenderer", "FrameResult", "frame_digest", "frame_is_current",
-           "read_frame_digest", "render_frame", "still_for_frame", "write_frame_png"]
+           "is_whitted_frame", "model_files", "read_frame_digest", "render_frame",
+           "still_for_frame", "write_frame_png"]
 
 FRAME_HASH_KEY = "whitted:frame-hash"
 FRAME_NUMBER_KEY = "whitted:frame"
-_HASH_VERSION = b"whitted-frame-v1"
+_HASH_VERSION = b"whitted-frame-v2"  # v2: a model's MTL files and their textures counted
 FRAME_PNG_LEVEL = 1
 
 
@@ -55,7 +56,11 @@ def _feed(h: Any, value: Any, scene: Scene) -> None:
             item = getattr(value, name)
             _feed(h, item, scene)
             if name == "file" and isinstance(item, str):
-                _feed_file(h, scene.resolve_path(item))
+                path = scene.resolve_path(item)
+                _feed_file(h, path)
+                if type(value).__name__ == "Mesh":  # what the model file itself reads
+                    for extra in model_files(path):
+                        _feed_file(h, extra)
         h.update(b"}")
     elif isinstance(value, ArrayData):
         h.update(f"<array {value.array.dtype} {value.array.shape}>".encode())
@@ -86,6 +91,22 @@ def _feed_file(h: Any, path: Path) -> None:
         h.update(f"<missing {path}>".encode())
 
 
+def model_files(path: Path) -> list[Path]:
+    """The files a render reads for the model file ``path`` besides ``path`` itself: its
+    material libraries (MTL) and the texture images they (or the model) name, as
+    :func:`whitted.assets.mesh.load_mesh` reads them (the same in-process cache, so the render
+    that follows reads nothing twice). A model that cannot be read gives none: the render
+    reports it."""
+    from ..assets.mesh import load_mesh
+    from ..errors import WhittedError
+
+    try:
+        mesh = load_mesh(path)
+    except (WhittedError, OSError, ValueError):
+        return []
+    return [Path(f) for f in (*mesh.library_files, *mesh.texture_files)]
+
+
 @functools.cache
 def _kernel_sources() -> str:
     from .._cache import kernel_source_hash
@@ -110,15 +131,39 @@ def frame_digest(still: Scene, frame: int) -> str:
 def read_frame_digest(path: str | Path) -> str | None:
     """The frame hash recorded in a PNG written by :func:`render_frame` (None when the file
     is missing, unreadable or has none)."""
+    import stat
+
     from PIL import Image as PILImage
 
-    try:
+    try:  # a regular file only: opening a pipe would wait for a writer
+        if not stat.S_ISREG(Path(path).stat().st_mode):
+            return None
         with PILImage.open(path) as im:
             text = getattr(im, "text", None) or im.info
             value = text.get(FRAME_HASH_KEY)
     except (OSError, ValueError, SyntaxError):
         return None
     return value if isinstance(value, str) else None
+
+
+_RECORD_MARK = b"tEXt" + FRAME_HASH_KEY.encode() + b"\0"
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def is_whitted_frame(path: str | Path) -> bool:
+    """Whether ``path`` is a frame PNG whitted wrote: a PNG whose head carries the frame
+    record (its text chunk comes before the pixels, so a frame cut short is still known as
+    whitted's, and rendered again). The only kind of file a film or a sweep may replace."""
+    import stat
+
+    try:
+        if not stat.S_ISREG(Path(path).stat().st_mode):
+            return False
+        with open(path, "rb") as f:
+            head = f.read(4096)
+    except (OSError, ValueError):
+        return False
+    return head.startswith(_PNG_SIGNATURE) and _RECORD_MARK in head
 
 
 def frame_is_current(path: str | Path, digest: str) -> bool:
@@ -142,7 +187,10 @@ def _write_frame_png(path: Path, image: Any, digest: str, frame: int) -> None:
         tmp, format="PNG", pnginfo=info, compress_level=FRAME_PNG_LEVEL))
 
 
-write_frame_png = _write_frame_png  # the public name: (path, image, digest, frame)
+def write_frame_png(path: str | Path, image: Any, digest: str, frame: int) -> None:
+    """Write ``image`` as the frame PNG ``path`` with its frame record (``digest``, the frame
+    number), atomically."""
+    _write_frame_png(Path(path), image, digest, frame)
 
 
 # ------------------------------------------------------------------------------ rendering

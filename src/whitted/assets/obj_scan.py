@@ -204,7 +204,7 @@ def parse_number(data, s, e):
     inexact = False
     seen_digit = False
     while i < e and data[i] >= 48 and data[i] <= 57:
-        d = data[i] - 48
+        d = int(data[i]) - 48
         seen_digit = True
         if significand == 0 and d == 0:
             pass
@@ -219,7 +219,7 @@ def parse_number(data, s, e):
     if i < e and data[i] == 46:
         i += 1
         while i < e and data[i] >= 48 and data[i] <= 57:
-            d = data[i] - 48
+            d = int(data[i]) - 48
             seen_digit = True
             if significand == 0 and d == 0:
                 exponent -= 1
@@ -245,7 +245,7 @@ def parse_number(data, s, e):
         written = 0
         while i < e and data[i] >= 48 and data[i] <= 57:
             if written < _EXPONENT_LIMIT:
-                written = written * 10 + (data[i] - 48)
+                written = written * 10 + (int(data[i]) - 48)
             i += 1
         exponent += -written if exponent_negative else written
     if i != e:
@@ -281,7 +281,7 @@ def _parse_index_field(data, s, e):
         if b < 48 or b > 57:
             return 2, 0
         if value < _INDEX_LIMIT:
-            value = value * 10 + (b - 48)
+            value = value * 10 + (int(b) - 48)
         i += 1
     return 0, -value if negative else value
 

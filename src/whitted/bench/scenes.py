@@ -63,6 +63,9 @@ SCENES: dict[str, BenchScene] = {
                    "merge of two glass balls"),
         BenchScene("dice100", "dice100.toml",
                    "a hundred dice, each a rounded cube minus 21 pips (23 solids of CSG)"),
+        BenchScene("caustics", "caustics.toml",
+                   "a glass ball and a glass slab on a floor, a directional and a point "
+                   "light: caustics by photon mapping (100,000 photons)"),
     )
 }
 

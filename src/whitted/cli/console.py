@@ -9,7 +9,7 @@ been made: what rich writes for unstyled printable text printed with ``soft_wrap
 and a newline, on a terminal or not (text with tabs or control characters goes to rich, which
 expands or drops them). A render never imports rich when its output goes to a pipe or
 a file (a script, a film's frames, a farm worker, a benchmark), nor on a terminal when it ends
-before its progress bar would appear (cli/main.py ``PROGRESS_DELAY``): 25-70 ms of its
+before its progress bar would appear (cli/render.py ``PROGRESS_DELAY``): 25-70 ms of its
 start-up.
 """
 

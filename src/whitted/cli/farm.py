@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from ..errors import WhittedError
+from .interrupt import InterruptGuard
 
 if TYPE_CHECKING:
     from rich.progress import Progress
@@ -27,7 +28,7 @@ SchedulerOption = Annotated[
 
 def farm_module():
     """``whitted.farm``, or the one-line error saying what to install."""
-    from .main import fail
+    from .app import fail
 
     try:
         from .. import farm
@@ -37,7 +38,7 @@ def farm_module():
 
 
 def bar(label: str, quiet: bool) -> Progress | None:
-    from .main import err
+    from .app import err
 
     if quiet or not err.is_terminal:
         return None
@@ -57,13 +58,15 @@ def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
                          scheduler: str | None, threads: int | None, quiet: bool,
                          bit_depth: int, aovs: list[str]) -> None:
     """``whitted render`` on a cluster: bands across the workers, one image written here."""
-    from .main import _save_npy, err, fail, out
+    from .app import err, fail, out, save_npy
 
     farm = farm_module()
     start = time.perf_counter()
     note = None if quiet else (lambda line: err.print(line, markup=False, highlight=False))
+    guard = InterruptGuard(at_once=True)  # SIGINT, SIGTERM: the cluster closed, nothing kept
     try:
-        with farm.farm_client(cluster, scheduler, threads=threads, note=note) as client:
+        with guard, farm.farm_client(cluster, scheduler, threads=threads,
+                                     note=note) as client:
             progress = bar("rendering bands", quiet)
             if progress is None:
                 image = farm.render_still(client, scene)
@@ -74,6 +77,8 @@ def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
                         client, scene,
                         progress=lambda done, total: progress.update(task, completed=done,
                                                                      total=total))
+    except KeyboardInterrupt:
+        raise guard.exit(f"nothing written ({output} is unchanged)") from None
     except WhittedError as exc:  # a bad option, an unreachable scheduler, a bad model file
         raise fail(str(exc)) from None
     stats = image.meta["stats"]
@@ -87,7 +92,7 @@ def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
         planes = render_aovs(scene)
         for name in aovs:
             path = output.with_name(f"{output.stem}.{name}.npy")
-            _save_npy(path, planes[name])
+            save_npy(path, planes[name])
             written.append(str(path))
     stats.wall_seconds = time.perf_counter() - start
     if not quiet:
@@ -101,40 +106,41 @@ def animate_on_farm(scene: Scene, frames: range, folder: Path, film: Path | None
                     scheduler: str | None, threads: int | None) -> None:
     """``whitted animate`` on a cluster: frames as tasks, each written here as it arrives
     (resumable, as the local command), then the film encoded from the whole sequence."""
-    from .main import EXIT_INTERRUPTED, err, fail, out
+    from .app import err, fail, out
 
     farm = farm_module()
     start = time.perf_counter()
     note = None if quiet else (lambda line: err.print(line, markup=False, highlight=False))
     finished: list[int | None] = []
-    try:
-        farm.check_farm_options(cluster, scheduler)
-        plan = farm.plan_film(scene, folder, frames=frames, force=force)
-        # a cluster only when frames are missing: a finished film is only encoded
-        connect = (farm.farm_client(cluster, scheduler, threads=threads, note=note)
-                   if plan.todo else nullcontext())
-        with connect as client:
-            progress = bar("frames", quiet)
+    guard = InterruptGuard(at_once=True)  # SIGINT, SIGTERM: the frames written are kept
+    with guard:
+        try:
+            farm.check_farm_options(cluster, scheduler)
+            plan = farm.plan_film(scene, folder, frames=frames, force=force)
+            # a cluster only when frames are missing: a finished film is only encoded
+            connect = (farm.farm_client(cluster, scheduler, threads=threads, note=note)
+                       if plan.todo else nullcontext())
+            with connect as client:
+                progress = bar("frames", quiet)
 
-            def frame_done(done: int, total: int, frame: int | None) -> None:
-                finished.append(frame)
-                if progress is not None:
-                    progress.update(task, completed=done, total=total)
-                elif not quiet and frame is not None:
-                    err.print(f"frame {frame} ({done}/{total})", highlight=False)
+                def frame_done(done: int, total: int, frame: int | None) -> None:
+                    finished.append(frame)
+                    if progress is not None:
+                        progress.update(task, completed=done, total=total)
+                    elif not quiet and frame is not None:
+                        err.print(f"frame {frame} ({done}/{total})", highlight=False)
 
-            with progress if progress is not None else nullcontext():
-                task = progress.add_task("frames", total=len(frames)) if progress else None
-                result = farm.render_film(client, scene, folder, film=film, fps=fps, crf=crf,
-                                          progress=frame_done, plan=plan)
-    except KeyboardInterrupt:
-        err.print(f"interrupted: {len(finished)} of {len(frames)} frames finished in {folder}; "
-                  "run the same command again to continue")
-        raise typer.Exit(EXIT_INTERRUPTED) from None
-    except WhittedError as exc:  # a bad option, an unreachable scheduler, a failed frame
-        raise fail(str(exc)) from None
-    except (ValueError, OSError) as exc:  # the encoder
-        raise fail(f"{film}: cannot encode: {exc}") from None
+                with progress if progress is not None else nullcontext():
+                    task = progress.add_task("frames", total=len(frames)) if progress else None
+                    result = farm.render_film(client, scene, folder, film=film, fps=fps, crf=crf,
+                                              progress=frame_done, plan=plan)
+        except KeyboardInterrupt:
+            raise guard.exit(f"{len(finished)} of {len(frames)} frames finished in {folder}; "
+                             "run the same command again to continue") from None
+        except WhittedError as exc:  # a bad option, an unreachable scheduler, a failed frame
+            raise fail(str(exc)) from None
+        except (ValueError, OSError) as exc:  # the encoder
+            raise fail(f"{film}: cannot encode: {exc}") from None
     for warning in result.warnings:
         err.print(f"warning: {warning}", markup=False, highlight=False)
     if not quiet:

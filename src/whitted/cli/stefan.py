@@ -5,9 +5,7 @@ A thin client: the physics is :mod:`whitted.stefan`, the rendering the render AP
 
 from __future__ import annotations
 
-import signal
 import sys
-import threading
 import time
 from pathlib import Path
 from typing import Annotated
@@ -15,9 +13,10 @@ from typing import Annotated
 import typer
 
 from ..errors import WhittedError
+from .app import app as main_app
+from .app import err, fail
 from .console import LazyConsole
-from .main import EXIT_INTERRUPTED, err, fail
-from .main import app as main_app
+from .interrupt import InterruptGuard
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="The Stefan problem: a hollow piece of ice with water inside, melting.")
@@ -31,23 +30,7 @@ def _fail(message: str) -> typer.Exit:
     return fail(message)
 
 
-class _Interrupt:
-    """Ctrl-C sets a flag the solver checks between chunks of steps."""
-
-    def __init__(self) -> None:
-        self.flag = threading.Event()
-        self.previous = None
-
-    def __enter__(self) -> _Interrupt:
-        self.previous = signal.getsignal(signal.SIGINT)
-        signal.signal(signal.SIGINT, lambda *_: self.flag.set())
-        return self
-
-    def __exit__(self, *exc) -> None:
-        signal.signal(signal.SIGINT, self.previous)
-
-
-def _load(case_path: Path):
+def load_scene_argument(case_path: Path):
     from ..stefan.case import load_case
 
     try:
@@ -57,19 +40,32 @@ def _load(case_path: Path):
     return case, case_path.read_text(encoding="utf-8")
 
 
-def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, size=(480, 360)):
+#: the files a run writes at the top of its folder (stefan/run.py)
+RUN_FILES = ("case.toml", "series.csv", "summary.json", "series.png")
+
+
+def _check_run_outputs(case_path: Path, output: Path) -> None:
+    """The output-safety check of ``render`` for a run's folder: its files can be written
+    there and none of them is the case file the run reads (one line)."""
+    from ..output.safety import check_outputs
+
+    if not output.is_dir():  # the run makes it
+        return
+    try:
+        check_outputs([output / name for name in RUN_FILES], inputs=[case_path])
+    except WhittedError as exc:
+        raise _fail(str(exc)) from None
+
+
+def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, guard: InterruptGuard,
+           size=(480, 360), allow_large: bool = False):
     from ..stefan.case import CaseError
     from ..stefan.run import run_case
 
-    case, text = _load(case_path)
+    case, text = load_scene_argument(case_path)
     if output.exists() and not output.is_dir():
         raise _fail(f"{output}: exists and is not a folder")
-    if output.resolve() == case_path.resolve().parent and fresh:
-        raise _fail(f"{output}: --fresh would clear the case file's own folder")
-    if fresh and output.exists():
-        for sub in ("fields", "surfaces", "scenes"):
-            for f in (output / sub).glob("*"):
-                f.unlink()
+    _check_run_outputs(case_path, output)
     from rich.progress import (
         BarColumn,
         Progress,
@@ -80,8 +76,8 @@ def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, size=(480, 3
 
     columns = (TextColumn("[bold]{task.description}"), BarColumn(), TaskProgressColumn(),
                TextColumn("t = {task.fields[t]}"), TimeRemainingColumn())
-    with _Interrupt() as stop, Progress(*columns, console=err, transient=True,
-                                        disable=quiet or not err.is_terminal) as bar:
+    with Progress(*columns, console=err, transient=True,
+                  disable=quiet or not err.is_terminal) as bar:
         task = bar.add_task("melting", total=1.0, t="0 s")
 
         def progress(fraction: float, t: float, what: str) -> None:
@@ -89,7 +85,8 @@ def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, size=(480, 3
 
         try:
             result = run_case(case, text, output, resume=not fresh, progress=progress,
-                              should_stop=stop.flag.is_set, scene_size=size)
+                              should_stop=guard.is_set, scene_size=size,
+                              allow_large=allow_large, case_path=case_path)
         except CaseError as exc:
             raise _fail(str(exc)) from None
     return case, result
@@ -100,19 +97,24 @@ def run(
     case_path: Annotated[Path, typer.Argument(metavar="CASE", help="Case file (TOML)")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Output folder")] = Path(
         "stefan-out"),
-    fresh: Annotated[bool, typer.Option("--fresh", help="Start over, do not resume")] = False,
+    fresh: Annotated[bool, typer.Option("--fresh", help="Start over, do not resume (removes "
+                                        "only the files whitted wrote there)")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
+    allow_large: Annotated[bool, typer.Option(
+        "--allow-large", help="Go beyond the soft limits on steps, cell updates, saved times "
+        "and disk (never beyond the machine's memory or free disk)")] = False,
 ) -> None:
     """Compute the melt of CASE: fields (.npz), surfaces (.ply) per saved time, a time series
     (CSV and plots) and a scene per saved time. Ctrl-C keeps what was saved; run again to
-    resume from the last saved time."""
-    case, result = _solve(case_path, output, fresh, quiet)
-    _report(result)
-    if result.interrupted:
-        err.print(f"interrupted at t = {result.end_time:.1f} s: kept the saved times up to "
-                  f"t = {result.last_saved:.0f} s in {output}; run the same command again to "
-                  "resume from there")
-        raise typer.Exit(EXIT_INTERRUPTED)
+    resume from the last saved time. The folder must be new, empty of the run's names, or
+    one whitted made (its .whitted-stefan-run marker): nothing else is written over."""
+    with InterruptGuard() as guard:
+        case, result = _solve(case_path, output, fresh, quiet, guard, allow_large=allow_large)
+        _report(result)
+        if result.interrupted:
+            raise guard.exit(f"at t = {result.end_time:.1f} s: kept the saved times up to "
+                             f"t = {result.last_saved:.0f} s in {output}; run the same "
+                             "command again to resume from there")
 
 
 def _report(result) -> None:
@@ -159,6 +161,17 @@ def validate(
                       f"{r['front_mm']:.4f}", f"{r['exact_mm']:.4f}", f"{r['error_pct']:+.2f} %",
                       "" if r["order"] is None else f"{r['order']:.2f}",
                       f"{r['far_change']:.1e}", f"{r['energy_rel']:.1e}")
+    out.print(table)
+
+    table = Table(title=f"Three more 1-D cases (issue 30) after {t_end:.0f} s")
+    for col in ("case", "dx (mm)", "steps", "front (mm)", "exact (mm)", "error", "order",
+                "energy (rel.)"):
+        table.add_column(col, justify="right")
+    for r in v.more_case_rows(t_end=t_end, cells_mm=(0.5, 0.25, 0.125) if full else (0.5, 0.25)):
+        table.add_row(r["case"], f"{r['dx_mm']:g}", str(r["steps"]), f"{r['front_mm']:.4f}",
+                      f"{r['exact_mm']:.4f}", f"{r['error_pct']:+.2f} %",
+                      "" if r["order"] is None else f"{r['order']:.2f}",
+                      f"{r['energy_rel']:.1e}")
     out.print(table)
 
     table = Table(title="The 1-D case along each axis and in 3-D (0.5 mm, 600 s, same dt)")
@@ -209,6 +222,43 @@ def _stamp(path: Path, text: str):
     return np.asarray(image)
 
 
+def _check_film_options(case_path: Path, output: Path, gif: Path | None, width: int,
+                        height: int, fps: float) -> None:
+    """What the film's options must be, checked before the solve (one line naming the
+    option): the image size, the frame rate each film's format takes, and films that can be
+    written where they go without writing over the case file or each other."""
+    from pydantic import ValidationError
+
+    from ..output.safety import check_outputs
+    from ..output.video import check_fps, video_format
+    from ..scene.scene import RenderSettings
+
+    try:
+        RenderSettings(width=width, height=height)
+    except ValidationError as exc:
+        from .app import override_error
+
+        raise _fail(override_error(exc)) from None
+    films = [output, *([gif] if gif is not None else [])]
+    formats = []
+    for option, path in zip(("-o", "--gif"), films, strict=False):
+        try:
+            formats.append(video_format(path))
+        except ValueError as exc:
+            raise _fail(f"{option}: {path}: {exc}") from None
+    for fmt in formats:
+        try:
+            check_fps(fps, fmt)
+        except ValueError as exc:
+            raise _fail(f"--fps: {exc}") from None
+    if gif is not None and output.resolve() == gif.resolve():
+        raise _fail(f"--gif: {gif} is the film -o names too")
+    try:
+        check_outputs(films, inputs=[case_path])
+    except WhittedError as exc:
+        raise _fail(str(exc)) from None
+
+
 @app.command()
 def film(
     case_path: Annotated[Path, typer.Argument(metavar="CASE", help="Case file (TOML)")],
@@ -222,54 +272,106 @@ def film(
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
 ) -> None:
     """Solve CASE (or resume it) into OUTPUT's folder NAME_stefan/, render one frame per saved
-    time with 'whitted animate' (the piece on a table, backlit; ice 1.31, water 1.333,
-    absorption exaggerated and said so) and encode the film with the simulated time in each
-    frame. Ctrl-C keeps the solved times and the finished frames; run again to continue."""
-    import csv
-
-    from ..output.video import encode_film, video_format
+    time (the piece on a table, backlit; ice 1.31, water 1.333, measured absorption, 4 samples
+    per pixel) and encode the film with the simulated time in each frame. Ctrl-C or SIGTERM
+    keeps the solved times and the finished frames; run again to continue."""
+    from ..animation.film import FilmPaths, frame_name, render_film
+    from ..output.video import encode_film
+    from ..render.api import CancelToken
+    from ..scene import load_scene
+    from ..stefan.run import film_frames
     from ..stefan.scene import ABSORPTION_BOOST, still_life_scene, write_scene
-    from .animate import animate as animate_command
 
     started = time.perf_counter()
-    try:
-        video_format(output)
-        if gif is not None:
-            video_format(gif)
-    except ValueError as exc:
-        raise _fail(f"{output}: {exc}") from None
-    if not output.parent.exists():
-        raise _fail(f"{output}: the folder {output.parent} does not exist")
+    _check_film_options(case_path, output, gif, width, height, fps)
     work = output.with_name(output.stem + "_stefan")
-    case, result = _solve(case_path, work, fresh, quiet, size=(width, height))
-    _report(result)
-    if result.interrupted:
-        err.print(f"interrupted while solving: kept every saved time in {work}; run the same "
-                  "command again to continue")
-        raise typer.Exit(EXIT_INTERRUPTED)
-    with (work / "series.csv").open(newline="") as fh:
-        times = [float(row["time_s"]) for row in csv.DictReader(fh)]
-    count = 0  # frames: saved times from 0 on where both surfaces exist
-    while (count < len(times) and (work / "surfaces" / f"outer_{count:04d}.ply").exists()
-           and (work / "surfaces" / f"inner_{count:04d}.ply").exists()):
-        count += 1
-    if count == 0:
-        raise _fail(f"{work}: no saved time has both surfaces to film")
-    scene_path = work / "film.toml"
-    write_scene(scene_path, still_life_scene(
-        "surfaces/outer_{frame:04d}.ply", "surfaces/inner_{frame:04d}.ply", None,
-        width=width, height=height, size_cm=100 * max(case.block.size), frames=count, fps=fps))
-    frames = work / "frames"
-    render_start = time.perf_counter()
-    animate_command(scene_path=scene_path, output=frames, frames=None, fps=None, width=None,
-                    height=None, samples=None, max_depth=None, threads=None, seed=None,
-                    set_values=None, crf=18, force=False, quiet=quiet)
-    render_seconds = time.perf_counter() - render_start
-    stamped = [_stamp(frames / f"{k:04d}.png",
-                      f"t = {times[k] / 60:5.1f} min   (absorption x{ABSORPTION_BOOST:g})")
-               for k in range(count)]
-    for path in [output, *([gif] if gif is not None else [])]:
-        encode_film(stamped, path, fps)
+    with InterruptGuard() as guard:
+        case, result = _solve(case_path, work, fresh, quiet, guard, size=(width, height))
+        _report(result)
+        if result.interrupted:
+            raise guard.exit(f"while solving: kept every saved time in {work}; run the same "
+                             "command again to continue")
+        shown = film_frames(work)  # to the end of the run (drain: the outer surface alone)
+        count = len(shown)
+        times = [f.time for f in shown]
+        if count == 0:
+            raise _fail(f"{work}: no saved time has a surface to film")
+        cancel = CancelToken()
+        guard.on_interrupt(cancel.cancel)
+        render_start = time.perf_counter()
+        if all(f.inner is not None for f in shown):  # one animated still life: render_film
+            scene_path = work / "film.toml"
+            write_scene(scene_path, still_life_scene(
+                "surfaces/outer_{frame:04d}.ply", "surfaces/inner_{frame:04d}.ply", None,
+                width=width, height=height, size_cm=100 * max(case.block.size), frames=count,
+                fps=fps))
+            try:
+                scene = load_scene(scene_path)
+                frames = render_film(scene, FilmPaths(None, work / "frames"), fps=fps,
+                                     scene_path=scene_path, cancel=cancel,
+                                     progress=None if quiet else _frame_line)
+            except WhittedError as exc:
+                raise _fail(str(exc)) from None
+            if frames.cancelled:
+                raise guard.exit(f"{len(frames.files)} of {count} frames finished in "
+                                 f"{work / 'frames'}; run the same command again to continue")
+            files = list(frames.files)
+        else:  # after the breach (drain) there is no cavity: each saved time's own still life
+            files = _render_saved_times(work, shown, width, height, cancel, quiet, guard,
+                                        frame_name)
+        render_seconds = time.perf_counter() - render_start
+        label = ("measured absorption" if ABSORPTION_BOOST == 1.0
+                 else f"absorption x{ABSORPTION_BOOST:g}")
+        stamped = [_stamp(path, f"t = {times[k] / 60:5.1f} min   ({label})")
+                   for k, path in enumerate(files)]
+        for path in [output, *([gif] if gif is not None else [])]:
+            try:
+                encode_film(stamped, path, fps, cancel=cancel)
+            except WhittedError:  # cancelled: ffmpeg stopped, the film as it was
+                raise guard.exit(f"every frame is in {work / 'frames'}; {path} was not "
+                                 "written") from None
+            except (ValueError, OSError) as exc:
+                raise _fail(f"{path}: cannot encode: "
+                            f"{getattr(exc, 'strerror', None) or exc}") from None
     out.print(f"{count} frames ({render_seconds / count:.2f} s a frame, wall) -> {output}"
               + (f", {gif}" if gif is not None else "")
               + f"; total {time.perf_counter() - started:.1f} s")
+
+
+def _render_saved_times(work: Path, shown, width: int, height: int, cancel, quiet: bool,
+                        guard: InterruptGuard, frame_name) -> list[Path]:
+    """Each saved time's own scene (``scenes/frame_NNNN.toml``, written by the run) rendered
+    to ``frames/``: the film of a run whose later times have no cavity. A cancel keeps the
+    frames finished (each written atomically)."""
+    from ..render import render as render_scene
+
+    folder = work / "frames"
+    folder.mkdir(exist_ok=True)
+    files = []
+    for k, f in enumerate(shown):
+        if cancel.cancelled:
+            raise guard.exit(f"{k} of {len(shown)} frames finished in {folder}; run the same "
+                             "command again to continue")
+        path = folder / frame_name(k, len(shown))
+        try:
+            image = render_scene(work / "scenes" / f"frame_{f.index:04d}.toml", width=width,
+                                 height=height, cancel=cancel)
+            if not cancel.cancelled:
+                image.save(path)
+        except WhittedError as exc:
+            raise _fail(str(exc)) from None
+        if not cancel.cancelled:
+            files.append(path)
+            if not quiet:
+                out.line(f"frame {k} ({k + 1}/{len(shown)}): rendered")
+    if cancel.cancelled:
+        raise guard.exit(f"{len(files)} of {len(shown)} frames finished in {folder}; run the "
+                         "same command again to continue")
+    return files
+
+
+def _frame_line(p) -> None:
+    """One line per frame finished (render_film's progress), on stdout."""
+    if p.event == "done":
+        state = f"{p.result.seconds:.2f} s" if p.result.rendered else "already done"
+        out.line(f"frame {p.frame} ({p.done}/{p.total}): {state}")

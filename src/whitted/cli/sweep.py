@@ -3,25 +3,22 @@
 from __future__ import annotations
 
 import math
-import signal
-import threading
 import time
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from ..errors import SceneError, WhittedError
-from .main import (
-    EXIT_INTERRUPTED,
+from ..errors import WhittedError
+from .app import (
     SceneArgument,
-    _load,
-    _override_error,
     app,
-    err,
     fail,
+    load_scene_argument,
     out,
+    override_error,
 )
+from .interrupt import InterruptGuard
 
 
 @app.command()
@@ -52,19 +49,19 @@ def sweep(
     "objects[glass sphere].material.kt=1:0:-0.2" (1, 0.8, ... 0)."""
     from pydantic import ValidationError
 
+    from ..animation.film import check_frame_files
     from ..animation.frames import FrameRenderer
     from ..animation.overrides import apply_overrides, parse_assignment, parse_values
-    from ..animation.sweep import contact_sheet, sweep_cells
+    from ..animation.sweep import sweep_cells
     from ..files import atomic_write
+    from ..output.safety import check_memory, check_outputs, input_files
     from ..render.api import CancelToken
 
     started = time.perf_counter()
     if output.suffix.lower() != ".png":
         raise fail(f"{output}: the sheet is a PNG (use a .png name)")
     try:
-        scene, name = _load(scene_path)
-        if scene_path is not None and output.resolve() == scene_path.resolve():
-            raise SceneError("would write over the scene file", where=str(output))
+        scene, name = load_scene_argument(scene_path)
         axes, fixed = [], []
         for text in set_values or []:
             path, value_text = parse_assignment(text)
@@ -78,53 +75,64 @@ def sweep(
                                     max_depth=max_depth)
         cells = sweep_cells(scene, axes)
         stills = [cell.scene.at_frame(frame) for cell in cells]
+        # before anything is written: the sheet and the cells can be written, none is a file
+        # the sweep reads, and no file in the cells' way was written by anyone but whitted
+        inputs = list(dict.fromkeys(  # a swept value may name other files
+            f for cell in cells for f in input_files(cell.scene, scene_path)))
+        check_outputs([output], inputs=inputs)
+        folder = output.with_name(f"{output.stem}_cells")
+        digits = len(str(len(cells) - 1))
+        cell_files = [folder / f"{cell.index:0{digits}d}.png" for cell in cells]
+        check_frame_files(folder, cell_files, inputs)
+        for still in stills:
+            check_memory(still.render.width, still.render.height, "png")
+        folder.mkdir(exist_ok=True)
     except WhittedError as exc:
         raise fail(str(exc)) from None
     except ValidationError as exc:
-        raise fail(_override_error(exc)) from None
-    if not output.parent.exists():
-        raise fail(f"{output}: the folder {output.parent} does not exist")
-    folder = output.with_name(f"{output.stem}_cells")
-    folder.mkdir(exist_ok=True)
+        raise fail(override_error(exc)) from None
+    except OSError as exc:
+        raise fail(f"{output}: cannot write: {exc.strerror or exc}") from None
 
     renderer = FrameRenderer(threads)
     cancel = CancelToken()
-    interrupted = threading.Event()
-    previous = signal.getsignal(signal.SIGINT)
-
-    def on_interrupt(signum, frame_) -> None:
-        interrupted.set()
-        cancel.cancel()
-
-    signal.signal(signal.SIGINT, on_interrupt)
     paths: list[Path] = []
     rendered = 0
-    digits = len(str(len(cells) - 1))
-    try:
-        for cell, still in zip(cells, stills, strict=True):
-            if interrupted.is_set():
-                break
-            path = folder / f"{cell.index:0{digits}d}.png"
-            result = renderer.render(still, frame, path, cancel=cancel)
-            if result.cancelled:
-                break
-            rendered += int(result.rendered)
-            paths.append(path)
-            if not quiet:
-                state = f"{result.seconds:.2f} s" if result.rendered else "already done"
-                err.print(f"{cell.label} ({cell.index + 1}/{len(cells)}): {state}",
-                          highlight=False, markup=False)
-    except WhittedError as exc:
-        raise fail(str(exc)) from None
-    finally:
-        signal.signal(signal.SIGINT, previous)
-    if len(paths) < len(cells):
-        err.print(f"interrupted: {len(paths)} of {len(cells)} images finished in {folder}; "
-                  "run the same command again to continue")
-        raise typer.Exit(EXIT_INTERRUPTED)
+    with InterruptGuard() as guard:
+        guard.on_interrupt(cancel.cancel)
+        try:
+            for cell, still, path in zip(cells, stills, cell_files, strict=True):
+                if cancel.cancelled:
+                    break
+                result = renderer.render(still, frame, path, cancel=cancel)
+                if result.cancelled:
+                    break
+                rendered += int(result.rendered)
+                paths.append(path)
+                if not quiet:
+                    state = f"{result.seconds:.2f} s" if result.rendered else "already done"
+                    out.line(f"{cell.label} ({cell.index + 1}/{len(cells)}): {state}")
+        except WhittedError as exc:
+            raise fail(str(exc)) from None
+        except OSError as exc:
+            raise fail(f"{folder}: cannot write: {exc.strerror or exc}") from None
+        if len(paths) < len(cells):
+            raise guard.exit(f"{len(paths)} of {len(cells)} images finished in {folder}; "
+                             "run the same command again to continue")
+        _write_sheet(output, paths, cells, axes, columns, title, guard, atomic_write)
+    if not quiet:
+        out.print(f"{len(cells)} images ({rendered} rendered) -> {folder}; sheet "
+                  f"{_sheet_size(output)} -> {output}; "
+                  f"{time.perf_counter() - started:.1f} s", highlight=False)
 
+
+def _write_sheet(output, paths, cells, axes, columns, title, guard, atomic_write) -> None:
+    """The contact sheet, written atomically (a signal during the write lets it finish: the
+    cells are all there, and the sheet is whole or not written)."""
     import numpy as np
     from PIL import Image as PILImage
+
+    from ..animation.sweep import contact_sheet
 
     images = [np.asarray(PILImage.open(p).convert("RGB")) for p in paths]
     if len(axes) == 2:
@@ -133,8 +141,17 @@ def sweep(
         ncols = columns or (len(cells) if len(cells) <= 6 else math.ceil(math.sqrt(len(cells))))
     heading = title if title is not None else " / ".join(path for path, _ in axes)
     sheet = contact_sheet(images, [c.label for c in cells], ncols, heading)
-    atomic_write(output, lambda tmp: PILImage.fromarray(sheet).save(tmp, format="PNG"))
-    if not quiet:
-        out.print(f"{len(cells)} images ({rendered} rendered) -> {folder}; sheet "
-                  f"{sheet.shape[1]}x{sheet.shape[0]} -> {output}; "
-                  f"{time.perf_counter() - started:.1f} s", highlight=False)
+    try:
+        atomic_write(output, lambda tmp: PILImage.fromarray(sheet).save(tmp, format="PNG"))
+    except OSError as exc:
+        raise fail(f"{output}: cannot write: {exc.strerror or exc}") from None
+    if guard.interrupted:
+        raise guard.exit(f"every image is in {output.with_name(output.stem + '_cells')} and "
+                         f"the sheet was written to {output}")
+
+
+def _sheet_size(output: Path) -> str:
+    from PIL import Image as PILImage
+
+    with PILImage.open(output) as im:
+        return f"{im.width}x{im.height}"

@@ -59,6 +59,9 @@ class CompiledScene:
     triangles: int = 0  # distinct mesh triangles stored (instances not multiplied)
     mesh_tracer: str = "whitted"  # who traces the instanced meshes: whitted or embree
     instanced_triangles: int = 0  # triangles in the scene counting every instance
+    #: (P, 3) world bounds of each primitive (inf for the unbounded): the caustics' targets
+    prim_lo: np.ndarray | None = None
+    prim_hi: np.ndarray | None = None
 
 
 def packed_nodes(bvh, dtype) -> tuple[np.ndarray, np.ndarray]:
@@ -205,4 +208,6 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
         triangles=meshes.n_tris + flat,
         instanced_triangles=instanced,
         mesh_tracer=tracer,
+        prim_lo=lo,
+        prim_hi=hi,
     )

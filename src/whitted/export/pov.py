@@ -290,7 +290,27 @@ class _PovWriter:
         return ("global_settings {\n  assumed_gamma 1.0\n"
                 f"  ambient_light rgb {vec(ambient)}\n"
                 f"  max_trace_level {r.max_depth + 1}\n"
-                f"  adc_bailout {num(r.min_weight)}\n}}")
+                f"  adc_bailout {num(r.min_weight)}\n{self.photon_settings()}}}")
+
+    # -- caustics (docs/caustics.md): POV-Ray's photon map ---------------------------------
+    def photon_settings(self) -> str:
+        """``global_settings``' photons block of a scene with caustics: as many photons as
+        whitted shoots in all its passes, gathered from at least 20 (POV-Ray's default)."""
+        c = self.scene.render.caustics
+        if c.photons == 0:
+            return ""
+        radius = f" radius {num(c.radius)}" if c.radius > 0 else ""
+        return (f"  photons {{ count {c.photons * c.passes} autostop 0 jitter 0.4 "
+                f"max_trace_level {self.scene.render.max_depth + 1} gather 20, 100"
+                f"{radius} }}\n")
+
+    def photons(self, mat: Material) -> str | None:
+        """An object's photons block: bodies that reflect or refract are targets (whitted
+        aims its photons at every one) and collect none."""
+        if self.scene.render.caustics.photons == 0 or (mat.kr == 0.0 and mat.kt == 0.0):
+            return None
+        return ("photons { target reflection " + ("on" if mat.kr > 0 or mat.fresnel else "off")
+                + " refraction " + ("on" if mat.kt > 0 else "off") + " collect off }")
 
     def camera(self) -> str:
         cam: Camera = self.scene.camera
@@ -364,6 +384,8 @@ class _PovWriter:
         interior = self.interior_name(mat) if solid else None
         if interior is not None:
             lines.append(f"  interior {{ {interior} }}")
+        if (photons := self.photons(mat)) is not None:
+            lines.append(f"  {photons}")
         if obj.transform is not None and not obj.transform.is_identity():
             lines.append(f"  {matrix_keyword(obj.transform.matrix())}")
         return _labelled(index, obj) + "\n".join(lines) + "\n}"
@@ -392,6 +414,8 @@ class _PovWriter:
             interior = self.interior_name(medium)
             if interior is not None:
                 lines.append(f"  interior {{ {interior} }}")
+            if (photons := self.photons(medium)) is not None:
+                lines.append(f"  {photons}")
         if obj.transform is not None and not obj.transform.is_identity():
             lines.append(f"  {matrix_keyword(obj.transform.matrix())}")
         return "\n".join(lines) + "\n}"
@@ -491,6 +515,8 @@ class _PovWriter:
         interior = self.interior_name(material) if obj.solid else None
         if interior is not None:
             out.append(f"  interior {{ {interior} }}")
+        if (photons := self.photons(material)) is not None:
+            out.append(f"  {photons}")
         if obj.transform is not None and not obj.transform.is_identity():
             out.append(f"  {matrix_keyword(obj.transform.matrix())}")
         return _labelled(index, obj) + "\n".join(out) + "\n}"

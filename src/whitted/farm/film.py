@@ -68,12 +68,6 @@ class FilmResult:
     warnings: list[str] = field(default_factory=list)
 
 
-def frame_file_name(frame: int, count: int) -> str:
-    """``0007.png``: four digits at least, more when the film has more frames (the names
-    ``whitted animate`` gives)."""
-    return f"{frame:0{max(4, len(str(count - 1)))}d}.png"
-
-
 def chunk_size(width: int, height: int, samples: int, frames: int, workers: int) -> int:
     """Frames per task: enough that a task holds about :data:`SAMPLES_PER_TASK` samples,
     few enough that every worker gets :data:`TASKS_PER_WORKER` tasks."""
@@ -99,6 +93,7 @@ def plan_film(scene: Scene, frames_dir: str | Path, *, frames: Sequence[int] | N
               force: bool = False, **settings: Any) -> FilmPlan:
     """Each frame's still, hash and file; the frames whose PNG already holds their hash are
     kept (unless ``force``)."""
+    from ..animation.film import frame_name
     from ..animation.frames import frame_digest, frame_is_current, still_for_frame
 
     folder = Path(frames_dir)
@@ -106,7 +101,7 @@ def plan_film(scene: Scene, frames_dir: str | Path, *, frames: Sequence[int] | N
     chosen = list(range(count) if frames is None else frames)
     stills = [still_for_frame(scene, k, **settings) for k in chosen]
     digests = [frame_digest(still, k) for still, k in zip(stills, chosen, strict=True)]
-    paths = [folder / frame_file_name(k, count) for k in chosen]
+    paths = [folder / frame_name(k, count) for k in chosen]
     todo, kept = [], []
     for i, (k, digest, path) in enumerate(zip(chosen, digests, paths, strict=True)):
         if not force and frame_is_current(path, digest):

@@ -125,11 +125,11 @@ class FrameOutcome:
 def frame_png(image: Any, digest: str, frame: int) -> bytes:
     """The bytes of the frame PNG the animation feature writes for ``image`` (its writer,
     into a temporary file: the same bytes ``whitted animate`` writes)."""
-    from ..animation.frames import _write_frame_png
+    from ..animation.frames import write_frame_png
 
     with tempfile.TemporaryDirectory(prefix="whitted-frame-") as tmp:
         path = Path(tmp) / "frame.png"
-        _write_frame_png(path, image, digest, frame)
+        write_frame_png(path, image, digest, frame)
         return path.read_bytes()
 
 

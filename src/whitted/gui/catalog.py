@@ -10,7 +10,7 @@ from pydantic import BaseModel
 
 from .. import scene as S
 from ..scene import Scene
-from .camera_ops import target_of
+from .camera_ops import project, target_of
 
 #: the Add Object menu, in order: kind -> menu text
 OBJECT_KINDS = {
@@ -81,13 +81,55 @@ def place_clear(scene: Scene, make: Callable[[np.ndarray], BaseModel]) -> BaseMo
         return obj
     lift = np.array([0.0, (floor - bounds[0][1]) if floor is not None else 0.0, 0.0])
     size = float(np.max(bounds[1] - bounds[0])) + 0.1
-    for k in range(41):
-        step = (k + 1) // 2 * (1 if k % 2 else -1) * size  # 0, +1, -1, +2, -2, ...
-        candidate = make(base + lift + step * right)
-        lo, hi = item_bounds(candidate, scene)
-        if not _overlaps(lo + 1e-6, hi - 1e-6, boxes):
-            return candidate
-    return make(base + lift)
+    toward = np.cross(right, [0.0, 1.0, 0.0])  # toward the camera, along the floor
+    clear_outside = None
+    for row in range(4):  # further back, where a row in front is full
+        for k in range(41):
+            step = (k + 1) // 2 * (1 if k % 2 else -1) * size  # 0, +1, -1, +2, -2, ...
+            candidate = make(base + lift + step * right - row * size * toward)
+            lo, hi = item_bounds(candidate, scene)
+            if _overlaps(lo + 1e-6, hi - 1e-6, boxes):
+                continue
+            if _in_view(scene, lo, hi):  # seen whole, not at the edge of the picture
+                return candidate
+            if clear_outside is None:
+                clear_outside = candidate
+    return clear_outside if clear_outside is not None else make(base + lift)
+
+
+#: a new object's whole box is seen within this margin of the picture's edges
+VIEW_MARGIN = 0.08
+
+
+def _in_view(scene: Scene, lo, hi) -> bool:
+    """Whether the box lo..hi is seen whole, clear of the picture's edges."""
+    s = scene.render
+    for corner in ((x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                   for z in (lo[2], hi[2])):
+        uv = project(scene.camera, s.width, s.height, corner)
+        if uv is None or not all(VIEW_MARGIN <= c <= 1 - VIEW_MARGIN for c in uv):
+            return False
+    return True
+
+
+def backdrop_plane(scene: Scene) -> BaseModel:
+    """A new plane in a scene that has a floor: a wall behind everything the camera sees,
+    facing it (a second floor would coincide with the first and never be seen)."""
+    from .transform_tool import item_bounds
+
+    pos = np.asarray(scene.camera.position, np.float64)
+    forward = np.asarray(scene.camera.basis()[2], np.float64)
+    forward = np.array([forward[0], 0.0, forward[2]])
+    n = float(np.linalg.norm(forward))
+    forward = forward / n if n > 1e-9 else np.array([0.0, 0.0, -1.0])
+    depths = [float((np.asarray(c) - pos) @ forward)
+              for o in scene.objects if (b := item_bounds(o, scene)) is not None
+              for c in ((x, y, z) for x in (b[0][0], b[1][0]) for y in (b[0][1], b[1][1])
+                        for z in (b[0][2], b[1][2]))]
+    depth = max([float((spot(scene) - pos) @ forward), *depths]) + 1.0
+    point = pos + depth * forward
+    point[1] = ground_height(scene) or 0.0
+    return S.Plane(point=_v(point), normal=_v(-forward), material="matte")
 
 
 def unique_name(scene: Scene, base: str) -> str:
@@ -116,9 +158,10 @@ def _objects(t: np.ndarray) -> dict[str, Callable[[], BaseModel]]:
 
 def new_object(scene: Scene, kind: str) -> BaseModel:
     """A new object of ``kind``: on the floor in front of the camera, clear of the others
-    (a plane stays the plane y = 0)."""
+    (a plane is the floor y = 0, or, when there is a floor, a wall behind the scene)."""
     if kind == "plane":
-        obj = _objects(spot(scene))[kind]()
+        obj = backdrop_plane(scene) if ground_height(scene) is not None else \
+            _objects(spot(scene))[kind]()
     else:
         obj = place_clear(scene, lambda t: _objects(t)[kind]())
     return obj.model_copy(update={"name": unique_name(scene, kind)})

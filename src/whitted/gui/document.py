@@ -148,6 +148,9 @@ class SceneDocument(QObject):
         self.scene: Scene = scene if scene is not None else Scene()
         self.path: Path | None = path
         self.selection: SelectionKey = CAMERA
+        #: more selected lights and objects besides ``selection`` (the active one): Shift or
+        #: Ctrl-click adds; G/R/S, Delete and Duplicate act on all of them
+        self.extra: list[SelectionKey] = []
         self.revision = 0  # bumped on every scene replacement
 
     # ------------------------------------------------------------------ state
@@ -162,6 +165,7 @@ class SceneDocument(QObject):
         self.scene = scene
         self.path = path
         self.selection = CAMERA
+        self.extra = []
         self.revision += 1
         if dirty:  # a recovered autosave: not what the file on disk says
             self.undo_stack.resetClean()
@@ -184,13 +188,34 @@ class SceneDocument(QObject):
     def item(self, key: SelectionKey | None = None) -> BaseModel | None:
         return item_of(self.scene, self.selection if key is None else key)
 
-    def select(self, key: SelectionKey | None) -> None:
-        """Select ``key`` (None: nothing); every view follows through ``selection_changed``."""
-        if key is not None and item_of(self.scene, key) is None:
-            key = None
-        if key != self.selection:
-            self.selection = key
-            self.selection_changed.emit(key)
+    def selected_keys(self) -> list[SelectionKey]:
+        """Everything selected, the active item (``selection``) first."""
+        keys = [self.selection] if self.selection is not None else []
+        return keys + [k for k in self.extra if k != self.selection]
+
+    def select(self, key: SelectionKey | list | None) -> None:
+        """Select ``key`` (None or []: nothing; a list: all of them, the last one active);
+        every view follows through ``selection_changed``."""
+        keys = key if isinstance(key, list) else [] if key is None else [key]
+        keys = [k for k in keys if item_of(self.scene, k) is not None]
+        active = keys[-1] if keys else None
+        extra = [k for k in keys[:-1] if len(k) == 2 and k != active]
+        if active is not None and len(active) != 2:
+            extra = []  # the camera, the settings, the background: alone
+        if active != self.selection or extra != self.extra:
+            self.selection, self.extra = active, extra
+            self.selection_changed.emit(active)
+
+    def toggle_selected(self, key: SelectionKey | None) -> None:
+        """Shift/Ctrl-click: add a light or an object to the selection, or take it out."""
+        if key is None or len(key) != 2:
+            return
+        keys = [k for k in self.selected_keys() if len(k) == 2]
+        if key in keys:
+            keys.remove(key)
+        else:
+            keys.append(key)
+        self.select(keys)
 
     # ------------------------------------------------------------------ edits
 
@@ -199,8 +224,9 @@ class SceneDocument(QObject):
         """Make ``scene`` (already validated) current as one undoable step."""
         if scene == self.scene:
             return False
-        after = select if select is not None else self.selection
-        self.undo_stack.push(SceneEdit(self, self.scene, scene, text, select_before=self.selection,
+        after = select if select is not None else self.selected_keys()
+        self.undo_stack.push(SceneEdit(self, self.scene, scene, text,
+                                       select_before=self.selected_keys(),
                                        select_after=after, merge_key=merge_key))
         return True
 
@@ -229,18 +255,22 @@ class SceneDocument(QObject):
         self.apply(rebuild_scene(self.scene, **{kind: items}), text, select=key)
         return key
 
-    def delete(self, key: SelectionKey) -> bool:
-        if key in SINGLETONS or item_of(self.scene, key) is None:
+    def delete(self, key: SelectionKey | list) -> bool:
+        """Delete a light or an object (or each of a list of them) as one undo step; then
+        nothing is selected (a second Delete removes nothing more)."""
+        keys = [k for k in (key if isinstance(key, list) else [key])
+                if k is not None and k not in SINGLETONS and item_of(self.scene, k) is not None]
+        if not keys:
             return False
-        kind, index = key
-        items = list(getattr(self.scene, kind))
-        removed = items.pop(index)
-        if items:
-            after = (kind, min(index, len(items) - 1))
-        else:
-            after = CAMERA
-        self.apply(rebuild_scene(self.scene, **{kind: items}), f"Delete {label_of(removed)}",
-                   select=after)
+        update, names = {}, []
+        for kind in ("lights", "objects"):
+            gone = {i for k, i in keys if k == kind}
+            if gone:
+                items = getattr(self.scene, kind)
+                update[kind] = [it for i, it in enumerate(items) if i not in gone]
+                names += [label_of(items[i]) for i in sorted(gone)]
+        text = f"Delete {names[0]}" if len(names) == 1 else f"Delete {len(names)} items"
+        self.apply(rebuild_scene(self.scene, **update), text, select=[])
         return True
 
     def duplicate(self, key: SelectionKey) -> SelectionKey | None:
@@ -269,17 +299,24 @@ class SceneDocument(QObject):
             return
         self.set_field(key, ("name",), name, f"Rename {label_of(item)}")
 
-    def _replace(self, scene: Scene, select: SelectionKey | None) -> None:
-        """Called by the undo commands only."""
+    def _replace(self, scene: Scene, select: SelectionKey | list | None) -> None:
+        """Called by the undo commands only. ``select``: a key, a list of keys (the last
+        active; [] is nothing), or None to keep the selection."""
         self.scene = scene
         self.revision += 1
-        before = self.selection
-        if select is not None and item_of(scene, select) is not None:
-            self.selection = select
-        elif self.selection is not None and item_of(scene, self.selection) is None:
-            self.selection = None
+        before = (self.selection, list(self.extra))
+        if isinstance(select, list):
+            keys = [k for k in select if item_of(scene, k) is not None]
+            self.selection = keys[0] if keys else None
+            self.extra = keys[1:]
+        elif select is not None and item_of(scene, select) is not None:
+            self.selection, self.extra = select, []
+        else:
+            if self.selection is not None and item_of(scene, self.selection) is None:
+                self.selection = None
+            self.extra = [k for k in self.extra if item_of(scene, k) is not None]
         self.changed.emit(self.selection)
-        if self.selection != before:
+        if (self.selection, self.extra) != before:
             self.selection_changed.emit(self.selection)
 
 

@@ -199,6 +199,12 @@ def render_specs(settings: Any) -> list[Spec]:
         Spec(("min_weight",), "Min ray weight", COEF, QUALITY, 0.0, 0.1),
         Spec(("threads",), "Threads", INT, QUALITY, tip="0 = every core"),
         Spec(("seed",), "Seed", INT, QUALITY),
+        Spec(("caustics", "photons"), "Caustic photons", INT, QUALITY,
+             tip="photons per pass (docs/caustics.md); 0 = no caustics"),
+        Spec(("caustics", "passes"), "Caustic passes", INT, QUALITY,
+             tip="progressive photon-mapping passes, 1..4096"),
+        Spec(("caustics", "radius"), "Caustic radius", NUMBER, QUALITY,
+             tip="first pass's gather radius; 0 = chosen from the scene"),
         Spec(("transfer",), "Transfer", CHOICE, OUTPUT, choices=("srgb", "linear")),
         Spec(("tonemap",), "Tone map", CHOICE, OUTPUT, choices=("clamp", "reinhard", "aces")),
     ]

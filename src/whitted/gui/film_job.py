@@ -1,10 +1,11 @@
-"""The editor's "Render animation…": what ``whitted animate SCENE -o FILM`` does, on a
-background thread of the editor, with progress the timeline polls (no Qt here).
+"""The editor's "Render animation…": :func:`whitted.animation.film.render_film` (what
+``whitted animate SCENE -o FILM`` runs) on a background thread of the editor, with progress
+the timeline polls (no Qt here).
 
 The frames go where ``whitted animate`` puts them (``FILM_frames/0000.png`` …, the same names,
 the same PNGs with the hash of what each shows), so the editor and the command resume each
 other's films: a frame already on disk from the same scene and settings is kept. Stopping
-keeps every finished frame. The film is encoded (imageio-ffmpeg) once every frame is there."""
+keeps every finished frame. The film is encoded once every frame is there."""
 
 from __future__ import annotations
 
@@ -13,8 +14,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..animation.frames import FrameRenderer
-from ..render.api import CancelToken, Progress
+from ..animation.film import FilmPlan, FilmProgress, prepare_film, render_film
+from ..render.api import CancelToken
 from ..scene import Scene
 
 __all__ = ["FilmJob"]
@@ -44,15 +45,17 @@ class FilmJob:
     started: float = 0.0
     seconds: float = 0.0
     frames_dir: Path | None = None
+    _plan: FilmPlan | None = field(default=None, repr=False)
     _thread: threading.Thread | None = field(default=None, repr=False)
 
     def start(self) -> None:
-        from ..cli.animate import film_paths
-
-        film, self.frames_dir = film_paths(Path(self.output))
-        if film is None:
+        """Check the film (one-line :class:`~whitted.WhittedError` or ValueError: nothing is
+        written), then render it on a thread of its own."""
+        plan = prepare_film(self.scene, Path(self.output))
+        if plan.paths.film is None:
             raise ValueError(f"{self.output}: a film is .mp4 or .gif")
-        self.total = self.scene.frame_count
+        self._plan, self.frames_dir = plan, plan.paths.frames
+        self.total = len(plan.frames)
         self.started = time.perf_counter()
         self._thread = threading.Thread(target=self._run, name="whitted-film", daemon=True)
         self._thread.start()
@@ -85,42 +88,29 @@ class FilmJob:
         per_frame = self.render_seconds / self.rendered
         return per_frame * (self.total - self.done - self.frame_fraction)
 
-    def _tiles(self, p: Progress) -> None:
-        self.frame_fraction = p.fraction
+    def _progress(self, p: FilmProgress) -> None:
+        if p.event == "frame":
+            self.frame, self.frame_fraction = p.frame, 0.0
+        elif p.event == "tiles" and p.tiles is not None:
+            self.frame_fraction = p.tiles.fraction
+        elif p.event == "done" and p.result is not None:
+            if p.result.rendered:
+                self.rendered += 1
+                self.render_seconds += p.result.seconds
+            else:
+                self.kept += 1
+            self.done, self.frame, self.frame_fraction = p.done, None, 0.0
+        elif p.event == "encoding":
+            self.frame = None
+            self.encoding = True
 
     def _run(self) -> None:
-        from ..cli.animate import frame_name
-        from ..output.video import encode_film
-
         try:
-            folder = self.frames_dir
-            assert folder is not None
-            folder.mkdir(exist_ok=True)
-            renderer = FrameRenderer(self.threads)
-            paths = []
-            for k in range(self.total):
-                if self.cancel.cancelled:
-                    break
-                self.frame, self.frame_fraction = k, 0.0
-                path = folder / frame_name(k, self.total)
-                result = renderer.render(self.scene.at_frame(k), k, path, progress=self._tiles,
-                                         cancel=self.cancel)
-                if result.cancelled:
-                    break
-                paths.append(path)
-                if result.rendered:
-                    self.rendered += 1
-                    self.render_seconds += result.seconds
-                else:
-                    self.kept += 1
-                self.done += 1
+            assert self._plan is not None
+            result = render_film(self.scene, self._plan, threads=self.threads,
+                                 progress=self._progress, cancel=self.cancel)
             self.frame = None
-            if len(paths) < self.total:
-                self.stopped = True
-                return
-            self.encoding = True
-            anim = self.scene.animation
-            encode_film(paths, Path(self.output), anim.fps if anim is not None else 24.0)
+            self.stopped = result.cancelled
         except Exception as exc:  # shown to the user in one line; the frames done stay
             text = str(exc).strip().splitlines()
             self.error = text[0] if text else type(exc).__name__

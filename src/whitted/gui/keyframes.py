@@ -117,7 +117,8 @@ def insert_keys(scene: Scene, targets: list[tuple[str, Any]], frame: int,
         else:
             tracks.append(Track(path, [[frame, value]], interpolation=interpolation))
     fields = {name: getattr(scene, name) for name in Scene.model_fields}
-    fields["animation"] = Animation(frames=anim.frames, fps=anim.fps, tracks=tracks)
+    # every other setting of the animation (cyclic, fps, frames...) stays as it is
+    fields["animation"] = anim.model_copy(update={"tracks": tracks})
     return Scene(**fields).with_base_dir(getattr(scene, "_base_dir", None))
 
 

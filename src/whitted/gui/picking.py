@@ -37,9 +37,11 @@ def id_at(ids: np.ndarray, u: float, v: float) -> int:
     return int(ids[y, x])
 
 
-def outline_image(ids: np.ndarray, index: int, thickness: int = 1) -> QImage | None:
-    """A transparent image with the outline of object ``index`` (None if it is not seen)."""
-    mask = ids == index
+def outline_image(ids: np.ndarray, index, thickness: int = 1) -> QImage | None:
+    """A transparent image with the outline of object ``index`` (or of each object of a
+    list of indices; None if none is seen)."""
+    mask = np.isin(ids, np.atleast_1d(np.asarray(index, np.int64))) if not isinstance(
+        index, int) else ids == index
     if not mask.any():
         return None
     inner = mask.copy()

@@ -20,6 +20,7 @@ from ..output.colour import encode_ldr
 from ..output.image import Image
 from ..render.api import Progress, RenderJob, available_threads, warm_up_kernels
 from ..scene import Scene
+from .render_eta import CostClock, CostMap
 
 POLL_MS = 15
 BACKDROP_DIM = 0.6  # the preview under unrendered tiles, dimmed so the finished ones stand out
@@ -32,6 +33,7 @@ INTERACTIVE_TARGET_S = 0.04
 REFINE_FACTOR = 4  # each idle refinement step has this many times the pixels
 PREVIEW_DEPTH = 2
 PREVIEW_SHADOW_SAMPLES = 4
+PREVIEW_PHOTONS = 20_000  # caustic photons per pass of a preview
 
 
 def qimage_of(rgb: np.ndarray) -> QImage:
@@ -54,9 +56,13 @@ def preview_scene(scene: Scene, pixels: int) -> Scene:
     scale = min(1.0, math.sqrt(pixels / (s.width * s.height)))
     width = max(1, round(s.width * scale))
     height = max(1, round(s.height * scale))
+    # caustics with fewer photons (their default radius grows to match): the same light
+    caustics = s.caustics.model_copy(update={"photons": min(s.caustics.photons,
+                                                            PREVIEW_PHOTONS)})
     return scene.with_settings(width=width, height=height, samples=1,
                                max_depth=min(s.max_depth, PREVIEW_DEPTH),
-                               shadow_samples=min(s.shadow_samples, PREVIEW_SHADOW_SAMPLES))
+                               shadow_samples=min(s.shadow_samples, PREVIEW_SHADOW_SAMPLES),
+                               caustics=caustics)
 
 
 @dataclass
@@ -82,11 +88,19 @@ class _Active:
     new_tiles: deque = field(default_factory=deque)
     display: np.ndarray | None = None  # uint8 display values, updated tile by tile
     backdrop: np.ndarray | None = None  # shown where no tile has arrived yet (the preview)
+    cost: CostMap | None = None  # a preview's: what each part of the picture cost
+    clock: CostClock | None = None  # a render's: the time left from the tiles' cost
 
     def on_progress(self, p: Progress) -> None:
-        """Called on a render thread: only plain stores and a deque append."""
+        """Called on a render thread: only plain stores, a deque append and a sum."""
         self.new_tiles.append(p.new_tiles)
+        if self.clock is not None:
+            self.clock.done(p.new_tiles)
         self.latest = p
+
+    def on_preview_progress(self, p: Progress) -> None:
+        """Called on a preview's thread: the rays each part of the picture cost."""
+        self.cost.learn(p.new_tiles, p.rays)
 
     def display_image(self) -> QImage:
         """The display picture: the dimmed preview (or black) where no tile has arrived yet,
@@ -125,6 +139,9 @@ class RenderController(QObject):
         self.last_preview: Image | None = None
         self.previews_done = 0
         self.last_preview_seconds: float | None = None
+        #: (scene, CostMap) of the last full preview: a render of that scene says its time
+        #: left from what each part of the picture cost
+        self.cost_map: tuple[Scene, CostMap] | None = None
         #: the user is dragging: coarse previews, no refinement until it stops
         self.interacting = False
         #: pixels of a preview at full viewport size (the refinement's goal)
@@ -176,6 +193,10 @@ class RenderController(QObject):
         self._pending = None
         active = _Active(RenderJob(scene, progress=None), "render", time.perf_counter(), scene)
         active.backdrop = self._backdrop(scene)
+        learnt = self.cost_map
+        if learnt is not None and learnt[0] == scene:  # the preview of this very picture
+            s = scene.render
+            active.clock = CostClock(learnt[1].scaled(s.width, s.height))
         active.job.progress = active.on_progress
         self.full = active
         self.first_pixels_seconds = None
@@ -244,6 +265,8 @@ class RenderController(QObject):
         job = RenderJob(small)
         active = _Active(job, "preview", time.perf_counter(), scene, pixels=pixels,
                          refining=refining)
+        active.cost = CostMap(small.render.width, small.render.height)
+        job.progress = active.on_preview_progress
         key = _geometry_key(small)
         cached = self._compiled[1] if self._compiled is not None and \
             self._compiled[0] == key else None
@@ -337,6 +360,8 @@ class RenderController(QObject):
         if full and active.refining and getattr(self, "_last_edit", None) is not None:
             self.edit_to_full.append(now - self._last_edit)
         self.last_preview = job.image
+        if active.cost is not None and active.cost.complete:
+            self.cost_map = (active.scene, active.cost)  # for a render's time left
         self.last_preview_seconds = seconds
         self.previews_done += 1
         s = job.settings
@@ -353,7 +378,12 @@ class RenderController(QObject):
                 active.first_pixels = time.perf_counter() - active.started
                 self.first_pixels_seconds = active.first_pixels
             self.frame.emit(active.display_image(), "render")
-            self.progress.emit(p.fraction, p.eta, _progress_text(p))
+            if active.clock is not None:  # from the tiles' cost, not their count
+                eta = active.clock.eta(p.elapsed)
+                fraction = min(active.clock.fraction, 1.0)
+            else:
+                eta, fraction = p.eta, p.fraction
+            self.progress.emit(fraction, eta, _progress_text(p, fraction, eta))
         if job.running:
             return
         self.full = None
@@ -393,9 +423,9 @@ def _geometry_key(scene: Scene) -> tuple:
             scene.base_dir)
 
 
-def _progress_text(p: Progress) -> str:
-    eta = "" if p.eta is None else f", {_duration(p.eta)} left"
-    return f"{p.fraction:.0%} ({p.tiles_done}/{p.tiles_total} tiles){eta}"
+def _progress_text(p: Progress, fraction: float, eta: float | None) -> str:
+    left = "" if eta is None else f", {_duration(eta)} left"
+    return f"{fraction:.0%} ({p.tiles_done}/{p.tiles_total} tiles){left}"
 
 
 def _duration(seconds: float) -> str:

@@ -507,7 +507,8 @@ class TimelinePanel(QWidget):
         return path
 
     def render_animation(self, output: Path | None = None) -> bool:
-        """Save the scene (asking where, if it has no file), then render its film on a
+        """Save the scene once the user agrees (asking where, if it has no file), then render
+        its film on a
         background thread (:class:`~whitted.gui.film_job.FilmJob`: the frames and the film
         ``whitted animate`` makes); False when cancelled or already running."""
         if self.film is not None:
@@ -518,7 +519,9 @@ class TimelinePanel(QWidget):
             window.show_error("Nothing to animate", "Key something first (I), or open an "
                               "animated scene.")
             return False
-        if (self.doc.path is None or self.doc.dirty) and not window.save():
+        # the film is made from the file, as ``whitted animate`` makes it: ask, then save
+        unsaved = self.doc.path is None or self.doc.dirty
+        if unsaved and (not window.ask_save_for_film() or not window.save()):
             return False
         output = output if output is not None else self.ask_film_path()
         if output is None:
@@ -631,10 +634,9 @@ def attach_timeline(window: MainWindow) -> TimelinePanel:
         window.addAction(act)  # works wherever the focus is in the window
         return act
 
-    panel.act_key = action("&Insert key", panel.insert_key, "I",
-                           "key the selected item's placement (or the camera) at this frame")
-    panel.act_delete_key = action("&Delete key", panel.delete_key, "Alt+I",
-                                  "remove the selection's keys at this frame")
+    # Insert key (I) and Delete key (Alt+I) are rows of the window's actions table
+    panel.act_key = window.acts["insert_key"]
+    panel.act_delete_key = window.acts["delete_key"]
     panel.act_play = action("&Play / Stop", panel.toggle_play, None,
                             "play the preview of the animation")
     panel.act_film = action("&Render animation…", lambda: panel.render_animation(), None,

@@ -285,7 +285,8 @@ class TransformTool:
             self._status(f"{self.NAMES[self.mode]}: {exc}")
 
     def show_status(self) -> None:
-        axis = f" along {self.axis.upper()}" if self.axis else (
+        along = "about" if self.mode == "rotate" else "along"
+        axis = f" {along} {self.axis.upper()}" if self.axis else (
             " on the ground" if self.mode == "move" else " about Y" if self.mode == "rotate"
             else "")
         typed = f" {self.typed}" if self.typed else ""

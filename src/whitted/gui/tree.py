@@ -1,10 +1,12 @@
 """The scene tree: Camera, Render settings, Background, then the lights and the objects.
-Selecting an item selects it in the document (the properties panel follows); double-click or
-F2 renames a light or an object in place."""
+Selecting an item selects it in the document (the properties panel follows); Shift or
+Ctrl-click selects more lights and objects; double-click or F2 renames one in place. Letters
+typed here do not jump to a row (no type-to-find): they are the window's shortcuts (G moves
+the selection, wherever the focus is)."""
 
 from __future__ import annotations
 
-from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtCore import QItemSelectionModel, Qt, QTimer, Signal
 from PySide6.QtWidgets import QAbstractItemView, QTreeWidget, QTreeWidgetItem
 
 from .document import BACKGROUND, CAMERA, RENDER, SceneDocument, label_of
@@ -20,7 +22,7 @@ class SceneTree(QTreeWidget):
         super().__init__(parent)
         self.doc = doc
         self.setHeaderHidden(True)
-        self.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
+        self.setSelectionMode(QAbstractItemView.SelectionMode.ExtendedSelection)
         self.setEditTriggers(QAbstractItemView.EditTrigger.DoubleClicked
                              | QAbstractItemView.EditTrigger.EditKeyPressed)
         self.setContextMenuPolicy(Qt.ContextMenuPolicy.ActionsContextMenu)
@@ -68,12 +70,9 @@ class SceneTree(QTreeWidget):
                     if kind == "objects" and obj.type == "csg":
                         self._add_csg_children(child, obj, (kind, i))
                 group.setExpanded(expanded.get(title, True))
-            found = self.item_for(self.doc.selection)
-            if found is not None:
-                self.setCurrentItem(found)
-                found.setSelected(True)
         finally:
             self._filling = False
+        self.select_key()
 
     def _add_csg_children(self, node: QTreeWidgetItem, csg, key: tuple) -> None:
         """A CSG object's children under its node, keyed ("objects", i, k, ...), to any
@@ -115,11 +114,9 @@ class SceneTree(QTreeWidget):
                 obj = self.doc.item(key)
                 if obj is not None and child.text(0) != self.text_of(obj):
                     child.setText(0, self.text_of(obj))
-            found = self.item_for(self.doc.selection)
-            if found is not None and not found.isSelected():
-                self.setCurrentItem(found)
         finally:
             self._filling = False
+        self.select_key()
 
     @staticmethod
     def text_of(obj) -> str:
@@ -132,25 +129,43 @@ class SceneTree(QTreeWidget):
                 return item
         return None
 
-    def select_key(self, key) -> None:
-        item = self.item_for(key) if key is not None else None
-        if item is None:
-            self._filling = True
-            try:
-                self.clearSelection()
-            finally:
-                self._filling = False
-        elif item is not self.currentItem() or not item.isSelected():
-            self.setCurrentItem(item)
+    def keyboardSearch(self, search: str) -> None:  # noqa: N802 - Qt's name
+        """No type-to-find: a letter never changes the selection."""
+
+    def select_key(self, *_: object) -> None:
+        """Show the document's selection (all of it; its active item current)."""
+        keys = self.doc.selected_keys()
+        wanted = {id(it): it for k in keys if (it := self.item_for(k)) is not None}
+        if {id(it) for it in self.selectedItems()} == set(wanted) and (
+                not keys or self.currentItem() is self.item_for(keys[0])):
+            return
+        self._filling = True
+        try:
+            self.clearSelection()
+            active = self.item_for(keys[0]) if keys else None
+            if active is not None:
+                self.setCurrentItem(active, 0,
+                                    QItemSelectionModel.SelectionFlag.NoUpdate)
+            for item in wanted.values():
+                item.setSelected(True)
+        finally:
+            self._filling = False
 
     def _selection_changed(self) -> None:
         if self._filling:
             return
-        items = self.selectedItems()
-        key = items[0].data(0, KEY_ROLE) if items else None
-        if key is not None and key != self.doc.selection:
-            self.doc.select(key)  # the properties panel follows through the document
-            self.selected.emit(key)
+        keys = [k for it in self.selectedItems() if (k := it.data(0, KEY_ROLE)) is not None]
+        current = self.currentItem()
+        active = current.data(0, KEY_ROLE) if current is not None else None
+        if active in keys:  # the clicked row is the active one (the document's last)
+            keys.remove(active)
+            keys.append(active)
+        if len(keys) > 1:
+            keys = [k for k in keys if len(k) == 2] or keys[-1:]
+        before = self.doc.selected_keys()
+        self.doc.select(keys)  # the properties panel follows through the document
+        if keys and self.doc.selected_keys() != before:
+            self.selected.emit(keys[-1])
 
     def _renamed(self, item: QTreeWidgetItem, column: int) -> None:
         if self._filling:

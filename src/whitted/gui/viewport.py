@@ -6,8 +6,8 @@ camera's target) and the mouse and keyboard of a 3-D view:
   a press only becomes a drag past the system's drag distance, so a shaky click moves nothing
 - left-drag (or middle-drag) orbits, right-drag or Shift-drag pans, the wheel zooms toward
   the pointer; Ctrl+wheel and Ctrl+drag zoom and pan the picture itself
-- keys (G, R, S, X, Y, Z, F, Home, the numpad views, digits of a typed value...) go to
-  ``key_handler``, and while a tool runs (a G/R/S move) the mouse goes to it
+- while a tool runs (a G/R/S move) the mouse and its keys (X, Y, Z, a typed value, Enter,
+  Esc) go to it, before the window's shortcuts; otherwise keys are the window's actions
 
 Positions handed out are in the picture's own coordinates: (u, v) in 0..1 from its top-left
 corner, whatever its zoom."""
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import itertools
 
-from PySide6.QtCore import QPointF, QRectF, QSize, Qt, Signal
+from PySide6.QtCore import QEvent, QPointF, QRectF, QSize, Qt, Signal
 from PySide6.QtGui import QColor, QImage, QKeyEvent, QMouseEvent, QPainter, QWheelEvent
 from PySide6.QtWidgets import QApplication, QSizePolicy, QWidget
 
@@ -52,8 +52,6 @@ class Viewport(QWidget):
         self.outline: QImage | None = None  # the selection's outline, over the picture
         #: draws over the picture: ``overlay(painter, to_widget)``, to_widget(u, v) -> QPointF
         self.overlay = None
-        #: ``key_handler(event) -> bool``: the window's keys (G/R/S, F, Home, views...)
-        self.key_handler = None
         #: a running modal tool (a G/R/S move): gets the pointer, a click confirms it
         self.tool = None
         self.hover = QPointF(-1, -1)  # where the pointer last was (a G/R/S move starts there)
@@ -269,14 +267,30 @@ class Viewport(QWidget):
 
     # ------------------------------------------------------------------ keys
 
+    def event(self, event) -> bool:  # noqa: D102 - Qt's name
+        if event.type() == QEvent.Type.ShortcutOverride and self.tool is not None \
+                and self.tool.wants(event):
+            event.accept()  # a running move's key (X, a digit, Enter, Esc): not a shortcut
+            return True
+        return super().event(event)
+
+    def fit_picture(self) -> None:
+        self.set_picture_scale(None)
+
+    def actual_pixels(self) -> None:
+        self.set_picture_scale(1.0)
+
+    def zoom_in(self) -> None:
+        self.zoom_picture(PICTURE_ZOOM_STEP)
+
+    def zoom_out(self) -> None:
+        self.zoom_picture(1 / PICTURE_ZOOM_STEP)
+
     def keyPressEvent(self, event: QKeyEvent) -> None:  # noqa: N802
         if self.tool is not None and self.tool.key(event):
             if self.tool is not None and self.tool.done:
                 self.tool = None
             self.update()
-            event.accept()
-            return
-        if self.key_handler is not None and self.key_handler(event):
             event.accept()
             return
         super().keyPressEvent(event)

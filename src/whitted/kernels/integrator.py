@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 from .accel import closest_hit, hit_material, surface_normals
+from .caustics import add_caustic, caustics_on
 from .extras import body_medium
 from .jit import kernel
 from .layout import (
@@ -167,9 +168,12 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
         tex, albedo = surface_colour(geo, mats, m, prim, tri, b1, b2, p)
         ka = mats[m, MAT_KA]
         amb = params.ambient
-        local = direct_light(geo, mats, lights, params, p, n_shade, v, m, albedo, media,
+        # with caustics, shadow rays stop at transparent bodies (their light is photons)
+        shadow_mats = lights.shadow_materials if caustics_on(lights) else mats
+        local = direct_light(geo, shadow_mats, lights, params, p, n_shade, v, m, albedo, media,
                              n_media, scratch, stack, hits, listed, counters,
                              (pixel, sample, 2 + vertex * RNG_DIMS_PER_HIT))
+        local = add_caustic(lights, mats, m, albedo, p, n, local)  # caustics.py
         vertex += 1
         r += w[0] * (ka * amb[0] * tex[0] * mats[m, MAT_AMBIENT] + local[0])
         g += w[1] * (ka * amb[1] * tex[1] * mats[m, MAT_AMBIENT + 1] + local[1])

@@ -205,17 +205,53 @@ class GeometryArrays(NamedTuple):
     tex_pixels: np.ndarray  # (P,) float32 linear RGB
 
 
+# photon map (LightArrays.photons rows, float32): where a photon landed, the power it
+# carries (per channel) and its unit direction of travel, and the progressive pass it
+# belongs to
+PHOTON_POSITION = 0
+PHOTON_POWER = 3
+PHOTON_DIRECTION = 6
+PHOTON_PASS = 9
+PHOTON_WIDTH = 10
+# photon grid scalars (LightArrays.photon_grid, float64), then per pass its squared radius
+# at GRID_PASS + 2 p and its estimator's normalisation at GRID_PASS + 2 p + 1
+GRID_INV_CELL = 0  # 1 / cell side (the side is the largest gather radius)
+GRID_BITS = 1  # bits of each cell coordinate in the hash (kernels/caustics.py's cell_hash)
+GRID_R2_MAX = 2  # the largest squared radius (pass 0's)
+GRID_PASSES = 3
+GRID_PASS = 4
+#: dtype of ``photons`` in scenes without caustics: kernels compiled without the gather
+#: (kernels/caustics.py), as ``inst_box`` marks scenes without instances (features.py)
+NO_CAUSTICS_DTYPE = "float64"
+_NO_PHOTONS = np.zeros((0, PHOTON_WIDTH), NO_CAUSTICS_DTYPE)
+_NO_CELLS = np.zeros(1, np.int32)
+_NO_GRID = np.zeros(GRID_PASS, np.float64)
+_NO_MATS = np.zeros((0, N_MAT_PARAMS), np.float64)
+
+
 class LightArrays(NamedTuple):
-    """The lights (ambient ones excluded) and the light buffers of the point lights.
+    """The lights (ambient ones excluded), the light buffers of the point lights and the
+    caustics' photon map.
 
     A light buffer (see light_buffer.py) divides the directions leaving a point light into the
     cells of a cube map, LIGHT_BUFFER_RES x LIGHT_BUFFER_RES per face, and lists for each cell
     the analytic primitives that could block a shadow ray travelling through it: a shadow ray
-    tests those instead of walking the BVH."""
+    tests those instead of walking the BVH.
+
+    The photon map (compile/photon_map.py, docs/caustics.md) is empty, with ``photons`` of
+    dtype NO_CAUSTICS_DTYPE, in renders without caustics: the render kernel is then compiled
+    without its gather. With caustics, ``photons`` (float32) are sorted by the hash of their
+    grid cell, ``photon_cells[h]:photon_cells[h + 1]`` being the photons of hash ``h``, and
+    ``shadow_materials`` is the material table with every kt zeroed: shadow rays stop at
+    transparent bodies, whose light arrives as photons."""
 
     table: np.ndarray  # (L, N_LIGHT_PARAMS) float64
     buffer_cells: np.ndarray  # (C, 3) int32: CELL_FIRST, CELL_COUNT, CELL_OPAQUE
     buffer_prims: np.ndarray  # (N,) int32 primitive indices
+    photons: np.ndarray = _NO_PHOTONS  # (N, PHOTON_WIDTH) float32
+    photon_cells: np.ndarray = _NO_CELLS  # (H + 1,) int32
+    photon_grid: np.ndarray = _NO_GRID  # (GRID_PASS + 2 passes,) float64
+    shadow_materials: np.ndarray = _NO_MATS  # (M, N_MAT_PARAMS) float64
 
 
 class RenderParams(NamedTuple):

@@ -79,10 +79,14 @@ def input_files(scene: object, scene_path: str | os.PathLike[str] | None) -> lis
 
 
 def check_outputs(outputs: Iterable[str | os.PathLike[str]], scene: object = None,
-                  scene_path: str | os.PathLike[str] | None = None) -> None:
-    """Every output can be written and none is a file the job reads (:class:`OutputError`)."""
-    inputs = input_files(scene, scene_path) if scene is not None else (
-        [Path(scene_path)] if scene_path is not None else [])
+                  scene_path: str | os.PathLike[str] | None = None, *,
+                  inputs: Iterable[str | os.PathLike[str]] | None = None) -> None:
+    """Every output can be written and none is a file the job reads (:class:`OutputError`):
+    ``inputs``, or those of ``scene`` (:func:`input_files`) when not given."""
+    if inputs is None:
+        inputs = input_files(scene, scene_path) if scene is not None else (
+            [Path(scene_path)] if scene_path is not None else [])
+    inputs = list(inputs)
     for output in outputs:
         for source in inputs:
             if same_file(output, source):

@@ -4,25 +4,74 @@ No ffmpeg needs to be installed: imageio-ffmpeg ships a static one. MP4 files ar
 yuv420p (what every player plays), quality by an explicit CRF (18: visually lossless for
 renders), with the index at the front (``+faststart``) so a browser starts playing before
 the whole file has arrived. yuv420p needs even sizes: an odd width or height gets one more
-column or row, a copy of the last one (the picture is never scaled). Files are written
-atomically, as every output of whitted.
+column or row, a copy of the last one (the picture is never scaled).
+
+Frame rates are bounded to what the formats hold (:func:`check_fps`): an MP4 takes
+:data:`FPS_MIN` .. 1000 frames a second, a GIF :data:`FPS_MIN` .. 50 (its delays are whole
+hundredths of a second, 2 at least: players show shorter ones at 10 fps). Files are written
+atomically, as every output of whitted: ffmpeg writes a temporary file that replaces the film
+only when ffmpeg says it succeeded, so a failed or cancelled encode never replaces a good
+film. ffmpeg runs as a child process in a session of its own (a Ctrl-C on the terminal
+reaches whitted only); it is stopped when the encode is cancelled (``cancel``) or fails.
 """
 
 from __future__ import annotations
 
+import contextlib
+import itertools
+import math
 import os
+import subprocess
+import tempfile
 from collections.abc import Iterable, Iterator
+from fractions import Fraction
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 
+from ..errors import RenderCancelled
 from ..files import atomic_write
 
-__all__ = ["DEFAULT_CRF", "VIDEO_FORMATS", "encode_film", "even_size", "pad_to_even",
-           "video_format"]
+__all__ = ["DEFAULT_CRF", "FPS_MAX", "FPS_MIN", "VIDEO_FORMATS", "check_crf", "check_fps",
+           "encode_film", "even_size", "pad_to_even", "video_format"]
 
 DEFAULT_CRF = 18
 VIDEO_FORMATS = {".mp4": "mp4", ".gif": "gif"}
+#: The slowest film: one frame every 100 s.
+FPS_MIN = 0.01
+#: The fastest film of each format (a GIF's delays are hundredths of a second, 2 at least).
+FPS_MAX = {"mp4": 1000.0, "gif": 50.0}
+
+
+class Cancel(Protocol):
+    """What ``cancel`` is: a :class:`~whitted.render.api.CancelToken` or the like."""
+
+    @property
+    def cancelled(self) -> bool: ...
+
+
+def check_fps(fps: object, fmt: str) -> float:
+    """``fps`` as a float when a film of format ``fmt`` (``mp4``, ``gif``) can show it;
+    ValueError saying the range otherwise."""
+    most = FPS_MAX[fmt]
+    try:
+        rate = float(fps)  # type: ignore[arg-type]
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"must be a number of frames a second, got {fps!r}") from None
+    if not (math.isfinite(rate) and FPS_MIN <= rate <= most):
+        why = (" (a GIF's delays are whole hundredths of a second, 2 at least)"
+               if fmt == "gif" and rate > most else "")
+        raise ValueError(f"must be {FPS_MIN:g} .. {most:g} frames a second for "
+                         f"{fmt.upper()}{why}, got {rate:g}")
+    return rate
+
+
+def check_crf(crf: object) -> int:
+    """``crf`` when it is an H.264 quality (0 best .. 51 worst); ValueError otherwise."""
+    if isinstance(crf, bool) or not isinstance(crf, int) or not 0 <= crf <= 51:
+        raise ValueError(f"must be 0 .. 51, got {crf!r}")
+    return crf
 
 
 def video_format(path: str | os.PathLike[str]) -> str:
@@ -81,48 +130,90 @@ def encode_film(
     fps: float,
     *,
     crf: int = DEFAULT_CRF,
+    cancel: Cancel | None = None,
 ) -> Path:
     """Encode ``frames`` (PNG file names or (H, W, 3) uint8 arrays, all one size) into the
     film ``path``: ``.mp4`` (H.264, yuv420p, ``crf``, +faststart) or ``.gif`` (looping,
-    an adaptive 256-colour palette per frame). Written atomically; returns ``path``."""
+    an adaptive 256-colour palette per frame). Written atomically: a failed encode raises
+    (ValueError or OSError) and leaves ``path`` as it was. ``cancel``: checked between
+    frames; once set, ffmpeg is stopped, nothing is written and
+    :class:`~whitted.errors.RenderCancelled` is raised. Returns ``path``."""
     fmt = video_format(path)
-    if not fps > 0:
-        raise ValueError(f"fps must be > 0, got {fps}")
+    fps = check_fps(fps, fmt)
+    crf = check_crf(crf)
     items = list(frames)
     if not items:
         raise ValueError("no frames to encode")
     if fmt == "gif":
-        return atomic_write(path, lambda tmp: _write_gif(tmp, _frames(items), fps))
-    return atomic_write(path, lambda tmp: _write_mp4(tmp, _frames(items), fps, crf))
+        return atomic_write(path, lambda tmp: _write_gif(tmp, _frames(items), fps, cancel))
+    return atomic_write(path, lambda tmp: _write_mp4(tmp, _frames(items), fps, crf, cancel))
 
 
-def _write_mp4(tmp: str, frames: Iterator[np.ndarray], fps: float, crf: int) -> None:
+def _check(cancel: Cancel | None) -> None:
+    if cancel is not None and cancel.cancelled:
+        raise RenderCancelled("the encode was cancelled")
+
+
+def _ffmpeg_command(tmp: str, width: int, height: int, fps: float, crf: int) -> list[str]:
     import imageio_ffmpeg
 
+    rate = Fraction(fps).limit_denominator(100_000)  # exact for 24000/1001 and the like
+    return [imageio_ffmpeg.get_ffmpeg_exe(), "-y", "-hide_banner", "-loglevel", "error",
+            "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{width}x{height}", "-r", str(rate),
+            "-i", "-", "-an", "-vcodec", "libx264", "-pix_fmt", "yuv420p",
+            "-crf", str(int(crf)), "-preset", "medium", "-movflags", "+faststart",
+            "-f", "mp4", tmp]
+
+
+def _write_mp4(tmp: str, frames: Iterator[np.ndarray], fps: float, crf: int,
+               cancel: Cancel | None = None) -> None:
+    _check(cancel)
     first = pad_to_even(next(frames))
     h, w = first.shape[:2]
-    writer = imageio_ffmpeg.write_frames(
-        tmp, (w, h), fps=fps, codec="libx264", pix_fmt_in="rgb24", pix_fmt_out="yuv420p",
-        quality=None, macro_block_size=1,  # never scaled to a multiple of 16
-        output_params=["-crf", str(int(crf)), "-preset", "medium", "-movflags", "+faststart",
-                       "-f", "mp4"],
-        ffmpeg_log_level="error",
-    )
-    writer.send(None)  # start ffmpeg
-    try:
-        writer.send(np.ascontiguousarray(first))
-        for frame in frames:
-            writer.send(np.ascontiguousarray(pad_to_even(frame)))
-    finally:
-        writer.close()
+    with tempfile.TemporaryFile() as log:
+        # a session of its own: a terminal's Ctrl-C reaches whitted, which stops ffmpeg
+        proc = subprocess.Popen(_ffmpeg_command(tmp, w, h, fps, crf), stdin=subprocess.PIPE,
+                                stdout=subprocess.DEVNULL, stderr=log, start_new_session=True)
+        assert proc.stdin is not None
+        try:
+            try:
+                for frame in itertools.chain([first], (pad_to_even(f) for f in frames)):
+                    _check(cancel)
+                    proc.stdin.write(np.ascontiguousarray(frame).tobytes())
+                proc.stdin.close()
+            except BrokenPipeError:  # ffmpeg ended early: its own words say why
+                pass
+            while True:
+                try:
+                    code = proc.wait(timeout=0.1)
+                    break
+                except subprocess.TimeoutExpired:
+                    _check(cancel)
+        finally:
+            if proc.poll() is None:  # cancelled, or an error on this side: stop ffmpeg
+                proc.kill()
+                proc.wait()
+            if proc.stdin is not None and not proc.stdin.closed:
+                with contextlib.suppress(OSError):
+                    proc.stdin.close()
+        if code != 0:
+            log.seek(0)
+            said = [ln for ln in log.read().decode("utf-8", "replace").splitlines() if ln.strip()]
+            raise ValueError(f"ffmpeg failed (exit status {code})"
+                             + (f": {said[-1].strip()}" if said else ""))
+    if os.path.getsize(tmp) == 0:
+        raise ValueError("ffmpeg wrote an empty film")
 
 
-def _write_gif(tmp: str, frames: Iterator[np.ndarray], fps: float) -> None:
+def _write_gif(tmp: str, frames: Iterator[np.ndarray], fps: float,
+               cancel: Cancel | None = None) -> None:
     from PIL import Image as PILImage
 
-    images = [PILImage.fromarray(f).quantize(colors=256, method=PILImage.Quantize.MEDIANCUT,
-                                             dither=PILImage.Dither.FLOYDSTEINBERG)
-              for f in frames]
+    images = []
+    for f in frames:
+        _check(cancel)
+        images.append(PILImage.fromarray(f).quantize(
+            colors=256, method=PILImage.Quantize.MEDIANCUT, dither=PILImage.Dither.FLOYDSTEINBERG))
     duration = max(20, round(1000 / fps / 10) * 10)  # GIF delays are in 1/100 s
     images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], loop=0,
                    duration=duration, optimize=True, disposal=1)

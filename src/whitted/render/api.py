@@ -110,6 +110,7 @@ class RenderStats:
     cancelled: bool = False
     warnings: list[str] = field(default_factory=list)  # from the scene's compilation
     triangles: int = 0  # mesh triangles stored (each distinct mesh once)
+    photons: object = None  # compile.photon_map.PhotonStats of a render with caustics
 
     @property
     def total_rays(self) -> int:
@@ -121,11 +122,15 @@ class RenderStats:
 
     def summary(self) -> str:
         state = " (cancelled)" if self.cancelled else ""
+        caustics = ""
+        if self.photons is not None:
+            caustics = (f", caustics {self.photons.shot:,} photons ({self.photons.stored:,} "
+                        f"stored) in {self.photons.seconds:.2f} s")
         return (
             f"{self.width}x{self.height}{state}: wall {self.wall_seconds:.2f} s, "
             f"compile {self.compile_seconds:.2f} s, render {self.render_seconds:.3f} s, "
             f"{self.total_rays:,} rays, {self.mrays_per_second:.1f} Mrays/s, "
-            f"{self.threads} thread{'s' if self.threads != 1 else ''}"
+            f"{self.threads} thread{'s' if self.threads != 1 else ''}{caustics}"
         )
 
 
@@ -277,11 +282,28 @@ class RenderJob:
         stats.warnings = list(compiled.warnings)
         stats.triangles = compiled.triangles
         params = render_params(self.scene, compiled, self.settings)
+        lights = compiled.lights
+        photon_seconds = 0.0
+        if self.settings.caustics.photons > 0:  # the photon map (compile/photon_map.py)
+            from ..compile.photon_map import PhotonStats, photon_lights
+
+            stats.photons = PhotonStats()
+            lights = photon_lights(compiled, params, self.settings.caustics, self.threads,
+                                   lambda: self.cancel_token.cancelled, stats.photons)
+            photon_seconds = stats.photons.seconds
+            # the render kernel's kind with caustics, compiled (first time) or loaded here,
+            # not in the first tile: its time is compile time
+            start = time.perf_counter()
+            render_tiles(np.zeros((0, 4), np.int32), self.framebuffer, compiled.geometry,
+                         compiled.materials, lights, params, np.zeros((0, N_RAY_KINDS),
+                                                                      np.int64),
+                         lane_workspace(params.max_depth), 0, 1)
+            stats.compile_seconds += time.perf_counter() - start
         tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size, self.rows)
         counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
         stats.tiles_total = len(tiles)
         lanes = self.threads
-        render_start = time.perf_counter()
+        render_start = time.perf_counter() - photon_seconds  # shooting photons is rendering
         done = 0
         lock = threading.Lock()
         self.rendering = True
@@ -326,10 +348,10 @@ class RenderJob:
                 part_counters = np.zeros((len(idx), N_RAY_KINDS), np.int64)
                 if aa is None:
                     render_tiles(part, self.framebuffer, compiled.geometry, compiled.materials,
-                                 compiled.lights, params, part_counters, work, 0, 1)
+                                 lights, params, part_counters, work, 0, 1)
                 else:  # adaptive anti-aliasing (kernels/adaptive.py)
                     render_tiles_adaptive(part, self.framebuffer, compiled.geometry,
-                                          compiled.materials, compiled.lights, params,
+                                          compiled.materials, lights, params,
                                           part_counters, work, aa, float(antialias.threshold),
                                           levels, 0, 1)
                 with lock:

@@ -38,6 +38,23 @@ class Antialias(Strict):
         while ((1 << (levels + 1)) + 1) ** 2 <= self.max_samples:
             levels += 1
         return levels
+MAX_PHOTONS = 50_000_000  # photons per pass
+MAX_PASSES = 4096
+
+
+class CausticsSettings(Strict):
+    """Caustics by (progressive) photon mapping (docs/caustics.md). ``photons``: photons
+    shot per pass (0, the default: no caustics, the renderer exactly as without this table);
+    ``passes``: progressive passes, each with its own photons and a smaller gather radius;
+    ``radius``: the first pass's gather radius in scene units (0: chosen from the size of
+    the light's targets and the photon count); ``alpha``: the radius reduction of
+    progressive photon mapping (each pass keeps this fraction of the new photons' density,
+    Hachisuka et al. 2008)."""
+
+    photons: int = Field(default=0, ge=0, le=MAX_PHOTONS)
+    passes: int = Field(default=1, ge=1, le=MAX_PASSES)
+    radius: float = Field(default=0.0, ge=0.0, le=1e6)
+    alpha: float = Field(default=0.7, gt=0.0, le=1.0)
 
 
 class RenderSettings(Strict):
@@ -61,6 +78,7 @@ class RenderSettings(Strict):
     tonemap: Literal["clamp", "reinhard", "aces"] = "clamp"
     mesh_tracer: Literal["auto", "whitted", "embree"] = "auto"
     antialias: Antialias | None = None
+    caustics: CausticsSettings = Field(default_factory=CausticsSettings)
 
     @model_validator(mode="after")
     def _size(self) -> RenderSettings:

@@ -6,10 +6,12 @@ differ from their defaults.
 - :func:`compact_data`: an item (or a whole scene) as plain data with only non-default values
 - :func:`compact_toml`: a whole scene as compact TOML (a file that did not exist before)
 - :func:`edit_toml`: the text of a TOML scene file with the changes from ``old`` to ``new``
+- :func:`edited_toml`: that edit, read back and checked, or None when it cannot be made
 - :func:`save_scene_toml`: write a scene, style-preserving when the file's text is known
 
-Every result is read back and compared with the scene before it is written; if a file's own
-style cannot carry an edit, the scene is written compactly instead (nothing is ever lost)."""
+Every result is read back and compared with the scene before it is written. When a file's own
+style cannot carry an edit, :func:`scene_toml` writes the scene compactly (nothing is lost);
+the editor asks first (:func:`edited_toml` says None) rather than rewrite a user's file."""
 
 from __future__ import annotations
 
@@ -121,10 +123,7 @@ def compact_toml(scene: Scene) -> str:
     for name in ("lights", "objects"):
         items = getattr(scene, name)
         if items:
-            aot = tomlkit.aot()
-            for it in items:
-                aot.append(_table(compact_data(it)))
-            doc[name] = aot
+            doc[name] = _aot(items)
     for name in _OTHER_FIELDS:  # e.g. the animation table
         value = getattr(scene, name, None)
         if value is not None and value != _scene_default(name):
@@ -170,8 +169,10 @@ def _set_field(table: Any, name: str, old: BaseModel, new: BaseModel) -> None:
             del table[name]
         return
     plain = _plain(new_value)
-    table[name] = _item(plain, inline=not isinstance(table, Table) or not isinstance(
-        new_value, BaseModel) or isinstance(node, InlineTable) or node is None)
+    # a sub-table only where the file has one: ``material = "glass"`` becoming an object's
+    # own material is written inline, on the line where the name was
+    table[name] = _item(plain, inline=not (isinstance(table, Table) and isinstance(
+        new_value, BaseModel) and isinstance(node, Table)))
 
 
 def _update_table(table: Any, old: BaseModel, new: BaseModel) -> None:
@@ -194,7 +195,7 @@ def _update_list(doc: Any, name: str, old: list, new: list) -> None:
         return
     inline = isinstance(node, Array)
     fresh = (lambda it: _item(compact_data(it))) if inline else (
-        lambda it: _table(compact_data(it)))
+        lambda it: _block(compact_data(it)))
     ops = difflib.SequenceMatcher(None, [_key(i) for i in old], [_key(i) for i in new],
                                   autojunk=False).get_opcodes()
     for tag, i1, i2, j1, j2 in reversed(ops):  # from the end: earlier indices stay valid
@@ -213,10 +214,17 @@ def _update_list(doc: Any, name: str, old: list, new: list) -> None:
             node.insert(i1 + paired, fresh(new[k]))
 
 
+def _block(data: dict[str, Any]) -> Table:
+    """A table of an array of tables (``[[objects]]``) with a blank line before it."""
+    table = _table(data)
+    table.trivia.indent = "\n"
+    return table
+
+
 def _aot(items: list) -> AoT:
     aot = tomlkit.aot()
     for it in items:
-        aot.append(_table(compact_data(it)))
+        aot.append(_block(compact_data(it)))
     return aot
 
 
@@ -387,15 +395,23 @@ def _loads(text: str, scene: Scene) -> Scene | None:
     return loaded
 
 
+def edited_toml(scene: Scene, text: str, loaded: Scene) -> str | None:
+    """``text`` (the file as read, which loaded as ``loaded``) with only the edits that make
+    it ``scene`` written into it, checked by reading it back; None when the file's own style
+    cannot carry them (the caller then asks before writing the whole file afresh)."""
+    try:
+        edited = edit_toml(text, loaded, scene)
+    except (KeyError, TypeError, ValueError, tomlkit.exceptions.TOMLKitError):
+        return None
+    return edited if _loads(edited, scene) == scene else None
+
+
 def scene_toml(scene: Scene, *, text: str | None = None, loaded: Scene | None = None) -> str:
     """The TOML to save ``scene`` as: ``text`` (the file as read, which loaded as ``loaded``)
     with only the edits written into it, else the compact form. Checked by reading it back."""
     if text is not None and loaded is not None:
-        try:
-            edited = edit_toml(text, loaded, scene)
-        except (KeyError, TypeError, ValueError, tomlkit.exceptions.TOMLKitError):
-            edited = None
-        if edited is not None and _loads(edited, scene) == scene:
+        edited = edited_toml(scene, text, loaded)
+        if edited is not None:
             return edited
     compact = compact_toml(scene)
     if _loads(compact, scene) == scene:
@@ -406,13 +422,15 @@ def scene_toml(scene: Scene, *, text: str | None = None, loaded: Scene | None = 
 
 
 def save_scene_toml(scene: Scene, path: str | Path, *, text: str | None = None,
-                    loaded: Scene | None = None) -> str:
-    """Write ``scene`` to the TOML file ``path`` atomically (see :func:`scene_toml`); relative
-    model and texture names are rewritten when the folder changes. Returns the text written."""
+                    loaded: Scene | None = None, payload: str | None = None) -> str:
+    """Write ``scene`` to the TOML file ``path`` atomically (see :func:`scene_toml`, or
+    ``payload`` when the caller has made the text already); relative model and texture names
+    are rewritten when the folder changes. Returns the text written."""
     path = Path(path)
-    if path.parent.resolve() != scene.base_dir.resolve():
-        scene = rebase_files(scene, path.parent)
-        text = loaded = None  # another folder: file names change, write it afresh
-    payload = scene_toml(scene, text=text, loaded=loaded)
+    if payload is None:
+        if path.parent.resolve() != scene.base_dir.resolve():
+            scene = rebase_files(scene, path.parent)
+            text = loaded = None  # another folder: file names change, write it afresh
+        payload = scene_toml(scene, text=text, loaded=loaded)
     atomic_write(path, lambda tmp: Path(tmp).write_text(payload, encoding="utf-8"))
     return payload

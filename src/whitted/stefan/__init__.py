@@ -12,7 +12,7 @@ In Python::
     H, kind, cavity, frame = stefan.initial_state(case)   # or step it yourself
     solver = stefan.EnthalpySolver(H, kind, case.dx, case.properties,
                                    faces=case.solver_faces(),
-                                   air=stefan.Air(case.air.temperature, case.air.h))
+                                   air=case.solver_air())
     solver.advance(600.0)
     outer, inner = stefan.extract_surfaces(solver.H, solver.kind, case.properties, frame)
 """

@@ -15,10 +15,33 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from ..errors import SceneError
 from .properties import ICE, LATENT_HEAT, WATER, Phase, Properties
 
-Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+# Strict types, as scene files have: a number is a TOML integer or float, never a string or a
+# boolean (``h = true``, ``rho = "917"`` and ``cells = "16"`` are refused); a count is an integer.
+
+
+def _num(**bounds: float):
+    return Annotated[float, Field(strict=True, allow_inf_nan=False, **bounds)]
+
+
+def _count(**bounds: int):
+    return Annotated[int, Field(strict=True, **bounds)]
+
+
+Positive = _num(gt=0.0)
+Finite = _num()
 Vec3 = tuple[Finite, Finite, Finite]
-Size3 = tuple[Positive, Positive, Positive]
+Length = _num(ge=1.0e-3, le=1.0)  # a block's side: 1 mm to 1 m
+Size3 = tuple[Length, Length, Length]
+CavitySize3 = tuple[Positive, Positive, Positive]
+
+# Physical properties: documented ranges (docs/stefan.md), wide enough for ice from -80 °C to
+# 0 °C and water from 0 to 100 °C with room for sensitivity studies, narrow enough that no value
+# makes the method meaningless (1e-300 or 1e308 used to run and end at t = 0 or in overflow).
+RANGES = {
+    "ice.rho": (800.0, 1000.0), "ice.c": (1000.0, 4000.0), "ice.k": (1.0, 5.0),
+    "water.rho": (900.0, 1100.0), "water.c": (3500.0, 5000.0), "water.k": (0.3, 1.0),
+    "latent_heat": (2.5e5, 4.0e5),
+}
 
 
 class CaseError(SceneError):
@@ -30,7 +53,8 @@ class _Strict(BaseModel):
 
 
 class PhaseProperties(_Strict):
-    """Density (kg/m³), specific heat capacity (J/kgK), thermal conductivity (W/mK)."""
+    """Density (kg/m³), specific heat capacity (J/kgK), thermal conductivity (W/mK), each in
+    its documented range (``RANGES``; checked by the case, which knows which phase it is)."""
 
     rho: Positive
     c: Positive
@@ -45,8 +69,8 @@ class Block(_Strict):
     ``edge_radius``, standing on the table, at ``temperature`` (<= 0 °C)."""
 
     size: Size3 = (0.04, 0.04, 0.04)
-    edge_radius: Annotated[float, Field(ge=0.0)] = 0.004
-    temperature: Annotated[float, Field(ge=-80.0, le=0.0)] = -5.0
+    edge_radius: _num(ge=0.0) = 0.004
+    temperature: _num(ge=-80.0, le=0.0) = -5.0
 
     @model_validator(mode="after")
     def _radius_fits(self) -> Block:
@@ -62,9 +86,9 @@ class Cavity(_Strict):
 
     shape: Literal["sphere", "box"] = "sphere"
     radius: Positive = 0.012
-    size: Size3 = (0.02, 0.02, 0.02)
+    size: CavitySize3 = (0.02, 0.02, 0.02)
     center: Vec3 = (0.0, 0.0, 0.0)
-    temperature: Annotated[float, Field(ge=0.0, le=100.0)] = 20.0
+    temperature: _num(ge=0.0, le=100.0) = 20.0
 
     def half_extent(self) -> tuple[float, float, float]:
         if self.shape == "sphere":
@@ -73,11 +97,17 @@ class Cavity(_Strict):
 
 
 class Air(_Strict):
-    """The room: air temperature (°C) and the heat transfer coefficient h (W/m²K: about
-    5-10 still air, 10-25 a gentle draught)."""
+    """The room: air temperature (°C) and the convective heat transfer coefficient h (W/m²K:
+    about 5-10 still air, 10-25 a gentle draught); radiation with surroundings at
+    ``surroundings`` °C (default: the air's) for ice of ``emissivity`` (0 turns it off); and
+    condensation of the air's vapour at ``relative_humidity`` (0-1; 0 turns it off). See
+    :mod:`whitted.stefan.room` and docs/stefan.md."""
 
-    temperature: Annotated[float, Field(ge=-80.0, le=200.0)] = 25.0
-    h: Annotated[float, Field(gt=0.0, le=1.0e4)] = 20.0
+    temperature: _num(ge=-80.0, le=200.0) = 25.0
+    h: _num(gt=0.0, le=1.0e4) = 20.0
+    surroundings: _num(ge=-80.0, le=200.0) | None = None
+    emissivity: _num(ge=0.0, le=1.0) = 0.97
+    relative_humidity: _num(ge=0.0, le=1.0) = 0.3
 
 
 class Table(_Strict):
@@ -85,24 +115,24 @@ class Table(_Strict):
     conductance ``h`` to a table at ``temperature``; meltwater there drains)."""
 
     contact: Literal["adiabatic", "conducting"] = "adiabatic"
-    temperature: Annotated[float, Field(ge=-80.0, le=200.0)] = 20.0
-    h: Annotated[float, Field(gt=0.0, le=1.0e5)] = 100.0
+    temperature: _num(ge=-80.0, le=200.0) = 20.0
+    h: _num(gt=0.0, le=1.0e5) = 100.0
 
 
 class Grid(_Strict):
     """``cells`` along the block's longest side (cubic cells)."""
 
-    cells: Annotated[int, Field(ge=8, le=512)] = 64
+    cells: _count(ge=8, le=100_000) = 64
 
 
 class Time(_Strict):
     """Simulated time to ``end`` (s), a saved state every ``save_every`` s; the time step is
     ``cfl`` times the stability limit unless ``dt`` is given (it must be under the limit)."""
 
-    end: Annotated[float, Field(gt=0.0, le=1.0e7)] = 3600.0
-    save_every: Annotated[float, Field(gt=0.0)] = 120.0
-    dt: Annotated[float, Field(gt=0.0)] | None = None
-    cfl: Annotated[float, Field(gt=0.0, le=1.0)] = 0.9
+    end: _num(gt=0.0, le=1.0e7) = 3600.0
+    save_every: Positive = 120.0
+    dt: Positive | None = None
+    cfl: _num(gt=0.0, le=1.0) = 0.9
 
 
 class Breach(_Strict):
@@ -116,8 +146,8 @@ class Surfaces(_Strict):
     """Surface extraction: Taubin smoothing passes, and the fraction of faces to keep (1: no
     decimation)."""
 
-    smoothing: Annotated[int, Field(ge=0, le=200)] = 10
-    keep: Annotated[float, Field(gt=0.0, le=1.0)] = 1.0
+    smoothing: _count(ge=0, le=200) = 10
+    keep: _num(gt=0.0, le=1.0) = 1.0
 
 
 class Case(_Strict):
@@ -125,7 +155,7 @@ class Case(_Strict):
 
     ice: PhaseProperties = PhaseProperties(rho=ICE.rho, c=ICE.c, k=ICE.k)
     water: PhaseProperties = PhaseProperties(rho=WATER.rho, c=WATER.c, k=WATER.k)
-    latent_heat: Annotated[float, Field(gt=0.0, le=1.0e7)] = LATENT_HEAT
+    latent_heat: Positive = LATENT_HEAT
     block: Block = Block()
     cavity: Cavity = Cavity()
     air: Air = Air()
@@ -146,6 +176,14 @@ class Case(_Strict):
     def check(self) -> list[tuple[str, str]]:
         """Physical checks beyond single values: (key, problem) pairs, empty when fine."""
         problems: list[tuple[str, str]] = []
+        for key, (low, high) in RANGES.items():
+            value = self.latent_heat if key == "latent_heat" else getattr(
+                getattr(self, key.split(".")[0]), key.split(".")[1])
+            if not low <= value <= high:
+                problems.append((key, f"{value:g} is outside the documented range {low:g} to "
+                                 f"{high:g} (docs/stefan.md)"))
+        if problems:
+            return problems
         b, cav = self.block, self.cavity
         dx = self.dx
         half = [0.5 * s for s in b.size]
@@ -166,11 +204,10 @@ class Case(_Strict):
             problems.append(("air.temperature", "nothing melts: the air, the cavity water and "
                              "the table are all at or below 0 °C"))
         if self.time.dt is not None:
-            from .solver import Air as SolverAir
             from .solver import stability_limit
 
             limit = stability_limit(self.properties, dx, 3, self.solver_faces(),
-                                    SolverAir(self.air.temperature, self.air.h))
+                                    self.solver_air())
             if self.time.dt > limit:
                 problems.append(("time.dt", f"{self.time.dt:g} s is over the stability limit "
                                  f"{limit:.4g} s of {dx * 1e3:.3g} mm cells"))
@@ -178,6 +215,17 @@ class Case(_Strict):
             problems.append(("time.save_every", f"{self.time.save_every:g} s is longer than "
                              f"time.end ({self.time.end:g} s)"))
         return problems
+
+    def solver_air(self):
+        """The solver's air: convection, radiation and condensation as one effective film
+        (:func:`whitted.stefan.room.outer_film`)."""
+        from .room import outer_film
+        from .solver import Air as SolverAir
+
+        a = self.air
+        film = outer_film(a.temperature, a.h, t_sur=a.surroundings, emissivity=a.emissivity,
+                          relative_humidity=a.relative_humidity)
+        return SolverAir(film.temperature, film.h)
 
     def solver_faces(self):
         from .solver import Faces

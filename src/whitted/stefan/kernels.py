@@ -259,7 +259,7 @@ def _neighbour(i, j, k, face):
 
 @njit(cache=True, inline="always")
 def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain, air_h,
-                  air_inv_h, air_t, i, j, k, scale, out, m, rescale, occ):
+                  air_inv_h, air_t, i, j, k, scale, out, m, rescale, occ, is_surface):
     """The boundary heat of one surface cell, added to Hn; drain if it is all liquid and a
     face drains. ``out[m]``: heat in (J/m² of face), drained (J/m³), breach signal, drains.
     Every air face of a cell carries the same flux: it is computed once and added once per
@@ -305,9 +305,10 @@ def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain
     if wet and hn >= hl:
         out[m, 1] = hn
         out[m, 3] = 1.0
-        for face in range(6):  # a liquid neighbour: the cavity opens
+        for face in range(6):  # an inner neighbour at least half liquid: the cavity opens
             ii, jj, kk = _neighbour(i, j, k, face)
-            if kind[ii, jj, kk] == BODY and H[ii, jj, kk] >= hl:
+            if (kind[ii, jj, kk] == BODY and is_surface[ii, jj, kk] == 0
+                    and H[ii, jj, kk] >= 0.5 * hl):
                 out[m, 2] += 1.0
 
 
@@ -425,7 +426,8 @@ def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h
                 m = plane_cells[e]
                 _surface_cell(src, kind, dst, p, dt, dx, face_h, face_inv_h, face_t,
                               face_drain, air_h, air_inv_h, air_t, surface[m, 0],
-                              surface[m, 1], surface[m, 2], scale, out, m, rescale, occ)
+                              surface[m, 1], surface[m, 2], scale, out, m, rescale, occ,
+                              is_surface)
         breach = 0.0
         drains = 0.0
         for m in range(ns):  # in list order: no dependence on the thread count
@@ -476,7 +478,8 @@ def run_steps_serial(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
         for m in range(ns):
             _surface_cell(src, kind, dst, p, dt, dx, face_h, face_inv_h,
                           face_t, face_drain, air_h, air_inv_h, air_t, surface[m, 0],
-                          surface[m, 1], surface[m, 2], scale, out, m, rescale, occ)
+                          surface[m, 1], surface[m, 2], scale, out, m, rescale, occ,
+                              is_surface)
         breach = 0.0
         drains = 0.0
         for m in range(ns):

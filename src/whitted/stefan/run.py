@@ -23,6 +23,7 @@ import csv
 import io
 import json
 import math
+import re
 import time as wallclock
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -34,9 +35,10 @@ from .case import Case, CaseError, case_digest
 from .geometry import GridFrame, grid_frame, initial_state
 from .measures import measure
 from .scene import still_life_scene, write_scene
-from .solver import Air, EnthalpySolver
+from .solver import EnthalpySolver
 from .surfaces import extract_surfaces, write_ply
 
+_STATE_NAME = re.compile(r"state_(\d+)\.npz")
 SERIES_COLUMNS = ("time_s", "ice_volume_cm3", "cavity_volume_cm3", "water_volume_cm3",
                   "min_shell_mm", "breached", "breach_time_s", "energy_imbalance_J")
 
@@ -77,8 +79,18 @@ def _save_state(path: Path, solver: EnthalpySolver, digest: str, index: int,
     _atomic_bytes(path, buf.getvalue())
 
 
+def state_files(fields: Path) -> list[Path]:
+    """``state_NNNN.npz`` files by their number (numeric: state_10000 comes after state_9999)."""
+    found = []
+    for path in Path(fields).glob("state_*.npz"):
+        m = _STATE_NAME.fullmatch(path.name)
+        if m is not None and path.is_file():
+            found.append((int(m.group(1)), path))
+    return [p for _, p in sorted(found)]
+
+
 def _latest_state(fields: Path, digest: str) -> Path | None:
-    for path in sorted(fields.glob("state_*.npz"), reverse=True):
+    for path in reversed(state_files(fields)):
         try:
             with np.load(path) as z:
                 if str(z["digest"]) == digest:
@@ -155,23 +167,36 @@ def _save_surfaces(out: Path, index: int, solver: EnthalpySolver, case: Case,
 def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
              progress: Callable[[float, float, str], None] | None = None,
              should_stop: Callable[[], bool] | None = None, scene_size: tuple[int, int] =
-             (480, 360)) -> RunResult:
-    """Solve ``case`` into the folder ``out`` (see the module docstring)."""
+             (480, 360), allow_large: bool = False, case_path: Path | None = None) -> RunResult:
+    """Solve ``case`` into the folder ``out`` (see the module docstring).
+
+    Before any work the cost is estimated (:func:`whitted.stefan.budget.check`: refused over
+    the machine's memory or free disk, or over a soft limit unless ``allow_large``), and
+    ``out`` must be a folder whitted made (:func:`whitted.stefan.folder.prepare`): ``resume``
+    False (``--fresh``) removes the files whitted wrote there and nothing else.
+    ``case_path``: the case file read, which the run must not write over."""
+    from . import budget, folder
+
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    for sub in ("fields", "surfaces", "scenes"):
-        (out / sub).mkdir(exist_ok=True)
     digest = case_digest(case)
     case_file = out / "case.toml"
-    if case_file.exists() and resume and _latest_state(out / "fields", digest) is None \
-            and any((out / "fields").glob("state_*.npz")):
-        raise CaseError(f"{out} holds a run of a different case (use a new folder or "
-                        "--fresh)", file=str(out))
+    if case_path is not None and Path(case_path).resolve() == case_file.resolve():
+        raise CaseError("the run would write its case.toml over the case file it reads: use "
+                        "another output folder", file=str(case_path))
+    existing = 0
+    if resume and folder.is_marked(out) and (out / "fields").is_dir():
+        existing = len(state_files(out / "fields"))
+    budget.check(case, out, allow_large=allow_large, existing_saves=existing,
+                 file=None if case_path is None else str(case_path))
+    folder.prepare(out, fresh=not resume, digest=digest)
+    if resume and _latest_state(out / "fields", digest) is None and state_files(out / "fields"):
+        raise CaseError("holds a run of a different case (use a new folder or --fresh)",
+                        file=str(out))
     _atomic_bytes(case_file, case_text.encode())
     props = case.properties
     frame = grid_frame(case)
     result = RunResult(out, cells=frame.shape)
-    air = Air(case.air.temperature, case.air.h)
+    air = case.solver_air()
     latest = _latest_state(out / "fields", digest) if resume else None
     rows: list[dict]
     if latest is not None:
@@ -245,6 +270,33 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
     return result
 
 
+@dataclass(frozen=True)
+class FilmFrame:
+    """One saved time of a run as a film frame: its index, time and surfaces (relative to the
+    run folder; ``inner`` None when the cavity is gone: after a breach in drain mode)."""
+
+    index: int
+    time: float
+    outer: str
+    inner: str | None
+
+
+def film_frames(out: Path) -> list[FilmFrame]:
+    """The saved times of the run in ``out`` that a film shows, from t = 0 to the end of the
+    run: every saved time with an outer surface (in ``drain`` mode the frames after the
+    breach have the outer surface alone); it stops at the first saved time without one."""
+    out = Path(out)
+    frames: list[FilmFrame] = []
+    for k, row in enumerate(_read_series(out / "series.csv")):
+        outer = f"surfaces/outer_{k:04d}.ply"
+        if not (out / outer).is_file():
+            break
+        inner = f"surfaces/inner_{k:04d}.ply"
+        frames.append(FilmFrame(k, float(row["time_s"]), outer,
+                                inner if (out / inner).is_file() else None))
+    return frames
+
+
 def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, digest: str,
             index: int, initial_cavity: float, rows: list[dict], result: RunResult,
             scene_size: tuple[int, int]) -> None:
@@ -271,4 +323,4 @@ def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, dig
     result.saved.append(solver.time)
 
 
-__all__ = ["RunResult", "asdict", "run_case"]
+__all__ = ["FilmFrame", "RunResult", "asdict", "film_frames", "run_case", "state_files"]

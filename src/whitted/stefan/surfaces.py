@@ -4,9 +4,12 @@ volume-preserving) and optional decimation; written as PLY.
 Two surfaces per saved time: the outer ice/air surface and the inner ice/water surface (the
 cavity). The fields they are cut from at 0.5:
 
-* outer: 0 in air, the ice fraction (1 - liquid fraction) in a body cell on the outer surface
-  (its meltwater has drained), 1 in every other body cell (ice, and the cavity's water);
-* inner: the liquid fraction in body cells off the outer surface, 0 elsewhere.
+* outer: 0 in air, 1 in the cavity's cells, the ice fraction (1 - liquid fraction) in every
+  other body cell (its meltwater has drained or will);
+* inner: the liquid fraction in the cavity's cells, 0 elsewhere.
+
+The cavity's cells are :func:`whitted.stefan.measures.regions`' (the time series measures the
+same surfaces).
 
 Both are padded with a layer of zeros so the surfaces close.
 """
@@ -20,16 +23,15 @@ import trimesh
 from skimage.measure import marching_cubes
 
 from .geometry import GridFrame
-from .measures import outer_cells
+from .measures import regions
 from .properties import Properties
 
 
 def surface_fields(H: np.ndarray, kind: np.ndarray, props: Properties):
-    f = np.where(kind == 1, props.liquid_fraction(H), 0.0)
-    outer = outer_cells(kind)
+    f, cavity = regions(H, kind, props)
     body = kind == 1
-    outer_field = np.where(body, np.where(outer, 1.0 - f, 1.0), 0.0)
-    inner_field = np.where(body & ~outer, f, 0.0)
+    outer_field = np.where(body, np.where(cavity, 1.0, 1.0 - f), 0.0)
+    inner_field = np.where(cavity, f, 0.0)
     return outer_field, inner_field
 
 

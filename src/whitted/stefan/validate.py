@@ -109,6 +109,24 @@ def convergence_rows(props: Properties | None = None, t_end: float = 3600.0,
     return rows
 
 
+#: Issue 30's independent 1-D cases: (wall °C, initial ice °C); 0 °C ice is the one-phase case
+MORE_CASES = ((25.0, -3.0), (3.0, -20.0), (15.0, 0.0))
+
+
+def more_case_rows(props: Properties | None = None, t_end: float = 600.0,
+                   cells_mm: tuple[float, ...] = (0.5, 0.25)) -> list[dict]:
+    """The three further Neumann cases (``MORE_CASES``) at each cell size: front, exact front
+    (its similarity constant root-found), error and observed order."""
+    props = props or Properties()
+    rows: list[dict] = []
+    for wall, initial in MORE_CASES:
+        for i, row in enumerate(convergence_rows(props, t_end=t_end, cells_mm=cells_mm,
+                                                 wall=wall, initial=initial)):
+            row["case"] = f"{wall:+g} °C wall, {initial:+g} °C ice" if i == 0 else ""
+            rows.append(row)
+    return rows
+
+
 def axis_rows(props: Properties | None = None, t_end: float = 600.0, dx: float = 0.5e-3,
               wall: float = 10.0, initial: float = -10.0) -> list[dict]:
     """The same 1-D case along x, y and z, and as a 3-D block (4 x 4 across, adiabatic
@@ -194,7 +212,7 @@ def energy_balance(cells: int = 16, t_end: float = 600.0) -> dict:
                                 "table": {"contact": "conducting"}})
     H, kind, _, _ = initial_state(case)
     solver = EnthalpySolver(H, kind, case.dx, case.properties, faces=case.solver_faces(),
-                            air=Air(case.air.temperature, case.air.h))
+                            air=case.solver_air())
     solver.advance(t_end)
     change = solver.enthalpy() - solver.initial_enthalpy
     return {"enthalpy_change_J": change, "heat_in_J": solver.heat_in,

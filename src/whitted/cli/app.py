@@ -1,0 +1,161 @@
+"""The ``whitted`` command line's typer app and what its commands share: the one-line error
+of a user mistake (:func:`fail`), the scene argument, ``--set``, and the state one run of the
+program keeps (what main() does when the command returns). The commands live in their own
+modules (render, info, export, bench, animate, sweep, stefan), which register on :data:`app`;
+:mod:`.main` imports them all and is the entry point."""
+
+from __future__ import annotations
+
+import gc
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+
+from ..errors import WhittedError, shorten
+from .console import Text, err, out
+
+if TYPE_CHECKING:
+    import numpy as np
+    from pydantic import ValidationError
+
+    from ..scene import Scene
+
+# NumPy, pydantic, rich, the scene models and the renderer are imported inside the commands
+# that use them: `whitted --help` and the import of the command line stay far under 0.2 s
+# (tests/test_startup.py).
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=False,
+    help="whitted: a fast Whitted ray tracer. Render scene files (TOML/JSON) to images.",
+    pretty_exceptions_enable=False,
+)
+
+#: The optional scene-file argument of render, export, animate and sweep.
+SceneArgument = Annotated[
+    Path | None, typer.Argument(metavar="[SCENE]", help="Scene file; default: built-in scene")
+]
+
+EXIT_USER_ERROR = 2
+#: set by render: its job's thread was abandoned after an interrupt during the first compile,
+#: or the render is local and done; either way main() may end the process at once (main.py)
+abandoned: list[bool] = []
+ends_at_once: list[bool] = []  # set by a local render: the process may skip the teardown
+#: The longest error line printed (a file may hold a huge key or value: it is cut, not echoed).
+MESSAGE_LIMIT = 400
+
+
+def one_line(message: str) -> str:
+    """``message`` as one line of at most :data:`MESSAGE_LIMIT` characters."""
+    return shorten(" ".join(str(message).split()), MESSAGE_LIMIT)
+
+
+def fail(message: str) -> typer.Exit:
+    """One line on stderr, exit status 2: the way every user mistake ends. The message is
+    printed literally (no rich markup, no emoji codes)."""
+    err.print(Text.assemble(("error:", "bold red"), " ", one_line(message)), soft_wrap=True)
+    return typer.Exit(EXIT_USER_ERROR)
+
+
+def note(message: str) -> None:
+    err.print(Text(one_line(message)), soft_wrap=True)
+
+
+def _version(value: bool) -> None:
+    if value:
+        from .. import __version__
+
+        out.print(f"whitted {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main_options(
+    version: Annotated[
+        bool, typer.Option("--version", callback=_version, is_eager=True, help="Show the version.")
+    ] = False,
+) -> None:
+    """whitted: a fast Whitted ray tracer."""
+
+
+def load_scene_argument(scene_path: Path | None) -> tuple[Scene, str]:
+    from ..scene import load_scene
+    from ..scene.default import default_scene
+
+    if scene_path is None:
+        return default_scene(), "<default scene>"
+    return load_scene(scene_path), str(scene_path)
+
+
+def apply_set_options(scene: Scene, set_values: list[str] | None) -> Scene:
+    """The scene with every ``--set PATH=VALUE`` applied (SceneError on a bad one)."""
+    if not set_values:
+        return scene
+    from ..animation.overrides import apply_overrides, parse_assignment
+
+    return apply_overrides(scene, [parse_assignment(text) for text in set_values])
+
+
+def is_dir(path: Path) -> bool:
+    try:
+        return path.is_dir()
+    except (OSError, ValueError):  # a name too long, a NUL byte: reported by the checks later
+        return False
+
+
+def with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
+    """A model or texture error from the render, with the scene file and key that name it."""
+    from ..scene.writing import named_files
+
+    file = getattr(exc, "file", None)
+    if not file or file == name:
+        return str(exc)
+    for keys, named in named_files(scene):
+        try:
+            target = scene.resolve_path(named)
+        except (OSError, RuntimeError, ValueError):
+            continue
+        from ..files import same_file
+
+        if same_file(target, file) or str(target) == file:
+            where = "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in keys).lstrip(".")
+            return f"{name}: {where}: {exc}"
+    return f"{name}: {exc}"
+
+
+def save_npy(path: Path, array: np.ndarray) -> None:
+    import numpy as np
+
+    from ..files import atomic_write
+
+    atomic_write(path, lambda tmp: np.save(tmp, array))
+
+
+def override_error(exc: ValidationError) -> str:
+    """One line for a command-line value the render settings reject."""
+    from ..scene.messages import clean_message as _clean_message
+
+    e = exc.errors()[0]
+    if e["loc"]:
+        option = "--" + str(e["loc"][0]).replace("_", "-")
+    else:  # the only whole-settings check is the image size
+        option = "--width/--height"
+    return f"{option}: {_clean_message(e)}"
+
+
+#: whether main() paused the cyclic garbage collector for a render's set-up (a list: set once)
+collector_paused: list[bool] = []
+
+
+def resume_collector() -> None:
+    """The cyclic garbage collector, paused by main() while ``whitted render`` imports its
+    modules and reads its scene (some 90 collections, 10-15 ms of a 0.57 s render, finding
+    next to nothing: modules, classes and the scene all live to the end), back on for the job,
+    with everything made so far frozen (``gc.freeze``), so later collections never scan it."""
+    if collector_paused:
+        collector_paused.clear()
+        gc.freeze()
+        gc.enable()
+
+

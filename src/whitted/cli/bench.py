@@ -1,0 +1,59 @@
+"""``whitted bench``: the benchmark scenes timed, beside POV-Ray or Embree on request."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ..errors import WhittedError, shorten
+from .app import app, fail
+from .console import err, out
+
+
+@app.command()
+def bench(
+    scene: Annotated[
+        list[str] | None, typer.Option("--scene", help="Scene(s): seed000, softshadow, ice, "
+                                       "mesh1m, lecture (default: all)")
+    ] = None,
+    runs: Annotated[int, typer.Option("--runs", "-n", help="Timed runs; the median")] = 5,
+    threads: Annotated[
+        str | None, typer.Option("--threads", "-t", help="Thread counts, e.g. 1,2 (all cores)")
+    ] = None,
+    quick: Annotated[bool, typer.Option("--quick", help="Tiny images, one run (CI)")] = False,
+    compare: Annotated[str | None, typer.Option("--compare", help="Also time: povray")] = None,
+    study: Annotated[str | None, typer.Option("--study", help="threads or size")] = None,
+    json_path: Annotated[Path | None, typer.Option("--json", help="Write results")] = None,
+    plot: Annotated[Path | None, typer.Option("--plot", help="Study plot (PNG)")] = None,
+    markdown: Annotated[Path | None, typer.Option("--markdown", help="Table as Markdown")] = None,
+    size: Annotated[str | None, typer.Option("--size", help="WxH for every scene")] = None,
+    in_process: Annotated[
+        bool, typer.Option("--in-process", help="Render in this process, not a fresh one")
+    ] = False,
+) -> None:
+    """Render the benchmark scenes (benchmarks/) and print times, rays and memory."""
+    from ..bench.command import bench_main
+    from ..bench.scenes import SCENES
+
+    for name in scene or []:  # checked before the header line: a mistake is one line
+        if name not in SCENES and not name.startswith("generated/"):
+            raise fail(f"--scene: unknown benchmark scene {shorten(name)!r} "
+                       f"(known: {', '.join(SCENES)})")
+    from ..output.safety import check_output_place
+
+    for option, path in (("--json", json_path), ("--plot", plot), ("--markdown", markdown)):
+        try:
+            if path is not None:
+                check_output_place(path)
+        except WhittedError as exc:
+            raise fail(f"{option}: {exc}") from None
+    try:
+        bench_main(scenes=scene, runs=runs, threads=threads, quick=quick, compare=compare,
+                   study=study, json_path=json_path, plot_path=plot, markdown_path=markdown,
+                   size=size, in_process=in_process, out=out, err=err)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+
+

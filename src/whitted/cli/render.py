@@ -1,0 +1,253 @@
+"""``whitted render``: one still, with a progress bar on a terminal, Ctrl-C and SIGTERM keeping
+the tiles finished (cli/interrupt.py), AOVs beside it, or bands on a farm (cli/farm.py)."""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ..errors import WhittedError, shorten
+from .app import (
+    SceneArgument,
+    abandoned,
+    app,
+    apply_set_options,
+    ends_at_once,
+    fail,
+    is_dir,
+    load_scene_argument,
+    override_error,
+    resume_collector,
+    save_npy,
+    with_scene_key,
+)
+from .console import err, out
+from .farm import ClusterOption, SchedulerOption, render_still_on_farm
+from .interrupt import InterruptGuard
+
+AOV_NAMES = ("depth", "normal", "id")
+
+
+def _parse_aovs(text: str | None) -> list[str]:
+    if not text:
+        return []
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    for n in names:
+        if n not in AOV_NAMES:
+            raise fail(f"--aov: unknown AOV {n!r} (choose from {', '.join(AOV_NAMES)})")
+    return names
+
+
+@app.command()
+def render(
+    scene_path: SceneArgument = None,
+    output: Annotated[Path, typer.Option("-o", "--output", help="Image to write")] = Path(
+        "render.png"
+    ),
+    width: Annotated[int | None, typer.Option("--width", "-W", help="Image width")] = None,
+    height: Annotated[int | None, typer.Option("--height", "-H", help="Image height")] = None,
+    samples: Annotated[int | None, typer.Option("--samples", "-s", help="Samples/pixel")] = None,
+    max_depth: Annotated[int | None, typer.Option("--max-depth", "-d", help="Recursion")] = None,
+    threads: Annotated[int | None, typer.Option("--threads", "-t", help="0 = all cores")] = None,
+    seed: Annotated[int | None, typer.Option("--seed", help="Random seed")] = None,
+    aov: Annotated[str | None, typer.Option("--aov", help="Also write depth,normal,id")] = None,
+    bit_depth: Annotated[int, typer.Option("--bit-depth", help="PNG bits: 8 or 16")] = 8,
+    transfer: Annotated[
+        str | None, typer.Option("--transfer", help="srgb or linear (default: the scene's)")
+    ] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar")] = False,
+    frame: Annotated[
+        int | None, typer.Option("--frame", "-f", help="Frame of an animated scene (from 0)")
+    ] = None,
+    set_values: Annotated[
+        list[str] | None, typer.Option("--set", help="PATH=VALUE: change a scene value")
+    ] = None,
+    cluster: ClusterOption = None,
+    scheduler: SchedulerOption = None,
+) -> None:
+    """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG).
+    An animated scene renders frame 0, or the frame --frame names."""
+    from pydantic import ValidationError
+
+    from ..output.formats import check_bit_depth, image_format
+    from ..render.api import RenderJob
+
+    process_start = time.perf_counter()
+    aovs = _parse_aovs(aov)
+    if is_dir(output):
+        raise fail(f"{output}: is a directory (give a file name such as {output / 'render.png'})")
+    try:
+        check_bit_depth(bit_depth, image_format(output))
+    except ValueError as exc:
+        raise fail(f"{output}: {exc}") from None
+    if transfer not in (None, "srgb", "linear"):
+        raise fail(f"--transfer: unknown transfer {shorten(transfer)!r} (use srgb or linear)")
+    try:
+        scene, name = load_scene_argument(scene_path)
+        scene = apply_set_options(scene, set_values)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    try:
+        scene = scene.with_settings(width=width, height=height, samples=samples,
+                                    max_depth=max_depth, threads=threads, seed=seed,
+                                    transfer=transfer)
+        if frame is not None or scene.is_animated:
+            scene = scene.at_frame(frame or 0)
+    except ValidationError as exc:  # a command-line override out of range
+        raise fail(override_error(exc)) from None
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    outputs = [output] + [output.with_name(f"{output.stem}.{a}.npy") for a in aovs]
+    try:
+        from ..output.safety import check_memory, check_outputs
+
+        check_outputs(outputs, scene, scene_path)
+        check_memory(scene.render.width, scene.render.height, image_format(output), bit_depth)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    resume_collector()  # set-up done: the job (or the farm's client) runs with it
+    if cluster is not None or scheduler is not None:  # bands on a Dask cluster (cli/farm.py)
+        render_still_on_farm(scene, output, cluster=cluster, scheduler=scheduler,
+                             threads=threads, quiet=quiet, bit_depth=bit_depth, aovs=aovs)
+
+    try:
+        job = RenderJob(scene)
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    ends_at_once.append(True)
+    # Ctrl-C, SIGTERM: stop after the tiles in flight (cli/interrupt.py); the handlers stay
+    # until the image is written: a signal during the write lets it finish
+    with InterruptGuard() as guard:
+        guard.on_interrupt(job.cancel)
+        _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet, guard,
+                          process_start, frame)
+
+
+def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
+                      guard: InterruptGuard, process_start, frame: int | None) -> None:
+    from ..output.formats import image_format
+    from ..render.api import render_aovs
+
+    interrupted = guard.event
+
+    try:
+        _run_with_progress(job, quiet, interrupted)
+    except WhittedError as exc:  # a model or texture file the scene names is unusable
+        raise fail(with_scene_key(exc, scene, name)) from None
+    stats = job.stats
+    if interrupted.is_set() and (job.running or stats.tiles_done == 0):
+        # stopped while compiling, or before any tile was finished: there is nothing to keep,
+        # and an existing file at the output path is left as it was
+        if job.running:
+            abandoned.append(True)
+        raise guard.exit(f"before any tile was finished: nothing written ({output} is "
+                         "unchanged)")
+    image = job.image
+    assert image is not None
+    for warning in stats.warnings:
+        err.line(f"warning: {warning}")
+    written = [str(output)]
+    try:
+        if frame is not None and not interrupted.is_set() and bit_depth == 8 \
+                and image_format(output) == "png":  # the very file the film's frame K is
+            from ..animation.frames import frame_digest, write_frame_png
+
+            write_frame_png(output, image, frame_digest(scene, frame), frame)
+        else:
+            image.save(output, bit_depth=bit_depth)
+        if aovs and not interrupted.is_set():
+            planes = render_aovs(scene)
+            for path, aov_name in zip(outputs[1:], aovs, strict=True):
+                save_npy(path, planes[aov_name])
+                written.append(str(path))
+    except OSError as exc:
+        raise fail(f"{getattr(exc, 'filename', None) or output}: cannot write: "
+                   f"{exc.strerror or exc}") from None
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
+    stats.wall_seconds = time.perf_counter() - process_start
+    if not quiet or interrupted.is_set():
+        out.line(f"{stats.summary()} -> {', '.join(written)}")
+    if interrupted.is_set():  # (a signal may have come during the write)
+        raise guard.exit(f"kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")
+
+
+def _wait(job, interrupted: threading.Event, tick=None, until: float | None = None) -> bool:
+    """Wait for the job; after an interrupt, stop waiting at once if no tile is being rendered
+    yet (the first compile of the kernels takes many seconds and cannot be cut short).
+    ``tick()`` is called every tenth of a second meanwhile. With ``until`` (a
+    ``time.monotonic()`` deadline), False when the job is still running then."""
+    while job.running:
+        left = 0.1 if until is None else min(0.1, until - time.monotonic())
+        if left <= 0:
+            return False
+        job.join(left)
+        if tick is not None:
+            tick()
+        if interrupted.is_set() and not job.rendering:
+            return True
+    job.wait()
+    return True
+
+
+#: seconds a render runs before its progress bar appears: a shorter one would only flash it
+#: (and a render of the timing scene would spend 40 ms importing rich's progress display);
+#: ``WHITTED_PROGRESS_DELAY`` (seconds) overrides it, 0 shows the bar at once
+PROGRESS_DELAY = 0.4
+
+
+def _progress_delay() -> float:
+    try:
+        value = float(os.environ["WHITTED_PROGRESS_DELAY"])
+    except (KeyError, ValueError):
+        return PROGRESS_DELAY
+    return value if value >= 0 else PROGRESS_DELAY
+
+
+def _show_compile(bar, task) -> None:
+    """While the first run compiles the kernels, the bar says so and how far along it is."""
+    from ..render.warm_up import compile_progress
+
+    fraction = compile_progress()
+    if fraction is not None:
+        bar.update(task, description="compiling the kernels (first run only)",
+                   completed=fraction)
+
+
+def _run_with_progress(job, quiet: bool, interrupted: threading.Event) -> None:
+    job.start()
+    if quiet or not err.is_terminal:
+        _wait(job, interrupted)
+        return
+    if _wait(job, interrupted, until=time.monotonic() + _progress_delay()):
+        return
+    from rich.progress import (
+        BarColumn,
+        Progress,
+        TaskProgressColumn,
+        TextColumn,
+        TimeRemainingColumn,
+    )
+
+    columns = (
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        TaskProgressColumn(),
+        TextColumn("{task.fields[rays]} rays"),
+        TimeRemainingColumn(),
+    )
+    with Progress(*columns, console=err.console, transient=True) as bar:
+        task = bar.add_task("rendering", total=1.0, rays="0")
+
+        def update(p) -> None:
+            bar.update(task, description="rendering", completed=p.fraction, rays=f"{p.rays:,}")
+
+        job.progress = update  # read by the job at each report: taken up from now on
+        _wait(job, interrupted, lambda: _show_compile(bar, task))
+
+

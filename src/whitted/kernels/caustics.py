@@ -1,0 +1,171 @@
+"""The caustics' side of the render kernel: the photon map's gather and the switch that
+compiles it in only for renders with caustics (docs/caustics.md).
+
+A render without caustics passes a ``LightArrays`` whose ``photons`` are float64 and empty
+(layout.NO_CAUSTICS_DTYPE); with caustics they are float32. The two are different Numba
+types, so the render kernel is compiled once per kind, and in the kind without caustics
+:func:`caustics_on` is the constant False (the integrator's shadow rays see the material
+table itself) and :func:`add_caustic` adds nothing: the integrator's machine code is what it
+was before caustics existed (the same images, bit for bit), and the gather is never
+compiled for it (as features.py does for mesh instances).
+"""
+
+from __future__ import annotations
+
+import math
+
+from .jit import kernel, overload
+from .layout import (
+    GRID_BITS,
+    GRID_INV_CELL,
+    GRID_PASS,
+    GRID_PASSES,
+    GRID_R2_MAX,
+    MAT_KD,
+    PHOTON_DIRECTION,
+    PHOTON_PASS,
+    PHOTON_POWER,
+)
+
+#: a photon counts at a point only when it lies within this fraction of the gather radius
+#: of the point's tangent plane (no light leaks round corners onto walls)
+PLANE_FRACTION = 0.5
+#: an estimate made of fewer photons than this fades out (to 0 at FEWEST_PHOTONS): where
+#: photons are sparse (light spread thin by a convex mirror), lone photons would show as
+#: blotches of the gather disc's size (POV-Ray's ``gather`` minimum does the same)
+MIN_PHOTONS = 8
+FEWEST_PHOTONS = 2
+
+
+def _photons_possible(lights_type) -> bool:
+    from numba import types
+
+    fields = dict(zip(lights_type.fields, lights_type.types, strict=True))
+    return fields["photons"].dtype == types.float32
+
+
+def caustics_on(lights):
+    """True when the render has a photon map (resolved when the kernel is compiled)."""
+    return lights.photons.dtype.name == "float32"
+
+
+@overload(caustics_on, inline="always")
+def _caustics_on(lights):
+    if not _photons_possible(lights):
+        return lambda lights: False
+    return lambda lights: True
+
+
+@kernel(inline="always")
+def cell_hash(ix, iy, iz, bits):
+    """Row of the photon grid's hash table for integer cell (ix, iy, iz): the cell's
+    coordinates modulo 2^bits, packed. Cells fewer than 2^bits apart on every axis never
+    share a row, so the 3x3x3 cells around a point are always distinct rows."""
+    m = (1 << bits) - 1
+    return (ix & m) | ((iy & m) << bits) | ((iz & m) << (2 * bits))
+
+
+@kernel(inline="always")
+def cell_of(x, inv_cell):
+    return int(math.floor(x * inv_cell))
+
+
+@kernel
+def caustic_irradiance(lights, p, n):
+    """Irradiance (per channel) the photon map gives at point ``p`` of a surface whose unit
+    normal ``n`` faces the side being shaded: the photons of each pass within that pass's
+    radius of ``p``, arriving on that side and near the tangent plane, weighted by the
+    Epanechnikov kernel ``2 / (pi r^2) (1 - d^2 / r^2)``, averaged over the passes (and
+    faded out where fewer than MIN_PHOTONS per pass are found). The grid's cells are the
+    largest radius: the ball around ``p`` meets at most 3x3x3 of them, each its own row of
+    the hash table (:func:`cell_hash`)."""
+    grid = lights.photon_grid
+    photons = lights.photons
+    cells = lights.photon_cells
+    inv_cell = grid[GRID_INV_CELL]
+    bits = int(grid[GRID_BITS])
+    r2_max = grid[GRID_R2_MAX]
+    r = math.sqrt(r2_max)
+    ix0 = cell_of(p[0] - r, inv_cell)
+    iy0 = cell_of(p[1] - r, inv_cell)
+    iz0 = cell_of(p[2] - r, inv_cell)
+    ix1 = cell_of(p[0] + r, inv_cell)
+    iy1 = cell_of(p[1] + r, inv_cell)
+    iz1 = cell_of(p[2] + r, inv_cell)
+    e0 = 0.0
+    e1 = 0.0
+    e2 = 0.0
+    found = 0
+    for ix in range(ix0, ix1 + 1):
+        for iy in range(iy0, iy1 + 1):
+            for iz in range(iz0, iz1 + 1):
+                h = cell_hash(ix, iy, iz, bits)
+                for q in range(cells[h], cells[h + 1]):
+                    ox = photons[q, 0] - p[0]
+                    oy = photons[q, 1] - p[1]
+                    oz = photons[q, 2] - p[2]
+                    d2 = ox * ox + oy * oy + oz * oz
+                    if d2 >= r2_max:
+                        continue
+                    s = GRID_PASS + 2 * int(photons[q, PHOTON_PASS])
+                    r2 = grid[s]
+                    if d2 >= r2:
+                        continue
+                    if (photons[q, PHOTON_DIRECTION] * n[0]
+                            + photons[q, PHOTON_DIRECTION + 1] * n[1]
+                            + photons[q, PHOTON_DIRECTION + 2] * n[2]) >= 0.0:
+                        continue  # it arrived on the other side
+                    off = ox * n[0] + oy * n[1] + oz * n[2]
+                    if off * off > PLANE_FRACTION * PLANE_FRACTION * r2:
+                        continue
+                    w = (1.0 - d2 / r2) * grid[s + 1]
+                    found += 1
+                    e0 += w * photons[q, PHOTON_POWER]
+                    e1 += w * photons[q, PHOTON_POWER + 1]
+                    e2 += w * photons[q, PHOTON_POWER + 2]
+    passes = grid[GRID_PASSES]
+    if found < MIN_PHOTONS * passes:
+        fade = max(0.0, (found - FEWEST_PHOTONS * passes) / ((MIN_PHOTONS - FEWEST_PHOTONS)
+                                                              * passes))
+        return e0 * fade, e1 * fade, e2 * fade
+    return e0, e1, e2
+
+
+@kernel(inline="always")
+def with_caustic(lights, mats, m, albedo, p, n, local):
+    """``local`` (a hit's direct light) plus the caustic's diffuse term kd·albedo·E, E the
+    photon map's irradiance at ``p`` (exactly as a light's direct term enters)."""
+    kd = mats[m, MAT_KD]
+    if kd == 0.0:
+        return local
+    e = caustic_irradiance(lights, p, n)
+    return (local[0] + kd * albedo[0] * e[0], local[1] + kd * albedo[1] * e[1],
+            local[2] + kd * albedo[2] * e[2])
+
+
+@kernel(entry=True)  # called from Python: the photon map's estimate at given points
+def irradiance_at(lights, points, normals, out):
+    """:func:`caustic_irradiance` at each row of ``points`` (with unit ``normals``) into
+    ``out`` (tests, docs/caustics.md's validation)."""
+    for i in range(points.shape[0]):
+        e = caustic_irradiance(lights, (points[i, 0], points[i, 1], points[i, 2]),
+                               (normals[i, 0], normals[i, 1], normals[i, 2]))
+        out[i, 0] = e[0]
+        out[i, 1] = e[1]
+        out[i, 2] = e[2]
+
+
+def add_caustic(lights, mats, m, albedo, p, n, local):
+    """:func:`with_caustic` in renders with caustics; ``local`` unchanged, and nothing
+    compiled, without."""
+    if not caustics_on(lights):
+        return local
+    return with_caustic(lights, mats, m, albedo, p, n, local)
+
+
+@overload(add_caustic, inline="always")
+def _add_caustic(lights, mats, m, albedo, p, n, local):
+    if not _photons_possible(lights):
+        return lambda lights, mats, m, albedo, p, n, local: local
+    return lambda lights, mats, m, albedo, p, n, local: with_caustic(lights, mats, m, albedo,
+                                                                     p, n, local)

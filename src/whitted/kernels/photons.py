@@ -1,0 +1,370 @@
+"""Photon tracing for caustics (docs/caustics.md): photons leave the lights toward the
+bodies that reflect or refract (the *targets*), follow reflections and refractions with
+Fresnel, Beer-Lambert absorption and nested media exactly as camera rays do
+(kernels/integrator.py), and are stored where they land on a diffuse surface after at least
+one specular bounce. Rays are traced by the renderer's own ``closest_hit`` and normals.
+
+Each photon's path depends only on the seed, the pass and its index: its emission sample is
+the index's point of the R2 low-discrepancy sequence, shifted per pass and emitter, and its
+choices between reflection and refraction draw counter-based random numbers; the photon
+writes its stored records into its own slots of the output. So the photon map is the same
+whatever the thread count or the machine.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .accel import closest_hit, hit_material, surface_normals
+from .integrator import _absorbed, refract, schlick
+from .jit import kernel, numba_object
+from .layout import (
+    LIGHT_DIRECTION,
+    LIGHT_DIRECTIONAL,
+    LIGHT_DISK,
+    LIGHT_DISK_U,
+    LIGHT_DISK_V,
+    LIGHT_DIST_SCALE,
+    LIGHT_FALLOFF,
+    LIGHT_POSITION,
+    LIGHT_RADIANCE,
+    LIGHT_RADIUS,
+    LIGHT_TYPE,
+    MAT_ATTEN,
+    MAT_COLOR,
+    MAT_FRESNEL,
+    MAT_IOR,
+    MAT_KD,
+    MAT_KR,
+    MAT_KT,
+    MAT_OUTSIDE,
+    PRIM_SOLID,
+)
+from .media import media_enter, media_leave
+from .sampling import concentric_disk, random01, random_pair
+from .vec import dot, madd, normalize, vload
+
+geometry_ref_if_instances = numba_object(".geometry_ref", "geometry_ref_if_instances")
+
+# emitter rows (compile/photon_map.py): one per (light, target) pair
+EMIT_LIGHT = 0  # row of the light table
+EMIT_CENTRE = 1  # 1:4 the target's bounding sphere: centre
+EMIT_RADIUS = 4  # and radius
+EMIT_FIRST = 5  # first photon index of this emitter in a pass
+EMIT_COUNT = 6  # photons it shoots per pass
+EMIT_BACK = 7  # directional lights: how far behind the target its photons start
+N_EMIT = 8
+
+# photon settings (a float64 array): the seed, the pass, the path length, the ray offset
+SET_SEED = 0
+SET_PASS = 1
+SET_DEPTH = 2
+SET_EPSILON = 3
+SET_SLOTS = 4  # records one photon may store
+N_SET = 5
+
+
+
+def _r_steps(dims: int) -> tuple[float, ...]:
+    """The steps of Roberts' R_d low-discrepancy sequence: 1 / g^k, g the root of
+    x^(d+1) = x + 1 (the plastic number for d = 2)."""
+    g = 2.0
+    for _ in range(64):
+        g = (1.0 + g) ** (1.0 / (dims + 1))
+    return tuple(g ** -k for k in range(1, dims + 1))
+
+
+#: a photon's emission is the point of its index in R_2 (the best spread in two
+#: dimensions), and its first LD_BOUNCES choices between reflection and refraction further
+#: coordinates of a low-discrepancy sequence (steps of R_6 that are not R_2's), so that
+#: the choices of many photons come out in proportion; later choices draw counter-based
+#: random numbers
+LD_BOUNCES = 4
+R_A1, R_A2 = _r_steps(2)
+_, _, R_B1, R_B2, R_B3, R_B4 = _r_steps(6)
+PHOTON_SAMPLE_BASE = 0x10000  # the random streams' "sample" of pass p: base + p
+DISK_DIM = 0x40000  # random dimension of a disk light's point (+ emitter); bounces use 1, 2, ...
+MIN_POWER = 1e-12  # a photon carrying less than this is dropped
+
+
+@kernel
+def _frame(w):
+    """Two unit vectors completing unit ``w`` to an orthonormal frame."""
+    if abs(w[0]) < 0.9:
+        a = normalize((0.0, w[2], -w[1]))
+    else:
+        a = normalize((-w[2], 0.0, w[0]))
+    b = (w[1] * a[2] - w[2] * a[1], w[2] * a[0] - w[0] * a[2], w[0] * a[1] - w[1] * a[0])
+    return a, b
+
+
+@kernel
+def _cone(emitters, e, y):
+    """(cosine of the half angle, solid angle, unit axis) of the cone from ``y`` around the
+    target of emitter ``e`` (the whole sphere, cosine -1, when ``y`` is inside it)."""
+    c = vload(emitters, e, EMIT_CENTRE)
+    v = (c[0] - y[0], c[1] - y[1], c[2] - y[2])
+    dist = math.sqrt(dot(v, v))
+    r = emitters[e, EMIT_RADIUS]
+    if dist <= r:
+        return -1.0, 4.0 * math.pi, (0.0, 0.0, 1.0)
+    s = r / dist
+    cos_max = math.sqrt(max(0.0, 1.0 - s * s))
+    return cos_max, 2.0 * math.pi * (1.0 - cos_max), (v[0] / dist, v[1] / dist, v[2] / dist)
+
+
+@kernel
+def _density(emitters, light, y, d, directional):
+    """Photons per pass per unit of the light's measure (solid angle from ``y``, or area
+    across a directional light's beam) in the direction ``d`` from ``y``: the sum over the
+    light's emitters whose target the photon is aimed into of count / measure. A photon's
+    power is the light's intensity (or radiance) divided by this."""
+    total = 0.0
+    for e in range(emitters.shape[0]):
+        if int(emitters[e, EMIT_LIGHT]) != light or emitters[e, EMIT_COUNT] == 0.0:
+            continue
+        c = vload(emitters, e, EMIT_CENTRE)
+        r = emitters[e, EMIT_RADIUS]
+        v = (c[0] - y[0], c[1] - y[1], c[2] - y[2])
+        if directional:
+            along = dot(v, d)
+            perp2 = dot(v, v) - along * along
+            if perp2 <= r * r:
+                total += emitters[e, EMIT_COUNT] / (math.pi * r * r)
+        else:
+            cos_max, omega, axis = _cone(emitters, e, y)
+            if dot(d, axis) >= cos_max:
+                total += emitters[e, EMIT_COUNT] / omega
+    return total
+
+
+@kernel
+def emit_photon(table, emitters, e, i, seed, pass_index):
+    """Photon ``i`` (an index within emitter ``e``'s photons of this pass): (origin, unit
+    direction, power per channel, whether its light is directional, its light's position
+    for the path length)."""
+    j = int(emitters[e, EMIT_LIGHT])
+    kind = table[j, LIGHT_TYPE]
+    shift = random_pair(seed, e, PHOTON_SAMPLE_BASE + pass_index, 0)
+    u1 = (shift[0] + (i + 1) * R_A1) % 1.0
+    u2 = (shift[1] + (i + 1) * R_A2) % 1.0
+    radiance = vload(table, j, LIGHT_RADIANCE)
+    c = vload(emitters, e, EMIT_CENTRE)
+    r = emitters[e, EMIT_RADIUS]
+    if kind == LIGHT_DIRECTIONAL:
+        d = vload(table, j, LIGHT_DIRECTION)
+        a, b = _frame(d)
+        dx, dy = concentric_disk(u1, u2)
+        x = madd(madd(c, a, dx * r), b, dy * r)
+        o = madd(x, d, -emitters[e, EMIT_BACK])
+        density = _density(emitters, j, o, d, True)
+    else:
+        y = vload(table, j, LIGHT_POSITION)
+        if kind == LIGHT_DISK:
+            v1, v2 = random_pair(seed, i, PHOTON_SAMPLE_BASE + pass_index, DISK_DIM + e)
+            px, py = concentric_disk(v1, v2)
+            rad = table[j, LIGHT_RADIUS]
+            y = madd(madd(y, vload(table, j, LIGHT_DISK_U), px * rad),
+                     vload(table, j, LIGHT_DISK_V), py * rad)
+        cos_max, _, axis = _cone(emitters, e, y)
+        # the disk's point (dx, dy) -> a direction in the cone: uniform in solid angle,
+        # with the sequence's even spread kept (equal areas of the disk, equal solid angles)
+        dx, dy = concentric_disk(u1, u2)
+        rho2 = dx * dx + dy * dy
+        cos_t = 1.0 - rho2 * (1.0 - cos_max)
+        sin_t = math.sqrt(max(0.0, 1.0 - cos_t * cos_t))
+        if rho2 > 0.0:
+            s = sin_t / math.sqrt(rho2)
+            dx *= s
+            dy *= s
+        a, b = _frame(axis)
+        d = normalize((cos_t * axis[0] + dx * a[0] + dy * b[0],
+                       cos_t * axis[1] + dx * a[1] + dy * b[1],
+                       cos_t * axis[2] + dx * a[2] + dy * b[2]))
+        o = y
+        density = _density(emitters, j, o, d, False)
+    if density <= 0.0:
+        return o, d, (0.0, 0.0, 0.0), kind == LIGHT_DIRECTIONAL
+    return o, d, (radiance[0] / density, radiance[1] / density,
+                  radiance[2] / density), kind == LIGHT_DIRECTIONAL
+
+
+@kernel
+def _choice(seed, photon, index, emitter, pass_index, bounce):
+    """The number in [0, 1) that decides a photon's ``bounce``: a coordinate of its R_d point
+    (``index`` within its emitter) for the first LD_BOUNCES, else a random one."""
+    if bounce < LD_BOUNCES:
+        step = R_B1 if bounce == 0 else (R_B2 if bounce == 1 else (R_B3 if bounce == 2
+                                                                    else R_B4))
+        shift = random01(seed, emitter, PHOTON_SAMPLE_BASE + pass_index, 1 + bounce)
+        return (shift + (index + 1) * step) % 1.0
+    return random01(seed, photon, PHOTON_SAMPLE_BASE + pass_index, 1 + bounce)
+
+
+@kernel
+def falloff_scale(table, j, length):
+    """What a point or disk light's photon carrying intensity x solid angle is multiplied
+    by when it lands after a path of ``length``: the light's falloff times length^2, so that
+    an unobstructed path gives exactly the light's direct term (1 for inverse-square)."""
+    mode = table[j, LIGHT_FALLOFF]
+    if mode == 2.0:
+        return 1.0
+    if mode == 1.0:
+        return table[j, LIGHT_DIST_SCALE] * length
+    return length * length
+
+
+@kernel
+def _interface(geo, mats, prim, m, entering, media, n_media, scratch):
+    """Refractive indices on both sides of the surface of material ``m`` a ray crosses, and
+    the media on the far side (into ``scratch``), as kernels/integrator.py's trace_path
+    finds them. Returns (n1, n2, media count on the far side)."""
+    n_out = n_media
+    for k in range(n_media):
+        scratch[k] = media[k]
+    if not geo.prim_info[prim, PRIM_SOLID]:  # a thin sheet: light passes straight through
+        return 1.0, 1.0, n_out
+    n1 = mats[media[n_media - 1], MAT_IOR] if n_media > 0 else 1.0
+    outside = int(mats[m, MAT_OUTSIDE])
+    if entering:
+        if outside >= 0:
+            n_out = media_leave(scratch, n_out, outside)
+            n1 = mats[outside, MAT_IOR]
+        n_out = media_enter(scratch, n_out, m)
+        n2 = mats[m, MAT_IOR]
+    else:
+        n_out = media_leave(scratch, n_out, m)
+        n1 = mats[m, MAT_IOR]
+        if outside >= 0:
+            n_out = media_enter(scratch, n_out, outside)
+            n2 = mats[outside, MAT_IOR]
+        else:
+            n2 = mats[scratch[n_out - 1], MAT_IOR] if n_out > 0 else 1.0
+    return n1, n2, n_out
+
+
+@kernel
+def trace_photon(geo, mats, shadow_mats, table, j, o, d, power, directional, settings, photon,
+                 index, emitter, out, slot0, stack, media, scratch):
+    """Follow one photon; store a record (layout.PHOTON_* columns) at each diffuse surface it
+    reaches after a specular bounce, into ``out[slot0:]``. Returns the records stored. A
+    refraction counts as specular where shadow rays stop (``shadow_mats``' kt is 0): where
+    they pass, they carry that light already."""
+    seed = int(settings[SET_SEED])
+    pass_index = int(settings[SET_PASS])
+    eps = settings[SET_EPSILON]
+    slots = int(settings[SET_SLOTS])
+    w = power
+    n_media = 0
+    stored = 0
+    specular = False
+    length = 0.0
+    for bounce in range(int(settings[SET_DEPTH]) + 1):
+        t, prim, tri, b1, b2 = closest_hit(geo, o, d, 0.0, math.inf, stack)
+        if prim < 0:
+            break
+        if n_media > 0:  # Beer-Lambert absorption in the medium it crossed
+            cur = media[n_media - 1]
+            w = (_absorbed(w[0], mats[cur, MAT_ATTEN], t),
+                 _absorbed(w[1], mats[cur, MAT_ATTEN + 1], t),
+                 _absorbed(w[2], mats[cur, MAT_ATTEN + 2], t))
+        length += t
+        m = hit_material(geo, prim, tri)
+        p = madd(o, d, t)
+        n_geo, n_shade = surface_normals(geo, prim, tri, b1, b2, p)
+        entering = dot(d, n_geo) < 0.0
+        if entering:
+            n = n_geo
+        else:
+            n = (-n_geo[0], -n_geo[1], -n_geo[2])
+            n_shade = (-n_shade[0], -n_shade[1], -n_shade[2])
+        if dot(n_shade, d) >= 0.0:
+            n_shade = n
+        if specular and mats[m, MAT_KD] > 0.0 and stored < slots:
+            f = 1.0 if directional else falloff_scale(table, j, length)
+            row = slot0 + stored
+            out[row, 0] = p[0]
+            out[row, 1] = p[1]
+            out[row, 2] = p[2]
+            out[row, 3] = w[0] * f
+            out[row, 4] = w[1] * f
+            out[row, 5] = w[2] * f
+            out[row, 6] = d[0]
+            out[row, 7] = d[1]
+            out[row, 8] = d[2]
+            out[row, 9] = pass_index
+            stored += 1
+        kr = mats[m, MAT_KR]
+        kt = mats[m, MAT_KT]
+        if kr == 0.0 and kt == 0.0:
+            break
+        cos_i = -dot(d, n_shade)
+        kr_eff = kr
+        bt = (0.0, 0.0, 0.0)
+        tdir = d
+        n_out = n_media
+        if kt > 0.0:
+            n1, n2, n_out = _interface(geo, mats, prim, m, entering, media, n_media, scratch)
+            ok, tdir = refract(d, n_shade, n1 / n2)
+            if not ok:  # total internal reflection
+                kr_eff = kr + kt
+            else:
+                kt_eff = kt
+                if mats[m, MAT_FRESNEL] != 0.0:
+                    fr = schlick(cos_i, n1, n2, -dot(tdir, n_shade))
+                    kr_eff = kr + kt * fr
+                    kt_eff = kt * (1.0 - fr)
+                bt = (kt_eff * mats[m, MAT_COLOR], kt_eff * mats[m, MAT_COLOR + 1],
+                      kt_eff * mats[m, MAT_COLOR + 2])
+        b_mean = (bt[0] + bt[1] + bt[2]) / 3.0
+        total = kr_eff + b_mean
+        if total <= 0.0:
+            break
+        u = _choice(seed, photon, index, emitter, pass_index, bounce)
+        if u * total < b_mean:  # refracted, with probability b_mean / total
+            s = total / b_mean
+            w = (w[0] * bt[0] * s, w[1] * bt[1] * s, w[2] * bt[2] * s)
+            o = madd(p, n, -eps)
+            d = tdir
+            n_media = n_out
+            for k in range(n_out):
+                media[k] = scratch[k]
+            specular = specular or shadow_mats[m, MAT_KT] == 0.0
+        else:  # reflected
+            w = (w[0] * total, w[1] * total, w[2] * total)
+            o = madd(p, n, eps)
+            d = madd(d, n_shade, 2.0 * cos_i)
+            specular = True
+        if max(w[0], max(w[1], w[2])) < MIN_POWER:
+            break
+    return stored
+
+
+@kernel(entry=True)  # called from Python, one call per lane
+def trace_photons(geo, mats, shadow_mats, table, emitters, settings, first, last, out, counts,
+                  stack, media, scratch):
+    """Photons ``first`` .. ``last - 1`` of a pass (``settings``: SET_* values): photon
+    ``i`` writes its records into rows ``i * slots ...`` of ``out`` and their number into
+    ``counts[i]``."""
+    geo = geometry_ref_if_instances(geo)
+    slots = int(settings[SET_SLOTS])
+    seed = int(settings[SET_SEED])
+    pass_index = int(settings[SET_PASS])
+    e = 0
+    for i in range(first, last):
+        while (e < emitters.shape[0] - 1
+               and i >= emitters[e, EMIT_FIRST] + emitters[e, EMIT_COUNT]):
+            e += 1
+        while e > 0 and i < emitters[e, EMIT_FIRST]:
+            e -= 1
+        o, d, power, directional = emit_photon(table, emitters, e,
+                                               i - int(emitters[e, EMIT_FIRST]), seed,
+                                               pass_index)
+        counts[i] = 0
+        if max(power[0], max(power[1], power[2])) <= 0.0:
+            continue
+        counts[i] = trace_photon(geo, mats, shadow_mats, table, int(emitters[e, EMIT_LIGHT]),
+                                 o, d, power, directional, settings, i,
+                                 i - int(emitters[e, EMIT_FIRST]), e, out, i * slots, stack,
+                                 media, scratch)
+

@@ -1,0 +1,344 @@
+"""Caustics by photon mapping (docs/caustics.md): the physics checked against exact optics,
+with the expected values computed here from whitted's own Fresnel model (Schlick, cosine on
+the air side), determinism, and the settings."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from whitted import render
+from whitted.compile.photon_map import (
+    check_photon_memory,
+    irradiance,
+    pass_radii,
+    scene_photon_map,
+)
+from whitted.errors import SceneError
+from whitted.kernels.layout import PHOTON_POWER
+from whitted.render.api import RenderJob
+from whitted.scene.scene import CausticsSettings, Scene
+
+GLASS = {"color": [1, 1, 1], "ka": 0.0, "kd": 0.0, "ks": 0.0, "kr": 0.0, "kt": 1.0,
+         "ior": 1.5, "fresnel": True}
+SUN = {"type": "directional", "direction": [0, -1, 0], "intensity": 1.0}
+
+
+def scene_of(objects, photons=100_000, passes=1, radius=0.0, lights=None, size=(8, 8),
+             camera=None):
+    data = {
+        "render": {"width": size[0], "height": size[1], "transfer": "linear", "max_depth": 8,
+                   "caustics": {"photons": photons, "passes": passes, "radius": radius}},
+        "materials": {"floor": {"color": [1, 1, 1], "ka": 0.0, "kd": 1.0, "ks": 0.0}},
+        "lights": lights or [SUN],
+        "objects": [{"type": "plane", "material": "floor"}] + objects,
+    }
+    if camera:
+        data["camera"] = camera
+    return Scene.model_validate(data)
+
+
+def schlick_air(cos_air, n):
+    """whitted's Fresnel reflectance at a glass/air surface, either way through it."""
+    r0 = ((n - 1) / (n + 1)) ** 2
+    return r0 + (1 - r0) * (1 - cos_air) ** 5
+
+
+def floor_points(half, count):
+    xs = np.linspace(-half, half, count)
+    return np.array([[x, 0.0, z] for x in xs for z in xs])
+
+
+def test_slab_passes_its_transmittance_under_a_directional_light():
+    # normal incidence: F = r0 = 0.04 at each face; with the internal reflections the slab
+    # passes T = (1 - F)^2 (1 + F^2 + F^4 + ...) = (1 - F) / (1 + F) = 0.923077
+    f = schlick_air(1.0, 1.5)
+    expected = (1 - f) / (1 + f)
+    assert expected == pytest.approx(0.923077, abs=1e-6)
+    scene = scene_of([{"type": "box", "min": [-2, 1, -2], "max": [2, 1.5, 2],
+                       "material": GLASS}], photons=200_000)
+    _, lights, stats = scene_photon_map(scene, threads=2)
+    e = irradiance(lights, floor_points(1.0, 7), [0, 1, 0])[:, 0]
+    assert e.mean() == pytest.approx(expected, rel=0.02)
+    assert np.all(np.abs(e / expected - 1) < 0.1)  # no blotches
+    assert stats.targets == 1 and stats.stored > 0
+
+
+def test_a_body_of_ior_1_leaves_the_floor_as_lit_as_without_it():
+    clear = dict(GLASS, ior=1.0, fresnel=False)
+    scene = scene_of([{"type": "sphere", "center": [0, 2, 0], "radius": 1.0,
+                       "material": clear}])
+    _, lights, _ = scene_photon_map(scene, threads=2)
+    e = irradiance(lights, floor_points(0.6, 5), [0, 1, 0])[:, 0]
+    # the unoccluded floor's irradiance from the unit sun straight above is 1
+    assert e.mean() == pytest.approx(1.0, rel=0.02)
+    assert np.all(np.abs(e - 1.0) < 0.05)
+    # and the photons arrive only on the lit side
+    assert irradiance(lights, [[0, 0, 0]], [0, -1, 0])[0, 0] == 0.0
+
+
+def ball_power_on_floor(n, steps=400_000):
+    """Fraction of the power through a glass ball's cross-section that reaches the floor
+    below, by whitted's Fresnel: the part reflected by the outer surface downward
+    (incidence past 45 degrees) plus the part leaving after k internal reflections whose
+    deviation 2(i - t) + k(pi - 2t) still points down."""
+    b = (np.arange(steps) + 0.5) / steps
+    cos_i = np.sqrt(1 - b * b)
+    i = np.arcsin(b)
+    t = np.arcsin(b / n)
+    f = schlick_air(cos_i, n)
+    total = np.sum(f * 2 * b * (np.cos(math.pi - 2 * i) > 0)) / steps
+    for k in range(12):
+        deviation = 2 * (i - t) + k * (math.pi - 2 * t)
+        total += np.sum((1 - f) ** 2 * f ** k * 2 * b * (np.cos(deviation) > 0)) / steps
+    return total
+
+
+def test_glass_ball_total_caustic_power():
+    expected = ball_power_on_floor(1.5)
+    assert expected == pytest.approx(0.91979, abs=2e-4)
+    scene = scene_of([{"type": "sphere", "center": [0, 3, 0], "radius": 1.0,
+                       "material": GLASS}], photons=200_000)
+    _, lights, _ = scene_photon_map(scene, threads=2)
+    power = lights.photons[:, PHOTON_POWER].astype(np.float64).sum()
+    assert power / math.pi == pytest.approx(expected, rel=0.02)
+
+
+def test_glass_ball_focuses_on_its_axis_at_the_paraxial_focus():
+    n, radius_ball = 1.5, 1.0
+    f = n * radius_ball / (2 * (n - 1))  # 1.5 from the centre
+    r = 0.02
+    scene = scene_of([{"type": "sphere", "center": [0, f, 0], "radius": radius_ball,
+                       "material": GLASS}], photons=300_000, radius=r)
+    _, lights, _ = scene_photon_map(scene, threads=2)
+    pts = floor_points(0.2, 41)  # a 0.01 grid on the floor at the paraxial focus
+    e = irradiance(lights, pts, [0, 1, 0])[:, 0]
+    brightest = pts[np.argmax(e)]
+    assert math.hypot(brightest[0], brightest[2]) <= r
+    # along the axis, the irradiance falls beyond the paraxial focus (spherical aberration
+    # brings the marginal rays to the axis before it, never after)
+    axis = []
+    for h in (f - 0.1, f, f + 0.1):
+        s = scene_of([{"type": "sphere", "center": [0, h, 0], "radius": radius_ball,
+                       "material": GLASS}], photons=300_000, radius=r)
+        axis.append(irradiance(scene_photon_map(s, threads=2)[1], [[0, 0, 0]], [0, 1, 0])[0, 0])
+    assert axis[0] > axis[1] > 3 * axis[2]
+
+
+def test_point_light_photons_match_the_direct_term_through_an_ior_1_body():
+    clear = dict(GLASS, ior=1.0, fresnel=False)
+    lights = [{"type": "point", "position": [0, 6, 0], "intensity": 2.0,
+               "falloff": "inverse_square"}]
+    # the floor is 1.5 times as far from the light as the ball: photons spread 2.25 times
+    # as thin there as on the ball, so a radius gathering enough of them
+    scene = scene_of([{"type": "sphere", "center": [0, 2, 0], "radius": 1.0,
+                       "material": clear}], lights=lights, radius=0.08)
+    _, arrays, _ = scene_photon_map(scene, threads=2)
+    pts = floor_points(0.5, 5)
+    e = irradiance(arrays, pts, [0, 1, 0])[:, 0]
+    d2 = pts[:, 0] ** 2 + pts[:, 2] ** 2 + 36.0
+    direct = 2.0 / d2 * (6.0 / np.sqrt(d2))  # I / d^2 * cos
+    assert np.all(np.abs(e / direct - 1) < 0.05)
+    assert e.mean() / direct.mean() == pytest.approx(1.0, rel=0.02)
+
+
+def test_radius_shrinks_as_progressive_photon_mapping_prescribes():
+    r = pass_radii(0.1, 4, 0.7)
+    assert r[0] == 0.1
+    assert r[1] ** 2 == pytest.approx(0.01 * 1.7 / 2)
+    assert r[2] ** 2 == pytest.approx(0.01 * 1.7 / 2 * 2.7 / 3)
+    assert r[3] ** 2 == pytest.approx(0.01 * 1.7 / 2 * 2.7 / 3 * 3.7 / 4)
+
+
+def test_photon_map_is_the_same_on_any_number_of_threads():
+    scene = scene_of([{"type": "sphere", "center": [0, 2, 0], "radius": 1.0,
+                       "material": GLASS}], photons=20_000, passes=2)
+    one = scene_photon_map(scene, threads=1)[1]
+    three = scene_photon_map(scene, threads=3)[1]
+    assert np.array_equal(one.photons, three.photons)
+    assert np.array_equal(one.photon_cells, three.photon_cells)
+    other_seed = scene_photon_map(scene.with_settings(seed=1), threads=1)[1]
+    assert not np.array_equal(one.photons, other_seed.photons)
+
+
+def test_render_with_caustics_shows_them_and_is_thread_independent():
+    camera = {"position": [0, 5, 5], "look_at": [0, 0, 0], "fov": 40.0}
+    scene = scene_of([{"type": "sphere", "center": [0, 2.5, 0], "radius": 1.0,
+                       "material": GLASS}], photons=50_000, size=(40, 30), camera=camera)
+    a = render(scene, threads=1).pixels
+    b = render(scene, threads=2).pixels
+    assert np.array_equal(a, b)
+    # a still split in bands of rows, as the render farm's workers render it
+    bands = [RenderJob(scene, threads=2, rows=rows).run().pixels for rows in ((0, 13), (13, 30))]
+    assert np.array_equal(np.concatenate([bands[0][:13], bands[1][13:]]), a)
+    plain = render(scene.with_settings(caustics=CausticsSettings())).pixels
+    # without caustics the floor under a clear ball is lit through it (kt·colour = 1): the
+    # floor is 1 everywhere; with them the shadow ray stops at the ball and the light
+    # arrives as photons, focused in the middle of its shadow and missing at its rim
+    assert plain.max() == 1.0
+    assert a.max() > 1.3 and (a < 0.5).sum() > (plain < 0.5).sum() + 20
+    assert not np.array_equal(a, plain)
+
+
+def test_no_photons_is_the_renderer_without_caustics():
+    camera = {"position": [0, 5, 5], "look_at": [0, 0, 0], "fov": 40.0}
+    scene = scene_of([{"type": "sphere", "center": [0, 2.5, 0], "radius": 1.0,
+                       "material": GLASS}], photons=0, size=(20, 15), camera=camera)
+    assert scene.render.caustics == CausticsSettings()
+    image = render(scene)
+    assert image.meta["stats"].photons is None
+
+
+@pytest.mark.parametrize("key, value", [("photons", -1), ("photons", 10**9),
+                                        ("passes", 0), ("radius", -1.0),
+                                        ("radius", float("nan")), ("alpha", 0.0),
+                                        ("alpha", 1.5), ("photons", "many"),
+                                        ("colour", 1)])
+def test_bad_caustics_settings_are_refused(key, value):
+    with pytest.raises(SceneError):
+        Scene.model_validate({"render": {"caustics": {key: value}}}, strict=True)
+
+
+def test_a_photon_map_too_big_for_memory_is_refused():
+    with pytest.raises(SceneError, match=r"render\.caustics"):
+        check_photon_memory(CausticsSettings(photons=50_000_000, passes=4096))
+
+
+def test_disk_light_casts_a_soft_caustic_of_the_same_power():
+    point = [{"type": "point", "position": [0, 6, 0], "intensity": 1.0,
+              "falloff": "inverse_square"}]
+    disk = [{"type": "disk", "center": [0, 6, 0], "radius": 1.0, "intensity": 1.0,
+             "falloff": "inverse_square"}]
+    ball = [{"type": "sphere", "center": [0, 2, 0], "radius": 1.0, "material": GLASS}]
+    _, sharp, _ = scene_photon_map(scene_of(ball, lights=point, radius=0.02), threads=2)
+    _, soft, _ = scene_photon_map(scene_of(ball, lights=disk, radius=0.02), threads=2)
+    power = [a.photons[:, PHOTON_POWER].astype(np.float64).sum() for a in (sharp, soft)]
+    # a disk of this size, 6 away, sends the ball nearly the point light's power (within
+    # the change of solid angle over the disk: 1 - ~1.5 %)
+    assert power[1] == pytest.approx(power[0], rel=0.03)
+    peak = [irradiance(a, [[0, 0, 0]], [0, 1, 0])[0, 0] for a in (sharp, soft)]
+    assert peak[1] < 0.5 * peak[0]  # the disk's focus is spread: a soft caustic
+
+
+def test_meshes_traced_as_instances_focus_like_flattened_ones():
+    from whitted.compile.params import render_params
+    from whitted.compile.photon_map import photon_lights
+    from whitted.compile.scene import compile_scene
+
+    # a glass icosphere-like mesh: a UV sphere of triangles
+    n_lat, n_lon = 16, 32
+    verts = [[0, 1, 0]]
+    for i in range(1, n_lat):
+        th = math.pi * i / n_lat
+        for j in range(n_lon):
+            ph = 2 * math.pi * j / n_lon
+            verts.append([math.sin(th) * math.cos(ph), math.cos(th), math.sin(th) * math.sin(ph)])
+    verts.append([0, -1, 0])
+    faces = [[0, 1 + (j + 1) % n_lon, 1 + j] for j in range(n_lon)]
+    for i in range(n_lat - 2):
+        for j in range(n_lon):
+            a, b = 1 + i * n_lon + j, 1 + i * n_lon + (j + 1) % n_lon
+            faces += [[a, b, b + n_lon], [a, b + n_lon, a + n_lon]]
+    last = len(verts) - 1
+    base = 1 + (n_lat - 2) * n_lon
+    faces += [[last, base + j, base + (j + 1) % n_lon] for j in range(n_lon)]
+    mesh = {"type": "mesh", "vertices": verts, "faces": faces, "material": GLASS,
+            "transform": {"translate": [0, 2.5, 0]}}
+    scene = scene_of([mesh], photons=50_000)
+    powers = []
+    for limit in (10**6, 0):  # flattened into the scene BVH, then instanced
+        compiled = compile_scene(scene, flatten_limit=limit)
+        params = render_params(scene, compiled, scene.render)
+        lights = photon_lights(compiled, params, scene.render.caustics, 2)
+        powers.append(lights.photons[:, PHOTON_POWER].astype(np.float64).sum())
+    assert powers[0] > 0.8 * math.pi  # the power through the cross-section, mostly
+    assert powers[1] == pytest.approx(powers[0], rel=1e-3)
+
+
+def test_water_inside_ice_passes_light_through_both_media():
+    ice = {"color": [1, 1, 1], "ka": 0.0, "kd": 0.0, "ks": 0.0, "kr": 0.0, "kt": 1.0,
+           "ior": 1.309, "fresnel": True}
+    water = dict(ice, ior=1.333, attenuation=[0.5, 0.5, 0.5])
+    objects = [{"type": "box", "min": [-2, 1, -2], "max": [2, 3, 2], "material": ice},
+               {"type": "box", "min": [-1.5, 1.5, -1.5], "max": [1.5, 2.5, 1.5],
+                "material": water}]
+    _, lights, _ = scene_photon_map(scene_of(objects, photons=200_000), threads=2)
+    e = irradiance(lights, floor_points(0.5, 5), [0, 1, 0])[:, 0].mean()
+    # straight down through four faces: ice (n 1.309) from air, water from ice, ice from
+    # water, air from ice; 1 of water absorbs exp(-0.5); internal reflections between the
+    # faces add (1 + F^2 ...) for each, less than 0.5 % here and left out
+    r = [((a - b) / (a + b)) ** 2 for a, b in ((1, 1.309), (1.309, 1.333), (1.333, 1.309),
+                                                (1.309, 1))]
+    expected = math.prod(1 - f for f in r) * math.exp(-0.5)
+    assert e == pytest.approx(expected, rel=0.02)
+
+
+def test_export_writes_photons_blocks():
+    from whitted.export.pov import scene_to_pov
+
+    scene = scene_of([{"type": "sphere", "center": [0, 2, 0], "radius": 1.0,
+                       "material": GLASS}], photons=1000, passes=3, radius=0.05)
+    text = scene_to_pov(scene)
+    assert "photons { count 3000 autostop 0 jitter 0.4" in text
+    assert "radius 0.05" in text
+    assert "photons { target reflection on refraction on collect off }" in text
+    plain = scene_to_pov(scene.with_settings(caustics=CausticsSettings()))
+    assert "photons" not in plain
+
+
+def test_fuzzed_caustics_tables_are_accepted_or_refused_in_one_line():
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    from whitted.scene.io import scene_from_dict
+
+    values = st.one_of(st.integers(-10, 10**9), st.floats(allow_nan=True, allow_infinity=True),
+                       st.text(max_size=5), st.booleans(), st.none(), st.lists(st.integers(),
+                                                                              max_size=2))
+    tables = st.dictionaries(st.sampled_from(["photons", "passes", "radius", "alpha",
+                                              "other"]), values, max_size=4)
+
+    @settings(max_examples=200, deadline=None)
+    @given(tables)
+    def check(table):
+        try:
+            made = scene_from_dict({"render": {"caustics": table}}, file="fuzz.toml")
+        except SceneError as exc:  # one line naming the file and the key
+            message = str(exc)
+            assert "\n" not in message.strip() and message.startswith("fuzz.toml")
+            assert "render.caustics" in message
+            return
+        c = made.render.caustics
+        assert 0 <= c.photons <= 50_000_000 and 1 <= c.passes <= 4096
+        assert 0 <= c.radius <= 1e6 and 0 < c.alpha <= 1 and math.isfinite(c.radius)
+
+    check()
+
+
+def test_render_through_a_clear_body_of_ior_1_equals_the_render_without_it():
+    # ior 1, kt 1, no Fresnel, nothing of its own (ka = kd = ks = 0), seen straight down
+    # (orthographic: pixel (i, j) shows the floor point ((j + 0.5) / 6 - 2, ..)): with
+    # caustics the ball's shadow is filled by photons
+    clear = dict(GLASS, ior=1.0, fresnel=False)
+    camera = {"position": [0, 8, 0.0], "look_at": [0, 0, 0], "up": [0, 0, -1],
+              "projection": "orthographic", "ortho_height": 4.0}
+    ball = [{"type": "sphere", "center": [0, 2, 0], "radius": 1.0, "material": clear}]
+    with_ball = scene_of(ball, photons=200_000, size=(24, 24), camera=camera)
+    a = render(with_ball).pixels[..., 0]
+    b = render(scene_of([], photons=0, size=(24, 24), camera=camera)).pixels[..., 0]
+    assert np.all(b == 1.0)
+    centres = (np.arange(24) + 0.5) / 6 - 2
+    rho = np.hypot(*np.meshgrid(centres, centres))
+    r = with_ball.render.caustics.radius or 0.062  # the default radius here (docs)
+    inside = rho < 1 - 2 * r
+    assert inside.sum() > 60
+    assert a[inside].mean() == pytest.approx(1.0, rel=0.01)
+    assert np.all(np.abs(a[inside] - 1.0) < 0.05)
+    assert np.all(a[rho > 1 + 2 * r] == 1.0)  # directly lit: exactly as without
+    # within the gather radius of the shadow's edge the estimate blurs the edge: photons
+    # spill out (the kernel's half outside: up to 1 + 1/2) and are missed inside (down to
+    # 1/2): the estimator's resolution, which progressive passes shrink
+    rim = np.abs(rho - 1) <= 2 * r
+    assert np.all((a[rim] >= 0.5) & (a[rim] <= 1.5))
