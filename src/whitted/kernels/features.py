@@ -62,9 +62,7 @@ def extras_possible(geo_type) -> bool:
     ``unbounded`` is int64)."""
     from numba import types
 
-    from .geometry_ref import geometry_type
-
-    geo_type = geometry_type(geo_type)
+    geo_type = getattr(geo_type, "geometry", geo_type)  # as instances_possible
     field_type = dict(zip(geo_type.fields, geo_type.types, strict=True))["unbounded"]
     return field_type.dtype == types.int64
 
