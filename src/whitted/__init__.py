@@ -30,20 +30,20 @@ _LAZY = {
     "RenderStats": ".render", "render": ".render", "render_aovs": ".render",
     "default_scene": ".scene.default",
     **dict.fromkeys((
-        "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera",
+        "CSG", "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera",
         "CheckerTexture", "Cone", "Cylinder", "DirectionalLight", "Disk", "DiskLight",
         "Gradient", "GradientTexture", "ImageTexture", "Material", "Mesh", "Plane",
-        "PointLight", "Rectangle", "RenderSettings", "Scene", "Sphere", "Transform",
-        "Triangle", "load_scene", "save_scene"), ".scene"),
+        "PointLight", "Rectangle", "RenderSettings", "Scene", "Sphere", "Torus",
+        "Transform", "Triangle", "load_scene", "save_scene"), ".scene"),
 }
 
 __all__ = [
     "Animation", "Track",
-    "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera", "CancelToken",
+    "CSG", "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera", "CancelToken",
     "CheckerTexture", "Cone", "Cylinder", "DirectionalLight", "Disk", "DiskLight", "Gradient",
     "GradientTexture", "Image", "ImageTexture", "Material", "Mesh", "Plane",
     "PointLight", "Progress", "Rectangle", "RenderJob", "RenderSettings", "RenderStats", "Scene",
-    "SceneError", "Sphere", "Transform", "Triangle", "WhittedError", "__version__",
+    "SceneError", "Sphere", "Torus", "Transform", "Triangle", "WhittedError", "__version__",
     "default_scene", "load_scene", "render", "render_aovs", "save_scene",
 ]
 
@@ -93,6 +93,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs: the same names, imported eagerl
     from .output import Image
     from .render import CancelToken, Progress, RenderJob, RenderStats, render, render_aovs
     from .scene import (
+        CSG,
         PRESETS,
         AmbientLight,
         AxisAngle,
@@ -116,6 +117,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs: the same names, imported eagerl
         RenderSettings,
         Scene,
         Sphere,
+        Torus,
         Transform,
         Triangle,
         load_scene,

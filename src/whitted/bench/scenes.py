@@ -58,6 +58,11 @@ SCENES: dict[str, BenchScene] = {
                    mesh_bench=True),
         BenchScene("instances100", "instances100.toml",
                    "100 instances of a 100,000-triangle torus, shadows", mesh_bench=True),
+        BenchScene("csg", "csg.toml",
+                   "CSG of analytic solids: differences, an intersection, a half torus, a "
+                   "merge of two glass balls"),
+        BenchScene("dice100", "dice100.toml",
+                   "a hundred dice, each a rounded cube minus 21 pips (23 solids of CSG)"),
         BenchScene("caustics", "caustics.toml",
                    "a glass ball and a glass slab on a floor, a directional and a point "
                    "light: caustics by photon mapping (100,000 photons)"),

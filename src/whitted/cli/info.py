@@ -93,7 +93,11 @@ def info(
             else "from the file" if obj.type == "mesh" and getattr(obj, "file", None)
             else "default")
         label = f" '{obj.name}'" if obj.name else ""
-        out.print(f"  [{i}] {obj.type}{label} material={mat}", markup=False)
+        operation = f" {obj.operation}" if obj.type == "csg" else ""
+        out.print(f"  [{i}] {obj.type}{operation}{label} material={mat}", markup=False)
+        if obj.type == "csg":  # the tree of a CSG object
+            for line in obj.tree_lines():
+                out.print(line, markup=False, highlight=False)
     out.print(f"lights: {len(scene.lights)}")
     for i, light in enumerate(scene.lights):
         out.print(f"  [{i}] {light.type} intensity={light.intensity}", markup=False)

@@ -58,4 +58,7 @@ def render_params(scene: Scene, compiled: CompiledScene, settings: RenderSetting
         camera_up=t3(np.asarray(up) * hh),
         camera_forward=t3(forward),
         orthographic=int(cam.projection == "orthographic"),
+        lens_u=t3(np.asarray(right) * (cam.aperture / 2)),
+        lens_v=t3(np.asarray(up) * (cam.aperture / 2)),
+        focal_distance=float(cam.focus()) if cam.aperture > 0 else 0.0,
     )

@@ -12,11 +12,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..kernels.features import NO_INSTANCES_DTYPE
+from ..kernels.features import EXTRAS_DTYPE, NO_INSTANCES_DTYPE
 from ..kernels.layout import (
+    FIRST_EXTRA_SHAPE,
     N_MAT_PARAMS,
     N_PRIM_INFO,
+    PRIM_FLIP,
     PRIM_MATERIAL,
+    PRIM_MEDIUM,
     PRIM_OBJECT,
     PRIM_SOLID,
     PRIM_TYPE,
@@ -26,7 +29,8 @@ from ..kernels.layout import (
     LightArrays,
 )
 from ..scene.scene import Scene
-from ..scene.shapes import Mesh
+from ..scene.shapes import CSG, Mesh
+from .csg import add_csg
 from .embree import attach_embree
 from .geometry import box_corners, corners_bounds
 from .light_buffers import LIGHT_BUFFER_RES, build_light_buffers
@@ -123,15 +127,30 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
                   solid=shape.solid, world_to_object=None if identity else np.linalg.inv(m))
             instanced += stored.triangles
             continue
+        if isinstance(shape, CSG):
+            def emit_mesh(src, child, cm, mat, obj_index=obj_index):
+                own = child.material is None and child.file is not None and src.materials
+                rows = np.array([materials.add(x) for x in src.materials], np.int32)
+                first = b.rows
+                count = add_flat_mesh(b, meshes, src, rows, child, cm,
+                                      -1 if own else materials.add(mat), obj_index)
+                return first, count
+
+            add_csg(b, shape, m, materials.add, scene.resolve_material, obj_index,
+                    scene.material_of(obj_index),
+                    lambda child, where, i=obj_index: mesh_source(scene, i, child, warnings),
+                    emit_mesh)
+            continue
         add_shape(b, shape, m, materials.add(scene.material_of(obj_index)), obj_index)
     warnings.extend(meshes.warnings)
 
     prim_type, params, prim_xform, prim_material, prim_object, prim_solid, lo, hi = b.columns()
-    finite = np.all(np.isfinite(lo) & np.isfinite(hi), axis=1)
+    walked, prim_flip, prim_medium = b.extra_columns()
+    finite = np.all(np.isfinite(lo) & np.isfinite(hi), axis=1) & walked
     is_instance = prim_type == SHAPE_MESH
     bounded = np.flatnonzero(finite & ~is_instance).astype(np.int32)
     instances = np.flatnonzero(is_instance).astype(np.int32)
-    unbounded = np.flatnonzero(~finite)
+    unbounded = np.flatnonzero(~finite & walked)
     bvh = cached_build_bvh(lo[bounded], hi[bounded])
     inst_bvh = cached_build_bvh(lo[instances], hi[instances])
     prim_info = np.empty((len(prim_type), N_PRIM_INFO), np.int32)
@@ -140,6 +159,8 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
     prim_info[:, PRIM_MATERIAL] = prim_material
     prim_info[:, PRIM_SOLID] = prim_solid
     prim_info[:, PRIM_OBJECT] = prim_object
+    prim_info[:, PRIM_FLIP] = prim_flip
+    prim_info[:, PRIM_MEDIUM] = prim_medium
     node_box, node_link = packed_nodes(bvh, np.float64)
     # float32 marks a scene without instances: kernels specialised for it (features.py)
     inst_box, inst_link = packed_nodes(
@@ -157,7 +178,9 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
         node_box=node_box,
         node_link=node_link,
         node_prims=np.ascontiguousarray(bounded[bvh.prim_order], dtype=np.int32),
-        unbounded=unbounded.astype(np.int32),
+        # int64 selects the kernels compiled with tori and CSG (features.py)
+        unbounded=unbounded.astype(
+            EXTRAS_DTYPE if (prim_type >= FIRST_EXTRA_SHAPE).any() else np.int32),
         inst_box=inst_box,
         inst_link=inst_link,
         inst_prims=np.ascontiguousarray(instances[inst_bvh.prim_order], dtype=np.int32),

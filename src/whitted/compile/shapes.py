@@ -17,9 +17,10 @@ from ..kernels.layout import (
     SHAPE_PLANE,
     SHAPE_RECTANGLE,
     SHAPE_SPHERE,
+    SHAPE_TORUS,
     SHAPE_TRIANGLE,
 )
-from ..scene.shapes import Box, Cone, Cylinder, Disk, Plane, Rectangle, Sphere, Triangle
+from ..scene.shapes import Box, Cone, Cylinder, Disk, Plane, Rectangle, Sphere, Torus, Triangle
 from .geometry import (
     box_corners,
     corners_bounds,
@@ -121,5 +122,16 @@ def add_shape(b: PrimitiveRows, shape, m: np.ndarray, material: int, obj: int) -
             lo, hi = corners_bounds(box_corners(lo, hi), to_world)
         b.add(SHAPE_FRUSTUM, [*base, *axis, h, r0, r1, float(capped), *u_dir], lo, hi,
               material=material, obj=obj, solid=capped, world_to_object=xf)
+    elif isinstance(shape, Torus):
+        big, small = shape.major_radius, shape.minor_radius
+        outer = big + small
+        lo, hi = corners_bounds(box_corners(np.array([-outer, -small, -outer]),
+                                            np.array([outer, small, outer])), to_world)
+        if s is not None:  # rows: the object's x, y, z axes in the world
+            b.add(SHAPE_TORUS, [*point((0.0, 0.0, 0.0)), *(lin / s).T.reshape(-1), big * s,
+                                small * s], lo, hi, material=material, obj=obj, solid=True)
+        else:
+            b.add(SHAPE_TORUS, [0.0, 0.0, 0.0, *np.eye(3).reshape(-1), big, small], lo, hi,
+                  material=material, obj=obj, solid=True, world_to_object=inv)
     else:  # pragma: no cover - the scene model admits no other shape
         raise TypeError(f"cannot compile {type(shape).__name__}")

@@ -51,7 +51,19 @@ from ..scene.camera import Camera
 from ..scene.lights import AmbientLight, DirectionalLight, DiskLight, PointLight
 from ..scene.materials import Material
 from ..scene.scene import Scene
-from ..scene.shapes import Box, Cone, Cylinder, Disk, Mesh, Plane, Rectangle, Sphere, Triangle
+from ..scene.shapes import (
+    CSG,
+    Box,
+    Cone,
+    Cylinder,
+    Disk,
+    Mesh,
+    Plane,
+    Rectangle,
+    Sphere,
+    Torus,
+    Triangle,
+)
 from ..scene.textures import CheckerTexture, GradientTexture, ImageTexture
 
 MIRROR = np.diag([1.0, 1.0, -1.0])
@@ -213,8 +225,12 @@ class _PovWriter:
             return f"pigment {{ {_colour(cd, kt)} }}"
         mapping = "uv_mapping " if uv else ""
         if isinstance(tex, CheckerTexture):
+            # POV-Ray's checker is three-dimensional: the surface (pattern z = 0) is moved to
+            # the middle of a layer of cubes, not onto the boundary between two, where
+            # rounding picked the colour point by point
             body = (f"checker {_colour(cd * np.asarray(tex.color1), kt)}, "
-                    f"{_colour(cd * np.asarray(tex.color2), kt)} scale {num(1.0 / tex.checks)}")
+                    f"{_colour(cd * np.asarray(tex.color2), kt)} translate <0, 0, -0.5> "
+                    f"scale {num(1.0 / tex.checks)}")
         elif isinstance(tex, GradientTexture):
             body = (f"gradient {'x' if tex.axis == 'u' else 'y'} color_map {{ "
                     f"[0 {_colour(cd * np.asarray(tex.color1), kt)}] "
@@ -301,10 +317,20 @@ class _PovWriter:
         right, up, forward = cam.basis()
         hw, hh = cam.half_extents(self.width, self.height)
         kind = "orthographic" if cam.projection == "orthographic" else "perspective"
+        blur = ""
+        if cam.aperture > 0:
+            # POV-Ray moves the eye by up to aperture/4 (aperture·0.5 times sample offsets
+            # within ±0.5, tracepixel.cpp JitterCameraRay): twice ours reaches our lens's
+            # rim. Its samples lie on a hexagonal grid, stopping early when they agree
+            # (variance 0: never)
+            focus = np.asarray(cam.position) + np.asarray(forward) * cam.focus()
+            samples = max(19, self.scene.render.samples)
+            blur = (f"  aperture {num(2 * cam.aperture)}\n  blur_samples {samples}\n"
+                    f"  focal_point {mirrored(focus)}\n  variance 0\n")
         return (f"camera {{\n  {kind}\n  location {mirrored(cam.position)}\n"
                 f"  direction {mirrored(forward)}\n"
                 f"  right {mirrored(np.asarray(right) * 2 * hw)}\n"
-                f"  up {mirrored(np.asarray(up) * 2 * hh)}\n}}")
+                f"  up {mirrored(np.asarray(up) * 2 * hh)}\n{blur}}}")
 
     def background(self) -> str:
         bg = self.scene.background
@@ -348,7 +374,55 @@ class _PovWriter:
                 + "".join(f"\n  {e}" for e in extra) + " }")
 
     def shape(self, index: int, obj) -> str:
+        if isinstance(obj, Mesh):
+            return self.mesh(index, obj)
+        if isinstance(obj, CSG):
+            return _labelled(index, obj) + self.csg(index, obj, self.scene.material_of(index))
         mat = self.scene.material_of(index)
+        body, solid, uv, placement = self.primitive(index, obj)
+        lines = [body, f"  texture {{ {self.texture_name(mat, uv)}{placement} }}"]
+        interior = self.interior_name(mat) if solid else None
+        if interior is not None:
+            lines.append(f"  interior {{ {interior} }}")
+        if (photons := self.photons(mat)) is not None:
+            lines.append(f"  {photons}")
+        if obj.transform is not None and not obj.transform.is_identity():
+            lines.append(f"  {matrix_keyword(obj.transform.matrix())}")
+        return _labelled(index, obj) + "\n".join(lines) + "\n}"
+
+    def csg(self, index: int, obj: CSG, inherited: Material, top: bool = True) -> str:
+        """POV-Ray's union / intersection / difference / merge of the children, each with its
+        own texture (a child without a material takes the nearest CSG object's, as POV-Ray's
+        children without a texture do) and one interior for the whole body: the object's
+        material, or its first solid's (whitted's medium of a CSG object)."""
+        children = []
+        for child in obj.objects:
+            mat = (self.scene.resolve_material(child.material) if child.material is not None
+                   else inherited)
+            if isinstance(child, CSG):
+                children.append(self.csg(index, child, mat, top=False))
+                continue
+            body, _, uv, placement = self.primitive(index, child)
+            lines = [body, f"  texture {{ {self.texture_name(mat, uv)}{placement} }}"]
+            if child.transform is not None and not child.transform.is_identity():
+                lines.append(f"  {matrix_keyword(child.transform.matrix())}")
+            children.append("\n".join(lines) + "\n}")
+        lines = [f"{obj.operation} {{", *("  " + c.replace("\n", "\n  ") for c in children)]
+        if top:
+            medium = inherited if obj.material is not None else _first_material(
+                self.scene, obj, inherited)
+            interior = self.interior_name(medium)
+            if interior is not None:
+                lines.append(f"  interior {{ {interior} }}")
+            if (photons := self.photons(medium)) is not None:
+                lines.append(f"  {photons}")
+        if obj.transform is not None and not obj.transform.is_identity():
+            lines.append(f"  {matrix_keyword(obj.transform.matrix())}")
+        return "\n".join(lines) + "\n}"
+
+    def primitive(self, index: int, obj) -> tuple[str, bool, bool, str]:
+        """(the opening of the shape's block, whether it bounds a volume, whether its texture
+        is uv-mapped, a texture placement) for an analytic shape."""
         solid = True
         uv = isinstance(obj, Sphere | Box | Rectangle | Triangle | Mesh)
         placement = ""  # texture orientation for shapes POV-Ray has no uv mapping for
@@ -395,19 +469,12 @@ class _PovWriter:
             body = (f"cone {{ {mirrored(obj.base)}, {num(obj.radius)}, {mirrored(obj.top)}, "
                     f"{num(obj.top_radius)}" + ("" if obj.capped else " open"))
             solid = obj.capped
-        elif isinstance(obj, Mesh):
-            return self.mesh(index, obj)
+        elif isinstance(obj, Torus):  # POV-Ray's torus lies around y too (mirroring z
+            # leaves it as it is)
+            body = f"torus {{ {num(obj.major_radius)}, {num(obj.minor_radius)}"
         else:  # pragma: no cover - every shape type is handled above
             raise SceneError(f"objects[{index}]: cannot export a {obj.type!r} to POV-Ray")
-        lines = [body, f"  texture {{ {self.texture_name(mat, uv)}{placement} }}"]
-        interior = self.interior_name(mat) if solid else None
-        if interior is not None:
-            lines.append(f"  interior {{ {interior} }}")
-        if (photons := self.photons(mat)) is not None:
-            lines.append(f"  {photons}")
-        if obj.transform is not None and not obj.transform.is_identity():
-            lines.append(f"  {matrix_keyword(obj.transform.matrix())}")
-        return _labelled(index, obj) + "\n".join(lines) + "\n}"
+        return body, solid, uv, placement
 
     def mesh(self, index: int, obj: Mesh) -> str:
         parts = mesh_parts(self.scene, obj)
@@ -462,12 +529,30 @@ class _PovWriter:
         header = [
             "// POV-Ray 3.7 scene written by whitted"
             + (f" from {source}" if source else ""),
-            f"// render: povray +I<this file> +W{self.width} +H{self.height} -A +FN"
+            f"// render: povray +I<this file> +W{self.width} +H{self.height} "
+            f"{povray_antialias_options(self.scene)} +FN"
             + (" File_Gamma=1.0" if r.transfer == "linear" else "")
-            + f"  (whitted's samples per pixel: {r.samples}; -A: one ray per pixel)",
+            + (f"  (whitted's samples per pixel: {r.samples}; -A: one ray per pixel)"
+               if r.antialias is None else "  (adaptive anti-aliasing, as whitted's)"),
             "#version 3.7;",
         ]
         return "\n\n".join(["\n".join(header), *body, *self.declarations, *shapes]) + "\n"
+
+
+def povray_antialias_options(scene: Scene) -> str:
+    """POV-Ray's anti-aliasing options for the scene: ``-A`` (one ray per pixel), or for
+    ``[render.antialias]`` method 2 at its threshold and depth (``+A0.3 +AM2 +R3``)."""
+    aa = scene.render.antialias
+    if aa is None:
+        return "-A"
+    return f"+A{num(aa.threshold)} +AM2 +R{max(1, aa.levels)}"
+
+
+def _first_material(scene: Scene, obj: CSG, inherited: Material) -> Material:
+    """The material of a CSG object's first solid (its children's order, depth first)."""
+    child = obj.objects[0]
+    mat = scene.resolve_material(child.material) if child.material is not None else inherited
+    return _first_material(scene, child, mat) if isinstance(child, CSG) else mat
 
 
 def _labelled(index: int, obj) -> str:
@@ -476,9 +561,15 @@ def _labelled(index: int, obj) -> str:
 
 
 def _planar_placement(normal, point) -> str:
-    """A texture transform that lays POV-Ray's x/y pattern plane onto the given plane."""
-    u, v = _perpendicular_basis(normal)
+    """A texture transform that lays POV-Ray's x/y pattern plane onto the given plane, x
+    along whitted's u direction there (compile/geometry.py ``tangent``: world x made
+    perpendicular to the normal, or -z for surfaces facing along x) and y along v = n x u."""
     n = np.asarray(normal, dtype=np.float64) / np.linalg.norm(normal)
+    helper = (np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9
+              else np.array([0.0, 0.0, -np.sign(n[0])]))
+    u = helper - np.dot(helper, n) * n
+    u /= np.linalg.norm(u)
+    v = np.cross(n, u)
     m = np.eye(4)
     m[:3, 0], m[:3, 1], m[:3, 2] = u, v, n
     m[:3, 3] = point

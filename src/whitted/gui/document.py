@@ -55,19 +55,38 @@ def item_of(scene: Scene, key: SelectionKey | None) -> BaseModel | None:
         return None
     if key in SINGLETONS:
         return getattr(scene, key[0])
-    if len(key) == 2 and key[0] in ("lights", "objects"):
+    if len(key) >= 2 and key[0] in ("lights", "objects"):
         items = getattr(scene, key[0])
-        return items[key[1]] if 0 <= key[1] < len(items) else None
+        if not 0 <= key[1] < len(items):
+            return None
+        item = items[key[1]]
+        for k in key[2:]:  # ("objects", i, k, ...): a child of a CSG object, to any depth
+            children = getattr(item, "objects", None)
+            if children is None or not 0 <= k < len(children):
+                return None
+            item = children[k]
+        return item
     return None
+
+
+def _with_child(parent: BaseModel, path: tuple, item: BaseModel) -> BaseModel:
+    """CSG object ``parent`` with its descendant at ``path`` replaced by ``item``."""
+    if not path:
+        return item
+    children = list(parent.objects)
+    children[path[0]] = _with_child(children[path[0]], path[1:], item)
+    data = parent.model_dump()
+    data["objects"] = [c.model_dump() for c in children]
+    return type(parent).model_validate(data)
 
 
 def with_item(scene: Scene, key: SelectionKey, item: BaseModel) -> Scene:
     """``scene`` with the item at ``key`` replaced by ``item``."""
     if key in SINGLETONS:
         return rebuild_scene(scene, **{key[0]: item})
-    kind, index = key
+    kind, index, *path = key
     items = list(getattr(scene, kind))
-    items[index] = item
+    items[index] = _with_child(items[index], tuple(path), item)
     return rebuild_scene(scene, **{kind: items})
 
 

@@ -37,7 +37,7 @@ class SceneTree(QTreeWidget):
         """Rebuild the tree from the document's scene and select the document's selection
         (only the texts change when the lists keep their lengths)."""
         scene = self.doc.scene
-        shape = (len(scene.lights), len(scene.objects))
+        shape = (len(scene.lights), len(scene.objects), self._csg_shape())
         if shape == getattr(self, "_shape", None):
             self._update_texts()
             return
@@ -67,21 +67,53 @@ class SceneTree(QTreeWidget):
                     child.setToolTip(0, f"{obj.type} {'light' if kind == 'lights' else ''}")
                     child.setFlags(child.flags() | Qt.ItemFlag.ItemIsEditable)
                     group.addChild(child)
+                    if kind == "objects" and obj.type == "csg":
+                        self._add_csg_children(child, obj, (kind, i))
                 group.setExpanded(expanded.get(title, True))
         finally:
             self._filling = False
         self.select_key()
 
+    def _add_csg_children(self, node: QTreeWidgetItem, csg, key: tuple) -> None:
+        """A CSG object's children under its node, keyed ("objects", i, k, ...), to any
+        depth (expanded: the tree of the solid shows at once)."""
+        for k, obj in enumerate(csg.objects):
+            child = QTreeWidgetItem([self.text_of(obj)])
+            child.setData(0, KEY_ROLE, (*key, k))
+            child.setIcon(0, icon_for(obj.type))
+            child.setToolTip(0, f"{obj.type} in {csg.operation}")
+            child.setFlags(child.flags() | Qt.ItemFlag.ItemIsEditable)
+            node.addChild(child)
+            if obj.type == "csg":
+                self._add_csg_children(child, obj, (*key, k))
+        node.setExpanded(True)
+
+    def _items(self):
+        """Every item of the tree, depth first."""
+        stack = [self.topLevelItem(i) for i in range(self.topLevelItemCount())][::-1]
+        while stack:
+            item = stack.pop()
+            yield item
+            stack.extend(item.child(j) for j in range(item.childCount() - 1, -1, -1))
+
+    def _csg_shape(self) -> tuple:
+        """The children counts of every CSG object (a change rebuilds the tree)."""
+        def counts(obj):
+            if obj.type != "csg":
+                return ()
+            return (len(obj.objects), *(counts(c) for c in obj.objects))
+        return tuple(counts(obj) for obj in self.doc.scene.objects)
+
     def _update_texts(self) -> None:
         self._filling = True
         try:
-            for i in range(self.topLevelItemCount()):
-                top = self.topLevelItem(i)
-                for j in range(top.childCount()):
-                    child = top.child(j)
-                    obj = self.doc.item(child.data(0, KEY_ROLE))
-                    if obj is not None and child.text(0) != self.text_of(obj):
-                        child.setText(0, self.text_of(obj))
+            for child in self._items():
+                key = child.data(0, KEY_ROLE)
+                if key is None or child.parent() is None:
+                    continue
+                obj = self.doc.item(key)
+                if obj is not None and child.text(0) != self.text_of(obj):
+                    child.setText(0, self.text_of(obj))
         finally:
             self._filling = False
         self.select_key()
@@ -92,13 +124,9 @@ class SceneTree(QTreeWidget):
         return name if name == obj.type else f"{name}  ({obj.type})"
 
     def item_for(self, key) -> QTreeWidgetItem | None:
-        for i in range(self.topLevelItemCount()):
-            top = self.topLevelItem(i)
-            if top.data(0, KEY_ROLE) == key:
-                return top
-            for j in range(top.childCount()):
-                if top.child(j).data(0, KEY_ROLE) == key:
-                    return top.child(j)
+        for item in self._items():
+            if item.data(0, KEY_ROLE) == key:
+                return item
         return None
 
     def keyboardSearch(self, search: str) -> None:  # noqa: N802 - Qt's name
@@ -143,7 +171,7 @@ class SceneTree(QTreeWidget):
         if self._filling:
             return
         key = item.data(0, KEY_ROLE)
-        if key is None or len(key) != 2:
+        if key is None or len(key) < 2:
             return
         text = item.text(0).strip()
         # after the editor has closed: renaming rebuilds the tree

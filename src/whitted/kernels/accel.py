@@ -10,14 +10,24 @@ the barycentric coordinates on the triangle.
 
 from __future__ import annotations
 
-from .features import has_instances, instances_possible
+import numpy as np
+
+from .extras import (
+    csg_hit_if_extras,
+    extra_normal_if_extras,
+    extra_t_if_extras,
+    flipped_if_extras,
+)
+from .features import has_extras, has_instances, instances_possible
 from .intersect import INF, intersect_local, normal_local, triangle_barycentric
 from .jit import kernel, overload
 from .layout import (
+    FIRST_EXTRA_SHAPE,
     MAT_KT,
     PRIM_MATERIAL,
     PRIM_TYPE,
     PRIM_XFORM,
+    SHAPE_CSG,
     SHAPE_TRIANGLE,
     TRIANGLE_NORMALS,
 )
@@ -30,43 +40,33 @@ from .traverse import (
     start_scene_walk,
 )
 from .vec import normalize
+from .xform import normal_to_world as _normal_to_world
+from .xform import to_object
 
 MESH_STACK_BASE = 64  # traversal stack entries [0, 64) for the scene BVH, the rest for meshes
 
 
-@kernel
-def to_object(xforms, xf, o, d):
-    """Ray (o, d) mapped by the world-to-object matrix ``xforms[xf]``; t is unchanged."""
-    lo = (
-        xforms[xf, 0, 0] * o[0]
-        + xforms[xf, 0, 1] * o[1]
-        + xforms[xf, 0, 2] * o[2]
-        + xforms[xf, 0, 3],
-        xforms[xf, 1, 0] * o[0]
-        + xforms[xf, 1, 1] * o[1]
-        + xforms[xf, 1, 2] * o[2]
-        + xforms[xf, 1, 3],
-        xforms[xf, 2, 0] * o[0]
-        + xforms[xf, 2, 1] * o[1]
-        + xforms[xf, 2, 2] * o[2]
-        + xforms[xf, 2, 3],
-    )
-    ld = (
-        xforms[xf, 0, 0] * d[0] + xforms[xf, 0, 1] * d[1] + xforms[xf, 0, 2] * d[2],
-        xforms[xf, 1, 0] * d[0] + xforms[xf, 1, 1] * d[1] + xforms[xf, 1, 2] * d[2],
-        xforms[xf, 2, 0] * d[0] + xforms[xf, 2, 1] * d[1] + xforms[xf, 2, 2] * d[2],
-    )
-    return lo, ld
-
-
-@kernel
+@kernel(inline="always")
 def hit_analytic(geo, i, o, d, tmin, tmax):
-    """t of the ray with analytic primitive ``i`` (INF on a miss). Kept small so the compiler
-    inlines it into the traversal loops."""
+    """t of the ray with analytic primitive ``i`` (INF on a miss). Inlined into the traversal
+    loops (in kernels for scenes with tori or CSG it would otherwise be a call per candidate,
+    and the torus and the CSG walk stay calls behind it, made only for them)."""
     xf = geo.prim_info[i, PRIM_XFORM]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
-    return intersect_local(geo.prim_info[i, PRIM_TYPE], geo.prim_params, i, o, d, tmin, tmax)
+    typ = geo.prim_info[i, PRIM_TYPE]
+    if has_extras(geo) and typ >= FIRST_EXTRA_SHAPE:  # tori, CSG (compiled only where used)
+        return extra_t_if_extras(geo, i, o, d, tmin, tmax)
+    return intersect_local(typ, geo.prim_params, i, o, d, tmin, tmax)
+
+
+@kernel(inline="always")
+def hit_part(geo, i, o, d, tmin, tmax):
+    """(t, the primitive whose surface it is) for analytic primitive ``i``: ``i`` itself, or
+    for a CSG object the leaf whose surface shows."""
+    if has_extras(geo) and geo.prim_info[i, PRIM_TYPE] == SHAPE_CSG:
+        return csg_hit_if_extras(geo, i, o, d, tmin, tmax)
+    return hit_analytic(geo, i, o, d, tmin, tmax), np.int64(i)
 
 
 @kernel
@@ -112,27 +112,23 @@ def hit_material(geo, prim, tri):
 
 
 @kernel
-def _normal_to_world(m, xf, n):
-    """Normals map by the transpose of the world-to-object matrix, which keeps them
-    perpendicular to the surface even under non-uniform scale."""
-    return normalize(
-        (
-            m[xf, 0, 0] * n[0] + m[xf, 1, 0] * n[1] + m[xf, 2, 0] * n[2],
-            m[xf, 0, 1] * n[0] + m[xf, 1, 1] * n[1] + m[xf, 2, 1] * n[2],
-            m[xf, 0, 2] * n[0] + m[xf, 1, 2] * n[1] + m[xf, 2, 2] * n[2],
-        )
-    )
-
-
-@kernel
 def world_normal(geo, i, p):
     """Outward unit geometric normal of analytic primitive ``i`` at world point ``p``."""
     xf = geo.prim_info[i, PRIM_XFORM]
+    typ = geo.prim_info[i, PRIM_TYPE]
+    lp = p
+    if xf >= 0:
+        lp, _ = to_object(geo.xforms, xf, p, p)
+    n = normal_local(typ, geo.prim_params, i, lp)
+    if has_extras(geo):  # tori; CSG cuts turned inside out
+        if typ >= FIRST_EXTRA_SHAPE:
+            n = extra_normal_if_extras(geo, i, lp, n)
+        if xf >= 0:
+            n = _normal_to_world(geo.xforms, xf, n)
+        return flipped_if_extras(geo, i, n)
     if xf < 0:
-        return normal_local(geo.prim_info[i, PRIM_TYPE], geo.prim_params, i, p)
-    lp, _ = to_object(geo.xforms, xf, p, p)
-    return _normal_to_world(geo.xforms, xf,
-                            normal_local(geo.prim_info[i, PRIM_TYPE], geo.prim_params, i, lp))
+        return n
+    return _normal_to_world(geo.xforms, xf, n)
 
 
 @kernel
@@ -174,7 +170,10 @@ def surface_normals(geo, prim, tri, b1, b2, p):
         n = world_normal(geo, prim, p)
         smooth = geo.prim_params[prim, TRIANGLE_NORMALS] >= 0
         if geo.prim_info[prim, PRIM_TYPE] == SHAPE_TRIANGLE and smooth:
-            return n, _triangle_shading_normal(geo, prim, p, n)
+            ns = _triangle_shading_normal(geo, prim, p, n)
+            if has_extras(geo):  # a smooth mesh cutting a CSG difference: turned too
+                ns = flipped_if_extras(geo, prim, ns)
+            return n, ns
         return n, n
     ng, ns = mesh_normals_if_instances(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
     xf = geo.prim_info[prim, PRIM_XFORM]
@@ -248,10 +247,10 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
                                                          leaf, leaf_end, top, True)
         if i < 0:
             break
-        t = hit_analytic(geo, i, o, d, tmin, best_t)
+        t, part = hit_part(geo, i, o, d, tmin, best_t)
         if t < best_t:
             best_t = t
-            best = i
+            best = part
     if has_instances(geo):
         t, prim, tri, b1, b2 = closest_instance_hit_if_instances(geo, o, d, inv, tmin, best_t,
                                                                  stack)

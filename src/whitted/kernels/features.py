@@ -12,6 +12,10 @@ False, so the kinds without instances call the instance walks and the mesh looku
 the ``*_if_instances`` functions (in accel.py, lighting.py and uv.py): overloads that resolve,
 while the caller is typed, to the real kernel or to a stand-in returning the same types. The
 default scene's cold compile then never compiles the mesh kernels (2 s of it).
+
+The same way, scenes with tori or CSG objects get ``unbounded`` as int64 (int32 otherwise),
+and :func:`has_extras` is the constant False in the kinds without: the torus's quartic and
+the CSG walk (kernels/extras.py) stay out of the default scene's kernels and cold compile.
 """
 
 from __future__ import annotations
@@ -19,6 +23,9 @@ from __future__ import annotations
 from .jit import overload
 
 NO_INSTANCES_DTYPE = "float32"  # dtype of GeometryArrays.inst_box in scenes without
+# dtype of GeometryArrays.unbounded in scenes with the shapes from layout.FIRST_EXTRA_SHAPE
+# on (tori, CSG): the other kinds never compile their code (kernels/extras.py)
+EXTRAS_DTYPE = "int64"
 
 
 def has_instances(geo):
@@ -43,3 +50,25 @@ def _has_instances(geo):
     if not instances_possible(geo):
         return lambda geo: False
     return lambda geo: geo.inst_box.shape[0] > 0
+
+
+def has_extras(geo):
+    """True when the scene may hold tori or CSG objects (resolved at compile time)."""
+    return geo.unbounded.dtype == EXTRAS_DTYPE
+
+
+def extras_possible(geo_type) -> bool:
+    """Whether a GeometryArrays of this Numba type may hold tori or CSG objects (its
+    ``unbounded`` is int64)."""
+    from numba import types
+
+    geo_type = getattr(geo_type, "geometry", geo_type)  # as instances_possible
+    field_type = dict(zip(geo_type.fields, geo_type.types, strict=True))["unbounded"]
+    return field_type.dtype == types.int64
+
+
+@overload(has_extras, inline="always")
+def _has_extras(geo):
+    if extras_possible(geo):
+        return lambda geo: True
+    return lambda geo: False

@@ -89,8 +89,8 @@ def geometry_type(geo_type):
 
 
 def geometry_ref_if_instances(geo):
-    """:func:`geometry_ref` in kernels for scenes with mesh instances; ``geo`` itself in the
-    kind without (see below)."""
+    """:func:`geometry_ref` in kernels for scenes with mesh instances (or tori and CSG
+    objects); ``geo`` itself in the kind without (see below)."""
     return geo
 
 
@@ -99,8 +99,9 @@ def _geometry_ref_if_instances(geo):
     # Measured, CPU time, 1 thread, interleaved (AMD EPYC Zen 4): sphere1m at 640x360 0.242 ->
     # 0.094 s with the reference; but seed000, a scene without instances, 0.69 -> 0.79 s: there
     # LLVM inlines the walks into render_tiles and nothing was copied
-    from .features import instances_possible
+    from .features import extras_possible, instances_possible
 
-    if instances_possible(geo):
+    # scenes with tori or CSG too: their walks are calls, not inlined (csg.py)
+    if instances_possible(geo) or extras_possible(geo):
         return lambda geo: geometry_ref(geo)
     return lambda geo: geo

@@ -7,6 +7,7 @@ import math
 
 from .accel import closest_hit, hit_material, surface_normals
 from .caustics import add_caustic, caustics_on
+from .extras import body_medium
 from .jit import kernel
 from .layout import (
     MAT_AMBIENT,
@@ -196,15 +197,21 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
                 # a surface between two named media (a water cavity in ice): the outside
                 # medium is left on the way in and entered on the way out
                 outside = int(mats[m, MAT_OUTSIDE])
+                body = body_medium(geo, prim, m)  # a CSG object is one body (extras.py)
                 if entering:
                     if outside >= 0:
                         n_out = media_leave(scratch, n_out, outside)
                         n1 = mats[outside, MAT_IOR]
-                    n_out = media_enter(scratch, n_out, m)
-                    n2 = mats[m, MAT_IOR]
+                    n_out = media_enter(scratch, n_out, body)
+                    n2 = mats[body, MAT_IOR]
                 else:
-                    n_out = media_leave(scratch, n_out, m)
-                    n1 = mats[m, MAT_IOR]
+                    n_out = media_leave(scratch, n_out, body)
+                    n1 = mats[body, MAT_IOR]
+                    if n_out < n_media and media[n_media - 1] != body:
+                        # leaving a body that is not the innermost (overlapping bodies: a
+                        # water ball reaching a hair into the ice around it): the ray travels
+                        # in the innermost one, on both sides
+                        n1 = mats[media[n_media - 1], MAT_IOR]
                     if outside >= 0:
                         n_out = media_enter(scratch, n_out, outside)
                         n2 = mats[outside, MAT_IOR]

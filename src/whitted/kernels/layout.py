@@ -24,6 +24,27 @@ SHAPE_TRIANGLE = 4  # v0 0:3, edge1 3:6, edge2 6:9, unit normal 9:12, corner uvs
 SHAPE_BOX = 5  # corner 0:3, inverse edge matrix rows 3:12 (local = M^-1 (p - corner) in [0,1]^3)
 SHAPE_FRUSTUM = 6  # base 0:3, unit axis 3:6, height 6, base radius 7, top radius 8, capped 9
 SHAPE_MESH = 7  # an instance of a triangle mesh: mesh index 0 (a row of mesh_info)
+# The shapes below need the kernels compiled for scenes with them (features.py has_extras):
+# a torus about its own y axis: centre 0:3, the object's x, y, z axes in world space (unit)
+# 3:12, major radius 12, minor radius 13
+SHAPE_TORUS = 8
+# a CSG object (kernels/csg.py): the rows after it, count 0, are its tree in postfix order
+# (leaves: ordinary solid rows; operations: SHAPE_CSG_OP rows); leaves 1; its box: lower
+# corner 2:5, upper corner 5:8
+SHAPE_CSG = 9
+SHAPE_CSG_OP = 10  # an operation of a CSG tree: CSG_* code 0, number of operands 1
+# a closed mesh in a CSG tree: its triangles are the rows first 0 .. first + count 1 - 1
+# (flattened, in no BVH, after the tree's rows)
+SHAPE_CSG_MESH = 11
+FIRST_EXTRA_SHAPE = SHAPE_TORUS
+
+# CSG operation codes (SHAPE_CSG_OP rows)
+CSG_UNION = 0
+CSG_INTERSECTION = 1
+CSG_DIFFERENCE = 2
+CSG_MERGE = 3
+CSG_MAX_LEAVES = 63  # solids in one CSG tree (the inside states are the bits of an int64)
+CSG_MAX_ROWS = 63  # leaves and operations together (scene/shapes.py CSG_MAX_SOLIDS)
 
 # texture-space frames of the analytic shapes (after their own numbers above)
 SPHERE_FRAME = 4  # 4:13 the object's x, y, z axes in world space (unit), for spherical uv
@@ -112,7 +133,12 @@ PRIM_XFORM = 1  # row of xforms (world to object), -1 when the numbers are in wo
 PRIM_MATERIAL = 2  # row of the material table (-1: a mesh instance using its triangles')
 PRIM_SOLID = 3  # 1 when it bounds a volume (rays enter and leave media)
 PRIM_OBJECT = 4  # index of the scene object it came from
-N_PRIM_INFO = 5
+# 1 when the surface of a CSG leaf faces the other way in its solid (a difference's cut);
+# read only by kernels for scenes with extra shapes (features.py has_extras)
+PRIM_FLIP = 5
+# material row of the body whose medium a CSG leaf's surface bounds (-1: the surface's own)
+PRIM_MEDIUM = 6
+N_PRIM_INFO = 7
 
 # BVH layout (every level): node_box[n] = (lower corner, upper corner); node_link[n] = (offset,
 # count): a leaf (count > 0) holds entries offset .. offset + count - 1 of its index list; an
@@ -147,7 +173,9 @@ class GeometryArrays(NamedTuple):
     node_box: np.ndarray  # (M, 2, 3) float64 scene BVH over the bounded analytic primitives
     node_link: np.ndarray  # (M, 2) int32
     node_prims: np.ndarray  # (N,) int32 primitive indices in leaf order
-    unbounded: np.ndarray  # (U,) int32 primitives outside the BVH (infinite planes)
+    # (U,) primitives outside the BVH (infinite planes): int32, or int64 in scenes with tori
+    # or CSG objects, which selects kernels compiled with those shapes (features.py)
+    unbounded: np.ndarray
     # triangle meshes, each stored once in its own space with its own BVH (the bottom level);
     # SHAPE_MESH primitives instance them (their xform maps world to mesh space). The
     # instances have a top-level BVH of their own, walked after the analytic shapes'; its
@@ -244,3 +272,8 @@ class RenderParams(NamedTuple):
     camera_up: tuple[float, float, float]  # scaled by the half height
     camera_forward: tuple[float, float, float]
     orthographic: int
+    # focal blur: the lens's half axes (unit right and up times its radius; zero: a pinhole)
+    # and the distance along camera_forward of the plane in focus (0: no focal blur)
+    lens_u: tuple[float, float, float]
+    lens_v: tuple[float, float, float]
+    focal_distance: float

@@ -14,13 +14,17 @@ from .accel import (
     occludes,
     surface_normals,
 )
-from .features import has_instances, instances_possible
+from .csg import csg_hit
+from .extras import body_medium
+from .features import extras_possible, has_extras, has_instances, instances_possible
 from .intersect import INF
 from .jit import kernel, overload
 from .layout import (
     CELL_COUNT,
     CELL_FIRST,
     CELL_OPAQUE,
+    CSG_MAX_LEAVES,
+    FIRST_EXTRA_SHAPE,
     LIGHT_BUFFER,
     LIGHT_BUFFER_SIDE,
     LIGHT_DIRECTION,
@@ -48,6 +52,7 @@ from .layout import (
     PRIM_TYPE,
     PRIM_XFORM,
     RAY_SHADOW,
+    SHAPE_CSG,
     SHAPE_PLANE,
     SHAPE_TRIANGLE,
 )
@@ -270,6 +275,11 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
         if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT:
             hits[1] = i
             return -1, False
+        if has_extras(geo) and geo.prim_info[i, PRIM_TYPE] >= FIRST_EXTRA_SHAPE:
+            # a torus or a CSG object: every crossing (a CSG object's as its leaves)
+            n, full = gather_extra_hits_if_extras(geo, i, o, d, t, tmin, tmax, step, hits, n,
+                                                  full)
+            continue
         n, full = _keep_nearest(hits, n, t, i, full)
         # a closed analytic body is crossed twice (the triangles of a flattened solid mesh
         # are each crossed once: their body's other side is other triangles)
@@ -278,6 +288,38 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
             if t < INF:
                 n, full = _keep_nearest(hits, n, t, i, full)
     return n, full
+
+
+@kernel
+def gather_extra_hits(geo, i, o, d, t, tmin, tmax, step, hits, n, full):
+    """:func:`gather_transparent_hits` for a torus or CSG object ``i`` first crossed at
+    ``t``: that crossing and every later one before ``tmax`` (up to four on a torus; a CSG
+    object's as (t, leaf) pairs, each found from past the one before)."""
+    for _ in range(4 * CSG_MAX_LEAVES):
+        part = i
+        if geo.prim_info[i, PRIM_TYPE] == SHAPE_CSG:
+            t, part = csg_hit(geo, i, o, d, tmin, tmax)
+            if part < 0:
+                break
+        elif t == INF:
+            break
+        n, full = _keep_nearest(hits, n, t, part, full)
+        tmin = t * (1.0 + 1e-12) + step
+        if geo.prim_info[i, PRIM_TYPE] != SHAPE_CSG:
+            t = hit_analytic(geo, i, o, d, tmin, tmax)
+    return n, full
+
+
+def gather_extra_hits_if_extras(geo, i, o, d, t, tmin, tmax, step, hits, n, full):
+    return gather_extra_hits(geo, i, o, d, t, tmin, tmax, step, hits, n, full)
+
+
+@overload(gather_extra_hits_if_extras)
+def _gather_extra_hits_if_extras(geo, i, o, d, t, tmin, tmax, step, hits, n, full):
+    if not extras_possible(geo):
+        return lambda geo, i, o, d, t, tmin, tmax, step, hits, n, full: (n, full)
+    return lambda geo, i, o, d, t, tmin, tmax, step, hits, n, full: gather_extra_hits(
+        geo, i, o, d, t, tmin, tmax, step, hits, n, full)
 
 
 @kernel(specialise_constants=True)  # a variant per call site: LLVM inlines each
@@ -290,10 +332,11 @@ def _pass_surface(geo, mats, prim, tri, b1, b2, o, d, t, scratch, count, trans):
     if geo.prim_info[prim, PRIM_SOLID]:
         n, _ = surface_normals(geo, prim, tri, b1, b2, madd(o, d, t))
         entering = dot(d, n) < 0.0
+        body = body_medium(geo, prim, m)  # a CSG object is one body (extras.py)
         if entering:
-            count = media_enter(scratch, count, m)
+            count = media_enter(scratch, count, body)
         else:
-            count = media_leave(scratch, count, m)
+            count = media_leave(scratch, count, body)
     if entering:
         trans = (trans[0] * kt * mats[m, MAT_COLOR], trans[1] * kt * mats[m, MAT_COLOR + 1],
                  trans[2] * kt * mats[m, MAT_COLOR + 2])

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 
 from .accel import closest_hit, hit_material, surface_normals
+from .extras import body_medium
 from .integrator import _absorbed, refract, schlick
 from .jit import kernel, numba_object
 from .layout import (
@@ -226,15 +227,18 @@ def _interface(geo, mats, prim, m, entering, media, n_media, scratch):
         return 1.0, 1.0, n_out
     n1 = mats[media[n_media - 1], MAT_IOR] if n_media > 0 else 1.0
     outside = int(mats[m, MAT_OUTSIDE])
+    body = body_medium(geo, prim, m)  # a CSG object is one body (extras.py)
     if entering:
         if outside >= 0:
             n_out = media_leave(scratch, n_out, outside)
             n1 = mats[outside, MAT_IOR]
-        n_out = media_enter(scratch, n_out, m)
-        n2 = mats[m, MAT_IOR]
+        n_out = media_enter(scratch, n_out, body)
+        n2 = mats[body, MAT_IOR]
     else:
-        n_out = media_leave(scratch, n_out, m)
-        n1 = mats[m, MAT_IOR]
+        n_out = media_leave(scratch, n_out, body)
+        n1 = mats[body, MAT_IOR]
+        if n_out < n_media and media[n_media - 1] != body:  # not the innermost: as trace_path
+            n1 = mats[media[n_media - 1], MAT_IOR]
         if outside >= 0:
             n_out = media_enter(scratch, n_out, outside)
             n2 = mats[outside, MAT_IOR]

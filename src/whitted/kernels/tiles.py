@@ -22,8 +22,8 @@ from .layout import (
     RAY_PRIMARY,
 )
 from .lighting import MAX_SHADOW_HITS, SHADOW_LIST_CAP
-from .sampling import random_pair, stratum
-from .vec import madd, normalize
+from .sampling import concentric_disk, random_pair, stratum
+from .vec import dot, madd, normalize, sub
 
 BVH_STACK = 128
 
@@ -64,6 +64,22 @@ def camera_ray(params, x, y):
     )
 
 
+@kernel
+def lens_ray(params, o, d, pixel, sample):
+    """The camera ray (o, d) through a thin lens (focal blur): from a point of the lens
+    drawn by the pixel's sampler (dimension 1, concentric disk), toward the point where (o, d)
+    meets the plane in focus. Points on that plane stay as sharp as through a pinhole."""
+    u, v = random_pair(params.seed, pixel, sample, 1)
+    lx, ly = concentric_disk(u, v)
+    lu = params.lens_u
+    lv = params.lens_v
+    start = (o[0] + lx * lu[0] + ly * lv[0], o[1] + lx * lu[1] + ly * lv[1],
+             o[2] + lx * lu[2] + ly * lv[2])
+    f = params.focal_distance / dot(d, params.camera_forward)
+    focus = madd(o, d, f)
+    return start, normalize(sub(focus, start))
+
+
 @kernel(entry=True)  # called from Python
 def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, lane, lanes):
     """Render this lane's share of ``tiles`` (rows of x0, y0, x1, y1) into ``framebuffer``
@@ -91,6 +107,8 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
                         jx = (cx + ux) / m
                         jy = (cy + uy) / rows
                     o, d = camera_ray(params, px + jx, py + jy)
+                    if params.focal_distance > 0.0:  # focal blur (0: a pinhole)
+                        o, d = lens_ray(params, o, d, pixel, s)
                     cnt[RAY_PRIMARY] += 1
                     c = trace_path(geo, mats, lights, params, o, d, pixel, s, st_f, st_i,
                                    media, scratch, stack, hits, listed, cnt)

@@ -17,11 +17,13 @@ from __future__ import annotations
 import math
 
 from .accel import to_object
-from .features import instances_possible
+from .extras import extra_uv_if_extras
+from .features import has_extras, instances_possible
 from .intersect import _box_local, triangle_barycentric
 from .jit import kernel, overload
 from .layout import (
     DISK_TANGENT,
+    FIRST_EXTRA_SHAPE,
     FRUSTUM_TANGENT,
     PLANE_TANGENT,
     PRIM_TYPE,
@@ -136,4 +138,6 @@ def surface_uv(geo, prim, tri, b1, b2, p):
         return _box_uv(P, prim, p)
     if typ == SHAPE_FRUSTUM:
         return _frustum_uv(P, prim, p)
+    if has_extras(geo) and typ >= FIRST_EXTRA_SHAPE:  # the torus (kernels/torus.py)
+        return extra_uv_if_extras(geo, prim, p)
     return 0.0, 0.0

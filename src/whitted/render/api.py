@@ -308,6 +308,13 @@ class RenderJob:
         lock = threading.Lock()
         self.rendering = True
 
+        antialias = self.settings.antialias
+        levels = 0
+        if antialias is not None:
+            from ..kernels.adaptive import adaptive_workspace, render_tiles_adaptive
+
+            levels = antialias.levels
+
         next_tile = 0
         most_per_call = max(1, -(-len(tiles) // (64 * lanes)))  # ~64 progress updates a lane
 
@@ -329,6 +336,8 @@ class RenderJob:
             runs. Pixels do not depend on which lane renders them."""
             nonlocal done
             work = lane_workspace(params.max_depth)
+            aa = None if antialias is None else adaptive_workspace(
+                self.tile_size, self.tile_size, levels)
             while True:
                 if self.cancel_token.cancelled:
                     return
@@ -337,8 +346,14 @@ class RenderJob:
                     return
                 part = np.ascontiguousarray(tiles[idx])
                 part_counters = np.zeros((len(idx), N_RAY_KINDS), np.int64)
-                render_tiles(part, self.framebuffer, compiled.geometry, compiled.materials,
-                             lights, params, part_counters, work, 0, 1)
+                if aa is None:
+                    render_tiles(part, self.framebuffer, compiled.geometry, compiled.materials,
+                                 lights, params, part_counters, work, 0, 1)
+                else:  # adaptive anti-aliasing (kernels/adaptive.py)
+                    render_tiles_adaptive(part, self.framebuffer, compiled.geometry,
+                                          compiled.materials, lights, params,
+                                          part_counters, work, aa, float(antialias.threshold),
+                                          levels, 0, 1)
                 with lock:
                     counters[idx] = part_counters
                     done += len(idx)

@@ -29,6 +29,13 @@ class Camera(Strict):
     fov_axis: Literal["x", "y"] = "y"
     projection: Literal["perspective", "orthographic"] = "perspective"
     ortho_height: float = Field(default=2.0, gt=0.0)
+    #: focal blur (POV-Ray's ``aperture`` and ``focal_point``): the diameter of the lens in
+    #: scene units (0: a pinhole, everything sharp) and where it focuses: ``focal_distance``
+    #: along the viewing direction, or the plane through ``focal_point`` facing the camera
+    #: (neither: the look_at point, else 1 unit)
+    aperture: float = Field(default=0.0, ge=0.0, le=1e6)
+    focal_distance: float | None = Field(default=None, gt=0.0, le=1e12)
+    focal_point: Vec3 | None = None
 
     @model_validator(mode="after")
     def _orientation(self) -> Camera:
@@ -40,7 +47,23 @@ class Camera(Strict):
                 raise ValueError("look_at coincides with position")
             if np.linalg.norm(np.cross(forward, self.up)) < 1e-9 * np.linalg.norm(forward):
                 raise ValueError("up is parallel to the viewing direction")
+        if self.focal_distance is not None and self.focal_point is not None:
+            raise ValueError("give either focal_distance or focal_point, not both")
+        if self.focal_point is not None:
+            forward = self.basis()[2]
+            if not np.dot(np.subtract(self.focal_point, self.position), forward) > 0.0:
+                raise ValueError("focal_point is not in front of the camera")
         return self
+
+    def focus(self) -> float:
+        """Distance along the viewing direction of the plane in focus."""
+        _, _, forward = self.basis()
+        if self.focal_distance is not None:
+            return float(self.focal_distance)
+        point = self.focal_point if self.focal_point is not None else self.look_at
+        if point is None:
+            return 1.0
+        return float(np.dot(np.subtract(point, self.position), forward))
 
     def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Unit (right, up, forward) vectors of the camera in world space."""

@@ -18,7 +18,7 @@ from ..errors import SceneError, shorten
 _UNION_TAGS = {"str", "int", "float", "bool", "Material", "Transform", "Gradient", "AxisAngle"}
 _SHAPE_AND_LIGHT_TAGS = {
     "sphere", "plane", "rectangle", "disk", "triangle", "box", "cylinder", "cone", "mesh",
-    "image", "checker", "gradient",
+    "torus", "csg", "image", "checker", "gradient",
     "ambient", "point", "directional",
 }
 

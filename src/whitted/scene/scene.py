@@ -20,6 +20,24 @@ MAX_PIXELS = 100_000_000
 MAX_DEPTH = 64
 
 
+class Antialias(Strict):
+    """Adaptive anti-aliasing (``[render.antialias]``, POV-Ray's method 2: ``+A0.3 +AM2
+    +R3`` is ``threshold = 0.3, max_samples = 81``): a pixel's corners are traced, and a
+    pixel (then each of its quarters) whose corners differ by more than ``threshold`` (the
+    sum of the red, green and blue differences, 0..3) is split, while a square of it may
+    still take (2^k + 1)^2 <= ``max_samples`` samples."""
+
+    threshold: float = Field(default=0.3, ge=0.0, le=3.0)
+    max_samples: int = Field(default=81, ge=4, le=1089)
+
+    @property
+    def levels(self) -> int:
+        """Splits a pixel may take: the most whose grid, (2^levels + 1)^2 points, stays
+        within ``max_samples`` (POV-Ray's ``+R``)."""
+        levels = 0
+        while ((1 << (levels + 1)) + 1) ** 2 <= self.max_samples:
+            levels += 1
+        return levels
 MAX_PHOTONS = 50_000_000  # photons per pass
 MAX_PASSES = 4096
 
@@ -59,10 +77,14 @@ class RenderSettings(Strict):
     transfer: Literal["srgb", "linear"] = "srgb"
     tonemap: Literal["clamp", "reinhard", "aces"] = "clamp"
     mesh_tracer: Literal["auto", "whitted", "embree"] = "auto"
+    antialias: Antialias | None = None
     caustics: CausticsSettings = Field(default_factory=CausticsSettings)
 
     @model_validator(mode="after")
     def _size(self) -> RenderSettings:
+        if self.antialias is not None and self.samples > 1:
+            raise ValueError("antialias chooses the samples of each pixel: leave samples "
+                             "at 1 with [render.antialias]")
         if self.width * self.height > MAX_PIXELS:
             raise ValueError(
                 f"{self.width}x{self.height} is over {MAX_PIXELS // 1_000_000} megapixels"
@@ -111,14 +133,19 @@ class Scene(Strict):
 
     @model_validator(mode="after")
     def _material_names_resolve(self) -> Scene:
-        for i, obj in enumerate(self.objects):
-            name = obj.material
-            if isinstance(name, str) and name not in self.materials and name not in PRESETS:
-                known = sorted(set(self.materials) | set(PRESETS))
-                raise ValueError(
-                    f"objects[{i}].material: unknown material {name!r}"
-                    f" (known: {', '.join(known)})"
-                )
+        def check(objects, where: str) -> None:
+            for i, obj in enumerate(objects):
+                name = obj.material
+                if isinstance(name, str) and name not in self.materials and name not in PRESETS:
+                    known = sorted(set(self.materials) | set(PRESETS))
+                    raise ValueError(
+                        f"{where}[{i}].material: unknown material {name!r}"
+                        f" (known: {', '.join(known)})"
+                    )
+                if obj.type == "csg":  # the children of a CSG object, to any depth
+                    check(obj.objects, f"{where}[{i}].objects")
+
+        check(self.objects, "objects")
         return self
 
     @model_validator(mode="after")

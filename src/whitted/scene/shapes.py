@@ -144,6 +144,15 @@ class Cone(_Shape):
         return self
 
 
+class Torus(_Shape):
+    """A torus around the object's y axis through its origin (POV-Ray's ``torus``): the circle
+    of ``major_radius`` in the xz plane, swept by a tube of ``minor_radius``."""
+
+    type: Literal["torus"] = "torus"
+    major_radius: float = Field(gt=0.0, le=1e12)
+    minor_radius: float = Field(gt=0.0, le=1e12)
+
+
 class ArrayData:
     """An immutable NumPy array inside a scene model: compares by value, saves as a list."""
 
@@ -300,7 +309,76 @@ class Mesh(_Shape):
         return self
 
 
+CSG_OPERATIONS = ("union", "intersection", "difference", "merge")
+CSG_MAX_SOLIDS = 63  # kernels/layout.py CSG_MAX_ROWS: the walk keeps its states in int64 bits
+
+
+class CSG(_Shape):
+    """Constructive solid geometry (POV-Ray's ``union``, ``intersection``, ``difference`` and
+    ``merge``) of solid ``objects``: spheres, boxes, capped cylinders and cones, tori and
+    other CSG objects, to any depth. ``difference`` is the first object minus all the others;
+    ``merge`` is a union without its inner surfaces (for glass). Meshes take part when they
+    are closed (every edge shared by two triangles; checked when the scene is compiled) and
+    small (at most 65,536 triangles: each is tested in turn). ``material`` is used by the
+    children that have none; ``transform`` places the whole. Each surface keeps its child's
+    material (a difference's cut shows the material of the object that cut it), and the
+    solid is one body for refraction and absorption: its medium is its own ``material`` (or,
+    unset, its first child's)."""
+
+    type: Literal["csg"] = "csg"
+    operation: Literal["union", "intersection", "difference", "merge"]
+    objects: list[Shape] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _solid_children(self) -> CSG:
+        for k, child in enumerate(self.objects):
+            what = child.name or child.type
+            if isinstance(child, Plane | Rectangle | Disk | Triangle):
+                raise ValueError(f"objects[{k}] ({what}): a {child.type} bounds no volume, "
+                                 "so it cannot take part in CSG")
+            if isinstance(child, Cylinder | Cone) and not child.capped:
+                raise ValueError(f"objects[{k}] ({what}): an uncapped {child.type} is open, "
+                                 "so it cannot take part in CSG")
+            if isinstance(child, Mesh) and not child.solid:
+                raise ValueError(f"objects[{k}] ({what}): a mesh with solid = false bounds "
+                                 "no volume, so it cannot take part in CSG")
+        leaves, rows = self.leaves(), self.rows()
+        if leaves > CSG_MAX_SOLIDS or rows > CSG_MAX_SOLIDS:
+            raise ValueError(f"a CSG object holds at most {CSG_MAX_SOLIDS} solids and "
+                             f"operations together; this one has {leaves} solids in "
+                             f"{rows - leaves} operations")
+        return self
+
+    def rows(self) -> int:
+        """Solids and operations in the tree (its compiled rows after the object's own)."""
+        return 1 + sum(c.rows() if isinstance(c, CSG) else 1 for c in self.objects)
+
+    def tree_lines(self, indent: str = "    ") -> list[str]:
+        """The tree under this object, one line per child (nested children indented
+        further): its index path, type, name and material."""
+        lines = []
+
+        def walk(node: CSG, prefix: str, depth: int) -> None:
+            for k, child in enumerate(node.objects):
+                mat = (child.material if isinstance(child.material, str)
+                       else "inline" if child.material is not None else "inherited")
+                label = f" '{child.name}'" if child.name else ""
+                extra = f" {child.operation}" if isinstance(child, CSG) else ""
+                lines.append(f"{indent * depth}{prefix}[{k}] {child.type}{extra}{label} "
+                             f"material={mat}")
+                if isinstance(child, CSG):
+                    walk(child, f"{prefix}[{k}].objects", depth + 1)
+
+        walk(self, "objects", 1)
+        return lines
+
+    def leaves(self) -> int:
+        """Solids at the bottom of the tree (every nested CSG opened)."""
+        return sum(c.leaves() if isinstance(c, CSG) else 1 for c in self.objects)
+
+
 Shape = Annotated[
-    Sphere | Plane | Rectangle | Disk | Triangle | Box | Cylinder | Cone | Mesh,
+    Sphere | Plane | Rectangle | Disk | Triangle | Box | Cylinder | Cone | Torus | Mesh | CSG,
     Field(discriminator="type"),
 ]
+CSG.model_rebuild()

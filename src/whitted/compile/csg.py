@@ -1,0 +1,139 @@
+"""CSG objects -> primitive rows: the object's row (in the scene BVH, with the box of the
+whole), then its tree in postfix order, leaves as ordinary solid rows and operations as
+``SHAPE_CSG_OP`` rows (see kernels/csg.py for the walk that reads them).
+
+Materials follow POV-Ray: a child without a material takes the nearest enclosing CSG
+object's, and every surface shows its own leaf's material (so the cut of a difference shows
+the material of the object that cut it). The whole object is one body for refraction and
+absorption: its medium is its own material, or, when it has none, its first leaf's.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import SceneError
+from ..kernels.layout import (
+    CSG_DIFFERENCE,
+    CSG_INTERSECTION,
+    CSG_MERGE,
+    CSG_UNION,
+    SHAPE_CSG,
+    SHAPE_CSG_MESH,
+    SHAPE_CSG_OP,
+)
+from ..kernels.mesh import OPAQUE_KT
+from ..scene.shapes import CSG, Mesh
+from .primitives import PrimitiveRows
+from .shapes import add_shape
+
+CSG_MESH_LIMIT = 65_536  # triangles of a mesh in CSG (tested one by one, no BVH)
+OPERATION_CODES = {"union": CSG_UNION, "intersection": CSG_INTERSECTION,
+                   "difference": CSG_DIFFERENCE, "merge": CSG_MERGE}
+
+
+def _transform(shape) -> np.ndarray:
+    return shape.transform.matrix() if shape.transform is not None else np.eye(4)
+
+
+def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, obj: int,
+            default_material, mesh_source=None, emit_mesh=None) -> None:
+    """Append CSG object ``shape`` (world matrix ``m``) as rows of ``b``. ``resolve`` maps a
+    material reference to a Material, ``material_row`` a Material to its table row;
+    ``default_material`` is the object's resolved material (used by children without).
+    ``mesh_source(child, where)`` loads a mesh child (a ``MeshSource``);
+    ``emit_mesh(source, child, matrix, material)`` appends its triangles as rows and returns
+    (first row, count). An open mesh, or one too big, is a SceneError naming it."""
+    root = b.rows
+    b.add(SHAPE_CSG, [0.0] * 8, np.zeros(3), np.zeros(3), material=0, obj=obj, solid=True)
+    root_block = len(b.blocks) - 1
+    leaves: list[tuple[int, object, int]] = []  # (row, Material, flip)
+
+    meshes: list[tuple] = []
+
+    def walk(node: CSG, matrix: np.ndarray, inherited, flip: int, where: str):
+        """Rows of ``node``'s subtree; returns its bounds (lo, hi), None when empty."""
+        boxes = []
+        for k, child in enumerate(node.objects):
+            cm = matrix @ _transform(child)
+            mat = resolve(child.material) if child.material is not None else inherited
+            cflip = flip ^ (1 if node.operation == "difference" and k > 0 else 0)
+            if isinstance(child, CSG):
+                boxes.append(walk(child, cm, mat, cflip, f"{where}.objects[{k}]"))
+                continue
+            if isinstance(child, Mesh):  # its triangles go after the tree: see below
+                row = b.rows
+                b.add(SHAPE_CSG_MESH, [0.0, 0.0], np.zeros(3), np.zeros(3),
+                      material=material_row(mat), obj=obj, solid=True)
+                b.csg_rows[row] = (0, -1)
+                src = _closed_mesh(mesh_source, child, f"{where}.objects[{k}]")
+                meshes.append((row, len(b.blocks) - 1, src, child, cm, mat))
+                leaves.append((row, mat, cflip))
+                v = np.asarray(src.vertices, np.float64) @ cm[:3, :3].T + cm[:3, 3]
+                boxes.append((v.min(axis=0), v.max(axis=0)))
+                continue
+            row = b.rows
+            add_shape(b, child, cm, material_row(mat), obj)
+            blk = b.blocks[-1]
+            leaves.append((row, mat, cflip))
+            boxes.append((blk[6][0].copy(), blk[7][0].copy()))
+        b.add(SHAPE_CSG_OP, [float(OPERATION_CODES[node.operation]), float(len(node.objects))],
+              np.zeros(3), np.zeros(3), material=0, obj=obj, solid=False)
+        b.csg_rows[b.rows - 1] = (0, -1)
+        los = np.array([box[0] for box in boxes])
+        his = np.array([box[1] for box in boxes])
+        if node.operation == "intersection":
+            lo, hi = los.max(axis=0), his.min(axis=0)
+            return lo, np.maximum(hi, lo)
+        if node.operation == "difference":
+            return los[0], his[0]
+        return los.min(axis=0), his.max(axis=0)
+
+    lo, hi = walk(shape, m, default_material, 0, f"objects[{obj}]")
+    body_material = default_material if shape.material is not None else leaves[0][1]
+    body = material_row(body_material)
+    for row, _, flip in leaves:
+        b.csg_rows[row] = (flip, body)
+    for row, block, src, child, cm, mat in meshes:
+        first, count = emit_mesh(src, child, cm, mat)
+        b.blocks[block][1][0, :2] = (first, count)
+        flip = b.csg_rows[row][0]
+        for r in range(first, first + count):
+            b.csg_rows[r] = (flip, body)
+    # the object's own row: opaque (for shadow rays) only when every leaf is
+    clear = [mat for _, mat, _ in leaves if mat.kt >= OPAQUE_KT]
+    typ, params, xf, _, objs, solid, _, _ = b.blocks[root_block]
+    params[0, 0] = b.rows - root - 1
+    params[0, 1] = len(leaves)
+    params[0, 2:5] = lo  # the box of the whole: rays that miss it skip the walk
+    params[0, 5:8] = hi
+    material = np.array([material_row(clear[0]) if clear else body], np.int32)
+    b.blocks[root_block] = (typ, params, xf, material, objs, solid, lo.reshape(1, 3),
+                            hi.reshape(1, 3))
+
+
+def _closed_mesh(mesh_source, child: Mesh, where: str):
+    """The mesh child's source, checked: closed, and small enough to test triangle by
+    triangle."""
+    src = mesh_source(child, where)
+    what = f"{where} ({child.name or 'mesh'})"
+    if len(src.faces) == 0:
+        raise SceneError(f"{what}: the mesh has no triangles, so it bounds no volume")
+    if len(src.faces) > CSG_MESH_LIMIT:
+        raise SceneError(f"{what}: {len(src.faces):,} triangles; a mesh in CSG may have at "
+                         f"most {CSG_MESH_LIMIT:,} (each is tested in turn)")
+    holes = open_edges(src.faces)
+    if holes:
+        raise SceneError(f"{what}: the mesh is open ({holes:,} edges not shared by exactly two "
+                         "triangles), so it has no inside for CSG")
+    return src
+
+
+def open_edges(faces: np.ndarray) -> int:
+    """Edges of a triangle mesh not shared by exactly two of its triangles."""
+    f = np.asarray(faces, np.int64)
+    if len(f) == 0:
+        return 0
+    edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    return int(np.sum(counts != 2))

@@ -1,0 +1,128 @@
+"""The shapes beyond the core ones (tori, CSG objects), reached from the scene-level queries
+only in kernels compiled for scenes that have them (features.py ``has_extras``).
+
+Each ``*_if_extras`` function is an overload that resolves, while its caller is typed, to the
+real kernel or to a stand-in of the same types, so the kernels of the default scene never
+compile the torus's quartic or the CSG walk."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .csg import csg_hit
+from .features import extras_possible
+from .intersect import INF
+from .jit import kernel, overload
+from .layout import PRIM_FLIP, PRIM_MEDIUM, PRIM_TYPE, SHAPE_CSG, SHAPE_TORUS
+from .torus import intersect_torus, torus_normal, torus_uv
+
+
+@kernel
+def extra_t(geo, i, o, d, tmin, tmax):
+    """Nearest visible crossing in (tmin, tmax) of extra shape ``i`` (``o``, ``d`` in its
+    row's space)."""
+    typ = geo.prim_info[i, PRIM_TYPE]
+    if typ == SHAPE_TORUS:
+        return intersect_torus(geo.prim_params, i, o, d, tmin, tmax)
+    if typ == SHAPE_CSG:
+        t, _ = csg_hit(geo, i, o, d, tmin, tmax)
+        return t
+    return INF
+
+
+def extra_t_if_extras(geo, i, o, d, tmin, tmax):
+    return extra_t(geo, i, o, d, tmin, tmax)
+
+
+@overload(extra_t_if_extras)
+def _extra_t_if_extras(geo, i, o, d, tmin, tmax):
+    if not extras_possible(geo):
+        return lambda geo, i, o, d, tmin, tmax: INF
+    return lambda geo, i, o, d, tmin, tmax: extra_t(geo, i, o, d, tmin, tmax)
+
+
+def csg_hit_if_extras(geo, i, o, d, tmin, tmax):
+    return csg_hit(geo, i, o, d, tmin, tmax)
+
+
+@overload(csg_hit_if_extras)
+def _csg_hit_if_extras(geo, i, o, d, tmin, tmax):
+    if not extras_possible(geo):
+        return lambda geo, i, o, d, tmin, tmax: (INF, np.int64(-1))
+    return lambda geo, i, o, d, tmin, tmax: csg_hit(geo, i, o, d, tmin, tmax)
+
+
+@kernel
+def extra_normal(geo, i, p, n):
+    """Outward normal of extra shape ``i`` at ``p`` (its row's space); ``n``: the core
+    shapes' answer, kept for the others."""
+    if geo.prim_info[i, PRIM_TYPE] == SHAPE_TORUS:
+        return torus_normal(geo.prim_params, i, p)
+    return n
+
+
+def extra_normal_if_extras(geo, i, p, n):
+    return extra_normal(geo, i, p, n)
+
+
+@overload(extra_normal_if_extras)
+def _extra_normal_if_extras(geo, i, p, n):
+    if not extras_possible(geo):
+        return lambda geo, i, p, n: n
+    return lambda geo, i, p, n: extra_normal(geo, i, p, n)
+
+
+@kernel
+def flipped(geo, i, n):
+    """``n`` turned over where primitive ``i`` is the cut of a CSG difference."""
+    if geo.prim_info[i, PRIM_FLIP]:
+        return (-n[0], -n[1], -n[2])
+    return n
+
+
+def flipped_if_extras(geo, i, n):
+    return flipped(geo, i, n)
+
+
+@overload(flipped_if_extras, inline="always")
+def _flipped_if_extras(geo, i, n):
+    if not extras_possible(geo):
+        return lambda geo, i, n: n
+    return lambda geo, i, n: flipped(geo, i, n)
+
+
+def body_medium(geo, i, m):
+    """Material row of the medium behind the surface of primitive ``i`` whose own material
+    is ``m``: a CSG leaf's whole body's, else ``m``."""
+    r = geo.prim_info[i, PRIM_MEDIUM]
+    return m if r < 0 else r
+
+
+@overload(body_medium, inline="always")
+def _body_medium(geo, i, m):
+    if not extras_possible(geo):
+        return lambda geo, i, m: m
+
+    def impl(geo, i, m):
+        r = geo.prim_info[i, PRIM_MEDIUM]
+        return m if r < 0 else r
+
+    return impl
+
+
+@kernel
+def extra_uv(geo, i, p):
+    if geo.prim_info[i, PRIM_TYPE] == SHAPE_TORUS:
+        return torus_uv(geo.prim_params, i, p)
+    return 0.0, 0.0
+
+
+def extra_uv_if_extras(geo, i, p):
+    return extra_uv(geo, i, p)
+
+
+@overload(extra_uv_if_extras)
+def _extra_uv_if_extras(geo, i, p):
+    if not extras_possible(geo):
+        return lambda geo, i, p: (0.0, 0.0)
+    return lambda geo, i, p: extra_uv(geo, i, p)
