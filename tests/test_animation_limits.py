@@ -12,7 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from test_reliability import SCENE, one_line_error, run_main
+from cli_run import one_line_error, run_main
+from test_reliability import SCENE
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 GiB = 1 << 30

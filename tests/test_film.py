@@ -6,9 +6,7 @@ ffmpeg), never after a sleep."""
 from __future__ import annotations
 
 import ast
-import contextlib
 import hashlib
-import io
 import os
 import shutil
 import signal
@@ -23,6 +21,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from PIL import Image as PILImage
 
+from cli_run import run_main
 from whitted.animation import film as film_api
 from whitted.animation.film import (
     FilmPaths,
@@ -33,7 +32,6 @@ from whitted.animation.film import (
     render_film,
 )
 from whitted.animation.frames import frame_digest, is_whitted_frame, read_frame_digest
-from whitted.cli import main as cli_main
 from whitted.errors import OutputError, RenderCancelled, SceneError
 from whitted.output import video
 from whitted.output.video import encode_film
@@ -91,27 +89,6 @@ def _scene(folder: Path, frames: int = 4, texture: str | None = None) -> Path:
 def _digest(folder: Path) -> dict[str, str]:
     return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
             for p in sorted(folder.rglob("*")) if p.is_file()}
-
-
-def run_main(monkeypatch, *args: object, cwd: Path) -> tuple[int, str, str]:
-    """``whitted ARGS`` in this process through the console entry point."""
-    monkeypatch.setattr(cli_main, "EXIT_AT_ONCE_WHEN_ABANDONED", False)
-    out, err = io.StringIO(), io.StringIO()
-    previous_cwd, previous_argv = Path.cwd(), sys.argv
-    os.chdir(cwd)
-    sys.argv = ["whitted", *map(str, args)]
-    code: object = 0
-    try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            try:
-                cli_main.main()
-            except SystemExit as exc:
-                code = exc.code
-    finally:
-        os.chdir(previous_cwd)
-        sys.argv = previous_argv
-    return (code if isinstance(code, int) else 0 if code is None else 1), out.getvalue(), \
-        err.getvalue()
 
 
 def one_line(result: tuple[int, str, str], code: int, *needles: str) -> str:
@@ -249,7 +226,7 @@ def test_animate_never_writes_over_files_whitted_did_not_write(tmp_path, monkeyp
     for k in range(3):
         PILImage.fromarray(np.full((8, 8, 3), 40 * k, np.uint8)).save(photos / f"{k:04d}.png")
     before = _digest(photos)
-    line = one_line(run_main(monkeypatch, "animate", scene, "-o", photos, "-q", cwd=tmp_path),
+    line = one_line(run_main("animate", scene, "-o", photos, "-q", cwd=tmp_path),
                     2, str(photos / "0000.png"), "whitted did not write it")
     assert line.startswith("error: ")
     assert _digest(photos) == before  # nothing changed, nothing added
@@ -257,7 +234,7 @@ def test_animate_never_writes_over_files_whitted_did_not_write(tmp_path, monkeyp
     film = tmp_path / "out.mp4"
     (tmp_path / "out_frames").mkdir()
     (tmp_path / "out_frames" / "0002.png").write_bytes(b"my notes")
-    one_line(run_main(monkeypatch, "animate", scene, "-o", film, "-q", cwd=tmp_path), 2,
+    one_line(run_main("animate", scene, "-o", film, "-q", cwd=tmp_path), 2,
              "0002.png", "whitted did not write it")
     assert sorted(p.name for p in (tmp_path / "out_frames").iterdir()) == ["0002.png"]
     assert not film.exists()
@@ -288,8 +265,8 @@ def test_animate_sweep_export_refuse_to_write_over_their_inputs(tmp_path, monkey
         (["export", scene, "-o", "0000.png"], "is an input of this job"),
         (["animate", scene, "-o", "film.toml.gif"], None),
     ]:
-        result = run_main(monkeypatch, *args, "-q", cwd=tmp_path) if args[0] != "export" \
-            else run_main(monkeypatch, *args, cwd=tmp_path)
+        result = run_main(*args, "-q", cwd=tmp_path) if args[0] != "export" \
+            else run_main(*args, cwd=tmp_path)
         if needle is None:
             assert result[0] == 0, result
         else:
@@ -299,7 +276,7 @@ def test_animate_sweep_export_refuse_to_write_over_their_inputs(tmp_path, monkey
     (tmp_path / "tex.gif").write_bytes(b"GIF89a")
     gif_scene = tmp_path / "gif.toml"
     gif_scene.write_text(scene.read_text().replace("0000.png", "tex.gif"))
-    one_line(run_main(monkeypatch, "animate", gif_scene, "-o", "tex.gif", cwd=tmp_path), 2,
+    one_line(run_main("animate", gif_scene, "-o", "tex.gif", cwd=tmp_path), 2,
              "is an input of this job")
     assert (tmp_path / "tex.gif").read_bytes() == b"GIF89a"
     assert scene.read_bytes() == scene_text
@@ -308,7 +285,7 @@ def test_animate_sweep_export_refuse_to_write_over_their_inputs(tmp_path, monkey
 def test_stefan_film_refuses_to_write_over_its_case_file(tmp_path, monkeypatch):
     case = tmp_path / "case.gif"  # a case file named like a film
     case.write_text("[grid]\ncells = 8\n")
-    one_line(run_main(monkeypatch, "stefan", "film", case, "-o", case, cwd=tmp_path), 2,
+    one_line(run_main("stefan", "film", case, "-o", case, cwd=tmp_path), 2,
              "is an input of this job")
     assert case.read_text() == "[grid]\ncells = 8\n"
     assert not (tmp_path / "case_stefan").exists()
@@ -330,7 +307,7 @@ def test_film_options_checked_before_rendering(tmp_path, monkeypatch, args, need
     scene = _scene(tmp_path)
     film = tmp_path / "f.mp4"
     film.write_bytes(b"a good film")
-    one_line(run_main(monkeypatch, "animate", scene, "-o", "f.mp4", *args, cwd=tmp_path), 2,
+    one_line(run_main("animate", scene, "-o", "f.mp4", *args, cwd=tmp_path), 2,
              needle)
     assert film.read_bytes() == b"a good film"
     assert not (tmp_path / "f_frames").exists()  # nothing rendered
@@ -339,7 +316,7 @@ def test_film_options_checked_before_rendering(tmp_path, monkeypatch, args, need
 def test_a_scene_fps_the_gif_cannot_show_names_the_key(tmp_path, monkeypatch):
     scene = _scene(tmp_path)
     scene.write_text(scene.read_text().replace("fps = 8", "fps = 1e-9"))
-    one_line(run_main(monkeypatch, "animate", scene, "-o", "f.gif", cwd=tmp_path), 2,
+    one_line(run_main("animate", scene, "-o", "f.gif", cwd=tmp_path), 2,
              "animation.fps: must be 0.01 .. 50")
 
 
@@ -383,17 +360,17 @@ def test_a_cancelled_encode_stops_ffmpeg_and_keeps_the_old_film(tmp_path, monkey
 def test_frames_folder_that_is_a_file_and_odd_outputs_are_one_line(tmp_path, monkeypatch):
     scene = _scene(tmp_path)
     (tmp_path / "f_frames").write_text("mine")
-    one_line(run_main(monkeypatch, "animate", scene, "-o", "f.mp4", cwd=tmp_path), 2,
+    one_line(run_main("animate", scene, "-o", "f.mp4", cwd=tmp_path), 2,
              "f_frames: is a file, not a folder for the frames")
     assert (tmp_path / "f_frames").read_text() == "mine"
     (tmp_path / "plain").write_text("mine")
-    one_line(run_main(monkeypatch, "animate", scene, "-o", "plain", cwd=tmp_path), 2,
+    one_line(run_main("animate", scene, "-o", "plain", cwd=tmp_path), 2,
              "plain: is a file, not a folder")
     (tmp_path / "sheet_cells").write_text("mine")
-    one_line(run_main(monkeypatch, "sweep", scene, "-o", "sheet.png", "--set",
+    one_line(run_main("sweep", scene, "-o", "sheet.png", "--set",
                       "objects[ball].radius=0.3,0.4", cwd=tmp_path), 2,
              "sheet_cells: is a file, not a folder")
-    one_line(run_main(monkeypatch, "animate", scene, "-o", "missing/f.mp4", cwd=tmp_path), 2,
+    one_line(run_main("animate", scene, "-o", "missing/f.mp4", cwd=tmp_path), 2,
              "does not exist")
 
 
@@ -462,7 +439,7 @@ def test_the_frame_record_covers_a_models_mtl_and_its_textures(tmp_path):
 def test_stefan_film_options_checked_before_the_solve(tmp_path, monkeypatch, args, needle):
     case = tmp_path / "case.toml"
     case.write_text("[grid]\ncells = 8\n")
-    one_line(run_main(monkeypatch, "stefan", "film", case, "-o", "melt.mp4", *args,
+    one_line(run_main("stefan", "film", case, "-o", "melt.mp4", *args,
                       cwd=tmp_path), 2, needle)
     assert not (tmp_path / "melt_stefan").exists()  # nothing solved
 
@@ -496,7 +473,7 @@ def test_animate_signal_keeps_finished_frames_and_the_old_film(tmp_path, monkeyp
     film = tmp_path / "f.mp4"
     film.write_bytes(b"the old film")
     _signal_after_frames(monkeypatch, signum, 2)
-    line = one_line(run_main(monkeypatch, "animate", scene, "-o", "f.mp4", "-t", "1",
+    line = one_line(run_main("animate", scene, "-o", "f.mp4", "-t", "1",
                              cwd=tmp_path), status, f"{word}: 2 of 5 frames finished",
                     "run the same command again")
     assert "f_frames" in line
@@ -522,7 +499,7 @@ def test_animate_signal_during_the_encode_stops_ffmpeg(tmp_path, monkeypatch, si
             yield frame
 
     monkeypatch.setattr(video, "_frames", frames)
-    one_line(run_main(monkeypatch, "animate", scene, "-o", "f.mp4", "-t", "1", cwd=tmp_path),
+    one_line(run_main("animate", scene, "-o", "f.mp4", "-t", "1", cwd=tmp_path),
              status, "every frame is in", "the film was not encoded")
     assert len(seen) == 1
     assert not seen[0].is_running() or seen[0].status() == psutil.STATUS_ZOMBIE
@@ -536,7 +513,7 @@ def test_animate_signal_during_the_encode_stops_ffmpeg(tmp_path, monkeypatch, si
 def test_sweep_signal_keeps_finished_cells(tmp_path, monkeypatch, signum, status, word):
     scene = _scene(tmp_path)
     _signal_after_frames(monkeypatch, signum, 1)
-    one_line(run_main(monkeypatch, "sweep", scene, "-o", "s.png", "--set",
+    one_line(run_main("sweep", scene, "-o", "s.png", "--set",
                       "objects[ball].radius=0.2,0.3,0.4", "-q", cwd=tmp_path), status,
              f"{word}: 1 of 3 images finished")
     assert sorted(p.name for p in (tmp_path / "s_cells").iterdir()) == ["0.png"]
@@ -561,7 +538,7 @@ def test_stefan_run_sigterm_keeps_saved_times_and_exits_143(tmp_path, monkeypatc
 
     stopped: list[bool] = []
     monkeypatch.setattr(stefan_run, "run_case", run_case)
-    one_line(run_main(monkeypatch, "stefan", "run", case, "-o", "out", "-q", cwd=tmp_path),
+    one_line(run_main("stefan", "run", case, "-o", "out", "-q", cwd=tmp_path),
              143, "terminated: at t = ", "run the same command again")
     assert (tmp_path / "out" / "case.toml").exists()
     assert not [p for p in (tmp_path / "out").rglob("*") if "tmp" in p.name]
@@ -671,6 +648,6 @@ def test_stefan_run_refuses_to_write_over_its_case_file(tmp_path, monkeypatch):
     case = project / "case.toml"
     case.write_text("[grid]\ncells = 12\n")
     os.utime(case, ns=(1, 1))
-    one_line(run_main(monkeypatch, "stefan", "run", case, "-o", project, cwd=tmp_path), 2,
+    one_line(run_main("stefan", "run", case, "-o", project, cwd=tmp_path), 2,
              "case.toml: is an input of this job")
     assert case.stat().st_mtime_ns == 1 and sorted(project.iterdir()) == [case]

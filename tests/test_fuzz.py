@@ -20,7 +20,8 @@ import tomli_w
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from test_reliability import SCENE, run_main
+from cli_run import run_main
+from test_reliability import SCENE
 from whitted.assets import load_mesh
 from whitted.errors import SceneError
 

@@ -8,7 +8,6 @@ line of defence against tracebacks); a few cases need a real process (signals, F
 from __future__ import annotations
 
 import contextlib
-import io
 import json
 import os
 import signal
@@ -26,6 +25,7 @@ import pytest
 from PIL import Image as PILImage
 
 import whitted
+from cli_run import one_line_error, run_main
 from whitted.cli import main as cli_main
 from whitted.errors import (
     ArgumentError,
@@ -66,38 +66,6 @@ edge1 = [4, 0, 0]
 edge2 = [0, 4, 0]
 material = { texture = { type = "image", file = "tex.png" } }
 """
-
-
-def run_main(*args: object, cwd: Path) -> tuple[int, str, str]:
-    """``whitted ARGS`` in this process through the console entry point: (status, out, err)."""
-    out, err = io.StringIO(), io.StringIO()
-    previous_cwd, previous_argv = Path.cwd(), sys.argv
-    os.chdir(cwd)
-    sys.argv = ["whitted", *map(str, args)]
-    code: object = 0
-    try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            try:
-                cli_main.main()
-            except SystemExit as exc:
-                code = exc.code
-    finally:
-        os.chdir(previous_cwd)
-        sys.argv = previous_argv
-    return (code if isinstance(code, int) else 0 if code is None else 1), out.getvalue(), \
-        err.getvalue()
-
-
-def one_line_error(result: tuple[int, str, str], *needles: str) -> str:
-    code, out, err = result
-    assert code == 2, result
-    assert "Traceback" not in err + out
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("error: "), lines[0]
-    for needle in needles:
-        assert needle in lines[0], (needle, lines[0])
-    return lines[0]
 
 
 def write(path: Path, text: str) -> Path:
