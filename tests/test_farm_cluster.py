@@ -341,6 +341,38 @@ def test_a_killed_lone_worker_costs_retries_not_the_film(film_scene, local_frame
         assert (tmp_path / "frames" / f"{k:04d}.png").read_bytes() == local_frames[k]
 
 
+def test_a_local_worker_restarted_by_its_nanny_ignores_ctrl_c_too():
+    """The workers of ``--cluster local:N`` ignore a terminal's Ctrl-C (the client stops
+    them); one its nanny starts again after a kill is a new process, and ignores it too."""
+    from whitted.farm import farm_client
+
+    def handler() -> tuple[int, bool]:  # (the worker's pid, whether it ignores SIGINT)
+        import os
+        import signal
+
+        return os.getpid(), signal.getsignal(signal.SIGINT) == signal.SIG_IGN
+
+    with farm_client("local:1", threads=1) as client:
+        [(first, ignored)] = client.run(handler).values()
+        assert ignored
+        os.kill(first, signal.SIGKILL)
+
+        def restarted_and_ready() -> bool:
+            try:
+                [(pid, _)] = client.run(handler).values()
+                [identity] = workers_of(client).values()
+            except Exception:  # noqa: BLE001 - the nanny is starting it again
+                return False
+            return pid != first and identity.get("resources", {}).get("whitted", 0) > 0
+
+        wait_for(restarted_and_ready, "the nanny to start the worker again")
+        [(second, ignored)] = client.run(handler).values()
+        assert second != first and ignored
+        os.kill(second, signal.SIGINT)  # a terminal's Ctrl-C: nothing happens
+        [(same, ignored)] = client.run(handler).values()
+        assert same == second and ignored
+
+
 def test_losing_every_worker_ends_in_one_line_keeping_the_frames(scheduler, film_scene,
                                                                  tmp_path):
     address, worker, _ = scheduler

@@ -93,8 +93,11 @@ def local_cluster(workers: int, threads: int, dask_threads: int = 1) -> LocalClu
     task rendering with ``threads`` lanes. They ignore Ctrl-C's SIGINT (the client stops them
     itself: a terminal's Ctrl-C reaches every process of its group, and each printed its
     traceback): it is ignored here while they start, and a process started with SIGINT
-    ignored keeps it so (Python and asyncio then install no handler of their own). They log
-    errors only."""
+    ignored keeps it so (Python and asyncio then install no handler of their own). A worker
+    its nanny starts again after a kill is spawned by the nanny, in this process, once the
+    caller's handler is back: :func:`farm_client` registers the
+    :class:`~whitted.farm.probe.WhittedProbe` with ``quiet_interrupt``, which ignores SIGINT
+    in every worker that (re)joins. They log errors only."""
     main = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
     try:
