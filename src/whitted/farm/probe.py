@@ -25,7 +25,8 @@ import sys
 import threading
 
 import cloudpickle
-from distributed import WorkerPlugin
+
+from ._dask import WorkerPlugin
 
 PROBE_NAME = "whitted-probe"
 EVENT_TOPIC = "whitted-worker"  # the topic of the WhittedWorker plugin's events too
