@@ -193,7 +193,6 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
         raise CaseError("holds a run of a different case (use a new folder or --fresh)",
                         file=str(out))
     _atomic_bytes(case_file, case_text.encode())
-    props = case.properties
     frame = grid_frame(case)
     result = RunResult(out, cells=frame.shape)
     air = case.solver_air()
@@ -201,9 +200,9 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
     rows: list[dict]
     if latest is not None:
         with np.load(latest) as z:
-            solver = EnthalpySolver(z["H"], z["kind"], float(z["dx"]), props,
+            solver = EnthalpySolver(z["H"], z["kind"], float(z["dx"]), case.solver_properties(),
                                     faces=case.solver_faces(), air=air, dt=case.time.dt,
-                                    cfl=case.time.cfl,
+                                    cfl=case.time.cfl, convection=case.solver_convection(),
                                     stop_on_breach=case.breach.action == "stop",
                                     time=float(z["time"]))
             solver.steps = int(z["steps"])
@@ -218,8 +217,9 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
         result.resumed_from = solver.time
     else:
         H, kind, cavity, _ = initial_state(case)
-        solver = EnthalpySolver(H, kind, case.dx, props, faces=case.solver_faces(), air=air,
-                                dt=case.time.dt, cfl=case.time.cfl,
+        solver = EnthalpySolver(H, kind, case.dx, case.solver_properties(),
+                                faces=case.solver_faces(), air=air, dt=case.time.dt,
+                                cfl=case.time.cfl, convection=case.solver_convection(),
                                 stop_on_breach=case.breach.action == "stop")
         initial_cavity = float(cavity.sum()) * case.dx ** 3
         index = 0
