@@ -144,18 +144,19 @@ def water_conductivity(t_bulk: float, length: float, k: float, rho_c: float) -> 
 
 
 class CavityConvection:
-    """The cavity water's effective conductivity, refreshed every ``every`` steps from the
-    field: the largest body of all-liquid cells, its mean temperature and its equivalent
-    diameter (6 V / π)^(1/3) as Catton's L, k_eff = k Nu, at most ``k_max`` (the value the
-    time step was chosen for). The kernels have one water conductivity: every all-liquid
-    cell takes the cavity's k_eff (open meltwater drains at once, so in practice the cavity
-    is the only liquid region)."""
+    """The cavity water's effective conductivity, refreshed every ``interval`` seconds of
+    simulated time (a whole number of steps, ``every``) from the field: the largest body of
+    all-liquid cells, its mean temperature and its equivalent diameter (6 V / π)^(1/3) as
+    Catton's L, k_eff = k Nu, at most ``k_max`` (the value the time step was chosen for).
+    The kernels have one water conductivity: every all-liquid cell takes the cavity's k_eff
+    (open meltwater drains at once, so in practice the cavity is the only liquid region)."""
 
-    def __init__(self, k: float, rho_c: float, k_max: float, every: int = 100) -> None:
+    def __init__(self, k: float, rho_c: float, k_max: float, interval: float = 2.0) -> None:
         self.k = float(k)
         self.rho_c = float(rho_c)
         self.k_max = float(k_max)
-        self.every = int(every)
+        self.interval = float(interval)  # s: the solver refreshes k_eff every this often
+        self.every = 1  # steps (set by the solver from its time step)
         self.last = (float("nan"), float("nan"), float(k))  # mean T, L, k_eff
 
     def conductivity(self, H, kind, dx: float, props) -> float:

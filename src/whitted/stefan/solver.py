@@ -116,6 +116,8 @@ class EnthalpySolver:
         # the time step is chosen for its largest value (``props`` carry it)
         self.convection = convection
         self._k_set = False
+        if convection is not None:
+            convection.every = max(1, int(round(convection.interval / self.dt)))
         self.rescale_every = int(rescale_every)
         self.time = float(time)
         self.steps = 0
