@@ -121,7 +121,9 @@ def test_auto_h_and_convection_keys():
     on = case_from_dict({"grid": {"cells": 16}})
     assert on.solver_properties().water.k == pytest.approx(
         cv.largest_conductivity(20.0, 0.024, 0.56, 4.22e6))
-    for bad in ({"air": {"h": "automatic"}}, {"air": {"h": True}},
+    with pytest.raises(CaseError, match='air.h.*use a number .* or "auto"'):
+        case_from_dict({"air": {"h": "automatic"}})
+    for bad in ({"air": {"h": True}}, {"air": {"h": 0.0}}, {"air": {"h": float("nan")}},
                 {"cavity": {"convection": "yes"}}, {"cavity": {"convection": 1}}):
         with pytest.raises(CaseError):
             case_from_dict(bad)

@@ -10,7 +10,7 @@ import tomllib
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from ..errors import SceneError
 from .properties import ICE, LATENT_HEAT, WATER, Phase, Properties
@@ -114,6 +114,13 @@ class Air(_Strict):
     surroundings: _num(ge=-80.0, le=200.0) | None = None
     emissivity: _num(ge=0.0, le=1.0) = 0.97
     relative_humidity: _num(ge=0.0, le=1.0) = 0.3
+
+    @field_validator("h", mode="before")
+    @classmethod
+    def _h_word(cls, value):
+        if isinstance(value, str) and value != "auto":
+            raise ValueError(f'{value!r}: use a number (W/m²K) or "auto"')
+        return value
 
 
 class Table(_Strict):
