@@ -201,8 +201,8 @@ class EnthalpySolver:
                 m = min(n - done, self.convection.every - self.steps % self.convection.every)
                 did = self._run(m)
                 done += did
-                if did < m:
-                    break
+                if did < m or (self.breached and self.stop_on_breach):
+                    break  # a breach (even on a refresh's last step) stops as without
             return done
         return self._run(n)
 
