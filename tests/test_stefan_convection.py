@@ -121,6 +121,10 @@ def test_auto_h_and_convection_keys():
     on = case_from_dict({"grid": {"cells": 16}})
     assert on.solver_properties().water.k == pytest.approx(
         cv.largest_conductivity(20.0, 0.024, 0.56, 4.22e6))
+    # "auto" in air at 0 °C without radiation: no film at all, and no division by zero
+    still = case_from_dict({"air": {"h": "auto", "temperature": 0.0, "emissivity": 0.0},
+                            "grid": {"cells": 16}})
+    assert still.solver_air().h == 0.0
     with pytest.raises(CaseError, match='air.h.*use a number .* or "auto"'):
         case_from_dict({"air": {"h": "automatic"}})
     for bad in ({"air": {"h": True}}, {"air": {"h": 0.0}}, {"air": {"h": float("nan")}},

@@ -250,8 +250,9 @@ KEYS = {
          "breach", "surfaces", "bogus"],
     "ice": ["rho", "c", "k"], "water": ["rho", "c", "k"],
     "block": ["size", "edge_radius", "temperature"],
-    "cavity": ["shape", "radius", "size", "center", "temperature"],
-    "air": ["temperature", "h"], "table": ["contact", "temperature", "h"],
+    "cavity": ["shape", "radius", "size", "center", "temperature", "convection"],
+    "air": ["temperature", "h", "emissivity", "relative_humidity"],
+    "table": ["contact", "temperature", "h"],
     "grid": ["cells"], "time": ["end", "save_every", "dt", "cfl"], "breach": ["action"],
     "surfaces": ["smoothing", "keep"],
 }
@@ -260,7 +261,8 @@ scalars = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),
     st.sampled_from([0.0, -0.0, 1e-300, 1e300, 1e308, 917.0, 0.04, 0.012, 3600.0, 8, 12, 512]),
     st.text(alphabet=string.printable, max_size=8),
-    st.sampled_from(["sphere", "box", "stop", "drain", "adiabatic", "conducting", "917"]))
+    st.sampled_from(["sphere", "box", "stop", "drain", "adiabatic", "conducting", "917",
+                     "auto"]))
 values = st.one_of(scalars, st.lists(scalars, max_size=4))
 
 
