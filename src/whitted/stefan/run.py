@@ -34,7 +34,7 @@ import numpy as np
 from .case import Case, CaseError, case_digest
 from .geometry import GridFrame, grid_frame, initial_state
 from .measures import measure
-from .scene import still_life_scene, write_scene
+from .scene import still_life_scene, void_bubble, write_scene
 from .solver import EnthalpySolver
 from .surfaces import extract_surfaces, write_ply
 
@@ -281,6 +281,25 @@ class FilmFrame:
     inner: str | None
 
 
+def inner_top(path: Path) -> tuple[float, float, float]:
+    """The highest vertex of a cavity surface (PLY, metres): where the void's bubble sits."""
+    import trimesh
+
+    verts = trimesh.load(path, process=False).vertices
+    top = verts[int(verts[:, 1].argmax())]
+    return float(top[0]), float(top[1]), float(top[2])
+
+
+def film_bubbles(out: Path, frames: list[FilmFrame]) -> list:
+    """The void's bubble of each frame (:func:`whitted.stefan.scene.void_bubble`): the
+    series' cavity volume less its water's, under the top of that frame's cavity."""
+    rows = _read_series(Path(out) / "series.csv")
+    return [void_bubble(inner_top(Path(out) / f.inner),
+                        1e-6 * (float(rows[f.index]["cavity_volume_cm3"])
+                                - float(rows[f.index]["water_volume_cm3"])))
+            for f in frames if f.inner is not None]
+
+
 def film_frames(out: Path) -> list[FilmFrame]:
     """The saved times of the run in ``out`` that a film shows, from t = 0 to the end of the
     run: every saved time with an outer surface (in ``drain`` mode the frames after the
@@ -304,13 +323,15 @@ def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, dig
     of one saved time."""
     outer, inner, seconds = _save_surfaces(out, index, solver, case, frame)
     result.surface_seconds.append(seconds)
+    m = measure(solver.H, solver.kind, solver.dx, case.properties, solver.time, initial_cavity,
+                solver.breached)
+    bubble = None if inner is None else [void_bubble(inner_top(out / inner),
+                                                     m.cavity_volume - m.water_volume)]
     text = still_life_scene(None if outer is None else "../" + outer,
                             None if inner is None else "../" + inner, solver.time,
                             width=scene_size[0], height=scene_size[1],
-                            size_cm=100 * max(case.block.size))
+                            size_cm=100 * max(case.block.size), bubbles=bubble)
     write_scene(out / "scenes" / f"frame_{index:04d}.toml", text)
-    m = measure(solver.H, solver.kind, solver.dx, case.properties, solver.time, initial_cavity,
-                solver.breached)
     rows[:] = [r for r in rows if r["time_s"] < solver.time - 1e-9]
     rows.append({"time_s": solver.time, "ice_volume_cm3": m.ice_volume * 1e6,
                  "cavity_volume_cm3": m.cavity_volume * 1e6,
@@ -323,4 +344,5 @@ def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, dig
     result.saved.append(solver.time)
 
 
-__all__ = ["FilmFrame", "RunResult", "asdict", "film_frames", "run_case", "state_files"]
+__all__ = ["FilmFrame", "RunResult", "asdict", "film_bubbles", "film_frames", "inner_top",
+           "run_case", "state_files"]
