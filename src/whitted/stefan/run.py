@@ -34,7 +34,7 @@ import numpy as np
 from .case import Case, CaseError, case_digest
 from .geometry import GridFrame, grid_frame, initial_state
 from .measures import measure
-from .scene import still_life_scene, void_bubble, write_scene
+from .scene import puddle_radius, still_life_scene, void_bubble, write_scene
 from .solver import EnthalpySolver
 from .surfaces import extract_surfaces, write_ply
 
@@ -300,6 +300,24 @@ def film_bubbles(out: Path, frames: list[FilmFrame]) -> list:
             for f in frames if f.inner is not None]
 
 
+def meltwater(case: Case, first: tuple[float, float], now: tuple[float, float]) -> float:
+    """The water that left the block (m³): the ice and cavity water of the start less those
+    of now, in water's volume: (rho_i / rho_w) (V_ice,0 - V_ice) - (V_w - V_w,0)."""
+    ratio = case.ice.rho / case.water.rho
+    return max(0.0, ratio * (first[0] - now[0]) - (now[1] - first[1]))
+
+
+def film_puddles(out: Path, frames: list[FilmFrame], case: Case) -> list[float]:
+    """The meltwater's disc radius of each frame (:func:`whitted.stefan.scene.puddle_radius`)."""
+    rows = _read_series(Path(out) / "series.csv")
+
+    def volumes(row: dict) -> tuple[float, float]:
+        return 1e-6 * float(row["ice_volume_cm3"]), 1e-6 * float(row["water_volume_cm3"])
+
+    return [puddle_radius(meltwater(case, volumes(rows[0]), volumes(rows[f.index])),
+                          case.block.size) for f in frames]
+
+
 def film_frames(out: Path) -> list[FilmFrame]:
     """The saved times of the run in ``out`` that a film shows, from t = 0 to the end of the
     run: every saved time with an outer surface (in ``drain`` mode the frames after the
@@ -327,10 +345,15 @@ def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, dig
                 solver.breached)
     bubble = None if inner is None else [void_bubble(inner_top(out / inner),
                                                      m.cavity_volume - m.water_volume)]
+    first = (m.ice_volume, m.water_volume) if not rows else (
+        1e-6 * float(rows[0]["ice_volume_cm3"]), 1e-6 * float(rows[0]["water_volume_cm3"]))
+    puddle = puddle_radius(meltwater(case, first, (m.ice_volume, m.water_volume)),
+                           case.block.size)
     text = still_life_scene(None if outer is None else "../" + outer,
                             None if inner is None else "../" + inner, solver.time,
                             width=scene_size[0], height=scene_size[1],
-                            size_cm=100 * max(case.block.size), bubbles=bubble)
+                            size_cm=100 * max(case.block.size), bubbles=bubble,
+                            puddles=[puddle])
     write_scene(out / "scenes" / f"frame_{index:04d}.toml", text)
     rows[:] = [r for r in rows if r["time_s"] < solver.time - 1e-9]
     rows.append({"time_s": solver.time, "ice_volume_cm3": m.ice_volume * 1e6,
@@ -344,5 +367,5 @@ def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, dig
     result.saved.append(solver.time)
 
 
-__all__ = ["FilmFrame", "RunResult", "asdict", "film_bubbles", "film_frames", "inner_top",
-           "run_case", "state_files"]
+__all__ = ["FilmFrame", "RunResult", "asdict", "film_bubbles", "film_frames", "film_puddles",
+           "inner_top", "meltwater", "run_case", "state_files"]
