@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -110,7 +111,8 @@ def test_run_writes_everything_and_resumes(tmp_path):
         mesh = trimesh.load(out / "surfaces" / f"outer_{i:04d}.ply")
         assert mesh.is_watertight
         scene = load_scene(out / "scenes" / f"frame_{i:04d}.toml")
-        assert [o.name for o in scene.objects][-2:] == ["ice", "water"]
+        assert [o.name for o in scene.objects][-4:] == ["ice", "water", "void bubble",
+                                                        "meltwater"]
     assert (out / "series.png").stat().st_size > 1000
     summary = json.loads((out / "summary.json").read_text())
     assert summary["breach_time_s"] is None
@@ -149,6 +151,27 @@ def test_film_renders_one_frame_per_saved_time_with_the_time_in_it(tmp_path):
     assert result.exit_code == 0, result.output
     frames = iio.imread(film, index=None)
     assert frames.shape[:3] == (3, 72, 96)
+    # the void's bubble is keyed per frame: its radius from the series (cavity less water)
+    import tomllib
+
+    text = tomllib.loads((tmp_path / "melt_stefan" / "film.toml").read_text())
+    tracks = {t["path"]: [k[1] for k in t["keys"]] for t in text["animation"]["tracks"]}
+    radii = tracks["objects[void bubble].radius"]
+    rows = list(csv.DictReader((tmp_path / "melt_stefan" / "series.csv").open()))
+    for r, row in zip(radii, rows, strict=True):
+        void = float(row["cavity_volume_cm3"]) - float(row["water_volume_cm3"])
+        assert r == pytest.approx(max(1e-4, (3 * void / (4 * math.pi)) ** (1 / 3)), abs=1e-5)
+    assert radii[0] == 1e-4 and radii[-1] > 0.1  # none at first, then 9 % of the melt
+    # the meltwater's disc, 2.7 mm thick: pi (R² - 2²) 0.27 cm = the water that left the
+    # block, (917/1000) (ice lost) - (cavity water gained)
+    puddle = tracks["objects[meltwater].radius"]
+    ice0, w0 = float(rows[0]["ice_volume_cm3"]), float(rows[0]["water_volume_cm3"])
+    assert puddle[0] == 1e-4
+    for r, row in list(zip(puddle, rows, strict=True))[1:]:
+        water = (0.917 * (ice0 - float(row["ice_volume_cm3"]))
+                 - (float(row["water_volume_cm3"]) - w0))
+        assert math.pi * (r * r - 4.0) * 0.27 == pytest.approx(water, rel=1e-3)
+    assert puddle[-1] > puddle[1] > 2.0
     raw = iio.imread(tmp_path / "melt_stefan" / "frames" / "0000.png")
     # the stamped time differs from the raw render in the top-left corner only
     diff = np.abs(frames[0][..., :3].astype(int) - raw[..., :3].astype(int)).sum(axis=2)

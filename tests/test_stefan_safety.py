@@ -136,8 +136,17 @@ def test_the_estimate_of_the_default_case_and_the_allow_large_option(tmp_path):
     case = load_case(REPO / "examples" / "stefan" / "hollow_ice.toml")
     e = budget.estimate(case)
     assert e.shape == (50, 50, 50) and e.cells == 125_000
-    # dt = 0.9 x the limit of 0.833 mm cells (ice: C dx² / (6 k))
-    assert e.dt == pytest.approx(0.9 * 917 * 2100 * (0.04 / 48) ** 2 / (6 * 2.14), rel=0.02)
+    # dt = 0.9 x the limit of 0.833 mm cells, C dx² / (6 a): with cavity.convection the
+    # water's largest effective conductivity (k Nu of 20 °C water, 5.91 W/mK) makes an ice
+    # cell's face to water a = 2 k_i k_eff / (k_i + k_eff) = 3.14 W/mK, above k_i
+    k_eff = case.solver_properties().water.k
+    assert k_eff == pytest.approx(5.91, rel=0.01)
+    face = 2 * 2.14 * k_eff / (2.14 + k_eff)
+    assert e.dt == pytest.approx(0.9 * 917 * 2100 * (0.04 / 48) ** 2 / (6 * face), rel=0.02)
+    plain = case.model_copy(update={"cavity": case.cavity.model_copy(
+        update={"convection": False})})
+    assert budget.estimate(plain).dt == pytest.approx(
+        0.9 * 917 * 2100 * (0.04 / 48) ** 2 / (6 * 2.14), rel=0.02)
     assert e.steps == math.ceil(3600 / e.dt) and e.saves == 31
     long = case.model_copy(update={"time": case.time.model_copy(update={"end": 1e7})})
     with pytest.raises(CaseError, match="time.end"):
@@ -241,8 +250,9 @@ KEYS = {
          "breach", "surfaces", "bogus"],
     "ice": ["rho", "c", "k"], "water": ["rho", "c", "k"],
     "block": ["size", "edge_radius", "temperature"],
-    "cavity": ["shape", "radius", "size", "center", "temperature"],
-    "air": ["temperature", "h"], "table": ["contact", "temperature", "h"],
+    "cavity": ["shape", "radius", "size", "center", "temperature", "convection"],
+    "air": ["temperature", "h", "emissivity", "relative_humidity"],
+    "table": ["contact", "temperature", "h"],
     "grid": ["cells"], "time": ["end", "save_every", "dt", "cfl"], "breach": ["action"],
     "surfaces": ["smoothing", "keep"],
 }
@@ -251,7 +261,8 @@ scalars = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),
     st.sampled_from([0.0, -0.0, 1e-300, 1e300, 1e308, 917.0, 0.04, 0.012, 3600.0, 8, 12, 512]),
     st.text(alphabet=string.printable, max_size=8),
-    st.sampled_from(["sphere", "box", "stop", "drain", "adiabatic", "conducting", "917"]))
+    st.sampled_from(["sphere", "box", "stop", "drain", "adiabatic", "conducting", "917",
+                     "auto"]))
 values = st.one_of(scalars, st.lists(scalars, max_size=4))
 
 

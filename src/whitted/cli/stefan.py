@@ -279,7 +279,7 @@ def film(
     from ..output.video import encode_film
     from ..render.api import CancelToken
     from ..scene import load_scene
-    from ..stefan.run import film_frames
+    from ..stefan.run import film_bubbles, film_frames, film_puddles
     from ..stefan.scene import ABSORPTION_BOOST, still_life_scene, write_scene
 
     started = time.perf_counter()
@@ -304,7 +304,8 @@ def film(
             write_scene(scene_path, still_life_scene(
                 "surfaces/outer_{frame:04d}.ply", "surfaces/inner_{frame:04d}.ply", None,
                 width=width, height=height, size_cm=100 * max(case.block.size), frames=count,
-                fps=fps))
+                fps=fps, bubbles=film_bubbles(work, shown),
+                puddles=film_puddles(work, shown, case)))
             try:
                 scene = load_scene(scene_path)
                 frames = render_film(scene, FilmPaths(None, work / "frames"), fps=fps,

@@ -69,7 +69,7 @@ def time_step(case: Case) -> float:
 
     if case.time.dt is not None:
         return case.time.dt
-    limit = stability_limit(case.properties, case.dx, 3, case.solver_faces(),
+    limit = stability_limit(case.solver_properties(), case.dx, 3, case.solver_faces(),
                             case.solver_air())
     return case.time.cfl * limit
 

@@ -10,7 +10,7 @@ import tomllib
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from ..errors import SceneError
 from .properties import ICE, LATENT_HEAT, WATER, Phase, Properties
@@ -82,13 +82,17 @@ class Block(_Strict):
 
 class Cavity(_Strict):
     """The closed cavity full of water: a sphere of ``radius`` or a box of ``size``, its
-    centre ``center`` relative to the block's centre (off centre allowed)."""
+    centre ``center`` relative to the block's centre (off centre allowed). ``convection``:
+    the water's natural convection as an effective conductivity k Nu(Ra) (Catton's enclosure
+    correlation, Kell's density with its 4 °C maximum: :mod:`whitted.stefan.convection`);
+    false: conduction only."""
 
     shape: Literal["sphere", "box"] = "sphere"
     radius: Positive = 0.012
     size: CavitySize3 = (0.02, 0.02, 0.02)
     center: Vec3 = (0.0, 0.0, 0.0)
     temperature: _num(ge=0.0, le=100.0) = 20.0
+    convection: Annotated[bool, Field(strict=True)] = True
 
     def half_extent(self) -> tuple[float, float, float]:
         if self.shape == "sphere":
@@ -98,16 +102,25 @@ class Cavity(_Strict):
 
 class Air(_Strict):
     """The room: air temperature (°C) and the convective heat transfer coefficient h (W/m²K:
-    about 5-10 still air, 10-25 a gentle draught); radiation with surroundings at
+    about 5-10 still air, 10-25 a gentle draught; ``"auto"``: still air, h per face from
+    natural-convection correlations, :func:`whitted.stefan.convection.face_coefficients`);
+    radiation with surroundings at
     ``surroundings`` °C (default: the air's) for ice of ``emissivity`` (0 turns it off); and
     condensation of the air's vapour at ``relative_humidity`` (0-1; 0 turns it off). See
     :mod:`whitted.stefan.room` and docs/stefan.md."""
 
     temperature: _num(ge=-80.0, le=200.0) = 25.0
-    h: _num(gt=0.0, le=1.0e4) = 20.0
+    h: _num(gt=0.0, le=1.0e4) | Literal["auto"] = 20.0
     surroundings: _num(ge=-80.0, le=200.0) | None = None
     emissivity: _num(ge=0.0, le=1.0) = 0.97
     relative_humidity: _num(ge=0.0, le=1.0) = 0.3
+
+    @field_validator("h", mode="before")
+    @classmethod
+    def _h_word(cls, value):
+        if isinstance(value, str) and value != "auto":
+            raise ValueError(f'{value!r}: use a number (W/m²K) or "auto"')
+        return value
 
 
 class Table(_Strict):
@@ -206,7 +219,7 @@ class Case(_Strict):
         if self.time.dt is not None:
             from .solver import stability_limit
 
-            limit = stability_limit(self.properties, dx, 3, self.solver_faces(),
+            limit = stability_limit(self.solver_properties(), dx, 3, self.solver_faces(),
                                     self.solver_air())
             if self.time.dt > limit:
                 problems.append(("time.dt", f"{self.time.dt:g} s is over the stability limit "
@@ -223,9 +236,49 @@ class Case(_Strict):
         from .solver import Air as SolverAir
 
         a = self.air
+        if a.h == "auto":  # natural convection per face, for the melting surface at 0 °C
+            from .convection import face_coefficients
+
+            films = [outer_film(a.temperature, h, t_sur=a.surroundings,
+                                emissivity=a.emissivity, relative_humidity=a.relative_humidity)
+                     for h in face_coefficients(self.block.size, a.temperature)]
+            return SolverAir(a.temperature, max(f.h for f in films),
+                             tuple((f.h, f.temperature) for f in films))
         film = outer_film(a.temperature, a.h, t_sur=a.surroundings, emissivity=a.emissivity,
                           relative_humidity=a.relative_humidity)
         return SolverAir(film.temperature, film.h)
+
+    def cavity_length(self) -> float:
+        """The cavity's equivalent diameter (6 V / π)^(1/3) (m): Catton's L."""
+        import math
+
+        cav = self.cavity
+        volume = (4.0 / 3.0 * math.pi * cav.radius ** 3 if cav.shape == "sphere"
+                  else cav.size[0] * cav.size[1] * cav.size[2])
+        return (6.0 * volume / math.pi) ** (1.0 / 3.0)
+
+    def solver_properties(self) -> Properties:
+        """The properties the solver steps with: with ``cavity.convection`` the water's
+        conductivity is the largest k_eff the cavity can reach (the time step's bound; the
+        solver refreshes the actual one, :meth:`solver_convection`)."""
+        props = self.properties
+        if not self.cavity.convection:
+            return props
+        from .convection import largest_conductivity
+
+        w = props.water
+        k_max = largest_conductivity(self.cavity.temperature, self.cavity_length(), w.k,
+                                     w.capacity)
+        return Properties(props.ice, Phase(w.rho, w.c, max(w.k, k_max)), props.latent_heat)
+
+    def solver_convection(self):
+        """The solver's cavity convection (None when ``cavity.convection`` is false)."""
+        if not self.cavity.convection:
+            return None
+        from .convection import CavityConvection
+
+        w = self.properties.water
+        return CavityConvection(w.k, w.capacity, self.solver_properties().water.k)
 
     def solver_faces(self):
         from .solver import Faces

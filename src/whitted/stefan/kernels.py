@@ -262,8 +262,8 @@ def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain
                   air_inv_h, air_t, i, j, k, scale, out, m, rescale, occ, is_surface):
     """The boundary heat of one surface cell, added to Hn; drain if it is all liquid and a
     face drains. ``out[m]``: heat in (J/m² of face), drained (J/m³), breach signal, drains.
-    Every air face of a cell carries the same flux: it is computed once and added once per
-    face (the same sum as computing it per face)."""
+    ``air_h``, ``air_inv_h``, ``air_t``: the air's film per face direction (x-, x+, y-, y+,
+    z-, z+; the same six values give the uniform film of before, to the last bit)."""
     out[m, 0] = 0.0
     out[m, 1] = 0.0
     out[m, 2] = 0.0
@@ -275,6 +275,7 @@ def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain
     tc = _temperature(hc, p)
     kc = _conductivity(hc, p)
     outer = 0.0
+    air_faces = 0.0
     n_air = 0
     wet = False
     for face in range(6):
@@ -286,19 +287,16 @@ def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain
                                     hc, dx)
             if d and face_h[face] > 0.0:
                 wet = True
-        elif kn == AIR:
+        elif kn == AIR:  # the air's film of this face's direction (h per face: room.py)
             n_air += 1
-    if n_air > 0:
-        if air_h > 0.0:
-            wet = True
-        f_air = _boundary_flux(air_h, air_inv_h, air_t, True, tc, kc, hc, dx)
-        air_faces = 0.0
-        for _ in range(n_air):
-            air_faces += f_air
-        if air_faces != 0.0:
-            if rescale or scale[m] < 0.0:
-                scale[m] = _surface_scale(H, kind, i, j, k, hl, occ)
-            outer += scale[m] * air_faces
+            if air_h[face] > 0.0:
+                wet = True
+            air_faces += _boundary_flux(air_h[face], air_inv_h[face], air_t[face], True, tc,
+                                        kc, hc, dx)
+    if n_air > 0 and air_faces != 0.0:
+        if rescale or scale[m] < 0.0:
+            scale[m] = _surface_scale(H, kind, i, j, k, hl, occ)
+        outer += scale[m] * air_faces
     hn = Hn[i, j, k] + dt / dx * outer
     Hn[i, j, k] = hn
     out[m, 0] = outer * dt
@@ -347,7 +345,7 @@ def _apply_drains(Hn, kind, surface, scale, out, n_surface, is_surface):
 
 @njit(cache=True)
 def find_surface(kind, face_h, air_h, surface, is_surface):
-    """Fill the surface list: body cells with a face to air (when air_h > 0) or to a grid
+    """Fill the surface list: body cells with a face to air (its direction's air_h > 0) or to a grid
     face with h > 0. Returns its length."""
     nx, ny, nz = kind.shape
     n = 0
@@ -361,7 +359,7 @@ def find_surface(kind, face_h, air_h, surface, is_surface):
                 for face in range(6):
                     ii, jj, kk = _neighbour(i, j, k, face)
                     kn = kind[ii, jj, kk]
-                    if (kn == GHOST and face_h[face] > 0.0) or (kn == AIR and air_h > 0.0):
+                    if (kn == GHOST and face_h[face] > 0.0) or (kn == AIR and air_h[face] > 0.0):
                         hit = True
                 if hit:
                     is_surface[i, j, k] = 1
@@ -401,7 +399,9 @@ def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h
     face_inv_h = np.empty(6)
     for f in range(6):
         face_inv_h[f] = _inverse(face_h[f])
-    air_inv_h = _inverse(air_h)
+    air_inv_h = np.empty(6)
+    for f in range(6):
+        air_inv_h[f] = _inverse(air_h[f])
     g = dt / (dx * dx)
     done = 0
     src = H
@@ -461,7 +461,9 @@ def run_steps_serial(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
     face_inv_h = np.empty(6)
     for f in range(6):
         face_inv_h[f] = _inverse(face_h[f])
-    air_inv_h = _inverse(air_h)
+    air_inv_h = np.empty(6)
+    for f in range(6):
+        air_inv_h[f] = _inverse(air_h[f])
     g = dt / (dx * dx)
     done = 0
     src = H

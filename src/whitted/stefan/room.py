@@ -76,6 +76,8 @@ def outer_film(t_air: float, h: float, *, t_sur: float | None = None,
     h_rad = radiation_coefficient(t_sur, emissivity) if emissivity > 0 else 0.0
     q_cond = condensation_flux(h, t_air, relative_humidity) if relative_humidity > 0 else 0.0
     h_eff = h + h_rad
+    if h_eff == 0.0:  # no film at all ("auto" in air at 0 °C, no radiation)
+        return Film(0.0, t_air, 0.0, 0.0, q_cond)
     return Film(h_eff, (h * t_air + h_rad * t_sur + q_cond) / h_eff, h * t_air, h_rad * t_sur,
                 q_cond)
 

@@ -34,7 +34,7 @@ import numpy as np
 from .case import Case, CaseError, case_digest
 from .geometry import GridFrame, grid_frame, initial_state
 from .measures import measure
-from .scene import still_life_scene, write_scene
+from .scene import puddle_radius, still_life_scene, void_bubble, write_scene
 from .solver import EnthalpySolver
 from .surfaces import extract_surfaces, write_ply
 
@@ -193,7 +193,6 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
         raise CaseError("holds a run of a different case (use a new folder or --fresh)",
                         file=str(out))
     _atomic_bytes(case_file, case_text.encode())
-    props = case.properties
     frame = grid_frame(case)
     result = RunResult(out, cells=frame.shape)
     air = case.solver_air()
@@ -201,9 +200,9 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
     rows: list[dict]
     if latest is not None:
         with np.load(latest) as z:
-            solver = EnthalpySolver(z["H"], z["kind"], float(z["dx"]), props,
+            solver = EnthalpySolver(z["H"], z["kind"], float(z["dx"]), case.solver_properties(),
                                     faces=case.solver_faces(), air=air, dt=case.time.dt,
-                                    cfl=case.time.cfl,
+                                    cfl=case.time.cfl, convection=case.solver_convection(),
                                     stop_on_breach=case.breach.action == "stop",
                                     time=float(z["time"]))
             solver.steps = int(z["steps"])
@@ -218,8 +217,9 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
         result.resumed_from = solver.time
     else:
         H, kind, cavity, _ = initial_state(case)
-        solver = EnthalpySolver(H, kind, case.dx, props, faces=case.solver_faces(), air=air,
-                                dt=case.time.dt, cfl=case.time.cfl,
+        solver = EnthalpySolver(H, kind, case.dx, case.solver_properties(),
+                                faces=case.solver_faces(), air=air, dt=case.time.dt,
+                                cfl=case.time.cfl, convection=case.solver_convection(),
                                 stop_on_breach=case.breach.action == "stop")
         initial_cavity = float(cavity.sum()) * case.dx ** 3
         index = 0
@@ -281,6 +281,43 @@ class FilmFrame:
     inner: str | None
 
 
+def inner_top(path: Path) -> tuple[float, float, float]:
+    """The highest vertex of a cavity surface (PLY, metres): where the void's bubble sits."""
+    import trimesh
+
+    verts = trimesh.load(path, process=False).vertices
+    top = verts[int(verts[:, 1].argmax())]
+    return float(top[0]), float(top[1]), float(top[2])
+
+
+def film_bubbles(out: Path, frames: list[FilmFrame]) -> list:
+    """The void's bubble of each frame (:func:`whitted.stefan.scene.void_bubble`): the
+    series' cavity volume less its water's, under the top of that frame's cavity."""
+    rows = _read_series(Path(out) / "series.csv")
+    return [void_bubble(inner_top(Path(out) / f.inner),
+                        1e-6 * (float(rows[f.index]["cavity_volume_cm3"])
+                                - float(rows[f.index]["water_volume_cm3"])))
+            for f in frames if f.inner is not None]
+
+
+def meltwater(case: Case, first: tuple[float, float], now: tuple[float, float]) -> float:
+    """The water that left the block (m³): the ice and cavity water of the start less those
+    of now, in water's volume: (rho_i / rho_w) (V_ice,0 - V_ice) - (V_w - V_w,0)."""
+    ratio = case.ice.rho / case.water.rho
+    return max(0.0, ratio * (first[0] - now[0]) - (now[1] - first[1]))
+
+
+def film_puddles(out: Path, frames: list[FilmFrame], case: Case) -> list[float]:
+    """The meltwater's disc radius of each frame (:func:`whitted.stefan.scene.puddle_radius`)."""
+    rows = _read_series(Path(out) / "series.csv")
+
+    def volumes(row: dict) -> tuple[float, float]:
+        return 1e-6 * float(row["ice_volume_cm3"]), 1e-6 * float(row["water_volume_cm3"])
+
+    return [puddle_radius(meltwater(case, volumes(rows[0]), volumes(rows[f.index])),
+                          case.block.size) for f in frames]
+
+
 def film_frames(out: Path) -> list[FilmFrame]:
     """The saved times of the run in ``out`` that a film shows, from t = 0 to the end of the
     run: every saved time with an outer surface (in ``drain`` mode the frames after the
@@ -304,13 +341,20 @@ def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, dig
     of one saved time."""
     outer, inner, seconds = _save_surfaces(out, index, solver, case, frame)
     result.surface_seconds.append(seconds)
+    m = measure(solver.H, solver.kind, solver.dx, case.properties, solver.time, initial_cavity,
+                solver.breached)
+    bubble = None if inner is None else [void_bubble(inner_top(out / inner),
+                                                     m.cavity_volume - m.water_volume)]
+    first = (m.ice_volume, m.water_volume) if not rows else (
+        1e-6 * float(rows[0]["ice_volume_cm3"]), 1e-6 * float(rows[0]["water_volume_cm3"]))
+    puddle = puddle_radius(meltwater(case, first, (m.ice_volume, m.water_volume)),
+                           case.block.size)
     text = still_life_scene(None if outer is None else "../" + outer,
                             None if inner is None else "../" + inner, solver.time,
                             width=scene_size[0], height=scene_size[1],
-                            size_cm=100 * max(case.block.size))
+                            size_cm=100 * max(case.block.size), bubbles=bubble,
+                            puddles=[puddle])
     write_scene(out / "scenes" / f"frame_{index:04d}.toml", text)
-    m = measure(solver.H, solver.kind, solver.dx, case.properties, solver.time, initial_cavity,
-                solver.breached)
     rows[:] = [r for r in rows if r["time_s"] < solver.time - 1e-9]
     rows.append({"time_s": solver.time, "ice_volume_cm3": m.ice_volume * 1e6,
                  "cavity_volume_cm3": m.cavity_volume * 1e6,
@@ -323,4 +367,5 @@ def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, dig
     result.saved.append(solver.time)
 
 
-__all__ = ["FilmFrame", "RunResult", "asdict", "film_frames", "run_case", "state_files"]
+__all__ = ["FilmFrame", "RunResult", "asdict", "film_bubbles", "film_frames", "film_puddles",
+           "inner_top", "meltwater", "run_case", "state_files"]

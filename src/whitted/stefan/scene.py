@@ -26,13 +26,52 @@ ICE_ABSORPTION_CM = WATER_ABSORPTION_CM
 FILM_SAMPLES = 4
 
 
+LIFT_CM = 0.005  # the piece is lifted a hair so its base does not coincide with the table
+BUBBLE_MIN_CM = 1e-4  # no void yet: a bubble too small to see (a sphere needs a radius)
+
+
+def void_bubble(top_m: tuple[float, float, float], void_m3: float) -> tuple[tuple[float, ...],
+                                                                           float]:
+    """The void left by the 9 % density difference as one round bubble of air (scene
+    centimetres: centre, radius) just under the top of the cavity's surface ``top_m`` (its
+    highest vertex, metres): it has risen in the water. A real bubble flattens against the
+    wall; a sphere of the void's volume is what is drawn."""
+    import math
+
+    r = max(BUBBLE_MIN_CM, 100.0 * (3.0 * max(0.0, void_m3) / (4.0 * math.pi)) ** (1 / 3))
+    x, y, z = (100.0 * c for c in top_m)
+    return (x, y + LIFT_CM - 1.02 * r, z), r
+
+
+#: a puddle wider than water's capillary length (sqrt(gamma / (rho g)) = 2.7 mm) stands at
+#: e = 2 l_c sin(theta / 2): 2.7 mm for a contact angle of 60° on varnished wood (de Gennes,
+#: Brochard-Wyart & Quéré, *Capillarity and Wetting Phenomena*, 2004, section 2.1.3)
+PUDDLE_CM = 0.27
+
+
+def puddle_radius(water_m3: float, block_size_m: tuple[float, float, float]) -> float:
+    """The meltwater on the table as a disc of water PUDDLE_CM thick centred under the block
+    (scene centimetres): its area beyond the block's inscribed circle holds the water;
+    BUBBLE_MIN_CM (nothing to see) while there is none."""
+    import math
+
+    if water_m3 <= 0.0:
+        return BUBBLE_MIN_CM
+    inner = 50.0 * min(block_size_m[0], block_size_m[2])
+    return math.sqrt(inner ** 2 + 1e6 * water_m3 / PUDDLE_CM / math.pi)
+
+
 def still_life_scene(outer: str | None, inner: str | None, time_s: float | None, *,
                      width: int = 480, height: int = 360, samples: int = FILM_SAMPLES,
                      size_cm: float = 4.0, frames: int | None = None, fps: float = 8.0,
-                     absorption_boost: float = ABSORPTION_BOOST) -> str:
+                     absorption_boost: float = ABSORPTION_BOOST,
+                     bubbles: list[tuple[tuple[float, ...], float]] | None = None,
+                     puddles: list[float] | None = None) -> str:
     """The scene file's text; ``outer``/``inner`` are PLY paths relative to the scene file.
     With ``frames``, an animated scene whose meshes are sequences (``{frame:04d}`` in the
-    names): frame k shows saved time k."""
+    names): frame k shows saved time k. ``bubbles``: the void's bubble (:func:`void_bubble`)
+    in the cavity's water, one per frame (one for a still), keyed per frame in a film;
+    ``puddles``: the meltwater's disc radius on the table (:func:`puddle_radius`), likewise."""
     when = ("one frame per saved time (series.csv has the times)" if time_s is None
             else f"t = {time_s:.0f} s ({time_s / 60:.1f} min)")
     lines = [
@@ -118,10 +157,32 @@ def still_life_scene(outer: str | None, inner: str | None, time_s: float | None,
             *(['outside = "ice"'] if name == "water" else []),  # one surface, two media
             "smooth = true",
             # lifted a hair so the piece's base does not coincide with the table plane
-            "transform = { scale = 100.0, translate = [0.0, 0.005, 0.0] }",
+            f"transform = {{ scale = 100.0, translate = [0.0, {LIFT_CM:g}, 0.0] }}",
         ]
+    if bubbles and inner is not None:  # air (ior 1) inside the water: the media stack
+        (cx, cy, cz), r = bubbles[0]
+        lines += ["", "[[objects]]", 'name = "void bubble"', 'type = "sphere"',
+                  f"center = [{cx:.4f}, {cy:.4f}, {cz:.4f}]", f"radius = {r:.5f}",
+                  "material = { color = [1.0, 1.0, 1.0], ka = 0.0, kd = 0.0, ks = 0.0, "
+                  "kr = 0.0, kt = 1.0, ior = 1.0, fresnel = true }"]
+    if puddles:
+        lines += ["", "[[objects]]", 'name = "meltwater"', 'type = "cylinder"',
+                  "base = [0.0, 0.0, 0.0]", f"top = [0.0, {PUDDLE_CM:g}, 0.0]",
+                  f"radius = {puddles[0]:.4f}", 'material = "water"']
     if frames is not None:
         lines += ["", "[animation]", f"frames = {frames}", f"fps = {fps:g}"]
+        if puddles and len(puddles) > 1:
+            keys = ", ".join(f"[{k}, {r:.4f}]" for k, r in enumerate(puddles))
+            lines += ["", "[[animation.tracks]]", 'path = "objects[meltwater].radius"',
+                      'interpolation = "step"', f"keys = [{keys}]"]
+        if bubbles and inner is not None and len(bubbles) > 1:
+            centres = ", ".join(f"[{k}, [{c[0]:.4f}, {c[1]:.4f}, {c[2]:.4f}]]"
+                                for k, (c, _) in enumerate(bubbles))
+            radii = ", ".join(f"[{k}, {r:.5f}]" for k, (_, r) in enumerate(bubbles))
+            lines += ["", "[[animation.tracks]]", 'path = "objects[void bubble].center"',
+                      'interpolation = "step"', f"keys = [{centres}]",
+                      "", "[[animation.tracks]]", 'path = "objects[void bubble].radius"',
+                      'interpolation = "step"', f"keys = [{radii}]"]
     return "\n".join(lines) + "\n"
 
 

@@ -43,10 +43,21 @@ class Faces:
 
 @dataclass(frozen=True)
 class Air:
-    """The air around the body: its temperature (°C) and heat transfer coefficient h."""
+    """The air around the body: its temperature (°C) and heat transfer coefficient h; or,
+    with ``faces``, a film (h, temperature) per face direction in ``FACE_NAMES`` order
+    (``air.h = "auto"``: natural convection per face, :mod:`whitted.stefan.convection`);
+    ``h`` is then the largest (the stability limit's)."""
 
     temperature: float
     h: float
+    faces: tuple[tuple[float, float], ...] | None = None
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """h and far temperature per face direction (x-, x+, y-, y+, z-, z+)."""
+        if self.faces is None:
+            return np.full(6, float(self.h)), np.full(6, float(self.temperature))
+        return (np.array([float(f[0]) for f in self.faces]),
+                np.array([float(f[1]) for f in self.faces]))
 
 
 def stability_limit(props: Properties, dx: float, dims: int, faces: Faces, air: Air) -> float:
@@ -84,7 +95,7 @@ class EnthalpySolver:
     def __init__(self, H: np.ndarray, kind: np.ndarray, dx: float, props: Properties,
                  faces: Faces | None = None, air: Air | None = None, dt: float | None = None,
                  cfl: float = 0.9, stop_on_breach: bool = True, time: float = 0.0,
-                 rescale_every: int = 8) -> None:
+                 rescale_every: int = 8, convection=None) -> None:
         if H.ndim != 3 or H.shape != kind.shape:
             raise ValueError("H and kind must be 3-D arrays of one shape")
         self.dx = float(dx)
@@ -100,6 +111,13 @@ class EnthalpySolver:
                              f"{self.dt_limit:.4g} s")
         self.dt = float(dt)
         self.stop_on_breach = stop_on_breach
+        # the cavity water's effective conductivity (convection.CavityConvection), refreshed
+        # every ``convection.every`` steps (counted from the start: chunking changes nothing);
+        # the time step is chosen for its largest value (``props`` carry it)
+        self.convection = convection
+        self._k_set = False
+        if convection is not None:
+            convection.every = max(1, int(round(convection.interval / self.dt)))
         self.rescale_every = int(rescale_every)
         self.time = float(time)
         self.steps = 0
@@ -155,6 +173,9 @@ class EnthalpySolver:
         self._face_h = np.asarray(f.h, dtype=np.float64)[order].copy()
         self._face_t = np.asarray(f.temperature, dtype=np.float64)[order].copy()
         self._face_drain = np.asarray(f.drain, dtype=np.uint8)[order].copy()
+        air_h, air_t = self.air.arrays()
+        self._air_h = air_h[order].copy()
+        self._air_t = air_t[order].copy()
 
     def _build_surface(self) -> None:
         cells = max(1, int((self._kindp == 1).sum()))
@@ -162,7 +183,7 @@ class EnthalpySolver:
         self._scale = np.full(cells, -1.0)
         self._is_surface = np.zeros(self._kindp.shape, dtype=np.uint8)
         self._n_surface = np.zeros(1, dtype=np.int64)
-        self._n_surface[0] = kernels.find_surface(self._kindp, self._face_h, float(self.air.h),
+        self._n_surface[0] = kernels.find_surface(self._kindp, self._face_h, self._air_h,
                                                   self._surface, self._is_surface)
 
     # --- time stepping -------------------------------------------------------------------
@@ -170,6 +191,22 @@ class EnthalpySolver:
         """Up to n steps; fewer at the first sign of a breach (checked here on the field: a
         true one sets ``breach_time``; in drain mode the cavity's water open to the air then
         drains, and the next call goes on)."""
+        if self.convection is not None:
+            done = 0
+            while done < n:
+                if self.steps % self.convection.every == 0 or not self._k_set:
+                    self._k_set = True  # (a resumed run refreshes it at once)
+                    self._p[kernels.P_KW] = self.convection.conductivity(
+                        self.H, self.kind, self.dx, self.props)
+                m = min(n - done, self.convection.every - self.steps % self.convection.every)
+                did = self._run(m)
+                done += did
+                if did < m or (self.breached and self.stop_on_breach):
+                    break  # a breach (even on a refresh's last step) stops as without
+            return done
+        return self._run(n)
+
+    def _run(self, n: int) -> int:
         args = ()
         runner = kernels.run_steps_serial
         if self.parallel:  # one slab of x planes per thread
@@ -177,7 +214,7 @@ class EnthalpySolver:
             args = (numba.get_num_threads(),)
         done = runner(self._Hp, self._kindp, self._Hn, self._p, self.dt, self.dx, self._face_h,
                       self._face_t, self._face_drain,
-                      float(self.air.h), float(self.air.temperature), self._surface,
+                      self._air_h, self._air_t, self._surface,
                       self._scale, self._n_surface, self._is_surface, int(n), self.totals,
                       not self.breached, self.rescale_every, self.steps, *args)
         self.steps += done

@@ -211,8 +211,9 @@ def energy_balance(cells: int = 16, t_end: float = 600.0) -> dict:
     case = Case.model_validate({"grid": {"cells": cells},
                                 "table": {"contact": "conducting"}})
     H, kind, _, _ = initial_state(case)
-    solver = EnthalpySolver(H, kind, case.dx, case.properties, faces=case.solver_faces(),
-                            air=case.solver_air())
+    solver = EnthalpySolver(H, kind, case.dx, case.solver_properties(),
+                            faces=case.solver_faces(), air=case.solver_air(),
+                            convection=case.solver_convection())
     solver.advance(t_end)
     change = solver.enthalpy() - solver.initial_enthalpy
     return {"enthalpy_change_J": change, "heat_in_J": solver.heat_in,

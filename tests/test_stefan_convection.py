@@ -1,0 +1,163 @@
+"""Issue 30, natural convection: the air's h per face (``air.h = "auto"``) and the cavity
+water's effective conductivity (``cavity.convection``), each against numbers worked by hand
+from the published correlation (docs/stefan.md, "Natural convection")."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import minimize_scalar
+
+from whitted.stefan import convection as cv
+from whitted.stefan.case import CaseError, case_from_dict
+from whitted.stefan.properties import Properties
+from whitted.stefan.solver import Air, EnthalpySolver
+
+
+def test_auto_h_of_the_default_block_by_hand():
+    # 4 cm block, surface 0 °C, air 25 °C: film 12.5 °C = 285.65 K; Incropera Table A.4
+    # between 250 K (nu 11.44e-6, k 22.3e-3, alpha 15.9e-6, Pr 0.720) and 300 K (15.89e-6,
+    # 26.3e-3, 22.5e-6, 0.707), weight 0.713: nu 14.613e-6, k 25.152e-3, alpha 20.606e-6,
+    # Pr 0.7107. Ra_L = 9.80665 (25/285.65) 0.04³ / (nu alpha) = 1.824e5.
+    ra, pr, k = cv.rayleigh_air(0.0, 25.0, 0.04)
+    assert ra == pytest.approx(1.824e5, rel=2e-3)
+    assert pr == pytest.approx(0.7107, abs=1e-4) and k == pytest.approx(25.152e-3, rel=1e-4)
+    # Churchill & Chu: psi = (1 + (0.492/0.7107)^(9/16))^(8/27) = 1.1928,
+    # Nu = (0.825 + 0.387 Ra^(1/6) / psi)² = 10.68, h = Nu k / L = 6.72 W/m²K
+    assert cv.nusselt_vertical(1.824e5, 0.7107) == pytest.approx(10.68, rel=3e-3)
+    h = cv.face_coefficients((0.04, 0.04, 0.04), 25.0)
+    assert h[0] == h[1] == h[4] == h[5] == pytest.approx(6.72, rel=3e-3)
+    # top (a cold plate's upper face, stable): L = A/P = 0.01 m, Ra = 1.824e5 / 64 = 2850,
+    # Nu = 0.52 Ra^(1/5) = 2.553, h = 6.42; the bottom (its rising side, under overhangs):
+    # Nu = 0.54 Ra^(1/4) = 3.946, h = 9.92 W/m²K
+    assert h[3] == pytest.approx(6.42, rel=3e-3)
+    assert h[2] == pytest.approx(9.92, rel=3e-3)
+    # a warm plate swaps them; no temperature difference, no convection
+    warm = cv.face_coefficients((0.04, 0.04, 0.04), 0.0, t_surface=25.0)
+    assert warm[3] == pytest.approx(h[2], rel=0.02) and warm[2] == pytest.approx(h[3], rel=0.02)
+    assert cv.face_coefficients((0.04, 0.04, 0.04), 5.0, t_surface=5.0) == (0.0,) * 6
+
+
+def test_lloyd_moran_switches_to_the_turbulent_law_above_1e7():
+    assert cv.nusselt_horizontal(1e6, rising=True) == pytest.approx(0.54 * 1e6 ** 0.25)
+    assert cv.nusselt_horizontal(1e9, rising=True) == pytest.approx(0.15 * 1e3)
+
+
+def test_kell_density_has_its_maximum_at_3_98_c():
+    # Kell (1975): 999.8395 kg/m³ at 0 °C, the maximum 999.972 at 3.98 °C, 998.204 at 20 °C,
+    # 958.365 at 100 °C (CRC Handbook: 999.84, 999.97, 998.21, 958.37)
+    best = minimize_scalar(lambda t: -cv.water_density(t), bounds=(0.0, 10.0),
+                           method="bounded", options={"xatol": 1e-6})
+    assert best.x == pytest.approx(3.98, abs=0.01)
+    assert cv.water_density(best.x) == pytest.approx(999.972, abs=1e-3)
+    for t, rho in ((0.0, 999.8395), (20.0, 998.204), (100.0, 958.365)):
+        assert cv.water_density(t) == pytest.approx(rho, abs=2e-3)
+    # Vogel viscosity: 1.0016 mPa s at 20 °C, 1.7914 at 0 °C (CRC), within 1 %
+    assert cv.water_viscosity(20.0) == pytest.approx(1.0016e-3, rel=0.01)
+    assert cv.water_viscosity(0.0) == pytest.approx(1.7914e-3, rel=0.015)
+
+
+def test_catton_enclosure_nusselt_and_the_density_inversion():
+    # Catton: Nu = 0.18 (Pr/(0.2+Pr) Ra)^0.29; Ra = 1e6, Pr = 7: 0.18 (9.722e5)^0.29 = 9.81
+    assert cv.nusselt_enclosure(1e6, 7.0) == pytest.approx(9.81, rel=2e-3)
+    assert cv.nusselt_enclosure(500.0, 7.0) == 1.0  # below its range: conduction
+    # the default cavity (24 mm, water 20 °C, walls 0 °C): Delta rho / rho = 1.636e-3,
+    # nu = 1.3e-6 at 10 °C, alpha = 0.56 / 4.22e6: Ra = 1.28e6, Nu = 10.56, k_eff = 5.9 W/mK
+    ra, pr = cv.rayleigh_water(20.0, 0.024, 0.56, 4.22e6)
+    assert ra == pytest.approx(1.28e6, rel=0.01)
+    assert cv.water_conductivity(20.0, 0.024, 0.56, 4.22e6) == pytest.approx(0.56 * 10.56,
+                                                                             rel=0.01)
+    # near 8 °C the water is as dense as at 0 °C: the buoyancy vanishes (Nu -> 1 region)
+    # and below 4 °C it reverses (the wall's water rises) and the flow resumes, weaker
+    k8 = cv.water_conductivity(8.0, 0.024, 0.56, 4.22e6)
+    k15 = cv.water_conductivity(15.0, 0.024, 0.56, 4.22e6)
+    k2 = cv.water_conductivity(2.0, 0.024, 0.56, 4.22e6)
+    assert k8 < k2 < k15
+    zero = minimize_scalar(lambda t: abs(cv.water_density(t) - cv.water_density(0.0)),
+                           bounds=(5.0, 10.0), method="bounded")
+    assert zero.x == pytest.approx(8.0, abs=0.2)
+    assert cv.water_conductivity(zero.x, 0.024, 0.56, 4.22e6) == 0.56
+
+
+def _column(air: Air, t_end: float = 1200.0, cells: int = 20):
+    """A line of ice at 0 °C along y with two air cells on top: only its y+ face meets air."""
+    kind = np.ones((1, cells + 2, 1), dtype=np.uint8)
+    kind[0, -2:, 0] = 0
+    solver = EnthalpySolver(np.zeros(kind.shape), kind, 1e-3, Properties(), air=air)
+    solver.advance(t_end)
+    return solver
+
+
+def test_the_air_film_is_chosen_per_face_direction():
+    # only the y+ film acts on a column whose top meets the air: the same bits as a uniform
+    # film of the y+ values, whatever the other directions carry (the time step given alike)
+    uniform = _column(Air(20.0, 10.0))
+    faces = ((50.0, 40.0), (50.0, 40.0), (50.0, 40.0), (10.0, 20.0), (50.0, 40.0), (50.0, 40.0))
+    kind = np.ones((1, 22, 1), dtype=np.uint8)
+    kind[0, -2:, 0] = 0
+    per_face = EnthalpySolver(np.zeros(kind.shape), kind, 1e-3, Properties(),
+                              air=Air(20.0, 50.0, faces), dt=uniform.dt)
+    per_face.advance(1200.0)
+    assert np.array_equal(per_face.H, uniform.H)
+    # and it recedes at h dT t / (rho_i L) = 10 * 20 * 1200 / (917 * 333.6e3) = 0.7846 mm
+    melted = float(uniform.liquid_fraction().sum() + (uniform.kind[0, :20, 0] == 0).sum())
+    assert melted * 1e-3 == pytest.approx(10 * 20 * 1200 / (917 * 333.6e3), rel=2e-3)
+
+
+def test_auto_h_and_convection_keys():
+    auto = case_from_dict({"air": {"h": "auto"}, "grid": {"cells": 16}})
+    air = auto.solver_air()
+    hs = cv.face_coefficients(auto.block.size, 25.0)
+    assert air.faces is not None and air.h == max(f[0] for f in air.faces)
+    # each face's film is the room's (radiation, condensation) around its own h
+    from whitted.stefan.room import outer_film
+
+    film = outer_film(25.0, hs[3], relative_humidity=0.3)
+    assert air.faces[3] == pytest.approx((film.h, film.temperature))
+    # a number keeps the uniform film; convection off keeps the conduction-only water
+    plain = case_from_dict({"cavity": {"convection": False}, "grid": {"cells": 16}})
+    assert plain.solver_air().faces is None and plain.solver_convection() is None
+    assert plain.solver_properties() == plain.properties
+    on = case_from_dict({"grid": {"cells": 16}})
+    assert on.solver_properties().water.k == pytest.approx(
+        cv.largest_conductivity(20.0, 0.024, 0.56, 4.22e6))
+    # "auto" in air at 0 °C without radiation: no film at all, and no division by zero
+    still = case_from_dict({"air": {"h": "auto", "temperature": 0.0, "emissivity": 0.0},
+                            "grid": {"cells": 16}})
+    assert still.solver_air().h == 0.0
+    with pytest.raises(CaseError, match='air.h.*use a number .* or "auto"'):
+        case_from_dict({"air": {"h": "automatic"}})
+    for bad in ({"air": {"h": True}}, {"air": {"h": 0.0}}, {"air": {"h": float("nan")}},
+                {"cavity": {"convection": "yes"}}, {"cavity": {"convection": 1}}):
+        with pytest.raises(CaseError):
+            case_from_dict(bad)
+
+
+def test_convection_keeps_the_energy_balance_and_melts_the_cavity_faster():
+    # the default cavity's 20 °C water gives its heat to the wall: with k_eff (Nu about 10)
+    # in tens of seconds, by conduction alone in minutes (r²/(pi² alpha) = 110 s)
+    from whitted.stefan.geometry import initial_state
+
+    grown = {}
+    for on in (False, True):
+        case = case_from_dict({"grid": {"cells": 16}, "cavity": {"convection": on}})
+        H, kind, cavity, _ = initial_state(case)
+        solver = EnthalpySolver(H, kind, case.dx, case.solver_properties(),
+                                faces=case.solver_faces(), air=case.solver_air(),
+                                convection=case.solver_convection())
+        solver.advance(20.0)
+        grown[on] = float((solver.liquid_fraction() * ~cavity).sum())
+        if on:
+            t_mean, length, k_eff = solver.convection.last
+            assert length == pytest.approx(0.024, rel=0.15)
+            assert 0.56 < k_eff <= case.solver_properties().water.k
+            assert 0.0 < t_mean < 20.0
+        solver.advance(240.0)
+        assert abs(solver.energy_error()) < 1e-9 * solver.heat_in
+        if on:  # the water is near 0 °C: weak convection (measured 0.03 °C, k_eff 0.81)
+            assert solver.convection.last[0] < 0.1 and solver.convection.last[2] < 1.5
+        grown[on, "end"] = float((solver.liquid_fraction() * ~cavity).sum())
+    # measured at 16 cells: 52.1 against 15.8 cells' worth after 20 s, but about the same
+    # after 260 s (313 and 304): the water's heat is the same, convection gives it sooner
+    assert grown[True] > 2.0 * grown[False]
+    assert grown[True, "end"] == pytest.approx(grown[False, "end"], rel=0.1)
