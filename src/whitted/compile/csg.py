@@ -107,9 +107,18 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
     params[0, 1] = len(leaves)
     params[0, 2:5] = lo  # the box of the whole: rays that miss it skip the walk
     params[0, 5:8] = hi
+    if shape.operation in ("difference", "intersection"):  # nothing shows outside its first
+        params[0, 8] = first_leaves(shape)                  # operand: tested first
     material = np.array([material_row(clear[0]) if clear else body], np.int32)
     b.blocks[root_block] = (typ, params, xf, material, objs, solid, lo.reshape(1, 3),
                             hi.reshape(1, 3))
+
+
+def first_leaves(shape: CSG) -> int:
+    """Leaves of the first operand of ``shape``."""
+    def count(node) -> int:
+        return sum(count(c) for c in node.objects) if isinstance(node, CSG) else 1
+    return count(shape.objects[0])
 
 
 def _closed_mesh(mesh_source, child: Mesh, where: str):
