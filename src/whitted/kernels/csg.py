@@ -227,6 +227,7 @@ def csg_hit(geo, root, o, d, tmin, tmax):
     next_t = frame_floats()
     next_part = frame_ints()
     rows = frame_ints()
+    next_cos = frame_floats()  # d · the leaf's normal at next_t (NaN: not computed yet)
     inside = np.int64(0)
     alive = np.int64(0)
     leaf = 0
@@ -240,7 +241,9 @@ def csg_hit(geo, root, o, d, tmin, tmax):
         if t < INF:
             if t < tmax:
                 alive = _with_bit(alive, leaf, 1)
-            if dot(d, leaf_normal(geo, part, madd(o, d, t))) > 0.0:
+            cos = dot(d, leaf_normal(geo, part, madd(o, d, t)))
+            next_cos[leaf] = cos  # the walk's crossing there needs it again
+            if cos > 0.0:
                 inside = _with_bit(inside, leaf, 1)  # its first crossing leaves it
         leaf += 1
         if leaf == first_leaves and leaf < n_leaves:  # the rest unknown yet: possible
@@ -263,6 +266,7 @@ def csg_hit(geo, root, o, d, tmin, tmax):
                     t, part = leaf_t(geo, rows[k], o, d, t_cur, tmax)
                     next_t[k] = t
                     next_part[k] = part
+                    next_cos[k] = math.nan
                 if t == INF:
                     alive = _with_bit(alive, k, 0)
                     died = True
@@ -274,7 +278,9 @@ def csg_hit(geo, root, o, d, tmin, tmax):
             break
         if died and not may_show(geo, root, alive | inside):
             break
-        cos = dot(d, leaf_normal(geo, best_row, madd(o, d, best_t)))
+        cos = next_cos[best_leaf]
+        if math.isnan(cos):
+            cos = dot(d, leaf_normal(geo, best_row, madd(o, d, best_t)))
         t_cur = best_t
         if abs(cos) <= GRAZING * d_len:
             continue  # a touch: no state changes, nothing shows
