@@ -237,35 +237,49 @@ def test_no_worker_with_this_whitted_is_one_line_naming_them(scheduler, tmp_path
     message = str(lost.value)
     assert "\n" not in message and message.startswith("no worker can render: ")
     assert f"worker {by_name['other']} runs whitted" in message
-    assert f"worker {by_name['none']} cannot load whitted (ModuleNotFoundError" in message
+    assert (f"worker {by_name['none']} (none) cannot load whitted (ModuleNotFoundError: No "
+            "module named 'whitted'; is whitted[farm] installed there?)") in message
 
 
 # ------------------------------------------------------------------------------ hangs
 
 
-def test_a_worker_without_whitted_joining_mid_film_does_not_hang_it(scheduler, film_scene,
-                                                                   local_frames, tmp_path):
+def test_a_worker_without_whitted_joining_mid_film_is_named_and_does_not_hang_it(
+        scheduler, film_scene, local_frames, tmp_path):
     address, worker, _ = scheduler
     worker("--name", "good", pythonpath=str(SRC))
     joined: list[subprocess.Popen] = []
+    notes: list[str] = []
     with distributed.Client(address) as client:
         client.wait_for_workers(1)
-        ready_cluster(client, WhittedWorker(threads=1), None)
+        ready_cluster(client, WhittedWorker(threads=1), notes.append)
+        assert notes == []
+
+        def missing() -> list[dict]:
+            return [m for _, m in client.get_events("whitted-worker")
+                    if m.get("status") == "missing"]
 
         def join_one(done, total, frame) -> None:
             if joined:
                 return
             joined.append(worker("--name", "bare",
                                  pythonpath=f"{no_whitted(tmp_path)}{os.pathsep}{SRC}"))
-            # the film goes on only once the bare worker has joined (or given up)
-            wait_for(lambda: len(workers_of(client)) == 2 or joined[0].poll() is not None,
-                     "the worker without whitted")
+            # the film goes on only once the client named the bare worker (which then closes
+            # itself at once: it cannot load the whitted plugin)
+            wait_for(lambda: notes or joined[0].poll() is not None,
+                     "the worker without whitted to be named")
 
         result = render_film(client, film_scene, tmp_path / "frames", chunk=1,
-                             progress=join_one)
+                             progress=join_one, note=notes.append)
         good = {w for w, d in workers_of(client).items() if d["name"] == "good"}
+        [event] = missing()
     assert joined and sorted(result.rendered) == list(range(8))
     assert set(result.workers.values()) == good
+    assert event["name"] == "bare"
+    # one line naming it (address and name) and what it lacks, once
+    assert notes == [f"farm: worker {event['worker']} (bare) cannot load whitted "
+                     "(ModuleNotFoundError: No module named 'whitted'; is whitted[farm] "
+                     "installed there?): it gets no tasks"]
     for k in range(8):
         assert (tmp_path / "frames" / f"{k:04d}.png").read_bytes() == local_frames[k]
 
@@ -325,6 +339,38 @@ def test_a_killed_lone_worker_costs_retries_not_the_film(film_scene, local_frame
     assert killed and sorted(result.rendered) == list(range(8))
     for k in range(8):
         assert (tmp_path / "frames" / f"{k:04d}.png").read_bytes() == local_frames[k]
+
+
+def test_a_local_worker_restarted_by_its_nanny_ignores_ctrl_c_too():
+    """The workers of ``--cluster local:N`` ignore a terminal's Ctrl-C (the client stops
+    them); one its nanny starts again after a kill is a new process, and ignores it too."""
+    from whitted.farm import farm_client
+
+    def handler() -> tuple[int, bool]:  # (the worker's pid, whether it ignores SIGINT)
+        import os
+        import signal
+
+        return os.getpid(), signal.getsignal(signal.SIGINT) == signal.SIG_IGN
+
+    with farm_client("local:1", threads=1) as client:
+        [(first, ignored)] = client.run(handler).values()
+        assert ignored
+        os.kill(first, signal.SIGKILL)
+
+        def restarted_and_ready() -> bool:
+            try:
+                [(pid, _)] = client.run(handler).values()
+                [identity] = workers_of(client).values()
+            except Exception:  # noqa: BLE001 - the nanny is starting it again
+                return False
+            return pid != first and identity.get("resources", {}).get("whitted", 0) > 0
+
+        wait_for(restarted_and_ready, "the nanny to start the worker again")
+        [(second, ignored)] = client.run(handler).values()
+        assert second != first and ignored
+        os.kill(second, signal.SIGINT)  # a terminal's Ctrl-C: nothing happens
+        [(same, ignored)] = client.run(handler).values()
+        assert same == second and ignored
 
 
 def test_losing_every_worker_ends_in_one_line_keeping_the_frames(scheduler, film_scene,

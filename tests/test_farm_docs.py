@@ -180,3 +180,121 @@ fps = 12
 path = "camera.position"
 keys = [[0, [0, 1.5, 5]], [3, [3, 1.5, 4]]]
 """
+
+
+# ------------------------------------------------------------------ the container recipe
+
+NOBODY = ["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups"]  # uid/gid nobody
+SRC = Path(__file__).resolve().parents[1] / "src"
+#: runs the command line with a listener of Numba's compile events: one line ``COMPILE
+#: <kernel>`` on stdout for each kernel compiled (a kernel loaded from the cache is not)
+COUNTING = """
+import sys
+from numba.core import event
+
+class Seen(event.Listener):
+    def on_start(self, ev):
+        print("COMPILE", ev.data["dispatcher"].py_func.__qualname__, flush=True)
+    def on_end(self, ev):
+        pass
+
+event.register("numba:compile", Seen())
+from whitted.cli.main import main
+sys.argv[0] = "whitted"
+main()
+"""
+
+
+def dockerfile() -> str:
+    [text] = [text for language, text in blocks() if language == "dockerfile"]
+    return text.replace("\\\n", " ")
+
+
+def as_nobody(args: list[str], env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([*NOBODY, sys.executable, *args], capture_output=True, text=True,
+                          env=env, cwd=cwd, timeout=600)
+
+
+def _snapshot(folder: Path) -> dict[str, tuple[int, int]]:
+    return {str(p.relative_to(folder)): (p.stat().st_size, p.stat().st_mtime_ns)
+            for p in sorted(folder.rglob("*"))}
+
+
+@pytest.fixture
+def open_folder():
+    """A folder in /tmp that the user nobody can enter (pytest's tmp_path is root's only)."""
+    import shutil
+    import tempfile
+
+    folder = Path(tempfile.mkdtemp(prefix="whitted-image-"))
+    folder.chmod(0o755)
+    try:
+        yield folder
+    finally:
+        shutil.rmtree(folder)
+
+
+def test_the_container_recipe_renders_from_its_read_only_cache_as_another_user(open_folder):
+    """The Dockerfile's build steps as written (its warm-up render, its chmod; the image's
+    paths moved into a temporary folder), then renders as another user (nobody, through
+    setpriv) with that cache read-only: the kernels load from it (no compile), nothing is
+    written there, no warning; a kernel the image did not warm (the AOV kernel) is compiled
+    in memory with one warning line, and the render still succeeds."""
+    import shutil
+
+    from whitted import _cache
+    from whitted.render.warm_up import warm_up_kernels
+
+    if os.geteuid() != 0 or shutil.which("setpriv") is None:
+        pytest.skip("needs root and setpriv to run as another user")
+    base = open_folder
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("NUMBA_CACHE_DIR", "XDG_CACHE_HOME", "WHITTED_CACHE_DIR")}
+    env.update(PYTHONPATH=str(SRC), HOME="/nonexistent")  # nobody's home: no cache to fall to
+    probe = as_nobody(["-c", "import numba, whitted"], env, base)
+    if probe.returncode != 0:
+        pytest.skip(f"user nobody cannot run this Python: {probe.stderr.strip()[-200:]}")
+
+    text = dockerfile()
+    [cache_dir] = re.findall(r"^ENV WHITTED_CACHE_DIR=(\S+)$", text, flags=re.M)
+    [build] = [line[4:] for line in text.splitlines()
+               if line.startswith("RUN ") and "whitted render" in line]
+    steps = [shlex.split(step.replace(cache_dir, str(base / "cache"))
+                         .replace("/tmp/warm.png", str(base / "warm.png")))
+             for step in build.split("&&")]
+    assert [s[0] for s in steps] == ["whitted", "rm", "chmod"]  # warm, tidy, read-only
+    # the build's warm-up starts from this session's warm folder (a copy: no cold compile
+    # here), less the AOV kernel, which the recipe's warm-up does not compile
+    warm_up_kernels()
+    session = Path(_cache.prepare().folder)
+    shutil.copytree(session, base / "cache" / session.name,
+                    ignore=shutil.ignore_patterns("whitted.lock", "*render_aovs*"))
+    build_env = dict(env, WHITTED_CACHE_DIR=str(base / "cache"), HOME=os.environ["HOME"])
+    warm = subprocess.run([sys.executable, "-m", *steps[0]], capture_output=True, text=True,
+                          env=build_env, timeout=600)
+    assert warm.returncode == 0 and warm.stderr == "", warm.stderr
+    reference = (base / "warm.png").read_bytes()
+    subprocess.run(steps[2], check=True)  # the recipe's chmod (rm: the next render's -o)
+    folder = base / "cache" / session.name
+    assert not any(p.stat().st_mode & 0o222 for p in folder.rglob("*"))
+    before = _snapshot(folder)
+    out = base / "out"
+    out.mkdir()
+    out.chmod(0o777)
+    run_env = dict(env, WHITTED_CACHE_DIR=str(base / "cache"))
+    args = ["-c", COUNTING, *steps[0][1:]]
+    args[args.index(str(base / "warm.png"))] = str(out / "frame.png")
+
+    run = as_nobody(args, run_env, out)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout == "" and run.stderr == ""  # nothing compiled, no warning
+    assert (out / "frame.png").read_bytes() == reference
+    assert _snapshot(folder) == before
+
+    aov = as_nobody([*args, "--aov", "depth"], run_env, out)  # a kernel the image lacks
+    assert aov.returncode == 0, aov.stderr
+    assert "COMPILE render_aovs" in aov.stdout.splitlines()
+    lines = aov.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        f"warning: kernel cache folder {folder} cannot be written"), aov.stderr
+    assert _snapshot(folder) == before

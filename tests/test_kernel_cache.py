@@ -176,6 +176,54 @@ def test_an_unusable_folder_falls_back_with_one_warning(tmp_path, monkeypatch, c
     assert len(err) == 1 and err[0].startswith(f"warning: kernel cache folder {chosen}")
 
 
+@pytest.mark.parametrize("damaged", [False, True])
+def test_a_warm_folder_that_cannot_be_written_is_loaded_from_as_it_is(tmp_path, monkeypatch,
+                                                                     capsys, damaged):
+    """A container image's cache, read-only and another user's (simulated: its temporary
+    file refused, as the tests may run as root): used read-only, without a word, when its
+    files match their sums; damaged, it cannot be used (one warning; nothing deleted)."""
+    base = tmp_path / "image-cache"
+    folder = base / _cache._folder_name()
+    for sub, names in (("kernels_1", ("a-1.py311.nbi", "a-1.py311.0.nbc")),
+                       ("compile_2", ("b-2.py311.nbi", "b-2.py311.0.nbc"))):
+        (folder / sub).mkdir(parents=True)
+        for k, name in enumerate(names):
+            (folder / sub / name).write_bytes(bytes(range(256)) * (k + 3))
+    _cache.KernelCache(str(folder), own=True, helper=False).seal()
+    if damaged:
+        _flip(folder / "compile_2" / "b-2.py311.0.nbc", 100)
+    files = {p: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+    real = _cache.tempfile.TemporaryFile
+
+    def refuse(*args, dir=None, **kwargs):
+        if dir is not None and str(dir).startswith(str(base)):
+            raise PermissionError(13, "Permission denied")
+        return real(*args, dir=dir, **kwargs)
+
+    monkeypatch.setattr(_cache.tempfile, "TemporaryFile", refuse)
+    monkeypatch.setenv("WHITTED_CACHE_DIR", str(base))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "user"))
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.delenv(_cache.HELPER_ENV, raising=False)
+    monkeypatch.setattr(_cache, "_state", None)
+    monkeypatch.setattr(_cache, "_set_numba_cache_dir", lambda folder: None)
+    state = _cache.prepare()
+    err = capsys.readouterr().err.splitlines()
+    if damaged:
+        assert state.folder == str(tmp_path / "user" / "whitted" / _cache._folder_name())
+        assert not state.read_only
+        assert len(err) == 1 and err[0].startswith(f"warning: kernel cache folder {folder} "
+                                                   "cannot be used (Permission denied; its "
+                                                   "files do not match")
+    else:
+        assert state.folder == str(folder) and state.read_only and err == []
+        state.unsealed = True
+        state.seal()  # nothing to write there: a no-op
+        with state.locked():  # no lock file made
+            pass
+    assert {p: p.read_bytes() for p in folder.rglob("*") if p.is_file()} == files
+
+
 # ------------------------------------------------------------------ renders
 
 

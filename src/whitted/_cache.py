@@ -11,6 +11,16 @@ with ``WHITTED_NUMBA_TUNING=0``); an explicit ``NUMBA_CACHE_DIR`` set by the use
 in one ``warning:`` line and uses the per-user folder instead, or, when that cannot be used
 either, compiles in memory (every run compiles again). Never an error.
 
+**A warm folder this process cannot write** (a container image's cache, baked at build time
+and owned by another user; a shared read-only mount) is used as it is, for loading only
+(:attr:`KernelCache.read_only`), without a word, when it holds whitted's list of sums and
+every file in it matches the list (nothing could be deleted or sealed there). Nothing is
+written to it: no lock, no seal, no marker, no compile helper. A kernel it lacks is compiled
+in memory, with one ``warning:`` line (:func:`read_only_miss`, from kernels/dispatcher.py);
+with stock Numba (no tuned dispatcher, which can load from a folder it cannot write) every
+kernel is, with that same one line. A read-only folder that fails its check is one that
+cannot be used (above).
+
 **Checked before use.** Numba's cache files (``.nbi`` indexes, ``.nbc`` machine code) carry no
 checksum: one flipped bit can crash the process that loads them or give a wrong image. whitted
 keeps a list of their SHA-256 sums (:data:`SUMS`, written by whitted under a lock, whole or not
@@ -106,10 +116,14 @@ def _usable(folder: str) -> str | None:
 class KernelCache:
     """The kernel cache folder this process uses (``folder``; None: compiling in memory)."""
 
-    def __init__(self, folder: str | None, own: bool, helper: bool) -> None:
+    def __init__(self, folder: str | None, own: bool, helper: bool,
+                 read_only: bool = False) -> None:
         self.folder = folder
         self.own = own  # whitted's folder (not one the user named with NUMBA_CACHE_DIR)
         self.helper = helper
+        #: a warm folder this process cannot write: kernels are loaded from it, never saved
+        self.read_only = read_only
+        self.missed = False  # a kernel it lacked was compiled in memory (and said so)
         self._seen: dict[str, tuple[int, int, int]] = {}  # file -> (inode, size, mtime)
         self._lock = threading.RLock()
         self._lock_fd: int | None = None
@@ -121,7 +135,7 @@ class KernelCache:
     def locked(self):
         """Held by one process at a time (and one thread of it), for checking, sealing and
         a cold compile. Without a lock file (it cannot be made) it does nothing."""
-        if self.folder is None or self.helper:
+        if self.folder is None or self.helper or self.read_only:
             yield
             return
         with self._lock:
@@ -262,6 +276,21 @@ class KernelCache:
                 self.seal()
             return damaged
 
+    def intact(self) -> bool:
+        """For a folder used read-only: whether it holds a list of sums that every cache file
+        in it matches (then Numba may load any of them). Changes nothing."""
+        sums, damaged_list = self._read_sums()
+        if damaged_list or not sums:
+            return False
+        files = self._files()
+        for name, st in files.items():
+            entry = sums.get(name)
+            if entry is None or entry[1] != st.st_size \
+                    or self._digest(os.path.join(self.folder, name)) != entry[0]:
+                return False
+            self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
+        return True
+
     def _clear_markers(self) -> None:
         for marker in Path(self.folder).glob("whitted-ready-*"):
             with contextlib.suppress(OSError):
@@ -270,7 +299,7 @@ class KernelCache:
     def seal(self) -> None:
         """Enter in the list the cache files written since this process last looked: new
         ones, and ones replaced by a new file (module docstring)."""
-        if self.folder is None or self.helper:
+        if self.folder is None or self.helper or self.read_only:
             self.unsealed = False
             return
         with self.locked():
@@ -320,6 +349,13 @@ def prepare() -> KernelCache:
             chosen = str(cache_dir())
         folder: str | None = chosen
         problem = _usable(chosen)
+        if problem is not None and not helper and _warm_to_read(chosen):
+            state = KernelCache(chosen, own, helper, read_only=True)
+            if state.intact():  # a warm folder this process cannot write: loaded from only
+                _set_numba_cache_dir(chosen)
+                _state = state
+                return state
+            problem = f"{problem}; its files do not match its list of checksums"
         if problem is not None:
             fallback = str(Path(_user_base()) / _folder_name())
             if fallback != chosen and _usable(fallback) is None:
@@ -342,6 +378,24 @@ def prepare() -> KernelCache:
         state.verify()
         _state = state
         return state
+
+
+def _warm_to_read(folder: str) -> bool:
+    """Whether ``folder`` looks like a warm kernel cache this process can read: a folder
+    with whitted's list of sums in it."""
+    return (os.path.isdir(folder) and os.access(folder, os.R_OK | os.X_OK)
+            and os.access(os.path.join(folder, SUMS), os.R_OK))
+
+
+def read_only_miss(why: str = "") -> None:
+    """A kernel the read-only folder lacks is compiled in memory: say so once a process."""
+    state = _state
+    if state is None or state.missed:
+        return
+    state.missed = True
+    why = why or "it lacks some kernels; warm it with this whitted, docs/farm.md"
+    _warn(f"kernel cache folder {state.folder} cannot be written ({why}): kernels are "
+          "compiled in memory (every run compiles them again)")
 
 
 def configure_kernel_cache() -> str:

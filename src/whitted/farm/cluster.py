@@ -19,7 +19,8 @@ from urllib.parse import urlsplit
 from ..render.api import available_threads
 from ._dask import Client, LocalCluster
 from .errors import ClusterLost, FarmError
-from .watch import Watch, ready_workers
+from .probe import WhittedProbe
+from .watch import Watch, missing_reason, ready_workers
 from .worker import WhittedWorker
 
 #: seconds to wait for a scheduler that does not answer (a refused connection fails at once)
@@ -92,8 +93,11 @@ def local_cluster(workers: int, threads: int, dask_threads: int = 1) -> LocalClu
     task rendering with ``threads`` lanes. They ignore Ctrl-C's SIGINT (the client stops them
     itself: a terminal's Ctrl-C reaches every process of its group, and each printed its
     traceback): it is ignored here while they start, and a process started with SIGINT
-    ignored keeps it so (Python and asyncio then install no handler of their own). They log
-    errors only."""
+    ignored keeps it so (Python and asyncio then install no handler of their own). A worker
+    its nanny starts again after a kill is spawned by the nanny, in this process, once the
+    caller's handler is back: :func:`farm_client` registers the
+    :class:`~whitted.farm.probe.WhittedProbe` with ``quiet_interrupt``, which ignores SIGINT
+    in every worker that (re)joins. They log errors only."""
     main = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
     try:
@@ -110,14 +114,18 @@ def local_cluster(workers: int, threads: int, dask_threads: int = 1) -> LocalClu
 
 
 def ready_cluster(client: Client, plugin: WhittedWorker,
-                  note: Callable[[str], None] | None = None) -> list[str]:
-    """Register ``plugin`` (every worker readied: kernels loaded, or compiled with progress
-    told through ``note``); name each worker that cannot render in one line. Returns the
-    ready workers; raises :class:`ClusterLost` when there is none."""
+                  note: Callable[[str], None] | None = None,
+                  probe: WhittedProbe | None = None) -> list[str]:
+    """Register ``probe`` (default :class:`WhittedProbe`: a worker that cannot import
+    whitted, now or when it joins later, says so before it goes) and ``plugin`` (every worker
+    readied: kernels loaded, or compiled with progress told through ``note``); name each
+    worker that cannot render in one line. Returns the ready workers; raises
+    :class:`ClusterLost` when there is none."""
     watch = Watch(client, note)  # its events: the cold workers' progress, mismatches
     failure = None
     try:
         try:
+            client.register_plugin(probe or WhittedProbe())
             client.register_plugin(plugin)
         except (OSError, TimeoutError) as exc:
             raise watch.lost(exc) from None
@@ -130,12 +138,16 @@ def ready_cluster(client: Client, plugin: WhittedWorker,
         watch.close()
     why = (str(failure) if type(failure) is Exception else f"{type(failure).__name__}: "
            f"{failure}") if failure is not None else ""
-    reasons = []
+    reasons, told = [], []
     for worker in info.get("workers", {}):
         if worker in ready:
             continue
         state = states.get(worker) or {}
-        if state.get("status") == "mismatch":
+        if state.get("status") == "missing":
+            reasons.append(missing_reason(state))
+            if worker in watch.told:  # the watch named it as the probe's event came
+                told.append(reasons[-1])
+        elif state.get("status") == "mismatch":
             reasons.append(f"worker {worker} runs {state['fingerprint']}, not the client's "
                            f"{state['wanted']}")
         else:
@@ -143,7 +155,7 @@ def ready_cluster(client: Client, plugin: WhittedWorker,
     if not ready:
         raise ClusterLost("no worker can render: " + ("; ".join(reasons) or "no workers"))
     for reason in reasons:
-        if note is not None:
+        if note is not None and reason not in told:
             note(f"farm: {reason}: it gets no tasks")
     return ready
 
@@ -194,7 +206,8 @@ def farm_client(cluster: str | None = None, scheduler: str | None = None, *,
                  f"{'s' if total != 1 else ''}) at {client.scheduler.address}, "
                  f"{threads} render thread{'s' if threads != 1 else ''} a task"
                  + (f"; dashboard {link}" if link else ""))
-        ready_cluster(client, WhittedWorker(threads=threads, warm=warm), note)
+        ready_cluster(client, WhittedWorker(threads=threads, warm=warm), note,
+                      WhittedProbe(quiet_interrupt=owned is not None))
         yield client
     finally:
         _close_quietly(client, owned)

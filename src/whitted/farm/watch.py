@@ -73,6 +73,7 @@ class Watch:
         self.started = time.monotonic()
         self._lock = threading.Lock()
         self.states: dict[str, dict[str, Any]] = {}  # worker -> its last plugin event
+        self.told: set[str] = set()  # workers named already (once each)
         self.last_progress: dict[str, float] = {}  # worker -> when it last finished one
         self.seconds: list[float] = []  # each finished frame's (band's) time
         self.first_seen: dict[str, float] = {}
@@ -80,13 +81,14 @@ class Watch:
         self.busy_since: dict[str, float] = {}  # worker -> when it got its newest task
         self.given: dict[tuple[str, str], float] = {}
         self.excluded: set[str] = set()
-        self.told: set[str] = set()
         self.no_worker_since: float | None = None
         self.unplaced: dict[str, float] = {}  # our task key -> since when it is on no worker
         self.frames_per_task = 1
         self.result_seconds = stall_floor  # the longest wait for a finished task's result
         for _, message in client.get_events(EVENT_TOPIC):  # what happened before this job
             self.states[message.get("worker", "?")] = message
+            if message.get("status") == "missing":  # named when it happened
+                self.told.add(message.get("worker", "?"))
         client.subscribe_topic(EVENT_TOPIC, self._on_worker_event)
         client.subscribe_topic(PROGRESS_TOPIC, self._on_progress)
 
@@ -103,7 +105,13 @@ class Watch:
         with self._lock:
             before = self.states.get(worker) or {}
             self.states[worker] = message
-        if message.get("status") == "compiling":  # a cold worker: say so, in tenths
+        if message.get("status") == "missing":  # it cannot load whitted, and is going
+            with self._lock:
+                told = worker in self.told
+                self.told.add(worker)
+            if not told:
+                self.note(f"farm: {missing_reason(message)}: it gets no tasks")
+        elif message.get("status") == "compiling":  # a cold worker: say so, in tenths
             tenth = int(10 * message.get("fraction", 0.0))
             if before.get("status") != "compiling" or int(10 * before["fraction"]) != tenth:
                 self.note(f"farm: worker {worker} is compiling the kernels (a cold cache: "
@@ -286,6 +294,8 @@ class Watch:
                 self.note(f"farm: {line}: it gets no tasks")
 
     def unready_reason(self, worker: str, state: dict[str, Any] | None, now: float) -> str:
+        if state is not None and state.get("status") == "missing":
+            return missing_reason(state)
         if state is not None and state.get("status") == "mismatch":
             return (f"worker {worker} runs {state['fingerprint']}, not the client's "
                     f"{state['wanted']}")
@@ -317,6 +327,16 @@ class Watch:
                       or f"worker {worker} is not ready")
             reasons.append(reason)
         raise ClusterLost("no worker can render: " + "; ".join(reasons))
+
+
+def missing_reason(state: dict[str, Any]) -> str:
+    """What a ``missing`` event of the probe (:mod:`.probe`) says: the worker (its address,
+    and its name when it has another) cannot import whitted, and why."""
+    worker = state.get("worker", "?")
+    name = state.get("name")
+    named = f" ({name})" if name and name != worker else ""
+    return (f"worker {worker}{named} cannot load whitted ({state.get('error', '?')}; is "
+            "whitted[farm] installed there?)")
 
 
 def _first_line(exc: BaseException | None) -> str:

@@ -27,6 +27,9 @@ What the tuned dispatcher does:
   compile order).
 - **One writability check per folder** (:class:`KernelCacheLocator`): Numba checks the cache
   folder (a temporary file) and hashes the source file for each of some 230 dispatchers.
+- **A read-only warm folder** (whitted/_cache.py, ``KernelCache.read_only``): the locator
+  takes it without the writability check (Numba's would refuse it, and every other place),
+  and a failed save there is no error: the kernel is compiled in memory, said once.
 - **Loading without refreshing the compiler's registries**: before it looks in the cache,
   Numba's ``FunctionCache.load_overload`` installs every implementation registry, and the
   NumPy one probes for a BLAS by importing ``scipy.linalg`` (0.25-0.35 s of a warm render's
@@ -39,6 +42,7 @@ What the tuned dispatcher does:
 
 from __future__ import annotations
 
+import contextlib
 import os
 import threading
 import types as pytypes
@@ -54,7 +58,7 @@ PRIVATE_NAMES = (
     "Dispatcher.get_overload (overridden)",
     "Dispatcher.enable_caching (overridden), Dispatcher._cache",
     "numba.core.caching.FunctionCache (subclassed): load_overload, _load_overload, "
-    "_guard_against_spurious_io_errors, _py_func, _impl_class",
+    "_guard_against_spurious_io_errors (overridden), _cache_path, _py_func, _impl_class",
     "numba.core.runtime.rtsys.initialize",
     "numba.core.caching.CompileResultCacheImpl (subclassed): _locator_classes",
     "numba.core.caching.UserProvidedCacheLocator (subclassed): ensure_cache_path, "
@@ -145,7 +149,8 @@ def _make_classes():
         def ensure_cache_path(self):
             path = self.get_cache_path()
             if path not in self._writable:
-                super().ensure_cache_path()  # raises OSError when the folder is not usable
+                if not _read_only(path):  # a read-only warm folder: loaded from only
+                    super().ensure_cache_path()  # OSError when the folder is not usable
                 self._writable.add(path)
 
         def get_source_stamp(self):
@@ -169,8 +174,24 @@ def _make_classes():
         wait_for_helper = None
         _impl_class = KernelCacheImpl
 
+        @contextlib.contextmanager
+        def _guard_against_spurious_io_errors(self):
+            """Numba's guard; in a read-only folder, a file that cannot be written or read
+            is a kernel compiled in memory (said once), not an error."""
+            if not _read_only(self._cache_path):
+                with super()._guard_against_spurious_io_errors():
+                    yield
+                return
+            try:
+                yield
+            except OSError:
+                from .._cache import read_only_miss
+
+                read_only_miss()
+
         def load_overload(self, sig, target_context):
             rtsys.initialize(target_context)  # what loading needs of Numba's refresh
+            data = None
             with self._guard_against_spurious_io_errors():
                 data = self._load_overload(sig, target_context)
             wait = KernelCache.wait_for_helper
@@ -219,6 +240,14 @@ def _make_classes():
 
 
 _twin_lock = threading.Lock()
+
+
+def _read_only(path: str) -> bool:
+    """Whether ``path`` is in the kernel cache folder this process uses read-only."""
+    from .._cache import _state
+
+    return (_state is not None and _state.read_only and _state.folder is not None
+            and os.path.abspath(path).startswith(os.path.abspath(_state.folder)))
 
 
 def kernel_cache_class():

@@ -172,7 +172,16 @@ class Kernel:
                     from .._cache import prepare
                     from .dispatcher import make_dispatcher
 
-                    cache = self.cache and prepare().folder is not None
+                    state = prepare()
+                    cache = self.cache and state.folder is not None
+                    if cache and state.read_only:
+                        from .._cache import read_only_miss
+                        from .dispatcher import tuned
+
+                        if not tuned():  # stock Numba cannot load from a folder it
+                            cache = False  # cannot write: compiled in memory
+                            read_only_miss("stock Numba loads only from a folder it can "
+                                           "write")
                     self._dispatcher = make_dispatcher(self.py_func, self.options,
                                                        self.specialise_constants, cache)
         return self._dispatcher

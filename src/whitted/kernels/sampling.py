@@ -26,9 +26,11 @@ def mix32(x):
 @kernel
 def random01(seed, pixel, sample, dim):
     """Uniform number in [0, 1) determined only by (seed, pixel, sample, dim)."""
-    h = mix32(sample * 0x27D4EB2F + dim)
-    h = mix32(pixel * 0x85EBCA77 + h)
-    h = mix32(seed * 0x9E3779B1 + h)
+    # int(): the products need 64 bits whatever integer type the caller holds (as plain
+    # Python a NumPy int32 would overflow; compiled, the arguments are int64 already)
+    h = mix32(int(sample) * 0x27D4EB2F + dim)
+    h = mix32(int(pixel) * 0x85EBCA77 + h)
+    h = mix32(int(seed) * 0x9E3779B1 + h)
     return h * INV_2_32
 
 
@@ -38,9 +40,11 @@ def random_pair(seed, pixel, sample, dim):
     first as :func:`random01` draws it, the second hashed on from the first. One chain of
     dependent steps: four mixes instead of six, and nothing for the compiler to pack into
     64-bit vector multiplies, which x86 lacks (that doubled the cost of sampling)."""
-    h = mix32(sample * 0x27D4EB2F + dim)
-    h = mix32(pixel * 0x85EBCA77 + h)
-    h = mix32(seed * 0x9E3779B1 + h)
+    # int(): the products need 64 bits whatever integer type the caller holds (as plain
+    # Python a NumPy int32 would overflow; compiled, the arguments are int64 already)
+    h = mix32(int(sample) * 0x27D4EB2F + dim)
+    h = mix32(int(pixel) * 0x85EBCA77 + h)
+    h = mix32(int(seed) * 0x9E3779B1 + h)
     return h * INV_2_32, mix32(h + 0x632BE5AB) * INV_2_32
 
 

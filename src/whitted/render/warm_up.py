@@ -235,7 +235,8 @@ def _start_helper(instances: bool) -> subprocess.Popen | None:
 
     folder = prepare().folder
     if (config.DISABLE_JIT or os.environ.get("WHITTED_COMPILE_HELPER", "1") == "0"
-            or folder is None or len(os.sched_getaffinity(0)) < 2):
+            or folder is None or prepare().read_only  # it could save nothing there
+            or len(os.sched_getaffinity(0)) < 2):
         return None
     # the helper uses this folder (checked here, and locked while it runs)
     env = dict(os.environ, NUMBA_CACHE_DIR=folder, **{HELPER_ENV: "1"})
