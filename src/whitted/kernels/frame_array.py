@@ -9,11 +9,13 @@ the function's entry block, so a loop does not grow the stack).
 
 from __future__ import annotations
 
+import numpy as np
 from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 from numba.np.arrayobj import make_array, populate_array
 
+from .jit import _jit_disabled
 from .layout import CSG_MAX_LEAVES
 
 FRAME_SLOTS = CSG_MAX_LEAVES + 1
@@ -37,12 +39,24 @@ def _frame_array(dtype):
 
 
 @intrinsic
-def frame_floats(typingctx):
-    """``FRAME_SLOTS`` float64 slots in the caller's frame."""
+def _frame_floats(typingctx):
     return _frame_array(types.float64)
 
 
 @intrinsic
-def frame_ints(typingctx):
-    """``FRAME_SLOTS`` int64 slots in the caller's frame."""
+def _frame_ints(typingctx):
     return _frame_array(types.int64)
+
+
+def _new_floats():
+    return np.empty(FRAME_SLOTS)
+
+
+def _new_ints():
+    return np.empty(FRAME_SLOTS, np.int64)
+
+
+# ``frame_floats()``: FRAME_SLOTS float64 slots in the caller's frame; ``frame_ints()``:
+# int64 ones. Kernels run as plain Python (NUMBA_DISABLE_JIT) get new arrays instead.
+frame_floats, frame_ints = ((_new_floats, _new_ints) if _jit_disabled()
+                            else (_frame_floats, _frame_ints))
