@@ -426,3 +426,30 @@ def test_overlapping_children_are_one_body_and_water_fills_the_hole():
     (value,) = _through([block, water], [0.1])
     chord = 2 * math.sqrt(0.25 - 0.01)
     assert value == pytest.approx(math.exp(-0.5 * (2 - chord) - 2.0 * chord), rel=2e-3)
+
+
+def test_a_mesh_leafs_triangles_are_not_walked_as_leaves():
+    # the root row counts the tree's rows only (cube, mesh leaf, difference): the mesh's 12
+    # triangles come after the tree and are reached through the mesh leaf
+    c = Compiled(CSG(operation="difference", objects=[CUBE, _cube_mesh(0.0, 1.0)
+                                                      .model_copy(update={"transform": None})]))
+    assert c.geo.prim_params[0, :2].tolist() == [3.0, 2.0]
+
+
+def test_a_row_of_62_balls_every_crossing_in_order():
+    # the most leaves a CSG object may have (62 and its operation: the walk keeps each
+    # leaf's next crossing in 64 frame slots): a union of 62 balls of radius 0.5 spaced 1.0
+    # apart along x, crossed at z = 0.3 (chords of half-length 0.4 that do not meet); a
+    # difference of the first ball minus a small ball at x = 0.5 and the 60 others (outside
+    # it) shows its front and the cut at x = 0.25
+    balls = [Sphere(center=(float(k), 0.0, 0.0), radius=0.5) for k in range(62)]
+    c = Compiled(CSG(operation="union", objects=balls))
+    ts = c.ts((-10.0, 0.0, 0.3), (1.0, 0.0, 0.0))
+    h = math.sqrt(0.25 - 0.09)
+    assert len(ts) == 124
+    assert ts[:4] == pytest.approx([10 - h, 10 + h, 11 - h, 11 + h], rel=1e-12)
+    assert ts[-1] == pytest.approx(71 + h, rel=1e-12)
+    cut = CSG(operation="difference",
+              objects=[balls[0], Sphere(center=(0.5, 0.0, 0.0), radius=0.25), *balls[2:]])
+    c = Compiled(cut)
+    assert c.ts((-10.0, 0.0, 0.0), (1.0, 0.0, 0.0)) == pytest.approx([9.5, 10.25], rel=1e-12)

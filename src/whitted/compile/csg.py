@@ -90,6 +90,7 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
         return los.min(axis=0), his.max(axis=0)
 
     lo, hi = walk(shape, m, default_material, 0, f"objects[{obj}]")
+    tree_rows = b.rows - root - 1  # the walk reads these; mesh leaves' triangles come after
     body_material = default_material if shape.material is not None else leaves[0][1]
     body = material_row(body_material)
     for row, _, flip in leaves:
@@ -103,13 +104,22 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
     # the object's own row: opaque (for shadow rays) only when every leaf is
     clear = [mat for _, mat, _ in leaves if mat.kt >= OPAQUE_KT]
     typ, params, xf, _, objs, solid, _, _ = b.blocks[root_block]
-    params[0, 0] = b.rows - root - 1
+    params[0, 0] = tree_rows
     params[0, 1] = len(leaves)
     params[0, 2:5] = lo  # the box of the whole: rays that miss it skip the walk
     params[0, 5:8] = hi
+    if shape.operation in ("difference", "intersection"):  # nothing shows outside its first
+        params[0, 8] = first_leaves(shape)                  # operand: tested first
     material = np.array([material_row(clear[0]) if clear else body], np.int32)
     b.blocks[root_block] = (typ, params, xf, material, objs, solid, lo.reshape(1, 3),
                             hi.reshape(1, 3))
+
+
+def first_leaves(shape: CSG) -> int:
+    """Leaves of the first operand of ``shape``."""
+    def count(node) -> int:
+        return sum(count(c) for c in node.objects) if isinstance(node, CSG) else 1
+    return count(shape.objects[0])
 
 
 def _closed_mesh(mesh_source, child: Mesh, where: str):

@@ -34,7 +34,7 @@ import math
 import numpy as np
 
 from .intersect import INF, intersect_local, intersect_triangle, normal_local
-from .jit import kernel
+from .jit import kernel, numba_object
 from .layout import (
     CSG_DIFFERENCE,
     CSG_INTERSECTION,
@@ -49,6 +49,10 @@ from .torus import intersect_torus, torus_normal
 from .traverse import inverse_direction, slab_entry
 from .vec import dot, madd
 from .xform import normal_to_world, to_object
+
+# kernels/frame_array.py is a Numba extension: imported with Numba (kernels/jit.py)
+frame_floats = numba_object(".frame_array", "frame_floats")
+frame_ints = numba_object(".frame_array", "frame_ints")
 
 GRAZING = 1e-9  # |cos| between ray and normal below which a crossing is only a touch
 
@@ -170,49 +174,113 @@ def surface_shows(geo, root, hit_leaf, inside):
 
 
 @kernel
+def may_show(geo, root, possible):
+    """Can CSG object ``root`` still show a surface, given ``possible``: a bit per leaf, 0
+    where the leaf has no crossing left in the walk and the ray is outside it there? (0 for a
+    subtree: it stays outside and shows nothing for the rest of the walk; union and merge
+    need one such operand, intersection every one, difference its first.) One postfix pass."""
+    n_rows = int(geo.prim_params[root, 0])
+    st = np.int64(0)
+    sp = 0
+    leaf = 0
+    for r in range(root + 1, root + 1 + n_rows):
+        if geo.prim_info[r, PRIM_TYPE] != SHAPE_CSG_OP:
+            st = _with_bit(st, sp, _bit(possible, leaf))
+            sp += 1
+            leaf += 1
+            continue
+        op = int(geo.prim_params[r, 0])
+        base = sp - int(geo.prim_params[r, 1])
+        if op == CSG_DIFFERENCE:
+            v = _bit(st, base)
+        elif op == CSG_INTERSECTION:
+            v = np.int64(1)
+            for c in range(base, sp):
+                v &= _bit(st, c)
+        else:
+            v = np.int64(0)
+            for c in range(base, sp):
+                v |= _bit(st, c)
+        st = _with_bit(st, base, v)
+        sp = base + 1
+    return _bit(st, 0) == 1
+
+
+@kernel
 def csg_hit(geo, root, o, d, tmin, tmax):
     """(t, leaf row) of the nearest visible surface of CSG object ``root`` in (tmin, tmax),
-    or (INF, -1)."""
+    or (INF, -1).
+
+    Each leaf's next crossing is kept (``next_t``, ``next_part``) and asked for again only
+    once the walk has reached it: a crossing computed from the ray alone is the same whatever
+    ``tmin`` it was asked from, so the walk sees the crossings the leaves would report if
+    all were asked again at each step. The walk stops as soon as no surface can show
+    (``may_show``), first after the leaves of the root's first operand (a die: the rays
+    that miss its rounded cube skip its pips)."""
     P = geo.prim_params
     if slab_entry(P[root, 2], P[root, 3], P[root, 4], P[root, 5], P[root, 6], P[root, 7], o,
                   inverse_direction(d), tmin, tmax) == INF:
         return INF, np.int64(-1)  # (shadow rays test listed objects without their boxes)
     n_rows = int(P[root, 0])
+    n_leaves = int(P[root, 1])
+    first_leaves = int(P[root, 8])  # leaves of the first operand of a root that needs it
+    next_t = frame_floats()
+    next_part = frame_ints()
+    rows = frame_ints()
+    next_cos = frame_floats()  # d · the leaf's normal at next_t (NaN: not computed yet)
     inside = np.int64(0)
     alive = np.int64(0)
     leaf = 0
     for r in range(root + 1, root + 1 + n_rows):
         if geo.prim_info[r, PRIM_TYPE] == SHAPE_CSG_OP:
             continue
+        rows[leaf] = r
         t, part = leaf_t(geo, r, o, d, tmin, INF)
+        next_t[leaf] = t
+        next_part[leaf] = part
         if t < INF:
             if t < tmax:
                 alive = _with_bit(alive, leaf, 1)
-            if dot(d, leaf_normal(geo, part, madd(o, d, t))) > 0.0:
+            cos = dot(d, leaf_normal(geo, part, madd(o, d, t)))
+            next_cos[leaf] = cos  # the walk's crossing there needs it again
+            if cos > 0.0:
                 inside = _with_bit(inside, leaf, 1)  # its first crossing leaves it
         leaf += 1
+        if leaf == first_leaves and leaf < n_leaves:  # the rest unknown yet: possible
+            untested = ~((np.int64(1) << np.int64(leaf)) - np.int64(1))
+            if not may_show(geo, root, alive | inside | untested):
+                return INF, np.int64(-1)
+    if not may_show(geo, root, alive | inside):
+        return INF, np.int64(-1)
     d_len = math.sqrt(dot(d, d))
     t_cur = tmin
     while alive != 0:
         best_t = INF
         best_row = np.int64(-1)
         best_leaf = -1
-        leaf = 0
-        for r in range(root + 1, root + 1 + n_rows):
-            if geo.prim_info[r, PRIM_TYPE] == SHAPE_CSG_OP:
-                continue
-            if _bit(alive, leaf):
-                t, part = leaf_t(geo, r, o, d, t_cur, tmax)
+        died = False
+        for k in range(n_leaves):
+            if _bit(alive, k):
+                t = next_t[k]
+                if t <= t_cur:  # reached: its next crossing past here
+                    t, part = leaf_t(geo, rows[k], o, d, t_cur, tmax)
+                    next_t[k] = t
+                    next_part[k] = part
+                    next_cos[k] = math.nan
                 if t == INF:
-                    alive = _with_bit(alive, leaf, 0)
+                    alive = _with_bit(alive, k, 0)
+                    died = True
                 elif t < best_t:
                     best_t = t
-                    best_row = part
-                    best_leaf = leaf
-            leaf += 1
+                    best_row = next_part[k]
+                    best_leaf = k
         if best_row < 0:
             break
-        cos = dot(d, leaf_normal(geo, best_row, madd(o, d, best_t)))
+        if died and not may_show(geo, root, alive | inside):
+            break
+        cos = next_cos[best_leaf]
+        if math.isnan(cos):
+            cos = dot(d, leaf_normal(geo, best_row, madd(o, d, best_t)))
         t_cur = best_t
         if abs(cos) <= GRAZING * d_len:
             continue  # a touch: no state changes, nothing shows
