@@ -110,6 +110,8 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
     params[0, 5:8] = hi
     if shape.operation in ("difference", "intersection"):  # nothing shows outside its first
         params[0, 8] = first_leaves(shape)                  # operand: tested first
+    if shape.operation == "difference" and not any(isinstance(c, CSG) for c in shape.objects[1:]):
+        params[0, 9] = tree_rows_of(shape.objects[0])  # every cut one leaf: tested as a mask
     material = np.array([material_row(clear[0]) if clear else body], np.int32)
     b.blocks[root_block] = (typ, params, xf, material, objs, solid, lo.reshape(1, 3),
                             hi.reshape(1, 3))
@@ -120,6 +122,13 @@ def first_leaves(shape: CSG) -> int:
     def count(node) -> int:
         return sum(count(c) for c in node.objects) if isinstance(node, CSG) else 1
     return count(shape.objects[0])
+
+
+def tree_rows_of(node) -> int:
+    """Rows of ``node``'s subtree in the walk's postfix order (1 for a leaf)."""
+    if not isinstance(node, CSG):
+        return 1
+    return 1 + sum(tree_rows_of(c) for c in node.objects)
 
 
 def _closed_mesh(mesh_source, child: Mesh, where: str):

@@ -117,17 +117,17 @@ def _with_bit(bits, k, value):
 
 
 @kernel
-def surface_shows(geo, root, hit_leaf, inside):
-    """Is leaf number ``hit_leaf``'s surface, at a point where the other leaves' inside
-    states are the bits of ``inside``, a surface of CSG object ``root``? One postfix pass:
-    each entry of the evaluation stack is (inside the subtree, the point is a visible surface
-    of the subtree), both kept as bits of an int64."""
-    n_rows = int(geo.prim_params[root, 0])
+def _shows_in(geo, start, n_rows, hit_leaf, inside):
+    """(inside, shows) of the subtree in rows [start, start + n_rows) (its leaves numbered
+    from 0), at a point on leaf number ``hit_leaf``'s surface where the other leaves' inside
+    states are the bits of ``inside``. One postfix pass: each entry of the evaluation stack
+    is (inside the subtree, the point is a visible surface of the subtree), both kept as bits
+    of an int64."""
     ins = np.int64(0)
     vis = np.int64(0)
     sp = 0
     leaf = 0
-    for r in range(root + 1, root + 1 + n_rows):
+    for r in range(start, start + n_rows):
         if geo.prim_info[r, PRIM_TYPE] != SHAPE_CSG_OP:
             ins = _with_bit(ins, sp, _bit(inside, leaf) if leaf != hit_leaf else 0)
             vis = _with_bit(vis, sp, 1 if leaf == hit_leaf else 0)
@@ -170,16 +170,48 @@ def surface_shows(geo, root, hit_leaf, inside):
         ins = _with_bit(ins, base, inside_here)
         vis = _with_bit(vis, base, 1 if shows else 0)
         sp = base + 1
-    return _bit(vis, 0) == 1
+    return _bit(ins, 0), _bit(vis, 0)
 
 
 @kernel
-def may_show(geo, root, possible):
+def _cut_mask(geo, root):
+    """The bits of the leaves that are a difference root's cuts when every cut is one leaf
+    (``prim_params[root, 9]``: the rows of its first operand, 0 otherwise), else 0: then the
+    walk evaluates only the first operand's rows and tests the cuts as one mask."""
+    P = geo.prim_params
+    if P[root, 9] <= 0.0:
+        return np.int64(0)
+    n_leaves = np.int64(P[root, 1])
+    low = (np.int64(1) << np.int64(P[root, 8])) - np.int64(1)
+    every = (np.int64(1) << n_leaves) - np.int64(1) if n_leaves < 63 else ~np.int64(0)
+    return every & ~low
+
+
+@kernel
+def surface_shows(geo, root, hit_leaf, inside, cuts):
+    """Is leaf number ``hit_leaf``'s surface, at a point where the other leaves' inside
+    states are the bits of ``inside``, a surface of CSG object ``root``? ``cuts``: its
+    :func:`_cut_mask` (a difference whose cuts are leaves: a surface shows where no other
+    cut holds the point, and the first operand shows it, or, on a cut, holds it)."""
+    if cuts != 0:
+        if inside & cuts & ~(np.int64(1) << np.int64(hit_leaf)) != 0:
+            return False
+        ins, vis = _shows_in(geo, root + 1, int(geo.prim_params[root, 9]), hit_leaf, inside)
+        if hit_leaf < int(geo.prim_params[root, 8]):
+            return vis == 1
+        return ins == 1
+    _, vis = _shows_in(geo, root + 1, int(geo.prim_params[root, 0]), hit_leaf, inside)
+    return vis == 1
+
+
+@kernel
+def may_show(geo, root, possible, cuts):
     """Can CSG object ``root`` still show a surface, given ``possible``: a bit per leaf, 0
     where the leaf has no crossing left in the walk and the ray is outside it there? (0 for a
     subtree: it stays outside and shows nothing for the rest of the walk; union and merge
-    need one such operand, intersection every one, difference its first.) One postfix pass."""
-    n_rows = int(geo.prim_params[root, 0])
+    need one such operand, intersection every one, difference its first.) One postfix pass,
+    over the first operand's rows only when ``cuts`` (:func:`_cut_mask`) is not 0."""
+    n_rows = int(geo.prim_params[root, 9]) if cuts != 0 else int(geo.prim_params[root, 0])
     st = np.int64(0)
     sp = 0
     leaf = 0
@@ -224,6 +256,7 @@ def csg_hit(geo, root, o, d, tmin, tmax):
     n_rows = int(P[root, 0])
     n_leaves = int(P[root, 1])
     first_leaves = int(P[root, 8])  # leaves of the first operand of a root that needs it
+    cuts = _cut_mask(geo, root)
     next_t = frame_floats()
     next_part = frame_ints()
     rows = frame_ints()
@@ -248,9 +281,9 @@ def csg_hit(geo, root, o, d, tmin, tmax):
         leaf += 1
         if leaf == first_leaves and leaf < n_leaves:  # the rest unknown yet: possible
             untested = ~((np.int64(1) << np.int64(leaf)) - np.int64(1))
-            if not may_show(geo, root, alive | inside | untested):
+            if not may_show(geo, root, alive | inside | untested, cuts):
                 return INF, np.int64(-1)
-    if not may_show(geo, root, alive | inside):
+    if not may_show(geo, root, alive | inside, cuts):
         return INF, np.int64(-1)
     d_len = math.sqrt(dot(d, d))
     t_cur = tmin
@@ -276,7 +309,7 @@ def csg_hit(geo, root, o, d, tmin, tmax):
                     best_leaf = k
         if best_row < 0:
             break
-        if died and not may_show(geo, root, alive | inside):
+        if died and not may_show(geo, root, alive | inside, cuts):
             break
         cos = next_cos[best_leaf]
         if math.isnan(cos):
@@ -284,7 +317,7 @@ def csg_hit(geo, root, o, d, tmin, tmax):
         t_cur = best_t
         if abs(cos) <= GRAZING * d_len:
             continue  # a touch: no state changes, nothing shows
-        if surface_shows(geo, root, best_leaf, inside):
+        if surface_shows(geo, root, best_leaf, inside, cuts):
             return best_t, best_row
         inside = _with_bit(inside, best_leaf, 1 if cos < 0.0 else 0)
     return INF, np.int64(-1)
