@@ -453,3 +453,72 @@ def test_a_row_of_62_balls_every_crossing_in_order():
               objects=[balls[0], Sphere(center=(0.5, 0.0, 0.0), radius=0.25), *balls[2:]])
     c = Compiled(cut)
     assert c.ts((-10.0, 0.0, 0.0), (1.0, 0.0, 0.0)) == pytest.approx([9.5, 10.25], rel=1e-12)
+
+
+def _die():
+    """A die as benchmarks/make_dice.py builds it: a rounded cube minus 21 pips."""
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.spec_from_file_location(
+        "make_dice", Path(__file__).resolve().parents[1] / "benchmarks" / "make_dice.py")
+    dice = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(dice)
+    pips = []
+    for normal, count in dice.FACES.items():
+        n, u, v = dice._axes(normal)
+        for a, b in dice.LAYOUT[count]:
+            pips.append(Sphere(center=tuple(n[k] * (dice.HALF + dice.PIP - dice.DEPTH)
+                                            + dice.STEP * (a * u[k] + b * v[k])
+                                            for k in range(3)), radius=dice.PIP))
+    body = CSG(operation="intersection", objects=[
+        Box(min=(-dice.HALF,) * 3, max=(dice.HALF,) * 3), Sphere(radius=dice.ROUND)])
+    return CSG(operation="difference", objects=[body, *pips]), dice
+
+
+DIE, DICE = _die()
+DIE_FAST = Compiled(DIE)
+DIE_PLAIN = Compiled(DIE)  # the same rows, walked by the general postfix passes
+DIE_PLAIN.geo = DIE_PLAIN.geo._replace(prim_params=DIE_PLAIN.geo.prim_params.copy())
+DIE_PLAIN.geo.prim_params[0, 9:11] = 0.0
+
+
+def test_a_dies_cuts_are_grouped_face_by_face():
+    # 23 leaves (box, ball, 21 pips), the first operand's 3 rows walked alone, and the pips
+    # in groups of neighbours, each group's box enclosing its pips and no pip of another face
+    P = DIE_FAST.geo.prim_params
+    assert P[0, :2].tolist() == [25.0, 23.0] and P[0, 9] == 3.0
+    groups = P[26:26 + int(P[0, 10])]
+    assert groups[0, 0] == 2 and groups[-1, 1] == 23
+    assert (groups[1:, 0] == groups[:-1, 1]).all()  # a partition of the cuts, in order
+    assert 6 <= len(groups) <= 10
+    for g in groups:
+        centres = np.array([DIE.objects[k - 1].center for k in range(int(g[0]), int(g[1]))])
+        assert (centres - DICE.PIP >= g[2:5]).all() and (centres + DICE.PIP <= g[5:8]).all()
+        faces = {(int(np.argmax(abs(c))), bool(c[np.argmax(abs(c))] > 0)) for c in centres}
+        assert len(faces) == 1  # the pips of one face
+
+
+def test_a_ray_into_a_pip_meets_its_floor():
+    # straight down the z axis onto the face with one pip: the pip's ball (centre at
+    # z = 0.5 + 0.085 - 0.045, radius 0.085) is the floor of the dent, at z = 0.455;
+    # beside the pips, the face itself at z = 0.5
+    floor = DICE.HALF + DICE.PIP - DICE.DEPTH - DICE.PIP
+    for c in (DIE_FAST, DIE_PLAIN):
+        t, n, _ = c.hit((0.0, 0.0, 5.0), (0.0, 0.0, -1.0))
+        assert t == pytest.approx(5.0 - floor, rel=1e-12)
+        np.testing.assert_allclose(n, [0, 0, 1], atol=1e-12)  # the cut turned over
+        assert c.hit((0.12, -0.3, 5.0), (0.0, 0.0, -1.0))[0] == pytest.approx(4.5, rel=1e-12)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.tuples(*[st.floats(-3, 3)] * 3), st.tuples(*[st.floats(-0.7, 0.7)] * 3))
+def test_grouped_cuts_answer_as_the_general_walk(origin, target):
+    # the cut mask and the skipped groups change no answer: every crossing along the ray,
+    # surface and row, as the postfix passes over the whole tree give them
+    d = np.subtract(target, origin)
+    if np.linalg.norm(d) < 1e-3:
+        return
+    fast = DIE_FAST.hits(origin, d)
+    plain = DIE_PLAIN.hits(origin, d)
+    assert [(h[0], h[2]) for h in fast] == [(h[0], h[2]) for h in plain]

@@ -50,6 +50,7 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
     leaves: list[tuple[int, object, int]] = []  # (row, Material, flip)
 
     meshes: list[tuple] = []
+    leaf_boxes: list[tuple] = []  # (lo, hi) of each leaf, in the walk's order
 
     def walk(node: CSG, matrix: np.ndarray, inherited, flip: int, where: str):
         """Rows of ``node``'s subtree; returns its bounds (lo, hi), None when empty."""
@@ -71,12 +72,14 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
                 leaves.append((row, mat, cflip))
                 v = np.asarray(src.vertices, np.float64) @ cm[:3, :3].T + cm[:3, 3]
                 boxes.append((v.min(axis=0), v.max(axis=0)))
+                leaf_boxes.append(boxes[-1])
                 continue
             row = b.rows
             add_shape(b, child, cm, material_row(mat), obj)
             blk = b.blocks[-1]
             leaves.append((row, mat, cflip))
             boxes.append((blk[6][0].copy(), blk[7][0].copy()))
+            leaf_boxes.append(boxes[-1])
         b.add(SHAPE_CSG_OP, [float(OPERATION_CODES[node.operation]), float(len(node.objects))],
               np.zeros(3), np.zeros(3), material=0, obj=obj, solid=False)
         b.csg_rows[b.rows - 1] = (0, -1)
@@ -91,6 +94,14 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
 
     lo, hi = walk(shape, m, default_material, 0, f"objects[{obj}]")
     tree_rows = b.rows - root - 1  # the walk reads these; mesh leaves' triangles come after
+    groups = []
+    if shape.operation == "difference" and not any(isinstance(c, CSG) for c in shape.objects[1:]):
+        n_first = first_leaves(shape)
+        groups = cut_groups(leaf_boxes[n_first:], lo, hi, n_first)
+    for first, end, glo, ghi in groups:  # after the tree: the walk finds them from its size
+        b.add(SHAPE_CSG_OP, [float(first), float(end), *glo, *ghi], np.zeros(3), np.zeros(3),
+              material=0, obj=obj, solid=False)
+        b.csg_rows[b.rows - 1] = (0, -1)
     body_material = default_material if shape.material is not None else leaves[0][1]
     body = material_row(body_material)
     for row, _, flip in leaves:
@@ -112,6 +123,7 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
         params[0, 8] = first_leaves(shape)                  # operand: tested first
     if shape.operation == "difference" and not any(isinstance(c, CSG) for c in shape.objects[1:]):
         params[0, 9] = tree_rows_of(shape.objects[0])  # every cut one leaf: tested as a mask
+        params[0, 10] = len(groups)
     material = np.array([material_row(clear[0]) if clear else body], np.int32)
     b.blocks[root_block] = (typ, params, xf, material, objs, solid, lo.reshape(1, 3),
                             hi.reshape(1, 3))
@@ -122,6 +134,50 @@ def first_leaves(shape: CSG) -> int:
     def count(node) -> int:
         return sum(count(c) for c in node.objects) if isinstance(node, CSG) else 1
     return count(shape.objects[0])
+
+
+GROUP_BOX_COST = 0.5  # a group's box test, in tests of one leaf
+
+
+def _area(lo, hi) -> float:
+    e = np.maximum(np.asarray(hi) - np.asarray(lo), 0.0)
+    return float(e[0] * e[1] + e[1] * e[2] + e[2] * e[0])
+
+
+def cut_groups(boxes, lo, hi, first_leaf: int) -> list[tuple]:
+    """Runs of neighbouring cuts (leaf numbers from ``first_leaf``) that share a box the walk
+    tests before their leaves: (first leaf, end leaf, lo, hi), the box padded. A partition of
+    the cuts in order, chosen to minimise the expected tests of a ray through the object's
+    box (``lo``, ``hi``): a group costs its box test and, when the ray passes its box (its
+    share of the object's surface area), its leaves; a cut in no group costs one test."""
+    m = len(boxes)
+    whole = max(_area(lo, hi), 1e-300)
+    best = [0.0] * (m + 1)
+    choice = [(-1, False)] * (m + 1)
+    for j in range(1, m + 1):
+        best[j] = best[j - 1] + 1.0
+        choice[j] = (j - 1, False)
+        glo = np.full(3, np.inf)
+        ghi = np.full(3, -np.inf)
+        for i in range(j - 1, -1, -1):  # group of cuts i .. j-1
+            glo = np.minimum(glo, boxes[i][0])
+            ghi = np.maximum(ghi, boxes[i][1])
+            share = min(_area(glo, ghi) / whole, 1.0)
+            cost = best[i] + GROUP_BOX_COST + share * (j - i)
+            if cost < best[j]:
+                best[j] = cost
+                choice[j] = (i, True)
+    groups = []
+    j = m
+    while j > 0:
+        i, grouped = choice[j]
+        if grouped:
+            glo = np.min([boxes[k][0] for k in range(i, j)], axis=0)
+            ghi = np.max([boxes[k][1] for k in range(i, j)], axis=0)
+            pad = 1e-6 * max(1.0, float(np.max(np.abs(np.concatenate([glo, ghi])))))
+            groups.append((first_leaf + i, first_leaf + j, glo - pad, ghi + pad))
+        j = i
+    return groups[::-1]
 
 
 def tree_rows_of(node) -> int:

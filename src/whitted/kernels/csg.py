@@ -239,6 +239,24 @@ def may_show(geo, root, possible, cuts):
 
 
 @kernel
+def _missed_groups(geo, root, o, inv, tmin, tmax):
+    """Bits of the cut leaves in the groups (rows after the tree: first leaf, end leaf,
+    box padded) whose box the segment (tmin, tmax) misses: no crossing there, and outside
+    them all along it."""
+    P = geo.prim_params
+    skip = np.int64(0)
+    g0 = root + 1 + int(P[root, 0])
+    for g in range(g0, g0 + int(P[root, 10])):
+        if slab_entry(P[g, 2], P[g, 3], P[g, 4], P[g, 5], P[g, 6], P[g, 7], o, inv, tmin,
+                      tmax) == INF:
+            first = np.int64(P[g, 0])
+            end = np.int64(P[g, 1])
+            skip |= ((np.int64(1) << end) - np.int64(1)) & ~((np.int64(1) << first)
+                                                             - np.int64(1))
+    return skip
+
+
+@kernel
 def csg_hit(geo, root, o, d, tmin, tmax):
     """(t, leaf row) of the nearest visible surface of CSG object ``root`` in (tmin, tmax),
     or (INF, -1).
@@ -250,8 +268,9 @@ def csg_hit(geo, root, o, d, tmin, tmax):
     (``may_show``), first after the leaves of the root's first operand (a die: the rays
     that miss its rounded cube skip its pips)."""
     P = geo.prim_params
+    inv = inverse_direction(d)
     if slab_entry(P[root, 2], P[root, 3], P[root, 4], P[root, 5], P[root, 6], P[root, 7], o,
-                  inverse_direction(d), tmin, tmax) == INF:
+                  inv, tmin, tmax) == INF:
         return INF, np.int64(-1)  # (shadow rays test listed objects without their boxes)
     n_rows = int(P[root, 0])
     n_leaves = int(P[root, 1])
@@ -263,11 +282,16 @@ def csg_hit(geo, root, o, d, tmin, tmax):
     next_cos = frame_floats()  # d · the leaf's normal at next_t (NaN: not computed yet)
     inside = np.int64(0)
     alive = np.int64(0)
+    skip = np.int64(0)  # cut leaves in groups the ray misses: outside, no crossing
     leaf = 0
     for r in range(root + 1, root + 1 + n_rows):
         if geo.prim_info[r, PRIM_TYPE] == SHAPE_CSG_OP:
             continue
         rows[leaf] = r
+        if _bit(skip, leaf):
+            next_t[leaf] = INF
+            leaf += 1
+            continue
         t, part = leaf_t(geo, r, o, d, tmin, INF)
         next_t[leaf] = t
         next_part[leaf] = part
@@ -283,6 +307,8 @@ def csg_hit(geo, root, o, d, tmin, tmax):
             untested = ~((np.int64(1) << np.int64(leaf)) - np.int64(1))
             if not may_show(geo, root, alive | inside | untested, cuts):
                 return INF, np.int64(-1)
+            if P[root, 10] > 0.0:
+                skip = _missed_groups(geo, root, o, inv, tmin, tmax)
     if not may_show(geo, root, alive | inside, cuts):
         return INF, np.int64(-1)
     d_len = math.sqrt(dot(d, d))
