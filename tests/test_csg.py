@@ -522,3 +522,68 @@ def test_grouped_cuts_answer_as_the_general_walk(origin, target):
     fast = DIE_FAST.hits(origin, d)
     plain = DIE_PLAIN.hits(origin, d)
     assert [(h[0], h[2]) for h in fast] == [(h[0], h[2]) for h in plain]
+
+
+def _ball_mesh(subdivisions):
+    """A unit icosphere of 20 * 4**subdivisions triangles (closed), as a Mesh."""
+    import trimesh
+
+    from whitted.scene import Mesh
+
+    ball = trimesh.creation.icosphere(subdivisions=subdivisions)
+    return Mesh(vertices=ball.vertices.tolist(), faces=ball.faces.tolist())
+
+
+BITE = Box(min=(0.0, 0.0, -2.0), max=(2.0, 2.0, 0.5))
+
+
+@pytest.mark.parametrize("transform", [None, Transform(scale=(1.0, 0.5, 1.5),
+                                                       translate=(0.2, -0.1, 0.3))])
+def test_a_big_mesh_ball_minus_a_box_is_the_analytic_one(transform):
+    # 81,920 triangles (over the old limit of 65,536, crossings through the mesh's own BVH),
+    # as the child of a CSG with or without its own transform (then in the mesh's space):
+    # the same first hits as the exact ball minus the box, to the tessellation's error
+    # (an icosphere's flat faces lie within 1 - cos(half the edge's angle) ~ 5e-5 of it)
+    mesh = _ball_mesh(6).model_copy(update={"transform": transform})
+    ball = Sphere(radius=1.0, transform=transform)
+    tess = Compiled(CSG(operation="difference", objects=[mesh, BITE]))
+    exact = Compiled(CSG(operation="difference", objects=[ball, BITE]))
+    assert len(tess.compiled.geometry.prim_info) > 81_920
+    assert tess.geo.prim_params[1, 2] >= 1  # the mesh leaf names its stored mesh (+1)
+    rays = [((0.3, 0.3, 5.0), (0.0, 0.0, -1.0)), ((0.6, 0.55, 5.0), (0.0, 0.0, -1.0)),
+            ((0.7, 0.6, 5.0), (0.0, 0.0, -1.0)), ((5.0, 0.3, 0.2), (-1.0, 0.0, 0.0)),
+            ((-0.5, 0.2, 5.0), (0.0, 0.0, -1.0)), ((0.1, -4.0, 0.1), (0.05, 1.0, 0.02)),
+            ((3.0, 2.0, 4.0), (-0.7, -0.45, -1.0))]
+    shown = 0
+    for o, d in rays:
+        a = tess.hits(o, d)
+        b = exact.hits(o, d)
+        assert len(a) == len(b), (o, d)
+        for (ta, na, _), (tb, nb, _) in zip(a, b, strict=True):
+            assert ta == pytest.approx(tb, abs=2e-4)
+            assert np.dot(na, nb) > 0.97  # flat faces: the normal within ~1.5 degrees
+        shown += len(a)
+    assert shown >= 8
+    if transform is None:  # the worked values: the ball at (0.3, 0.3), the box's cut face
+        assert tess.hit((0.3, 0.3, 5.0), (0.0, 0.0, -1.0))[0] == pytest.approx(
+            5.0 - math.sqrt(1 - 0.18), abs=1e-4)
+        t, n, _ = tess.hit((5.0, 0.3, 0.2), (-1.0, 0.0, 0.0))
+        assert t == pytest.approx(5.0, rel=1e-12)  # x = 0, inside the ball
+        np.testing.assert_allclose(n, [1, 0, 0], atol=1e-12)
+        assert tess.hit((0.7, 0.6, 5.0), (0.0, 0.0, -1.0)) is None  # bitten away
+
+
+def test_one_big_mesh_in_two_csg_objects():
+    # the same file-less mesh in two objects (each its own stored copy and rows): both cut
+    mesh = _ball_mesh(5)
+    scene = Scene(objects=[
+        CSG(operation="intersection", objects=[mesh, Box(min=(-2, -2, -2), max=(2, 2, 0.0))]),
+        CSG(operation="intersection", objects=[mesh, Box(min=(-2, -2, -2), max=(2, 2, 0.0))],
+            transform=Transform(translate=(3.0, 0.0, 0.0)))])
+    c = Compiled(*scene.objects)
+    for x in (0.0, 3.0):
+        t, n, _ = c.hit((x + 0.2, 0.1, 5.0), (0.0, 0.0, -1.0))
+        assert t == pytest.approx(5.0, rel=1e-12)  # the box's face z = 0 inside the ball
+        np.testing.assert_allclose(n, [0, 0, 1], atol=1e-12)
+        t, _, _ = c.hit((x + 0.2, 0.1, -5.0), (0.0, 0.0, 1.0))
+        assert t == pytest.approx(5.0 - math.sqrt(1 - 0.05), abs=3e-4)

@@ -27,7 +27,8 @@ from ..scene.shapes import CSG, Mesh
 from .primitives import PrimitiveRows
 from .shapes import add_shape
 
-CSG_MESH_LIMIT = 65_536  # triangles of a mesh in CSG (tested one by one, no BVH)
+CSG_MESH_LIMIT = 2_000_000  # triangles of a mesh in CSG (each a row and in a BVH: ~300 B)
+CSG_MESH_SCAN = 64  # up to this many triangles a mesh leaf's rows are each tested, no BVH
 OPERATION_CODES = {"union": CSG_UNION, "intersection": CSG_INTERSECTION,
                    "difference": CSG_DIFFERENCE, "merge": CSG_MERGE}
 
@@ -37,13 +38,15 @@ def _transform(shape) -> np.ndarray:
 
 
 def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, obj: int,
-            default_material, mesh_source=None, emit_mesh=None) -> None:
+            default_material, mesh_source=None, emit_mesh=None, store_mesh=None) -> None:
     """Append CSG object ``shape`` (world matrix ``m``) as rows of ``b``. ``resolve`` maps a
     material reference to a Material, ``material_row`` a Material to its table row;
     ``default_material`` is the object's resolved material (used by children without).
     ``mesh_source(child, where)`` loads a mesh child (a ``MeshSource``);
     ``emit_mesh(source, child, matrix, material)`` appends its triangles as rows and returns
-    (first row, count). An open mesh, or one too big, is a SceneError naming it."""
+    (first row, count); ``store_mesh(source, child)`` stores a big one in the mesh table (in
+    its own space, with its BVH) and returns (mesh_info row, triangles) or None. An open
+    mesh, or one too big, is a SceneError naming it."""
     root = b.rows
     b.add(SHAPE_CSG, [0.0] * 8, np.zeros(3), np.zeros(3), material=0, obj=obj, solid=True)
     root_block = len(b.blocks) - 1
@@ -64,11 +67,13 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
                 continue
             if isinstance(child, Mesh):  # its triangles go after the tree: see below
                 row = b.rows
-                b.add(SHAPE_CSG_MESH, [0.0, 0.0], np.zeros(3), np.zeros(3),
-                      material=material_row(mat), obj=obj, solid=True)
-                b.csg_rows[row] = (0, -1)
                 src = _closed_mesh(mesh_source, child, f"{where}.objects[{k}]")
-                meshes.append((row, len(b.blocks) - 1, src, child, cm, mat))
+                big = store_mesh is not None and len(src.faces) > CSG_MESH_SCAN
+                b.add(SHAPE_CSG_MESH, [0.0, 0.0, 0.0], np.zeros(3), np.zeros(3),
+                      material=material_row(mat), obj=obj, solid=True,
+                      world_to_object=np.linalg.inv(cm) if big else None)
+                b.csg_rows[row] = (0, -1)
+                meshes.append((row, len(b.blocks) - 1, src, child, cm, mat, big))
                 leaves.append((row, mat, cflip))
                 v = np.asarray(src.vertices, np.float64) @ cm[:3, :3].T + cm[:3, 3]
                 boxes.append((v.min(axis=0), v.max(axis=0)))
@@ -106,9 +111,13 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
     body = material_row(body_material)
     for row, _, flip in leaves:
         b.csg_rows[row] = (flip, body)
-    for row, block, src, child, cm, mat in meshes:
+    for row, block, src, child, cm, mat, big in meshes:
         first, count = emit_mesh(src, child, cm, mat)
         b.blocks[block][1][0, :2] = (first, count)
+        if big:  # its crossings through the stored mesh's BVH: triangle k is row first + k
+            stored = store_mesh(src, child)
+            if stored is not None and stored[1] == count:
+                b.blocks[block][1][0, 2] = stored[0] + 1
         flip = b.csg_rows[row][0]
         for r in range(first, first + count):
             b.csg_rows[r] = (flip, body)
@@ -188,15 +197,15 @@ def tree_rows_of(node) -> int:
 
 
 def _closed_mesh(mesh_source, child: Mesh, where: str):
-    """The mesh child's source, checked: closed, and small enough to test triangle by
-    triangle."""
+    """The mesh child's source, checked: closed, and small enough to keep (each triangle a
+    row of the walk and a triangle of a stored mesh's BVH)."""
     src = mesh_source(child, where)
     what = f"{where} ({child.name or 'mesh'})"
     if len(src.faces) == 0:
         raise SceneError(f"{what}: the mesh has no triangles, so it bounds no volume")
     if len(src.faces) > CSG_MESH_LIMIT:
         raise SceneError(f"{what}: {len(src.faces):,} triangles; a mesh in CSG may have at "
-                         f"most {CSG_MESH_LIMIT:,} (each is tested in turn)")
+                         f"most {CSG_MESH_LIMIT:,} (about 300 bytes each)")
     holes = open_edges(src.faces)
     if holes:
         raise SceneError(f"{what}: the mesh is open ({holes:,} edges not shared by exactly two "

@@ -136,10 +136,15 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
                                       -1 if own else materials.add(mat), obj_index)
                 return first, count
 
+            def store_mesh(src, child):  # a big mesh leaf's crossings: its BVH
+                stored = meshes.add(src, np.array([materials.add(x) for x in src.materials],
+                                                  np.int32), child.smooth, child.crease_angle)
+                return None if stored is None else (stored.index, stored.triangles)
+
             add_csg(b, shape, m, materials.add, scene.resolve_material, obj_index,
                     scene.material_of(obj_index),
                     lambda child, where, i=obj_index: mesh_source(scene, i, child, warnings),
-                    emit_mesh)
+                    emit_mesh, store_mesh)
             continue
         add_shape(b, shape, m, materials.add(scene.material_of(obj_index)), obj_index)
     warnings.extend(meshes.warnings)

@@ -3,7 +3,8 @@
 A CSG object is a row ``SHAPE_CSG`` (in the scene BVH, with the box of the whole) followed by
 its tree in postfix order: leaves are ordinary solid rows (sphere, box, frustum, torus; the
 object's transform baked in or kept as their own ``PRIM_XFORM``) or ``SHAPE_CSG_MESH`` rows
-naming the triangle rows of a closed mesh (after the tree, each tested in turn), operations
+naming the triangle rows of a closed mesh (after the tree; a big one's crossings found
+through the BVH of the mesh stored for it, a small one's rows each tested), operations
 are ``SHAPE_CSG_OP`` rows with their code and number of operands. These rows are in no BVH;
 a visible surface is reported as the row it belongs to (a mesh's triangle), so shading reads
 its material and normal as anywhere else.
@@ -39,12 +40,14 @@ from .layout import (
     CSG_DIFFERENCE,
     CSG_INTERSECTION,
     CSG_MERGE,
+    MESH_TRI_OFFSET,
     PRIM_TYPE,
     PRIM_XFORM,
     SHAPE_CSG_MESH,
     SHAPE_CSG_OP,
     SHAPE_TORUS,
 )
+from .mesh import mesh_closest_hit
 from .torus import intersect_torus, torus_normal
 from .traverse import inverse_direction, slab_entry
 from .vec import dot, madd
@@ -60,8 +63,21 @@ GRAZING = 1e-9  # |cos| between ray and normal below which a crossing is only a 
 @kernel
 def _mesh_t(geo, j, o, d, tmin, tmax):
     """Nearest crossing in (tmin, tmax) with the triangles of mesh leaf ``j``, and the
-    triangle's row (each tested: a CSG mesh is small)."""
+    triangle's row: through the BVH of the mesh stored for it (``prim_params[j, 2]``: its
+    mesh_info row + 1, in its own space: ``PRIM_XFORM``), whose triangle k is row first + k,
+    or, for a small mesh, each row tested."""
     first = int(geo.prim_params[j, 0])
+    mesh = int(geo.prim_params[j, 2]) - 1
+    if mesh >= 0:
+        xf = geo.prim_info[j, PRIM_XFORM]
+        if xf >= 0:
+            o, d = to_object(geo.xforms, xf, o, d)
+        stack = frame_ints()  # as deep as an instance's walk (tiles.BVH_STACK - 64)
+        t, tri, _, _ = mesh_closest_hit(geo, mesh, o, d, inverse_direction(d), tmin, tmax,
+                                        stack, 0)
+        if tri < 0:
+            return INF, np.int64(-1)
+        return t, np.int64(first + tri - geo.mesh_info[mesh, MESH_TRI_OFFSET])
     best_t = INF
     best = np.int64(-1)
     for r in range(first, first + int(geo.prim_params[j, 1])):
