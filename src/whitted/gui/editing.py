@@ -12,7 +12,7 @@ from PySide6.QtCore import QObject, Qt
 
 from ..errors import WhittedError
 from . import catalog
-from .document import EditRefused, label_of, rebuild_scene
+from .document import EditRefused, item_of, label_of, rebuild_scene, with_item
 from .picking import id_at
 from .transform_tool import TransformTool, light_position
 
@@ -36,7 +36,8 @@ class GroupTool:
         self.tools = []
         for n, key in enumerate(keys):
             self.tools.append(TransformTool(
-                mode, scene, key[1], start, size, kind=key[0], finish=lambda *a: None,
+                mode, scene, key[1], start, size, kind=key[0], path=tuple(key[2:]),
+                finish=lambda *a: None,
                 apply=lambda value, merge, k=key: self.results.__setitem__(k, value),
                 status=status if n == 0 else (lambda text: None)))
         self.merge_key = self.tools[0].merge_key
@@ -130,8 +131,11 @@ class Editing(QObject):
         viewport = window.viewport
         if viewport.tool is not None:
             return False
-        keys = [k for k in self.doc.selected_keys() if len(k) == 2 and (
-            k[0] == "objects" or mode == "move" and light_position(self.doc.item(k)) is not None)]
+        # objects, the children of CSG objects (keys ("objects", i, k, ...)), and to move,
+        # the lights that have a place
+        keys = [k for k in self.doc.selected_keys() if len(k) >= 2 and (
+            k[0] == "objects" or len(k) == 2 and mode == "move"
+            and light_position(self.doc.item(k)) is not None)]
         if not keys:
             what = "an object" if mode != "move" else "an object or a light"
             self._status(f"{TransformTool.NAMES[mode]}: select {what} first", 3000)
@@ -155,11 +159,12 @@ class Editing(QObject):
     def _tool_edit(self, results: dict, merge, mode: str, tool: GroupTool) -> None:
         scene = self.doc.scene
         update = {kind: list(getattr(scene, kind)) for kind in ("lights", "objects")}
+        children = {}  # the CSG children's new items, put in place after the rest
         for key, value in results.items():
-            kind, index = key
-            item = update[kind][index]
+            kind, index = key[:2]
+            item = item_of(scene, key)
             data = item.model_dump()
-            sub = next(t for t in tool.tools if (t.kind, t.index) == key)
+            sub = next(t for t in tool.tools if (t.kind, t.index, *t.path) == key)
             if kind == "lights":  # a light moves by the vector, from where it was at the start
                 field = "position" if "position" in data else "center"
                 data[field] = tuple(round(float(v), 6) + 0.0 for v in sub.centre + value)
@@ -169,13 +174,18 @@ class Editing(QObject):
                     sub.obj.center, value.translate, strict=True))
             else:
                 data["transform"] = value.model_dump()
-            update[kind][index] = type(item).model_validate(data)
-        names = [label_of(getattr(scene, k)[i]) for k, i in results]
+            if len(key) > 2:
+                children[key] = type(item).model_validate(data)
+            else:
+                update[kind][index] = type(item).model_validate(data)
+        names = [label_of(item_of(scene, key)) for key in results]
         what = names[0] if len(names) == 1 else f"{len(names)} items"
         try:
             before = self.doc.undo_stack.index()
-            self.doc.apply(rebuild_scene(scene, **update),
-                           f"{TransformTool.NAMES[mode]} {what}", merge_key=merge)
+            new = rebuild_scene(scene, **update)
+            for key, item in children.items():
+                new = with_item(new, key, item)
+            self.doc.apply(new, f"{TransformTool.NAMES[mode]} {what}", merge_key=merge)
             self._tool_edits += self.doc.undo_stack.index() != before or self._tool_edits > 0
         except (EditRefused, ValueError) as exc:
             self._status(str(exc).splitlines()[0], 3000)

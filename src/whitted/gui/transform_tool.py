@@ -166,14 +166,32 @@ class TransformTool:
 
     def __init__(self, mode: str, scene: Scene, index: int, start: QPointF,
                  picture_size: tuple[float, float], apply: Callable, finish: Callable,
-                 status: Callable[[str], None], kind: str = "objects") -> None:
+                 status: Callable[[str], None], kind: str = "objects",
+                 path: tuple[int, ...] = ()) -> None:
         self.mode = mode
         self.scene = scene
         self.index = index
         self.kind = kind  # "objects", or "lights" (G only: ``apply`` gets the move's vector)
+        #: a child of CSG object ``index`` (its place among the children, to any depth): its
+        #: transform is in its parent's space, so the move's vector, the centre and the axes
+        #: are taken there (the parent's space: ``parent``, its object-to-world matrix)
+        self.path = tuple(path)
         self.obj = getattr(scene, kind)[index]
-        self.centre = object_centre(scene, index) if kind == "objects" else \
-            np.asarray(light_position(self.obj), np.float64)
+        self.parent = np.eye(4)
+        for k in self.path:
+            if self.obj.transform is not None:
+                self.parent = self.parent @ self.obj.transform.matrix()
+            self.obj = self.obj.objects[k]
+        if kind != "objects":
+            self.centre = np.asarray(light_position(self.obj), np.float64)
+        elif self.path:
+            b = item_bounds(self.obj, scene)
+            local = (b[0] + b[1]) / 2 if b is not None else np.zeros(3)
+            self.centre = self.parent[:3, :3] @ local + self.parent[:3, 3]
+        else:
+            self.centre = object_centre(scene, index)
+        #: the centre in the space the object's transform is in
+        self.own_centre = np.linalg.solve(self.parent[:3, :3], self.centre - self.parent[:3, 3])
         self.start = start
         self.pointer = start
         self.start_uv: tuple[float, float] | None = None
@@ -256,21 +274,23 @@ class TransformTool:
         return delta
 
     def transform(self) -> Transform:
+        """The object's new transform (in its parent's space for a CSG child: a typed move
+        and the axes are the parent's, a move by the pointer follows it on the ground)."""
         typed = self._typed_value()
         dx = self.pointer.x() - self.start.x()
         if self.mode == "move":
             if typed is not None:
                 delta = AXES[self.axis or "x"] * typed
             else:
-                delta = self._ground_delta()
+                delta = np.linalg.solve(self.parent[:3, :3], self._ground_delta())
             return moved(self.obj, delta)
         if self.mode == "rotate":
             deg = typed if typed is not None else dx * DEG_PER_PX
-            return rotated(self.obj, self.centre, AXES[self.axis or "y"], deg)
+            return rotated(self.obj, self.own_centre, AXES[self.axis or "y"], deg)
         factor = typed if typed is not None else math.exp(dx / SCALE_PX)
         if factor == 0:
             factor = 1e-3
-        return scaled(self.obj, self.centre, factor, self.axis)
+        return scaled(self.obj, self.own_centre, factor, self.axis)
 
     def delta(self) -> np.ndarray:
         typed = self._typed_value()
