@@ -39,6 +39,7 @@ from .jit import kernel, numba_object
 from .layout import (
     CSG_DIFFERENCE,
     CSG_INTERSECTION,
+    CSG_MAX_LEAVES,
     CSG_MERGE,
     MESH_TRI_OFFSET,
     PRIM_TYPE,
@@ -54,8 +55,10 @@ from .vec import dot, madd
 from .xform import normal_to_world, to_object
 
 # kernels/frame_array.py is a Numba extension: imported with Numba (kernels/jit.py)
-frame_floats = numba_object(".frame_array", "frame_floats")
-frame_ints = numba_object(".frame_array", "frame_ints")
+float_slots = numba_object(".frame_array", "float_slots")
+int_slots = numba_object(".frame_array", "int_slots")
+slots = numba_object(".frame_array", "slots")
+FRAME_SLOTS = CSG_MAX_LEAVES + 1  # kernels/frame_array.py's
 
 GRAZING = 1e-9  # |cos| between ray and normal below which a crossing is only a touch
 
@@ -72,7 +75,7 @@ def _mesh_t(geo, j, o, d, tmin, tmax):
         xf = geo.prim_info[j, PRIM_XFORM]
         if xf >= 0:
             o, d = to_object(geo.xforms, xf, o, d)
-        stack = frame_ints()  # as deep as an instance's walk (tiles.BVH_STACK - 64)
+        stack = slots(int_slots(), FRAME_SLOTS)  # as deep as an instance's walk
         t, tri, _, _ = mesh_closest_hit(geo, mesh, o, d, inverse_direction(d), tmin, tmax,
                                         stack, 0)
         if tri < 0:
@@ -292,10 +295,11 @@ def csg_hit(geo, root, o, d, tmin, tmax):
     n_leaves = int(P[root, 1])
     first_leaves = int(P[root, 8])  # leaves of the first operand of a root that needs it
     cuts = _cut_mask(geo, root)
-    next_t = frame_floats()
-    next_part = frame_ints()
-    rows = frame_ints()
-    next_cos = frame_floats()  # d · the leaf's normal at next_t (NaN: not computed yet)
+    next_t = slots(float_slots(), FRAME_SLOTS)
+    next_part = slots(int_slots(), FRAME_SLOTS)
+    rows = slots(int_slots(), FRAME_SLOTS)
+    # d · the leaf's normal at next_t (NaN: not computed yet)
+    next_cos = slots(float_slots(), FRAME_SLOTS)
     inside = np.int64(0)
     alive = np.int64(0)
     skip = np.int64(0)  # cut leaves in groups the ray misses: outside, no crossing
