@@ -148,9 +148,10 @@ def first_leaves(shape: CSG) -> int:
 GROUP_BOX_COST = 0.5  # a group's box test, in tests of one leaf
 
 
-def _area(lo, hi) -> float:
-    e = np.maximum(np.asarray(hi) - np.asarray(lo), 0.0)
-    return float(e[0] * e[1] + e[1] * e[2] + e[2] * e[0])
+def _areas(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Surface areas of boxes (rows of ``lo``, ``hi``), halved."""
+    e = np.maximum(hi - lo, 0.0)
+    return e[..., 0] * e[..., 1] + e[..., 1] * e[..., 2] + e[..., 2] * e[..., 0]
 
 
 def cut_groups(boxes, lo, hi, first_leaf: int) -> list[tuple]:
@@ -160,31 +161,34 @@ def cut_groups(boxes, lo, hi, first_leaf: int) -> list[tuple]:
     box (``lo``, ``hi``): a group costs its box test and, when the ray passes its box (its
     share of the object's surface area), its leaves; a cut in no group costs one test."""
     m = len(boxes)
-    whole = max(_area(lo, hi), 1e-300)
-    best = [0.0] * (m + 1)
-    choice = [(-1, False)] * (m + 1)
+    if m == 0:
+        return []
+    los = np.array([box[0] for box in boxes], np.float64)
+    his = np.array([box[1] for box in boxes], np.float64)
+    whole = max(float(_areas(np.asarray(lo, np.float64), np.asarray(hi, np.float64))), 1e-300)
+    best = np.zeros(m + 1)
+    start = np.zeros(m + 1, np.int64)  # the group ending at j starts at start[j] (-1: none)
     for j in range(1, m + 1):
-        best[j] = best[j - 1] + 1.0
-        choice[j] = (j - 1, False)
-        glo = np.full(3, np.inf)
-        ghi = np.full(3, -np.inf)
-        for i in range(j - 1, -1, -1):  # group of cuts i .. j-1
-            glo = np.minimum(glo, boxes[i][0])
-            ghi = np.maximum(ghi, boxes[i][1])
-            share = min(_area(glo, ghi) / whole, 1.0)
-            cost = best[i] + GROUP_BOX_COST + share * (j - i)
-            if cost < best[j]:
-                best[j] = cost
-                choice[j] = (i, True)
+        # the groups i .. j-1 for every i at once: running boxes from j-1 down to 0
+        glo = np.minimum.accumulate(los[j - 1::-1], axis=0)
+        ghi = np.maximum.accumulate(his[j - 1::-1], axis=0)
+        share = np.minimum(_areas(glo, ghi) / whole, 1.0)
+        i = np.arange(j - 1, -1, -1)
+        cost = best[i] + GROUP_BOX_COST + share * (j - i)
+        k = int(np.argmin(cost))
+        best[j], start[j] = best[j - 1] + 1.0, -1
+        if cost[k] < best[j]:
+            best[j], start[j] = cost[k], i[k]
     groups = []
     j = m
     while j > 0:
-        i, grouped = choice[j]
-        if grouped:
-            glo = np.min([boxes[k][0] for k in range(i, j)], axis=0)
-            ghi = np.max([boxes[k][1] for k in range(i, j)], axis=0)
-            pad = 1e-6 * max(1.0, float(np.max(np.abs(np.concatenate([glo, ghi])))))
-            groups.append((first_leaf + i, first_leaf + j, glo - pad, ghi + pad))
+        i = int(start[j])
+        if i < 0:
+            j -= 1
+            continue
+        glo, ghi = los[i:j].min(axis=0), his[i:j].max(axis=0)
+        pad = 1e-6 * max(1.0, float(np.max(np.abs(np.concatenate([glo, ghi])))))
+        groups.append((first_leaf + i, first_leaf + j, glo - pad, ghi + pad))
         j = i
     return groups[::-1]
 

@@ -318,10 +318,11 @@ class CSG(_Shape):
     ``merge``) of solid ``objects``: spheres, boxes, capped cylinders and cones, tori and
     other CSG objects, to any depth. ``difference`` is the first object minus all the others;
     ``merge`` is a union without its inner surfaces (for glass). Meshes take part when they
-    are closed (every edge shared by two triangles; checked when the scene is compiled) and
-    small (at most 65,536 triangles: each is tested in turn). ``material`` is used by the
-    children that have none; ``transform`` places the whole. Each surface keeps its child's
-    material (a difference's cut shows the material of the object that cut it), and the
+    are closed (every edge shared by two triangles; checked when the scene is compiled), up
+    to 2,000,000 triangles (a big one's crossings through a BVH of its own). ``material``
+    is used by the children that have none; ``transform`` places the whole. Each surface
+    keeps its child's material (a difference's cut shows the material of the object that
+    cut it), and the
     solid is one body for refraction and absorption: its medium is its own ``material`` (or,
     unset, its first child's)."""
 
