@@ -18,6 +18,7 @@ from ..kernels.layout import (
     CSG_INTERSECTION,
     CSG_MERGE,
     CSG_UNION,
+    N_PRIM_PARAMS,
     SHAPE_CSG,
     SHAPE_CSG_MESH,
     SHAPE_CSG_OP,
@@ -103,10 +104,15 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
     if shape.operation == "difference" and not any(isinstance(c, CSG) for c in shape.objects[1:]):
         n_first = first_leaves(shape)
         groups = cut_groups(leaf_boxes[n_first:], lo, hi, n_first)
-    for first, end, glo, ghi in groups:  # after the tree: the walk finds them from its size
-        b.add(SHAPE_CSG_OP, [float(first), float(end), *glo, *ghi], np.zeros(3), np.zeros(3),
-              material=0, obj=obj, solid=False)
-        b.csg_rows[b.rows - 1] = (0, -1)
+    if groups:  # after the tree (the walk finds them from its size), as one block
+        rows = np.zeros((len(groups), N_PRIM_PARAMS))
+        for k, (first, end, glo, ghi) in enumerate(groups):
+            rows[k, :8] = (first, end, *glo, *ghi)
+        start = b.rows
+        b.add_block(SHAPE_CSG_OP, rows, np.zeros((len(groups), 3)), np.zeros((len(groups), 3)),
+                    0, obj, False)
+        for row in range(start, b.rows):
+            b.csg_rows[row] = (0, -1)
     body_material = default_material if shape.material is not None else leaves[0][1]
     body = material_row(body_material)
     for row, _, flip in leaves:
