@@ -25,7 +25,7 @@ def _lights() -> dict:
     """Every light type and falloff, shading a floor, a Phong ball, a mirror, glass and a
     glass torus."""
     return {
-        "render": {"width": 6, "height": 5, "max_depth": 2},
+        "render": {"width": 10, "height": 8, "max_depth": 2},
         "camera": {"position": [0.0, 2.5, 6.0], "look_at": [0.0, 0.5, 0.0], "fov": 50.0},
         "lights": [
             {"type": "ambient", "intensity": 0.1},
@@ -85,7 +85,8 @@ def _glass_sheets(count: int, samples: int) -> dict:
 
 def _teapots() -> dict:
     """27 teapots (27 x 2,464 triangles: past the flatten limit, so instanced), glass (some
-    dark enough to stop the light) and opaque, between a point light and the floor."""
+    dark enough to stop the light) and opaque, and an opaque ball between a point light and
+    the floor."""
     dark = dict(GLASS, attenuation=40.0)
     pots = []
     for k in range(27):
@@ -95,11 +96,14 @@ def _teapots() -> dict:
                      "transform": {"translate": [0.9 * x, 1.2, 0.9 * z],
                                    "scale": [0.6, 0.6, 0.6]}})
     return {
-        "render": {"width": 5, "height": 4, "max_depth": 1, "mesh_tracer": "whitted"},
+        "render": {"width": 10, "height": 8, "max_depth": 1, "mesh_tracer": "whitted"},
         "camera": {"position": [0.0, 2.0, 6.0], "look_at": [0.0, 0.0, 0.0], "fov": 40.0},
         "lights": [{"type": "ambient", "intensity": 0.2},
                    {"type": "point", "position": [0.2, 12.0, 0.3], "intensity": 1.0}],
-        "objects": [{"type": "plane", "material": MATTE}, *pots],
+        # and an opaque ball whose shadow falls on the floor in front
+        "objects": [{"type": "plane", "material": MATTE},
+                    {"type": "sphere", "center": [0.6, 6.0, 1.4], "radius": 0.6,
+                     "material": MATTE}, *pots],
     }
 
 
