@@ -1,10 +1,11 @@
 """Tiny scenes for the kernel paths that tests/test_python_kernels.py's scenes leave out, rendered
 by tests/test_cov_python_kernels.py in its own process and, in a fresh process, with the other
 JIT mode (``python tests/python_kernel_scenes.py OUT.npz``): every light type and falloff,
-Phong and Blinn highlights with a fractional exponent, a mirror with no diffuse or specular
-term, soft-shadow bundles (listed occluders, a plane the light is clear of, the list cap),
-shadow rays through more transparent surfaces than one walk keeps, through a glass torus and
-through transparent mesh instances."""
+Phong and Blinn highlights with a fractional exponent, two samples a pixel, a mirror with no
+diffuse or specular term, soft-shadow bundles (listed occluders, a plane the light is clear
+of, the list cap), shadow rays through more transparent surfaces than one walk keeps, through
+a glass torus and through transparent mesh instances; and the depth, normal and object-id
+AOVs."""
 
 from __future__ import annotations
 
@@ -25,7 +26,7 @@ def _lights() -> dict:
     """Every light type and falloff, shading a floor, a Phong ball, a mirror, glass and a
     glass torus."""
     return {
-        "render": {"width": 10, "height": 8, "max_depth": 2},
+        "render": {"width": 10, "height": 8, "max_depth": 2, "samples": 2},
         "camera": {"position": [0.0, 2.5, 6.0], "look_at": [0.0, 0.5, 0.0], "fov": 50.0},
         "lights": [
             {"type": "ambient", "intensity": 0.1},
@@ -168,7 +169,15 @@ def render(name: str) -> np.ndarray:
 
 
 def render_all() -> dict[str, np.ndarray]:
-    return {name: render(name) for name in SCENES}
+    """Every scene's image, and the textures scene's depth, normal and object-id AOVs."""
+    from whitted.render.api import render_aovs
+    from whitted.scene.io import scene_from_dict
+
+    out = {name: render(name) for name in SCENES}
+    scene = scene_from_dict(_textures(), file=str(ROOT / "tests" / "scenes" / "x.toml"))
+    for key, value in render_aovs(scene, threads=1).items():
+        out[f"aov_{key}"] = np.asarray(value)
+    return out
 
 
 if __name__ == "__main__":

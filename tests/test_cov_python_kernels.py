@@ -36,6 +36,22 @@ def images(tmp_path_factory):
         return here, {k: other[k] for k in other.files}
 
 
+def test_python_and_compiled_aovs_agree(images):
+    here, other = images
+    aovs = sorted(k for k in here if k.startswith("aov_"))
+    assert aovs == ["aov_depth", "aov_id", "aov_normal"]
+    for key in aovs:
+        assert np.array_equal(np.isinf(here[key]), np.isinf(other[key])), key
+        assert np.allclose(here[key], other[key], rtol=1e-5, atol=1e-6), key
+    ids = here["aov_id"]
+    assert set(np.unique(ids)) == set(range(-1, 9))  # the sky and all 9 objects
+    depth = here["aov_depth"]
+    assert np.array_equal(np.isinf(depth), ids == -1)
+    # the floor (object 0) faces up; the sky has no normal
+    assert np.allclose(here["aov_normal"][ids == 0], [0.0, 1.0, 0.0], atol=1e-6)
+    assert not here["aov_normal"][ids == -1].any()
+
+
 @pytest.mark.parametrize("name", list(scenes.SCENES))
 def test_python_and_compiled_kernels_give_the_same_image(images, name):
     here, other = images
