@@ -79,6 +79,25 @@ def test_catton_enclosure_nusselt_and_the_density_inversion():
     assert cv.water_conductivity(zero.x, 0.024, 0.56, 4.22e6) == 0.56
 
 
+def test_catton_against_de_vahl_davis_benchmark():
+    # de Vahl Davis (1983): the square cavity with differentially heated sides, Pr = 0.71,
+    # mean Nu 1.118, 2.243, 4.519, 8.800 at Ra = 1e3 ... 1e6 (to 1 % or better). Catton's
+    # formula 0.18 (Pr/(0.2 + Pr) Ra)^0.29 by hand: Ra Pr/(0.2 + Pr) = 7802, 78 022, 780 220
+    # -> Nu 2.421, 4.721, 9.205: +7.9, +4.5, +4.6 %; at Ra = 1e3 (x = 780, below Catton's
+    # 10^3) the model conducts (Nu 1, -10.6 %) where the formula would give 1.242 (+11.1 %).
+    from whitted.stefan.validate import enclosure_rows
+
+    rows = enclosure_rows()
+    assert [r["ra"] for r in rows] == [1e3, 1e4, 1e5, 1e6]
+    assert [r["in_range"] for r in rows] == [False, True, True, True]
+    assert [round(r["error_pct"], 1) for r in rows] == [-10.6, 7.9, 4.5, 4.6]
+    assert rows[0]["model"] == 1.0
+    assert rows[0]["formula_error_pct"] == pytest.approx(11.06, abs=0.01)
+    assert [round(r["model"], 3) for r in rows[1:]] == [2.421, 4.721, 9.205]
+    # within its range the correlation is within 10 % of the benchmark, and above it
+    assert all(0.0 < r["error_pct"] < 10.0 for r in rows if r["in_range"])
+
+
 def _column(air: Air, t_end: float = 1200.0, cells: int = 20):
     """A line of ice at 0 °C along y with two air cells on top: only its y+ face meets air."""
     kind = np.ones((1, cells + 2, 1), dtype=np.uint8)
