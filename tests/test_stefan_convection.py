@@ -38,6 +38,28 @@ def test_auto_h_of_the_default_block_by_hand():
     assert cv.face_coefficients((0.04, 0.04, 0.04), 5.0, t_surface=5.0) == (0.0,) * 6
 
 
+def test_still_air_gives_the_sides_less_heat_than_the_old_h_20():
+    # docs/stefan.md, "Why still air melts the block later": into ice at 0 °C in the default
+    # room (25 °C, eps 0.97, 30 % humidity) the auto sides get 6.72 x 25 = 168 W/m² by
+    # convection, 128.4 by radiation, 30.5 by condensation (h_m follows h): 327 W/m²; h = 20
+    # gets 500 + 128.4 + 90.8 = 719; the first round's h = 20 alone 500. The hand estimate of
+    # the breach, (3.9 + 0.19) mm x rho_i L / q: 41.7, 29.0 and 63.8 min.
+    from whitted.stefan.room import outer_film
+
+    side = cv.face_coefficients((0.04, 0.04, 0.04), 25.0)[0]
+    fluxes = {}
+    for name, h, eps, rh in (("old", 20.0, 0.0, 0.0), ("h20", 20.0, 0.97, 0.3),
+                             ("auto", side, 0.97, 0.3)):
+        f = outer_film(25.0, h, emissivity=eps, relative_humidity=rh)
+        fluxes[name] = f.convection + f.radiation + f.condensation
+        assert f.h * (f.temperature - 0.0) == pytest.approx(fluxes[name], rel=1e-12)
+    assert fluxes["old"] == pytest.approx(500.0, rel=1e-12)
+    assert fluxes["h20"] == pytest.approx(719.2, abs=0.3)
+    assert fluxes["auto"] == pytest.approx(326.9, abs=0.3)
+    minutes = {k: 4.09e-3 * 917.0 * 333.6e3 / q / 60.0 for k, q in fluxes.items()}
+    assert [round(minutes[k], 1) for k in ("old", "h20", "auto")] == [41.7, 29.0, 63.8]
+
+
 def test_lloyd_moran_switches_to_the_turbulent_law_above_1e7():
     assert cv.nusselt_horizontal(1e6, rising=True) == pytest.approx(0.54 * 1e6 ** 0.25)
     assert cv.nusselt_horizontal(1e9, rising=True) == pytest.approx(0.15 * 1e3)
