@@ -56,6 +56,11 @@ def test_still_air_gives_the_sides_less_heat_than_the_old_h_20():
     assert fluxes["old"] == pytest.approx(500.0, rel=1e-12)
     assert fluxes["h20"] == pytest.approx(719.2, abs=0.3)
     assert fluxes["auto"] == pytest.approx(326.9, abs=0.3)
+    # at 70 % humidity the three parts are of one size, as Neufeld, Goldstein & Worster (2010)
+    # found for ice melting in warm still air: 168 convection, 167 condensation, 128 radiation
+    humid = outer_film(25.0, side, relative_humidity=0.7)
+    assert humid.condensation == pytest.approx(humid.convection, rel=0.01)
+    assert humid.radiation == pytest.approx(128.4, abs=0.1)
     minutes = {k: 4.09e-3 * 917.0 * 333.6e3 / q / 60.0 for k, q in fluxes.items()}
     assert [round(minutes[k], 1) for k in ("old", "h20", "auto")] == [41.7, 29.0, 63.8]
 
