@@ -288,6 +288,82 @@ def test_export_writes_photons_blocks():
     assert "photons" not in plain
 
 
+PRESET_GLASS = {"preset": "glass"}  # kr 0.05, kt 0.95, ior 1.5, fresnel
+
+
+def test_export_filter_makes_povray_transmit_what_whitted_does():
+    # POV-Ray's conserve_energy passes filter * (1 - kr - kt F) where whitted passes
+    # kt (1 - F): for the glass preset (kr + kt = 1) a filter of 1 is equal at every F, the
+    # old filter kt = 0.95 passed 0.95 (1 - F) * 0.95, 5 % less a surface
+    from whitted.export.pov import pov_filter, scene_to_pov
+    from whitted.scene.materials import Material
+
+    glass = Material(preset="glass")
+    assert pov_filter(glass) == 1.0
+    for f in (0.0, 0.04, 0.3, 1.0):
+        assert pov_filter(glass) * (1 - glass.kr - glass.kt * f) == pytest.approx(
+            glass.kt * (1 - f))
+    ice = Material(preset="ice")  # kr + kt = 0.93: equal at normal incidence
+    f0 = ((ice.ior - 1) / (ice.ior + 1)) ** 2
+    assert pov_filter(ice) * (1 - ice.kr - ice.kt * f0) == pytest.approx(ice.kt * (1 - f0))
+    assert pov_filter(Material(kt=0.5, kr=0.0)) == 0.5  # no Fresnel: the filter is kt
+    scene = scene_of([{"type": "sphere", "center": [0, 2, 0], "radius": 1.0,
+                       "material": PRESET_GLASS}])
+    assert "rgbf <1, 1, 1, 1>" in scene_to_pov(scene)
+    # without caustics POV-Ray's shadow rays pass the filter: it stays kt, as whitted's
+    plain = scene_to_pov(scene.with_settings(caustics=CausticsSettings()))
+    assert "rgbf <1, 1, 1, 0.95>" in plain
+
+
+def _povray_floor(scene, tmp_path, size=32):
+    """POV-Ray's linear image (red channel) of ``scene`` exported by whitted, read from a
+    16-bit PPM."""
+    import shutil
+    import subprocess
+
+    from whitted.export.pov import scene_to_pov
+
+    if shutil.which("povray") is None:
+        pytest.skip("povray is not installed")
+    pov = tmp_path / "s.pov"
+    pov.write_text(scene_to_pov(scene))
+    out = tmp_path / "s.ppm"
+    subprocess.run(["povray", f"+I{pov}", f"+O{out}", f"+W{size}", f"+H{size}", "-A", "-D",
+                    "-P", "+FP16", "+WT2", "-V", "File_Gamma=1.0"], capture_output=True,
+                   check=True, timeout=120)
+    data = out.read_bytes()
+    header, pos = [], 0
+    while len(header) < 4:  # P6, width, height, maxval, with '#' comment lines between
+        end = data.index(b"\n", pos)
+        line = data[pos:end].split(b"#")[0]
+        header += line.split()
+        pos = end + 1
+    assert header == [b"P6", str(size).encode(), str(size).encode(), b"65535"]
+    pixels = np.frombuffer(data[pos:pos + size * size * 6], ">u2").reshape(size, size, 3)
+    return pixels[..., 0] / 65535.0
+
+
+def test_povray_given_the_export_passes_the_slabs_transmittance(tmp_path):
+    # the glass preset slab under a unit sun, POV-Ray's camera between slab and floor
+    # (looking down, so camera rays do not cross the slab): the floor is lit only by
+    # photons. By whitted's model each face passes kt (1 - F) = 0.912 and reflects
+    # kr + kt F = 0.088 (F = 0.04 at normal incidence, Schlick and exact Fresnel alike):
+    # T = t^2 / (1 - R^2) = 0.838235. The old export (filter kt) gave 0.750.
+    t, r = 0.95 * 0.96, 0.05 + 0.95 * 0.04
+    expected = t * t / (1 - r * r)
+    assert expected == pytest.approx(0.838235, abs=1e-6)
+    camera = {"position": [0, 0.5, 0], "look_at": [0, 0, 0], "up": [0, 0, -1],
+              "projection": "orthographic", "ortho_height": 2.0}
+    scene = scene_of([{"type": "box", "min": [-3, 1, -3], "max": [3, 1.5, 3],
+                       "material": PRESET_GLASS}], photons=50_000, camera=camera)
+    floor = _povray_floor(scene, tmp_path)
+    assert floor.mean() == pytest.approx(expected, rel=0.02)
+    # and whitted's own photons, gathered the same way
+    _, lights, _ = scene_photon_map(scene, threads=2)
+    e = irradiance(lights, floor_points(0.9, 7), [0, 1, 0])[:, 0]
+    assert e.mean() == pytest.approx(expected, rel=0.02)
+
+
 def test_fuzzed_caustics_tables_are_accepted_or_refused_in_one_line():
     from hypothesis import given, settings
     from hypothesis import strategies as st
