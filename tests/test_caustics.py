@@ -46,6 +46,12 @@ def schlick_air(cos_air, n):
     return r0 + (1 - r0) * (1 - cos_air) ** 5
 
 
+def caustic_power(lights):
+    """The power of the caustic photons (the shadow photons carry less than 0)."""
+    power = lights.photons[:, PHOTON_POWER].astype(np.float64)
+    return power[power > 0].sum()
+
+
 def floor_points(half, count):
     xs = np.linspace(-half, half, count)
     return np.array([[x, 0.0, z] for x in xs for z in xs])
@@ -102,8 +108,10 @@ def test_glass_ball_total_caustic_power():
     scene = scene_of([{"type": "sphere", "center": [0, 3, 0], "radius": 1.0,
                        "material": GLASS}], photons=200_000)
     _, lights, _ = scene_photon_map(scene, threads=2)
-    power = lights.photons[:, PHOTON_POWER].astype(np.float64).sum()
-    assert power / math.pi == pytest.approx(expected, rel=0.02)
+    power = lights.photons[:, PHOTON_POWER].astype(np.float64)
+    assert power[power > 0].sum() / math.pi == pytest.approx(expected, rel=0.02)
+    # the shadow photons take away the unit sun's power through the cross-section, pi
+    assert power[power < 0].sum() == pytest.approx(-math.pi, rel=0.01)
 
 
 def test_glass_ball_focuses_on_its_axis_at_the_paraxial_focus():
@@ -214,7 +222,7 @@ def test_disk_light_casts_a_soft_caustic_of_the_same_power():
     ball = [{"type": "sphere", "center": [0, 2, 0], "radius": 1.0, "material": GLASS}]
     _, sharp, _ = scene_photon_map(scene_of(ball, lights=point, radius=0.02), threads=2)
     _, soft, _ = scene_photon_map(scene_of(ball, lights=disk, radius=0.02), threads=2)
-    power = [a.photons[:, PHOTON_POWER].astype(np.float64).sum() for a in (sharp, soft)]
+    power = [caustic_power(a) for a in (sharp, soft)]
     # a disk of this size, 6 away, sends the ball nearly the point light's power (within
     # the change of solid angle over the disk: 1 - ~1.5 %)
     assert power[1] == pytest.approx(power[0], rel=0.03)
@@ -252,7 +260,7 @@ def test_meshes_traced_as_instances_focus_like_flattened_ones():
         compiled = compile_scene(scene, flatten_limit=limit)
         params = render_params(scene, compiled, scene.render)
         lights = photon_lights(compiled, params, scene.render.caustics, 2)
-        powers.append(lights.photons[:, PHOTON_POWER].astype(np.float64).sum())
+        powers.append(caustic_power(lights))
     assert powers[0] > 0.8 * math.pi  # the power through the cross-section, mostly
     assert powers[1] == pytest.approx(powers[0], rel=1e-3)
 
@@ -362,6 +370,32 @@ def test_povray_given_the_export_passes_the_slabs_transmittance(tmp_path):
     _, lights, _ = scene_photon_map(scene, threads=2)
     e = irradiance(lights, floor_points(0.9, 7), [0, 1, 0])[:, 0]
     assert e.mean() == pytest.approx(expected, rel=0.02)
+
+
+def test_no_rim_at_the_edge_of_a_transparent_bodys_shadow():
+    # a glass slab (x < 0) under a unit sun: the floor under it gets T = 0.923 (photons),
+    # beside it 1 (direct). A profile across the shadow's edge, seen from between slab and
+    # floor, must step from T to 1 with no overshoot or undershoot beyond the noise. Before
+    # the shadow photons, the gather radius straddling the edge gave a dark rim inside
+    # (photons missing beyond the edge, ~T/2) and a bright one outside (1 + ~T/2).
+    f = schlick_air(1.0, 1.5)
+    t = (1 - f) / (1 + f)
+    r = 0.03
+    camera = {"position": [0, 0.5, 0], "look_at": [0, 0, 0], "up": [0, 0, -1],
+              "projection": "orthographic", "ortho_height": 0.125}
+    scene = scene_of([{"type": "box", "min": [-1, 1, -0.5], "max": [0, 1.2, 0.5],
+                       "material": GLASS}], photons=100_000, radius=r, camera=camera,
+                     size=(64, 8))
+    profile = render(scene, threads=2).pixels[..., 0].mean(axis=0)
+    x = ((np.arange(64) + 0.5) / 64 - 0.5) * 1.0  # the image is 1 unit wide
+    inside, outside = profile[x < -r], profile[x > r]
+    assert inside.mean() == pytest.approx(t, rel=0.02)
+    np.testing.assert_allclose(outside, 1.0, atol=0.01)
+    # across the edge too: nothing above the lit floor, nothing below the slab's shadow
+    # beyond the noise of the inside columns (a few per cent)
+    assert profile.max() <= 1.01
+    assert profile.min() >= t - 0.04
+    assert np.all(np.diff(profile[np.abs(x) <= 2 * r]) >= -0.04)  # a step up, no dip
 
 
 def test_fuzzed_caustics_tables_are_accepted_or_refused_in_one_line():
