@@ -398,6 +398,90 @@ def test_no_rim_at_the_edge_of_a_transparent_bodys_shadow():
     assert np.all(np.diff(profile[np.abs(x) <= 2 * r]) >= -0.04)  # a step up, no dip
 
 
+def test_first_caustics_compile_reports_progress(monkeypatch):
+    # the caustics stage (photon map + the render kernel's kind with caustics) compiles the
+    # first time; while it does, compile_progress() says how far along and compile_label()
+    # what, as for the render kernels' cold compile; loaded from the cache it stays None
+    import numba
+
+    import whitted.compile.photon_map as photon_map
+    from whitted.render import warm_up
+
+    seen = []
+    real = photon_map.photon_lights
+
+    def compiling_photon_lights(*args, **kwargs):
+        seen.append((warm_up.compile_progress(), warm_up.compile_label()))
+
+        @numba.njit(cache=False)
+        def fresh(x):  # a kernel never compiled before: a cold compile of the stage
+            return x + 1
+
+        fresh(1)
+        seen.append((warm_up.compile_progress(), warm_up.compile_label()))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(photon_map, "photon_lights", compiling_photon_lights)
+    scene = scene_of([{"type": "sphere", "center": [0, 2, 0], "radius": 1.0,
+                       "material": GLASS}], photons=2000, size=(4, 4))
+    render(scene, threads=1)
+    (before, _), (during, label) = seen
+    assert before is None  # nothing compiled yet: no bar claims a compile
+    assert 0.0 < during < 1.0 and label == "the caustics kernels"
+    assert warm_up.compile_progress() is None and warm_up.compile_label() == "the kernels"
+    # the CLI's bar shows it
+    from whitted.cli.render import _show_compile
+
+    class Bar:
+        def update(self, task, **fields):
+            self.fields = fields
+
+    monkeypatch.setattr(warm_up, "compile_progress", lambda: 0.25)
+    monkeypatch.setattr(warm_up, "compile_label", lambda: "the caustics kernels")
+    bar = Bar()
+    _show_compile(bar, 0)
+    assert bar.fields == {"description": "compiling the caustics kernels (first run only)",
+                          "completed": 0.25}
+
+
+def test_an_infinite_transparent_plane_casts_no_caustic_and_says_so():
+    # water as an infinite plane (y = 1) over the floor, a glass ball above it, a unit sun:
+    # the plane cannot be aimed at. Its light passes as shadow rays pass it (times kt, the
+    # colour), with caustics as without; the ball's photons cross it the same way
+    from whitted.compile.photon_map import unbounded_specular_objects
+    from whitted.compile.scene import compile_scene
+
+    water = {"color": [1.0, 0.9, 0.8], "ka": 0.0, "kd": 0.0, "ks": 0.0, "kr": 0.0,
+             "kt": 0.8, "ior": 1.33}
+    plane = {"type": "plane", "point": [0, 1, 0], "normal": [0, 1, 0], "material": water}
+    ball = {"type": "sphere", "center": [0, 3, 0], "radius": 1.0, "material": GLASS}
+    camera = {"position": [0, 0.5, 0], "look_at": [0, 0, 0], "up": [0, 0, -1],
+              "projection": "orthographic", "ortho_height": 4.0}
+    scene = scene_of([plane, ball], photons=50_000, camera=camera)
+    assert unbounded_specular_objects(compile_scene(scene)) == [1]
+    # seen from under the plane, with a ball of ior 1 (it bends nothing): the floor under
+    # and around the ball is as lit as with no ball, E kt colour, the ball's photons and
+    # its shadow photons crossing the plane alike
+    clear = dict(GLASS, ior=1.0, fresnel=False)
+    job = RenderJob(scene_of([plane, dict(ball, material=clear)], photons=50_000,
+                             camera=camera).with_settings(threads=2))
+    floor = job.run().pixels.reshape(-1, 3)
+    assert any("objects[1]" in w and "unbounded" in w for w in job.stats.warnings)
+    np.testing.assert_allclose(floor, np.tile([0.8, 0.72, 0.64], (len(floor), 1)), rtol=1e-3)
+    plain = render(scene_of([plane], photons=0, camera=camera)).pixels.reshape(-1, 3)
+    np.testing.assert_allclose(floor, plain, rtol=1e-3)
+    # the ball's light crosses the plane times kt and the colour; the shadow photons too
+    _, lights, stats = scene_photon_map(scene, threads=2)
+    assert stats.targets == 1  # the ball alone
+    power = lights.photons[:, PHOTON_POWER:PHOTON_POWER + 3].astype(np.float64)
+    positive = power[power.sum(axis=1) > 0].sum(axis=0)
+    negative = power[power.sum(axis=1) < 0].sum(axis=0)
+    kt_colour = np.array([0.8, 0.72, 0.64])
+    np.testing.assert_allclose(positive / math.pi, ball_power_on_floor(1.5) * kt_colour,
+                               rtol=0.02)
+    np.testing.assert_allclose(negative / math.pi, -kt_colour, rtol=0.01)
+
+
 def test_fuzzed_caustics_tables_are_accepted_or_refused_in_one_line():
     from hypothesis import given, settings
     from hypothesis import strategies as st

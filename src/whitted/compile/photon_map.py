@@ -15,7 +15,7 @@ import math
 import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -93,9 +93,8 @@ def _specular(mats: np.ndarray, rows: np.ndarray) -> np.ndarray:
     return mats[rows, MAT_KR] + mats[rows, MAT_KT]
 
 
-def caustic_targets(compiled: CompiledScene) -> Targets:
-    """The bounded objects with a material that reflects or refracts (kr or kt > 0): the
-    bounding sphere of their primitives that do, per scene object."""
+def _specular_primitives(compiled: CompiledScene) -> tuple[np.ndarray, np.ndarray]:
+    """(the largest kr + kt of each primitive's materials, whether it is bounded)."""
     geo = compiled.geometry
     mats = compiled.materials
     info = geo.prim_info
@@ -110,7 +109,25 @@ def caustic_targets(compiled: CompiledScene) -> Targets:
         rows = geo.tri_material[start:start + geo.mesh_info[mesh, MESH_TRI_COUNT]]
         strength[i] = _specular(mats, rows).max(initial=0.0)
     lo, hi = compiled.prim_lo, compiled.prim_hi
-    bounded = np.all(np.isfinite(lo) & np.isfinite(hi), axis=1)
+    return strength, np.all(np.isfinite(lo) & np.isfinite(hi), axis=1)
+
+
+def unbounded_specular_objects(compiled: CompiledScene) -> list[int]:
+    """The scene objects (indices) with an unbounded primitive that reflects or refracts:
+    an infinite plane. Photons cannot be aimed at all of it: it casts no caustic (a mirror
+    plane sends no light on; light passes a transparent one as it passes shadow rays,
+    times kt·colour, straight, without Fresnel) and renders say so."""
+    strength, bounded = _specular_primitives(compiled)
+    info = compiled.geometry.prim_info
+    return sorted({int(o) for o in info[(strength > 0.0) & ~bounded, PRIM_OBJECT]})
+
+
+def caustic_targets(compiled: CompiledScene) -> Targets:
+    """The bounded objects with a material that reflects or refracts (kr or kt > 0): the
+    bounding sphere of their primitives that do, per scene object."""
+    strength, bounded = _specular_primitives(compiled)
+    info = compiled.geometry.prim_info
+    lo, hi = compiled.prim_lo, compiled.prim_hi
     chosen = np.flatnonzero((strength > 0.0) & bounded)
     objects = info[chosen, PRIM_OBJECT]
     centres, radii, power = [], [], []
@@ -313,6 +330,7 @@ class PhotonStats:
     last_radius: float = 0.0
     targets: int = 0
     seconds: float = 0.0
+    warnings: list[str] = field(default_factory=list)
 
 
 def shoot_pass(compiled: CompiledScene, rows: np.ndarray, clear: np.ndarray,
@@ -364,6 +382,9 @@ def photon_lights(compiled: CompiledScene, params: RenderParams, settings: Caust
     check_photon_memory(settings, threads)
     stats = stats if stats is not None else PhotonStats()
     targets = caustic_targets(compiled)
+    stats.warnings = [f"objects[{i}] reflects or refracts but is unbounded: it casts no "
+                      "caustic (light passes it as shadow rays do, times kt; "
+                      "docs/caustics.md)" for i in unbounded_specular_objects(compiled)]
     rows = emitters(compiled, targets, settings.photons)
     shadow_mats = shadow_material_table(compiled)
     clear = clear_materials(compiled).astype(np.uint8)
