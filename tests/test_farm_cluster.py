@@ -5,6 +5,7 @@ none, workers stopped (SIGSTOP), killed or lost, the scheduler lost (issue 26)."
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import signal
 import socket
@@ -389,7 +390,11 @@ def test_losing_every_worker_ends_in_one_line_keeping_the_frames(scheduler, film
         with pytest.raises(ClusterLost) as lost:
             render_film(client, film_scene, tmp_path / "frames", chunk=1, progress=kill_it,
                         stall_floor=3.0)
-    assert str(lost.value).startswith("every worker was lost")
+    # which of the two ends it is a race the machine's load decides: the scheduler drops the
+    # killed worker (no worker left), or a task it had finished but not handed over times
+    # out with no worker left to run it again
+    assert re.match(r"every worker (was lost \(\d+ s without one\)|that could render stalled "
+                    r"or was lost)$", str(lost.value)), str(lost.value)
     assert len(list((tmp_path / "frames").glob("*.png"))) >= 1
 
 

@@ -4,11 +4,13 @@ renders share one folder; never a crash, a wrong image or an internal error."""
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import numpy as np
@@ -85,8 +87,8 @@ def test_truncated_files_are_dropped_with_one_warning_for_all(tmp_path, capsys):
 
 def test_files_nobody_sealed_are_not_trusted_in_whitteds_folder(tmp_path, capsys):
     """A file written by a process that stopped before sealing, or put there by hand, is
-    deleted (compiled again) without a warning; a file replaced by other content is
-    damaged."""
+    deleted (compiled again) without a warning; a file replaced by other content, with no
+    process compiling, is damaged."""
     state = _fake_cache(tmp_path)
     Path(state.folder, "kernels_1/c-9.py311.nbi").write_bytes(b"\x80\x04unsealed")
     replaced = Path(state.folder, "kernels_1/a-1.py311.nbi")
@@ -97,6 +99,85 @@ def test_files_nobody_sealed_are_not_trusted_in_whitteds_folder(tmp_path, capsys
     assert again.verify() == 1
     assert _names(again) == _names(state) - {"kernels_1/a-1.py311.nbi"}
     assert capsys.readouterr().err.startswith("warning: 1 damaged")
+
+
+def _hold_compiling_marker(folder: str, started: Path, release: Path) -> subprocess.Popen:
+    """Another process: it starts compiling into ``folder`` (takes its marker), says so,
+    and holds it until ``release`` exists."""
+    code = textwrap.dedent(f"""
+        import pathlib, sys, time
+        sys.path.insert(0, {str(REPO_ROOT / 'src')!r})
+        from whitted import _cache
+        state = _cache.KernelCache({folder!r}, own=True, helper=False)
+        state.compiling()
+        pathlib.Path({str(started)!r}).touch()
+        while not pathlib.Path({str(release)!r}).exists():
+            time.sleep(0.02)
+        """)
+    return subprocess.Popen([sys.executable, "-c", code])
+
+
+def _rewrite(path: Path, data: bytes) -> None:
+    new = path.with_suffix(".new")  # as Numba writes: a new file renamed over the old
+    new.write_bytes(data)
+    os.replace(new, path)
+
+
+def test_another_process_compiling_is_not_damage(tmp_path, capsys):
+    """Two processes share a cache: one's Numba has rewritten a sealed index (a new file
+    renamed into place) and not yet sealed it when the other starts. The other drops that
+    file without a word (not trusted, not damage) but still tells damage in place; once
+    the first has ended without sealing, its marker is stale and a rewrite is damage."""
+    state = _fake_cache(tmp_path)
+    started, release = tmp_path / "started", tmp_path / "release"
+    other = _hold_compiling_marker(state.folder, started, release)
+    try:
+        while not started.exists():  # an event, not a time: it exits on any failure
+            assert other.poll() is None, "the other process ended before compiling"
+            time.sleep(0.02)
+        _rewrite(Path(state.folder, "kernels_1/a-1.py311.nbi"), b"another signature")
+        _flip(Path(state.folder, "compile_2/b-2.py311.0.nbc"), 3)  # in place: damage still
+        again = _cache.KernelCache(state.folder, own=True, helper=False)
+        assert again.verify() == 1
+        assert _names(again) == _names(state) - {"kernels_1/a-1.py311.nbi",
+                                                 "compile_2/b-2.py311.0.nbc"}
+        err = capsys.readouterr().err.splitlines()
+        assert len(err) == 1 and err[0].startswith("warning: 1 damaged")
+    finally:
+        release.touch()
+        other.wait(timeout=60)
+    stale = Path(state.folder, f"{_cache.COMPILING}{other.pid}")
+    assert stale.exists()  # it ended without sealing: its marker is left, holding nothing
+    _rewrite(Path(state.folder, "compile_2/b-2.py311.nbi"), b"rewritten by nobody")
+    third = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert third.verify() == 1 and not stale.exists()
+
+
+def test_a_process_seals_and_drops_its_marker(tmp_path):
+    state = _fake_cache(tmp_path)
+    state.compiling()
+    marker = Path(state.folder, f"{_cache.COMPILING}{os.getpid()}")
+    assert marker.exists()
+    assert not _cache.KernelCache(state.folder, own=True, helper=False).others_compiling()
+    state.seal()
+    assert not marker.exists()
+
+
+def test_a_copied_folder_with_a_damaged_file_is_told(tmp_path, capsys):
+    """In a copy every inode is new: a damaged file there is still damage (no process is
+    compiling); the good ones are kept and their new inodes recorded."""
+    state = _fake_cache(tmp_path)
+    copy = tmp_path / "copy" / "numba-x"
+    shutil.copytree(state.folder, copy)
+    _flip(copy / "compile_2/b-2.py311.1.nbc", 9)
+    again = _cache.KernelCache(str(copy), own=True, helper=False)
+    assert again.verify() == 1
+    assert _names(again) == _names(state) - {"compile_2/b-2.py311.1.nbc"}
+    assert capsys.readouterr().err.startswith("warning: 1 damaged")
+    sums = json.loads(Path(copy, _cache.SUMS).read_text())
+    good = copy / "kernels_1/a-1.py311.0.nbc"
+    assert sums["kernels_1/a-1.py311.0.nbc"] == [sums["kernels_1/a-1.py311.0.nbc"][0],
+                                                 good.stat().st_size, good.stat().st_ino]
 
 
 def test_a_copied_folder_checks_clean(tmp_path, capsys):

@@ -27,20 +27,26 @@ keeps a list of their SHA-256 sums (:data:`SUMS`, written by whitted under a loc
 at all) and, before Numba first loads anything in a process (:func:`prepare`), checks every
 cache file against it:
 
-- a file whose sum differs from its entry was damaged (or replaced by hand): it is deleted
-  (Numba then compiles that kernel again and caches it anew) and one ``warning:`` line says
-  how many were;
+- a file whose sum differs from its entry, changed in place (the inode the entry records),
+  was damaged: it is deleted (Numba then compiles that kernel again and caches it anew) and
+  one ``warning:`` line says how many were;
 - a file the list does not name (written by a process that was stopped before it sealed
   it, or put there by hand) is not trusted either: in whitted's own folder it is deleted
   silently (it is compiled again); in a folder the user named with ``NUMBA_CACHE_DIR``, which
   may hold other programs' cache files, it is taken as found;
+- a new file under a name the list has (another inode: Numba writes a file whole and renames
+  it into place) while another process is compiling into the folder (it holds a
+  ``whitted-compiling-<pid>`` marker from its first compile to its seal) is that process's
+  work in progress: deleted silently too, never trusted, never reported as damage. With no
+  process compiling, it is damage like any other;
 - a damaged list is a list of nothing: every file is then compiled again, with one warning.
 
 After Numba wrote files (a compile of a kernel called from Python, the warm-up), whitted
 :func:`seal` s them: the files that are new since this process last looked, or were replaced
 by a new file (a new inode: Numba writes a file whole and renames it into place), get their
 entries; a file changed in place keeps its old entry, so damage is not sealed. A list that
-names files by content only survives copying the folder elsewhere (a container image). Two
+names files by content (size and SHA-256; the inode only tells a rewrite from damage) survives
+copying the folder elsewhere (a container image). Two
 processes compiling at once take turns through a lock file (``whitted.lock``); the
 cold compile of the render kernels holds it throughout (render/warm_up.py), so a second cold
 render waits and then loads what the first compiled.
@@ -62,6 +68,8 @@ KERNEL_DIRS = ("kernels", "compile", "assets")
 #: the list of sums in the cache folder
 SUMS = "whitted-sums.json"
 LOCK = "whitted.lock"
+#: the marker a process holds while it has compiled files not yet in the list
+COMPILING = "whitted-compiling-"
 #: what Numba writes into the cache folder
 CACHE_SUFFIXES = (".nbi", ".nbc")
 #: set in the environment of the compile helper (render/warm_up.py): its parent checked the
@@ -129,6 +137,7 @@ class KernelCache:
         self._lock_fd: int | None = None
         self._lock_depth = 0
         self.unsealed = False  # Numba compiled something since the last seal
+        self._compiling_fd: int | None = None  # held while this process has unsealed files
 
     # ---------------------------------------------------------------- lock
     @contextlib.contextmanager
@@ -174,6 +183,63 @@ class KernelCache:
         if fd is not None:
             os.close(fd)  # releases the lock
 
+    # ---------------------------------------------------------------- compiling marker
+    def compiling(self) -> None:
+        """Numba is compiling here: until the next :meth:`seal`, this process may leave
+        cache files the list does not name yet, and says so to other processes with a marker
+        file it holds a shared lock on (``whitted-compiling-<pid>``; a process that ended
+        holds nothing, whatever its marker says)."""
+        if self.folder is None or self.helper or self.read_only \
+                or self._compiling_fd is not None:
+            return
+        import fcntl
+
+        try:
+            fd = os.open(os.path.join(self.folder, f"{COMPILING}{os.getpid()}"),
+                         os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError:
+            return
+        try:
+            fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            return
+        self._compiling_fd = fd
+
+    def _done_compiling(self) -> None:
+        if self._compiling_fd is None:
+            return
+        with contextlib.suppress(OSError):
+            os.unlink(os.path.join(self.folder, f"{COMPILING}{os.getpid()}"))
+        os.close(self._compiling_fd)  # releases its lock
+        self._compiling_fd = None
+
+    def others_compiling(self) -> bool:
+        """Whether another live process is compiling into this folder now (its new files
+        are not sealed yet). Markers of processes that ended are deleted."""
+        import fcntl
+
+        busy = False
+        for marker in Path(self.folder).glob(f"{COMPILING}*"):
+            if marker.name == f"{COMPILING}{os.getpid()}":
+                continue
+            try:
+                fd = os.open(marker, os.O_RDWR)
+            except OSError:
+                continue
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                busy = True
+            except OSError:
+                pass
+            else:
+                with contextlib.suppress(OSError):
+                    marker.unlink()
+            finally:
+                os.close(fd)
+        return busy
+
     # ---------------------------------------------------------------- sums
     def _files(self) -> dict[str, os.stat_result]:
         found: dict[str, os.stat_result] = {}
@@ -203,8 +269,8 @@ class KernelCache:
         except (OSError, ValueError):
             return {}, True
         if not isinstance(data, dict) or not all(
-                isinstance(v, list) and len(v) == 2 and isinstance(v[0], str)
-                and isinstance(v[1], int) for v in data.values()):
+                isinstance(v, list) and len(v) in (2, 3) and isinstance(v[0], str)
+                and all(isinstance(n, int) for n in v[1:]) for v in data.values()):
             return {}, True
         return data, False
 
@@ -235,8 +301,9 @@ class KernelCache:
         with self.locked():
             sums, damaged_list = self._read_sums()
             damaged = 0
-            deleted = False
+            deleted = refreshed = False
             files = self._files()
+            rewriting = self.others_compiling()
             for name, st in files.items():
                 path = os.path.join(self.folder, name)
                 entry = sums.get(name)
@@ -244,11 +311,16 @@ class KernelCache:
                     and self._digest(path) == entry[0]
                 if good:
                     self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
+                    if entry[2:] != [st.st_ino]:  # a copied folder: new inodes, same content
+                        sums[name] = [entry[0], entry[1], st.st_ino]
+                        refreshed = True
                     continue
                 if entry is None and not damaged_list and not self.own:
                     continue  # another program's file in the user's NUMBA_CACHE_DIR
-                if entry is not None:
-                    damaged += 1
+                if entry is not None and (entry[2:] == [st.st_ino] or not rewriting):
+                    damaged += 1  # changed in place, or by no process compiling: damage
+                # else a new file under a sealed name while another process compiles (its
+                # Numba rewrote it and it has not sealed it yet): dropped without a word
                 if entry is not None or self.own or damaged_list:
                     with contextlib.suppress(OSError):
                         os.unlink(path)
@@ -260,7 +332,7 @@ class KernelCache:
             if damaged or damaged_list:
                 self._write_sums(sums)
                 self._clear_markers()
-            elif stale:
+            elif stale or refreshed:
                 self._write_sums(sums)
             if deleted:
                 self._clear_markers()
@@ -304,6 +376,7 @@ class KernelCache:
             return
         with self.locked():
             self.unsealed = False
+            self._done_compiling()
             sums, damaged_list = self._read_sums()
             changed = False
             for name, st in self._files().items():
@@ -314,7 +387,7 @@ class KernelCache:
                 digest = self._digest(os.path.join(self.folder, name))
                 if digest is None:
                     continue
-                sums[name] = [digest, st.st_size]
+                sums[name] = [digest, st.st_size, st.st_ino]
                 self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
                 changed = True
             if changed or damaged_list:

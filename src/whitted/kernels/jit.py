@@ -114,7 +114,7 @@ def _compile_listener():
 
     class CompileSeen(event.Listener):
         def on_start(self, ev) -> None:
-            pass
+            prepare().compiling()
 
         def on_end(self, ev) -> None:
             prepare().unsealed = True
