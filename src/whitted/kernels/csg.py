@@ -38,6 +38,7 @@ from .jit import kernel, numba_object
 from .layout import (
     CSG_DIFFERENCE,
     CSG_INTERSECTION,
+    CSG_MAX_LEAVES,
     CSG_MERGE,
     PRIM_TYPE,
     PRIM_XFORM,
@@ -51,8 +52,10 @@ from .vec import dot, madd
 from .xform import normal_to_world, to_object
 
 # kernels/frame_array.py is a Numba extension: imported with Numba (kernels/jit.py)
-frame_floats = numba_object(".frame_array", "frame_floats")
-frame_ints = numba_object(".frame_array", "frame_ints")
+float_slots = numba_object(".frame_array", "float_slots")
+int_slots = numba_object(".frame_array", "int_slots")
+slots = numba_object(".frame_array", "slots")
+FRAME_SLOTS = CSG_MAX_LEAVES + 1  # kernels/frame_array.py's
 
 GRAZING = 1e-9  # |cos| between ray and normal below which a crossing is only a touch
 
@@ -224,10 +227,11 @@ def csg_hit(geo, root, o, d, tmin, tmax):
     n_rows = int(P[root, 0])
     n_leaves = int(P[root, 1])
     first_leaves = int(P[root, 8])  # leaves of the first operand of a root that needs it
-    next_t = frame_floats()
-    next_part = frame_ints()
-    rows = frame_ints()
-    next_cos = frame_floats()  # d · the leaf's normal at next_t (NaN: not computed yet)
+    next_t = slots(float_slots(), FRAME_SLOTS)
+    next_part = slots(int_slots(), FRAME_SLOTS)
+    rows = slots(int_slots(), FRAME_SLOTS)
+    # d · the leaf's normal at next_t (NaN: not computed yet)
+    next_cos = slots(float_slots(), FRAME_SLOTS)
     inside = np.int64(0)
     alive = np.int64(0)
     leaf = 0

@@ -64,6 +64,8 @@ PRIVATE_NAMES = (
     "numba.core.caching.UserProvidedCacheLocator (subclassed): ensure_cache_path, "
     "get_cache_path, get_source_stamp, _py_file",
     "target options _nrt, no_cpython_wrapper, no_cfunc_wrapper, forceinline",
+    "numba.np.arrayobj.make_array, populate_array (frame_view: an array over stack slots "
+    "without the runtime, which numba.carray needs)",
 )
 
 #: the options only the tuned dispatcher takes
@@ -289,3 +291,34 @@ def make_dispatcher(f, options: dict, specialise_constants: bool, cache: bool):
     dispatcher = make(f, options)
     dispatcher.make_callee = lambda: make(_twin_function(f), {**options, **CALLEE_ONLY})
     return dispatcher
+
+
+def frame_view():
+    """For kernels compiled without Numba's runtime (``_nrt=False``): ``view(pointer,
+    count)``, an intrinsic viewing ``count`` slots at ``pointer`` (stack slots of the calling
+    kernel, kernels/frame_array.py) as a 1-D C array without a memory owner. Numba's public
+    ``numba.carray`` does the same but returns an array its runtime owns, which such kernels
+    cannot take; stock Numba (runtime on) uses ``numba.carray``. Tuned dispatcher only."""
+    from numba import types
+    from numba.extending import intrinsic
+    from numba.np.arrayobj import make_array, populate_array
+
+    @intrinsic
+    def view(typingctx, pointer, count):
+        if not isinstance(pointer, types.CPointer) or not isinstance(count, types.Integer):
+            return None
+        array_type = types.Array(pointer.dtype, 1, "C")
+
+        def codegen(context, builder, sig, args):
+            data, n = args
+            array = make_array(array_type)(context, builder)
+            item = context.get_value_type(pointer.dtype)
+            itemsize = context.get_constant(types.intp, context.get_abi_sizeof(item))
+            populate_array(array, data=data,
+                           shape=[context.cast(builder, n, sig.args[1], types.intp)],
+                           strides=[itemsize], itemsize=itemsize, meminfo=None)
+            return array._getvalue()
+
+        return array_type(pointer, count), codegen
+
+    return view

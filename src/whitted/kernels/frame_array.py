@@ -2,50 +2,51 @@
 
 The kernels run without Numba's runtime (no ``np.empty`` inside them); a walk that needs a
 few slots per call (the CSG walk keeps each leaf's next crossing) takes them from its frame:
-``frame_floats()`` and ``frame_ints()`` are ``FRAME_SLOTS`` float64 / int64 slots, left
-uninitialised, living as long as the calling kernel's frame (LLVM places the allocation in
-the function's entry block, so a loop does not grow the stack).
+
+    next_t = slots(float_slots(), FRAME_SLOTS)
+
+``float_slots()`` and ``int_slots()`` are intrinsics (``numba.extending.intrinsic``) that
+reserve ``FRAME_SLOTS`` float64 / int64 slots in the calling kernel's frame, left
+uninitialised (``cgutils.alloca_once``: LLVM places the allocation in the function's entry
+block, so a loop does not grow the stack), and give their address; ``slots`` views the
+address as an array: Numba's public ``numba.carray`` with stock Numba, and the tuned
+dispatcher's ``frame_view`` for kernels compiled without Numba's runtime (whose returned
+arrays ``numba.carray`` cannot make; kernels/dispatcher.py lists the names it relies on).
+Both must be called in the kernel that uses the array: the slots live as long as its frame.
+Kernels run as plain Python (NUMBA_DISABLE_JIT) get new NumPy arrays instead.
 """
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
-from numba.np.arrayobj import make_array, populate_array
 
+from .dispatcher import frame_view, tuned
 from .jit import _jit_disabled
 from .layout import CSG_MAX_LEAVES
 
 FRAME_SLOTS = CSG_MAX_LEAVES + 1
 
 
-def _frame_array(dtype):
-    array_type = types.Array(dtype, 1, "C")
-
+def _reserve(dtype):
     def codegen(context, builder, sig, args):
-        item = context.get_value_type(dtype)
-        data = cgutils.alloca_once(builder, item,
+        return cgutils.alloca_once(builder, context.get_value_type(dtype),
                                    size=context.get_constant(types.intp, FRAME_SLOTS))
-        array = make_array(array_type)(context, builder)
-        itemsize = context.get_constant(types.intp, context.get_abi_sizeof(item))
-        populate_array(array, data=data,
-                       shape=[context.get_constant(types.intp, FRAME_SLOTS)],
-                       strides=[itemsize], itemsize=itemsize, meminfo=None)
-        return array._getvalue()
 
-    return array_type(), codegen
+    return types.CPointer(dtype)(), codegen
 
 
 @intrinsic
-def _frame_floats(typingctx):
-    return _frame_array(types.float64)
+def _float_slots(typingctx):
+    return _reserve(types.float64)
 
 
 @intrinsic
-def _frame_ints(typingctx):
-    return _frame_array(types.int64)
+def _int_slots(typingctx):
+    return _reserve(types.int64)
 
 
 def _new_floats():
@@ -56,7 +57,12 @@ def _new_ints():
     return np.empty(FRAME_SLOTS, np.int64)
 
 
-# ``frame_floats()``: FRAME_SLOTS float64 slots in the caller's frame; ``frame_ints()``:
-# int64 ones. Kernels run as plain Python (NUMBA_DISABLE_JIT) get new arrays instead.
-frame_floats, frame_ints = ((_new_floats, _new_ints) if _jit_disabled()
-                            else (_frame_floats, _frame_ints))
+def _as_is(array, count):
+    return array
+
+
+if _jit_disabled():
+    float_slots, int_slots, slots = _new_floats, _new_ints, _as_is
+else:
+    float_slots, int_slots = _float_slots, _int_slots
+    slots = frame_view() if tuned() else numba.carray
