@@ -292,3 +292,27 @@ def test_povray_version_and_a_failing_povray(monkeypatch, tmp_path):
     monkeypatch.setattr(povray, "povray_executable", lambda: None)
     with pytest.raises(povray.PovrayError, match="povray is not installed"):
         povray.run_povray(Path("x.pov"), Path("x.png"), 4, 4, 1, False)
+
+
+def test_an_interrupted_timing_kills_its_child(monkeypatch):
+    import signal
+    import subprocess
+
+    from whitted.bench import timing
+
+    started = []
+
+    class Recorded(subprocess.Popen):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            started.append(self)
+
+    def interrupted(pid, options):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(timing.subprocess, "Popen", Recorded)
+    monkeypatch.setattr(timing.os, "wait4", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        timed_process([sys.executable, "-c", "import time; time.sleep(600)"])
+    (child,) = started
+    assert child.returncode == -signal.SIGKILL  # killed and reaped, not left running
