@@ -82,3 +82,9 @@ def test_image_pixels_replaced_and_converted():
     assert str(info.value) == "cannot convert Image pixels to float64 without a copy"
     with pytest.raises(ValueError):
         image.pixels = np.zeros((2, 2), np.float32)  # not (H, W, 3)
+
+
+def test_a_name_with_a_nul_byte_is_one_line():
+    with pytest.raises(OutputError) as info:
+        check_output_place("out\0.png")
+    assert str(info.value) == "out\0.png: cannot write: embedded null byte"
