@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -199,3 +200,32 @@ def test_private_names_are_listed_and_checked():
     for name in ("get_call_template", "_load_overload", "rtsys.initialize", "_nrt",
                  "no_cpython_wrapper", "forceinline", "UserProvidedCacheLocator"):
         assert name in source.split("PRIVATE_NAMES = (", 1)[1].split(")\n", 1)[0], name
+
+
+#: Numba's documented modules whitted may import outside kernels/dispatcher.py: the package,
+#: its high-level and low-level extension API (numba.extending, numba.core.cgutils and the
+#: typing templates its examples use), and the event API (numba.core.event)
+DOCUMENTED_NUMBA = {"numba", "numba.extending", "numba.types", "numba.core.cgutils",
+                    "numba.core.event", "numba.core.typing.templates"}
+
+
+def test_only_the_dispatcher_imports_undocumented_numba_modules():
+    import ast
+
+    root = Path(dispatcher.__file__).parents[1]
+    found = []
+    for path in sorted(root.rglob("*.py")):
+        if path == Path(dispatcher.__file__):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names = [node.module] + [f"{node.module}.{alias.name}" for alias in node.names]
+                names = [node.module] if node.module != "numba.core" else names[1:]
+            else:
+                continue
+            for name in names:
+                if name.split(".")[0] == "numba" and name not in DOCUMENTED_NUMBA:
+                    found.append(f"{path.relative_to(root)}:{node.lineno}: {name}")
+    assert found == []

@@ -54,21 +54,17 @@ _warm_seconds: float | None = None
 
 
 def set_worker_threads(threads: int) -> None:
-    """Render with ``threads`` lanes in this process, and cap Numba's own pool there too."""
+    """Render with ``threads`` lanes in this process (Numba's pool keeps its size)."""
     global _threads
     _threads = max(1, int(threads))
     import numba
-    from numba.np.ufunc import parallel
 
     # Numba re-reads its environment at each compile and refuses a NUMBA_NUM_THREADS that
-    # differs from the pool it launched; a worker may have imported Numba before Dask set
-    # its environment (a spawned worker re-imports the client's main module), so the two
-    # are made to agree here, before the pool starts.
-    if not getattr(parallel, "_is_initialized", False):
-        os.environ["NUMBA_NUM_THREADS"] = str(_threads)
-        numba.config.reload_config()
-    else:
-        os.environ["NUMBA_NUM_THREADS"] = str(numba.config.NUMBA_NUM_THREADS)
+    # differs from the pool it launched (with the size its configuration had when Numba was
+    # imported); a worker may have imported Numba before Dask set its environment (a spawned
+    # worker re-imports the client's main module). The environment is made to say what the
+    # configuration does, and the threads a render uses are capped (public API only).
+    os.environ["NUMBA_NUM_THREADS"] = str(numba.config.NUMBA_NUM_THREADS)
     numba.set_num_threads(min(_threads, numba.config.NUMBA_NUM_THREADS))
 
 

@@ -12,14 +12,14 @@ field (``geo.prim_info``) loads just that field through the pointer. The kernels
 once for either (attribute access is the same); ``render_tiles`` makes the reference at its
 start in scenes with mesh instances (:func:`geometry_ref_if_instances`), so every call below
 it passes one word. The pointer lives as long as that kernel's
-frame, which outlives every call it makes.
+frame, which outlives every call it makes. Only the tuned kernels (kernels/dispatcher.py),
+which run without Numba's runtime, make references; with stock Numba the tuple is passed.
 """
 
 from __future__ import annotations
 
 from numba import types
 from numba.core import cgutils
-from numba.core.imputils import impl_ret_borrowed
 from numba.core.typing.templates import AttributeTemplate
 from numba.extending import (
     infer_getattr,
@@ -63,7 +63,7 @@ def _geometry_ref_field(context, builder, ref, value, attr):
     field = builder.load(cgutils.gep_inbounds(builder, value, 0, index))
     # the tuple never changes once stored: loads of it may be merged and hoisted freely
     field.set_metadata("invariant.load", builder.module.add_metadata([]))
-    return impl_ret_borrowed(context, builder, ref.geometry.types[index], field)
+    return field  # borrowed: made only by kernels without Numba's runtime (no counts)
 
 
 @intrinsic
@@ -99,9 +99,12 @@ def _geometry_ref_if_instances(geo):
     # Measured, CPU time, 1 thread, interleaved (AMD EPYC Zen 4): sphere1m at 640x360 0.242 ->
     # 0.094 s with the reference; but seed000, a scene without instances, 0.69 -> 0.79 s: there
     # LLVM inlines the walks into render_tiles and nothing was copied
+    from .dispatcher import tuned
     from .features import extras_possible, instances_possible
 
-    # scenes with tori or CSG too: their walks are calls, not inlined (csg.py)
-    if instances_possible(geo) or extras_possible(geo):
+    # scenes with tori or CSG too: their walks are calls, not inlined (csg.py). Tuned kernels
+    # only: they run without Numba's runtime, so a field read through the pointer is a
+    # plain borrowed value; stock Numba (reference counts) passes the tuple itself
+    if tuned() and (instances_possible(geo) or extras_possible(geo)):
         return lambda geo: geometry_ref(geo)
     return lambda geo: geo
