@@ -316,3 +316,45 @@ def test_an_interrupted_timing_kills_its_child(monkeypatch):
         timed_process([sys.executable, "-c", "import time; time.sleep(600)"])
     (child,) = started
     assert child.returncode == -signal.SIGKILL  # killed and reaped, not left running
+
+
+def _row_only(spec, scene, threads, options, folder):
+    return {"scene": spec.name, "width": scene.render.width, "height": scene.render.height,
+            "threads": threads, "render_s": 1.0, "wall_s": 2.0}
+
+
+def test_the_embree_columns_join_the_mesh_scenes_rows(monkeypatch):
+    from whitted.bench import embree
+
+    monkeypatch.setattr(runner, "_bench_whitted", _row_only)
+    seen = []
+    monkeypatch.setattr(embree, "compare_embree", lambda scene: seen.append(scene) or {
+        "embree_mrays_per_s": 7.0})
+    lines = []
+    result = run_bench(BenchOptions(scenes=["lecture", "mesh1m"], quick=True, size=(8, 4),
+                                    threads=[1, 2], compare="embree"), log=lines.append)
+    assert [(r["scene"], r["threads"], r.get("embree_mrays_per_s")) for r in result.rows] == [
+        ("lecture", 1, None), ("lecture", 2, None), ("mesh1m", 1, 7.0), ("mesh1m", 2, 7.0)]
+    assert len(seen) == 1 and (seen[0].render.width, seen[0].render.height) == (8, 4)
+    assert "mesh1m: the same camera and shadow rays, whitted and Embree, 1 thread" in lines
+
+    def no_light(scene):
+        raise ValueError("the scene has no point light to cast shadow rays toward")
+
+    monkeypatch.setattr(embree, "compare_embree", no_light)
+    with pytest.raises(BenchError, match="^the scene has no point light to cast shadow rays "
+                                         "toward$"):
+        run_bench(BenchOptions(scenes=["mesh1m"], quick=True, size=(8, 4), compare="embree"),
+                  log=lambda s: None)
+
+
+def test_a_failing_povray_is_a_bench_error(monkeypatch):
+    def failing(*args):
+        raise povray.PovrayError("povray failed on lecture.pov (exit 1): Parse Error")
+
+    monkeypatch.setattr(runner, "_bench_whitted", _row_only)
+    monkeypatch.setattr(povray, "run_povray", failing)
+    with pytest.raises(BenchError, match=r"^povray failed on lecture.pov \(exit 1\): Parse "
+                                         "Error$"):
+        run_bench(BenchOptions(scenes=["lecture"], quick=True, size=(8, 4), compare="povray"),
+                  log=lambda s: None)
