@@ -4,6 +4,7 @@ none, workers stopped (SIGSTOP), killed or lost, the scheduler lost (issue 26)."
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import shutil
@@ -89,12 +90,15 @@ def env_with(pythonpath: str | None = None, **extra: str) -> dict[str, str]:
 
 @contextmanager
 def processes():
-    """Processes started by a test, each ended (its own id) when the test is done."""
+    """Processes started by a test, each in a process group of its own, ended with all
+    its children when the test is done: a ``dask worker`` (a nanny) runs its worker as a
+    child, which a test may have stopped (SIGSTOP) or left behind; a stopped orphan could
+    hold the kernel cache's lock and make every later test wait for it."""
     started: list[subprocess.Popen] = []
 
     def start(args, **kwargs) -> subprocess.Popen:
         proc = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                **kwargs)
+                                start_new_session=True, **kwargs)
         started.append(proc)
         return proc
 
@@ -102,9 +106,9 @@ def processes():
         yield start
     finally:
         for proc in started:
-            if proc.poll() is None:
-                os.kill(proc.pid, signal.SIGCONT)
-                proc.kill()
+            for sig in (signal.SIGCONT, signal.SIGKILL):
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(proc.pid, sig)  # the group outlives its leader's death
             proc.wait(timeout=30)
 
 
@@ -288,14 +292,16 @@ def test_a_worker_without_whitted_joining_mid_film_is_named_and_does_not_hang_it
 def test_a_stopped_worker_stalls_nothing_its_tasks_go_elsewhere(scheduler, film_scene,
                                                                  local_frames, tmp_path):
     address, worker, _ = scheduler
-    procs = [worker("--name", f"w{i}", pythonpath=str(SRC)) for i in range(2)]
+    for i in range(2):
+        worker("--name", f"w{i}", pythonpath=str(SRC))
     notes: list[str] = []
     stopped: list[str] = []
+    pids: dict[str, int] = {}
     try:
         with distributed.Client(address) as client:
             client.wait_for_workers(2)
             ready_cluster(client, WhittedWorker(threads=1), None)
-            pids = client.run(os.getpid)
+            pids.update(client.run(os.getpid))
 
             def stop_a_busy_worker(done, total, frame) -> None:
                 if stopped:
@@ -313,8 +319,9 @@ def test_a_stopped_worker_stalls_nothing_its_tasks_go_elsewhere(scheduler, film_
                 print(notes)
                 raise
     finally:
-        for proc in procs:
-            os.kill(proc.pid, signal.SIGCONT)
+        for worker_pid in pids.values():
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(worker_pid, signal.SIGCONT)  # the stopped worker, not its nanny
     assert stopped and sorted(result.rendered) == list(range(8))
     told = [n for n in notes if n.startswith(f"farm: worker {stopped[0]} ")]
     assert told and all("\n" not in n for n in told)  # it is named, in one line each
