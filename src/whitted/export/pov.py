@@ -156,30 +156,18 @@ def mesh_parts(scene: Scene, obj: Mesh) -> MeshParts:
             None if obj.normals is None else np.asarray(obj.normals, dtype=np.float64),
             None if obj.uvs is None else np.asarray(obj.uvs, dtype=np.float64), None, [],
         )
-    path = scene.resolve_path(obj.file)
-    try:
-        from ..assets import load_mesh  # the model loader (OBJ with MTL, PLY, ...)
-    except ImportError:
-        load_mesh = None
-    if load_mesh is not None:
-        data = load_mesh(path)
-        materials = list(getattr(data, "materials", None) or [])
-        face_material = getattr(data, "face_material", None)
-        return MeshParts(
-            np.asarray(data.vertices, dtype=np.float64), np.asarray(data.faces, dtype=np.int64),
-            None if data.normals is None else np.asarray(data.normals, dtype=np.float64),
-            None if data.uvs is None else np.asarray(data.uvs, dtype=np.float64),
-            None if face_material is None or not materials else np.asarray(face_material),
-            materials,
-        )
-    import trimesh  # a fallback while whitted.assets has no model loader
+    from ..assets import load_mesh  # the model loader (OBJ with MTL, PLY, ...)
 
-    try:
-        loaded = trimesh.load(str(path), force="mesh", process=False)
-    except Exception as exc:  # noqa: BLE001 - any reader failure is the file's problem
-        raise SceneError(f"cannot read model {obj.file!r}: {exc}") from None
-    return MeshParts(np.asarray(loaded.vertices, dtype=np.float64),
-                     np.asarray(loaded.faces, dtype=np.int64), None, None, None, [])
+    data = load_mesh(scene.resolve_path(obj.file))
+    materials = list(getattr(data, "materials", None) or [])
+    face_material = getattr(data, "face_material", None)
+    return MeshParts(
+        np.asarray(data.vertices, dtype=np.float64), np.asarray(data.faces, dtype=np.int64),
+        None if data.normals is None else np.asarray(data.normals, dtype=np.float64),
+        None if data.uvs is None else np.asarray(data.uvs, dtype=np.float64),
+        None if face_material is None or not materials else np.asarray(face_material),
+        materials,
+    )
 
 
 def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
