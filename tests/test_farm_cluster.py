@@ -71,7 +71,7 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def wait_for(condition, what: str, limit: float = 120.0) -> None:
+def wait_for(condition, what: str, limit: float = 600.0) -> None:
     """Wait until ``condition()`` holds (checked every 50 ms); fail naming ``what`` after
     ``limit`` seconds (a hang guard, not a timing assert)."""
     end = time.monotonic() + limit
