@@ -4,6 +4,7 @@ none, workers stopped (SIGSTOP), killed or lost, the scheduler lost (issue 26)."
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import shutil
@@ -70,7 +71,7 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def wait_for(condition, what: str, limit: float = 120.0) -> None:
+def wait_for(condition, what: str, limit: float = 600.0) -> None:
     """Wait until ``condition()`` holds (checked every 50 ms); fail naming ``what`` after
     ``limit`` seconds (a hang guard, not a timing assert)."""
     end = time.monotonic() + limit
@@ -89,12 +90,15 @@ def env_with(pythonpath: str | None = None, **extra: str) -> dict[str, str]:
 
 @contextmanager
 def processes():
-    """Processes started by a test, each ended (its own id) when the test is done."""
+    """Processes started by a test, each in a process group of its own, ended with all
+    its children when the test is done: a ``dask worker`` (a nanny) runs its worker as a
+    child, which a test may have stopped (SIGSTOP) or left behind; a stopped orphan could
+    hold the kernel cache's lock and make every later test wait for it."""
     started: list[subprocess.Popen] = []
 
     def start(args, **kwargs) -> subprocess.Popen:
         proc = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                **kwargs)
+                                start_new_session=True, **kwargs)
         started.append(proc)
         return proc
 
@@ -102,9 +106,9 @@ def processes():
         yield start
     finally:
         for proc in started:
-            if proc.poll() is None:
-                os.kill(proc.pid, signal.SIGCONT)
-                proc.kill()
+            for sig in (signal.SIGCONT, signal.SIGKILL):
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(proc.pid, sig)  # the group outlives its leader's death
             proc.wait(timeout=30)
 
 
@@ -288,33 +292,32 @@ def test_a_worker_without_whitted_joining_mid_film_is_named_and_does_not_hang_it
 def test_a_stopped_worker_stalls_nothing_its_tasks_go_elsewhere(scheduler, film_scene,
                                                                  local_frames, tmp_path):
     address, worker, _ = scheduler
-    procs = [worker("--name", f"w{i}", pythonpath=str(SRC)) for i in range(2)]
+    for i in range(2):
+        worker("--name", f"w{i}", pythonpath=str(SRC))
     notes: list[str] = []
     stopped: list[str] = []
+    pids: dict[str, int] = {}
     try:
         with distributed.Client(address) as client:
             client.wait_for_workers(2)
             ready_cluster(client, WhittedWorker(threads=1), None)
-            pids = client.run(os.getpid)
-
-            def stop_a_busy_worker(done, total, frame) -> None:
-                if stopped:
-                    return
-                busy = [w for w, keys in client.processing().items() if keys]
-                if busy:  # SIGSTOP: the worker holds its tasks and answers nothing
-                    os.kill(pids[busy[0]], signal.SIGSTOP)
-                    stopped.append(busy[0])
+            pids.update(client.run(os.getpid))
+            # SIGSTOP before the film: the scheduler still counts the worker and gives it
+            # tasks, which it holds without a word (an event, not a race with the frames)
+            victim = sorted(pids)[0]
+            os.kill(pids[victim], signal.SIGSTOP)
+            stopped.append(victim)
 
             try:
                 result = render_film(client, film_scene, tmp_path / "frames", chunk=1,
-                                     progress=stop_a_busy_worker, note=notes.append,
-                                     stall_floor=2.0)
+                                     note=notes.append, stall_floor=2.0)
             except ClusterLost:
                 print(notes)
                 raise
     finally:
-        for proc in procs:
-            os.kill(proc.pid, signal.SIGCONT)
+        for worker_pid in pids.values():
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(worker_pid, signal.SIGCONT)  # the stopped worker, not its nanny
     assert stopped and sorted(result.rendered) == list(range(8))
     told = [n for n in notes if n.startswith(f"farm: worker {stopped[0]} ")]
     assert told and all("\n" not in n for n in told)  # it is named, in one line each
@@ -390,11 +393,10 @@ def test_losing_every_worker_ends_in_one_line_keeping_the_frames(scheduler, film
         with pytest.raises(ClusterLost) as lost:
             render_film(client, film_scene, tmp_path / "frames", chunk=1, progress=kill_it,
                         stall_floor=3.0)
-    # which of the two ends it is a race the machine's load decides: the scheduler drops the
-    # killed worker (no worker left), or a task it had finished but not handed over times
-    # out with no worker left to run it again
-    assert re.match(r"every worker (was lost \(\d+ s without one\)|that could render stalled "
-                    r"or was lost)$", str(lost.value)), str(lost.value)
+    # a task the killed worker had finished but not handed over goes back to any worker
+    # (none is left): the watch, not the resubmission, ends it
+    assert re.fullmatch(r"every worker was lost \(\d+ s without one\)", str(lost.value)), \
+        str(lost.value)
     assert len(list((tmp_path / "frames").glob("*.png"))) >= 1
 
 

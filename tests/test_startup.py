@@ -231,6 +231,7 @@ def test_a_missing_extra_is_one_line_naming_it(tmp_path, blocked, args, extra):
     assert len(lines) == 1 and f"pip install 'whitted[{extra}]'" in lines[0], result.stderr
 
 
+@pytest.mark.timing  # "at once" is seconds, and a loaded machine may finish the compile
 def test_cold_compile_reports_progress_and_stops_at_once_on_ctrl_c(tmp_path):
     """A first render on an empty cache: compile_progress() climbs from 0 while it runs, and
     Ctrl-C (SIGINT, here sent by the process to itself once the progress is above 0) ends

@@ -93,3 +93,11 @@ def test_the_film_scene_has_measured_absorption_and_four_samples(tmp_path):
     assert f"{WATER_ABSORPTION_CM[0]:.4g}" in text
     boosted = still_life_scene(None, None, 60.0, absorption_boost=3.0)
     assert "exaggerated x3" in boosted
+    # caustics on by default (issue 30: the light the ice focuses on the table), 5/3 photons
+    # a pixel (480 x 360: 288,000; 400 x 300: 200,000), off with 0
+    assert scene.render.caustics.photons == 288_000
+    small = tmp_path / "small.toml"
+    small.write_text(still_life_scene(None, None, 60.0, width=400, height=300))
+    assert load_scene(small).render.caustics.photons == 200_000
+    path.write_text(still_life_scene(None, None, 60.0, caustic_photons=0))
+    assert load_scene(path).render.caustics.photons == 0

@@ -136,7 +136,7 @@ def _read_frame_record(path: str | Path) -> dict[str, Any]:
 
     try:  # a regular file only: opening a pipe would wait for a writer
         if not stat.S_ISREG(Path(path).stat().st_mode):
-            return None
+            return {}
         with PILImage.open(path) as im:
             return dict(getattr(im, "text", None) or im.info)
     except (OSError, ValueError, SyntaxError):

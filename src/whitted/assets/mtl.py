@@ -157,8 +157,8 @@ def parse_mtl(text: str, source: str, warnings: list[str]) -> dict[str, MtlRecor
         line = raw.replace("\x00", "").strip()
         if not line or line.startswith("#"):
             continue
-        keyword, _, rest = line.partition(" ") if " " in line else line.partition("\t")
-        keyword = keyword.strip().lower()
+        keyword, _, rest = line.replace("\t", " ").partition(" ")  # "Kd\t1 0 0" too
+        keyword = keyword.lower()
         rest = rest.strip()
         if keyword == "newmtl":
             name = rest.strip()

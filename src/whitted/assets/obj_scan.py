@@ -313,16 +313,11 @@ def _fail(info, code, line, s, e, aux1, aux2, aux3):
 
 @_scanner
 def _keyword_is(data, s, e, c0, c1, c2, c3, c4, c5):
-    """Whether data[s:e] spells the keyword given as up to 6 byte codes (0 = end)."""
+    """Whether data[s:e] spells the six-letter keyword given as its byte codes."""
     codes = (c0, c1, c2, c3, c4, c5)
-    length = 0
-    for c in codes:
-        if c == 0:
-            break
-        length += 1
-    if e - s != length:
+    if e - s != 6:
         return False
-    for k in range(length):  # noqa: SIM110 - a loop Numba compiles
+    for k in range(6):  # noqa: SIM110 - a loop Numba compiles
         if data[s + k] != codes[k]:
             return False
     return True
@@ -516,9 +511,7 @@ def scan_obj(data, fill, info, positions, texcoords, normals, corner_v, corner_v
             is_usemtl = first == 117
             i, line = _skip_blanks(data, i, n, line)
             name_start = i
-            i, name_end = _rest_of_line(data, i, n)
-            if name_end < name_start:
-                name_end = name_start
+            i, name_end = _rest_of_line(data, i, n)  # (name_end >= name_start)
             for k in range(name_start, name_end):
                 if _is_control(data[k]):
                     _fail(info, ERR_CONTROL_BYTE, line, name_start, name_end, 0, data[k], 0)

@@ -102,8 +102,10 @@ def _material_of(geometry: object, images: dict[str, Path], name: str, warnings:
     image = getattr(material, "baseColorTexture", None)
     if image is None:
         image = getattr(material, "image", None)
-    if image is not None:
-        label = getattr(material, "name", None) or ""
+    label = getattr(material, "name", None) or ""
+    # an image file next to a .gltf counts also when trimesh could not read it (it does
+    # not decode the URI: "wood%20grain.png" names "wood grain.png")
+    if image is not None or label in images:
         image_path = images.get(label) or _embedded_image_file(image)
         if image_path is None:
             warnings.append(f"{name}: material '{label}': its texture image cannot be stored "

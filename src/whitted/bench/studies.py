@@ -49,12 +49,12 @@ def run_study(kind: str, options: BenchOptions,
     """``kind`` = ``threads``: one scene at its own size, 1, 2, 4, ... threads; ``size``: one
     scene at S x S for every S of 001's table, at each thread count asked (default 1 and
     every core)."""
+    if kind not in STUDY_DEFAULT_SCENE:
+        raise ValueError(f"unknown study {kind!r} (threads or size)")
     scenes = options.scenes or [STUDY_DEFAULT_SCENE[kind]]
     if kind == "threads":
         return run_bench(replace(options, scenes=scenes,
                                  threads=options.threads or study_thread_counts()), log)
-    if kind != "size":
-        raise ValueError(f"unknown study {kind!r} (threads or size)")
     cores = available_threads()
     threads = options.threads or sorted({1, cores})
     sizes = [(s, s) for s in STUDY_SIZES] if not options.quick else [(16, 16), (32, 32)]

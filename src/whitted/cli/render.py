@@ -212,11 +212,11 @@ def _progress_delay() -> float:
 
 def _show_compile(bar, task) -> None:
     """While the first run compiles the kernels, the bar says so and how far along it is."""
-    from ..render.warm_up import compile_progress
+    from ..render.warm_up import compile_label, compile_progress
 
     fraction = compile_progress()
     if fraction is not None:
-        bar.update(task, description="compiling the kernels (first run only)",
+        bar.update(task, description=f"compiling {compile_label()} (first run only)",
                    completed=fraction)
 
 

@@ -182,6 +182,15 @@ def validate(
                       f"{r['vs_first']:.1e}")
     out.print(table)
 
+    table = Table(title="The cavity's convection: Catton's enclosure law against de Vahl Davis's "
+                  "square cavity (Pr 0.71)")
+    for col in ("Ra", "benchmark Nu", "model Nu", "error", "Catton's range"):
+        table.add_column(col, justify="right")
+    for r in v.enclosure_rows():
+        table.add_row(f"{r['ra']:.0e}", f"{r['benchmark']:.3f}", f"{r['model']:.3f}",
+                      f"{r['error_pct']:+.1f} %", "yes" if r["in_range"] else "below (Nu = 1)")
+    out.print(table)
+
     slab = v.convective_slab()
     out.print(f"convective slab (h = 20 W/m²K, air 20 °C, 3000 s): receded "
               f"{slab['receded_mm']:.4f} mm, h dT t / (rho_i L) = {slab['expected_mm']:.4f} mm, "

@@ -15,7 +15,7 @@ import math
 import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -34,11 +34,14 @@ from ..kernels.layout import (
     LIGHT_POSITION,
     LIGHT_RADIANCE,
     LIGHT_TYPE,
+    MAT_ATTEN,
+    MAT_COLOR,
     MAT_KR,
     MAT_KT,
     MAX_MEDIA,
     MESH_TRI_COUNT,
     MESH_TRI_OFFSET,
+    PHOTON_POWER,
     PHOTON_WIDTH,
     PRIM_MATERIAL,
     PRIM_OBJECT,
@@ -65,7 +68,8 @@ from ..kernels.photons import (
 from ..scene.scene import CausticsSettings
 from .scene import CompiledScene
 
-SLOTS = 4  # records one photon may store (diffuse surfaces that also reflect or refract)
+SLOTS = 6  # records one photon may store: SHADOW_SLOTS shadow photons, caustic photons
+#: (diffuse surfaces that also reflect or refract) in the rest
 DEFAULT_NEIGHBOURS = 256  # photons the default radius gathers where light is not focused
 MAX_TARGETS = 64  # more bodies than this are aimed at as one bounding sphere
 PHOTON_BYTES = PHOTON_WIDTH * 4
@@ -89,9 +93,8 @@ def _specular(mats: np.ndarray, rows: np.ndarray) -> np.ndarray:
     return mats[rows, MAT_KR] + mats[rows, MAT_KT]
 
 
-def caustic_targets(compiled: CompiledScene) -> Targets:
-    """The bounded objects with a material that reflects or refracts (kr or kt > 0): the
-    bounding sphere of their primitives that do, per scene object."""
+def _specular_primitives(compiled: CompiledScene) -> tuple[np.ndarray, np.ndarray]:
+    """(the largest kr + kt of each primitive's materials, whether it is bounded)."""
     geo = compiled.geometry
     mats = compiled.materials
     info = geo.prim_info
@@ -106,7 +109,25 @@ def caustic_targets(compiled: CompiledScene) -> Targets:
         rows = geo.tri_material[start:start + geo.mesh_info[mesh, MESH_TRI_COUNT]]
         strength[i] = _specular(mats, rows).max(initial=0.0)
     lo, hi = compiled.prim_lo, compiled.prim_hi
-    bounded = np.all(np.isfinite(lo) & np.isfinite(hi), axis=1)
+    return strength, np.all(np.isfinite(lo) & np.isfinite(hi), axis=1)
+
+
+def unbounded_specular_objects(compiled: CompiledScene) -> list[int]:
+    """The scene objects (indices) with an unbounded primitive that reflects or refracts:
+    an infinite plane. Photons cannot be aimed at all of it: it casts no caustic (a mirror
+    plane sends no light on; light passes a transparent one as it passes shadow rays,
+    times kt·colour, straight, without Fresnel) and renders say so."""
+    strength, bounded = _specular_primitives(compiled)
+    info = compiled.geometry.prim_info
+    return sorted({int(o) for o in info[(strength > 0.0) & ~bounded, PRIM_OBJECT]})
+
+
+def caustic_targets(compiled: CompiledScene) -> Targets:
+    """The bounded objects with a material that reflects or refracts (kr or kt > 0): the
+    bounding sphere of their primitives that do, per scene object."""
+    strength, bounded = _specular_primitives(compiled)
+    info = compiled.geometry.prim_info
+    lo, hi = compiled.prim_lo, compiled.prim_hi
     chosen = np.flatnonzero((strength > 0.0) & bounded)
     objects = info[chosen, PRIM_OBJECT]
     centres, radii, power = [], [], []
@@ -127,19 +148,36 @@ def caustic_targets(compiled: CompiledScene) -> Targets:
                    np.array(power, np.float64))
 
 
-def shadow_material_table(compiled: CompiledScene) -> np.ndarray:
-    """The material table shadow rays see with caustics on: kt zero (light through the body
-    arrives as photons), except for materials of unbounded shapes (a transparent infinite
-    plane cannot be aimed at: its light keeps passing shadow rays, and photons crossing it
-    do not count it as a specular bounce)."""
-    table = compiled.materials.copy()
+def clear_materials(compiled: CompiledScene) -> np.ndarray:
+    """Which material rows are *clear* with caustics on (bool per row): the transparent
+    ones (kt > 0) of bounded bodies. Shadow rays pass them as if they were not there, and
+    their effect on the light arrives as photons: the caustic photons add the light they
+    send on, the shadow photons take away what passed straight through them. Materials of
+    unbounded shapes are not clear (a transparent infinite plane cannot be aimed at: its
+    light keeps passing shadow rays multiplied by kt, and photons crossing it do not count
+    it as a specular bounce)."""
+    table = compiled.materials
     lo, hi = compiled.prim_lo, compiled.prim_hi
     unbounded = ~np.all(np.isfinite(lo) & np.isfinite(hi), axis=1)
     keep = compiled.geometry.prim_info[unbounded, PRIM_MATERIAL]
     keep = keep[keep >= 0]
-    zero = np.ones(len(table), bool)
-    zero[keep] = False
-    table[zero, MAT_KT] = 0.0
+    clear = table[:, MAT_KT] > 0.0
+    clear[keep] = False
+    return clear
+
+
+def shadow_material_table(compiled: CompiledScene) -> np.ndarray:
+    """The material table shadow rays see with caustics on: the clear materials
+    (:func:`clear_materials`) pass all the light (kt 1, white, no absorption); the rest
+    as they are. The direct term is then the light as if the clear bodies were not there,
+    and the photon map corrects it (docs/caustics.md): no double counting, and no rim at
+    the shadow's edge, since the shadow photons blur the shadow exactly as the caustic
+    photons blur the caustic."""
+    table = compiled.materials.copy()
+    clear = clear_materials(compiled)
+    table[clear, MAT_KT] = 1.0
+    table[clear, MAT_COLOR:MAT_COLOR + 3] = 1.0
+    table[clear, MAT_ATTEN:MAT_ATTEN + 3] = 0.0
     return table
 
 
@@ -292,9 +330,10 @@ class PhotonStats:
     last_radius: float = 0.0
     targets: int = 0
     seconds: float = 0.0
+    warnings: list[str] = field(default_factory=list)
 
 
-def shoot_pass(compiled: CompiledScene, rows: np.ndarray, shadow_mats: np.ndarray,
+def shoot_pass(compiled: CompiledScene, rows: np.ndarray, clear: np.ndarray,
                params: RenderParams, photons: int, pass_index: int, threads: int,
                pool: ThreadPoolExecutor | None,
                cancelled: Callable[[], bool] = lambda: False) -> np.ndarray:
@@ -317,7 +356,7 @@ def shoot_pass(compiled: CompiledScene, rows: np.ndarray, shadow_mats: np.ndarra
     def run(k: int) -> None:
         if cancelled():
             return
-        trace_photons(compiled.geometry, compiled.materials, shadow_mats,
+        trace_photons(compiled.geometry, compiled.materials, clear,
                       compiled.lights.table, rows, settings, int(bounds[k]),
                       int(bounds[k + 1]), out, counts,
                       np.empty(BVH_STACK, np.int32), np.empty(MAX_MEDIA, np.int32),
@@ -343,8 +382,12 @@ def photon_lights(compiled: CompiledScene, params: RenderParams, settings: Caust
     check_photon_memory(settings, threads)
     stats = stats if stats is not None else PhotonStats()
     targets = caustic_targets(compiled)
+    stats.warnings = [f"objects[{i}] reflects or refracts but is unbounded: it casts no "
+                      "caustic (light passes it as shadow rays do, times kt; "
+                      "docs/caustics.md)" for i in unbounded_specular_objects(compiled)]
     rows = emitters(compiled, targets, settings.photons)
     shadow_mats = shadow_material_table(compiled)
+    clear = clear_materials(compiled).astype(np.uint8)
     parts = []
     pool = ThreadPoolExecutor(threads, thread_name_prefix="whitted-photons") if threads > 1 \
         else None
@@ -353,7 +396,7 @@ def photon_lights(compiled: CompiledScene, params: RenderParams, settings: Caust
             if cancelled():
                 break
             if len(rows):
-                parts.append(shoot_pass(compiled, rows, shadow_mats, params, settings.photons,
+                parts.append(shoot_pass(compiled, rows, clear, params, settings.photons,
                                         p, threads, pool, cancelled))
     finally:
         if pool is not None:
@@ -364,7 +407,9 @@ def photon_lights(compiled: CompiledScene, params: RenderParams, settings: Caust
     if radius == 0.0:  # fitted to the first pass's photons (the same on every machine)
         radius = default_radius(targets, settings.photons)
         if parts:
-            radius = fitted_radius(parts[0][:, :3], radius)
+            first = parts[0]  # its caustic photons (the shadow photons carry less than 0)
+            radius = fitted_radius(first[first[:, PHOTON_POWER:PHOTON_POWER + 3].sum(axis=1)
+                                         > 0.0, :3], radius)
     radii = pass_radii(radius, settings.passes, settings.alpha)
     grid = np.zeros(GRID_PASS + 2 * settings.passes)
     grid[GRID_INV_CELL] = 1.0 / radius
@@ -398,13 +443,15 @@ def scene_photon_map(scene, threads: int = 1) -> tuple[CompiledScene, LightArray
                                    stats=stats), stats
 
 
-def irradiance(lights: LightArrays, points, normals) -> np.ndarray:
+def irradiance(lights: LightArrays, points, normals, shadows: bool = False) -> np.ndarray:
     """The caustic irradiance (N, 3) the render kernel's gather finds at ``points`` (N, 3)
-    of surfaces with unit ``normals`` (N, 3) facing the side seen."""
+    of surfaces with unit ``normals`` (N, 3) facing the side seen: the caustic photons'
+    estimate, and with ``shadows`` the shadow photons' (negative) added, as the render adds
+    it to the direct term of lights passing the clear bodies."""
     from ..kernels.caustics import irradiance_at
 
     points = np.ascontiguousarray(points, np.float64).reshape(-1, 3)
     normals = np.ascontiguousarray(np.broadcast_to(normals, points.shape), np.float64)
     out = np.zeros((len(points), 3))
-    irradiance_at(lights, points, normals, out)
+    irradiance_at(lights, points, normals, shadows, out)
     return out

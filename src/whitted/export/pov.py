@@ -26,8 +26,14 @@ How the Whitted model maps onto POV-Ray's (see docs/scene-format.md for ours):
   ``specular``/``roughness`` = 1/shininess (POV-Ray's highlights take the light's colour:
   a non-white ``specular_color`` scales ``ks`` by its mean);
 - ``kr`` → ``reflection``; with ``fresnel`` → ``reflection { kr, kr + kt fresnel on }`` and
-  ``conserve_energy`` (kr + kt·F reflected, kt·(1 − F) transmitted, as ours);
+  ``conserve_energy`` (kr + kt·F reflected, filter·(1 − kr − kt·F) transmitted);
 - ``kt`` → the pigment's ``filter`` (transmitted light is tinted by the colour, as ours);
+  with ``fresnel`` and caustics, POV-Ray's ``conserve_energy`` multiplies the filter by
+  1 − reflection for camera rays and photons alike (its shadow rays stop at photon
+  targets), so the filter is :func:`pov_filter` (1 when kr + kt = 1: the glass preset
+  transmits kt·(1 − F) in both, where a filter of kt passes kt·(kt − kt·F), 5 % less a
+  surface). Without caustics the filter stays kt, which POV-Ray's shadow rays pass as
+  whitted's do;
   ``ior`` and ``attenuation`` → ``interior { ior fade_power 1001 }``: POV-Ray's exponential
   fade exp(−(1 − fade_color)·d / fade_distance) equals exp(−attenuation·d) per channel;
 - ``max_depth`` → ``max_trace_level`` = max_depth + 1 (POV-Ray counts the camera ray);
@@ -72,6 +78,21 @@ PARALLEL_DISTANCE = 1e6  # how far up-stream a directional light is placed
 IMAGE_TYPES = {".png": "png", ".jpg": "jpeg", ".jpeg": "jpeg", ".tga": "tga", ".bmp": "bmp",
                ".gif": "gif", ".tif": "tiff", ".tiff": "tiff", ".ppm": "ppm", ".hdr": "hdr",
                ".exr": "exr"}
+
+
+def pov_filter(mat: Material) -> float:
+    """The pigment's ``filter`` that makes POV-Ray transmit what whitted does. Without
+    ``fresnel`` it is ``kt``. With it, POV-Ray's ``conserve_energy`` passes
+    filter·(1 − kr − kt·F) where whitted passes kt·(1 − F): equal at every angle for
+    filter = 1 when kr + kt = 1 (the glass and water presets; ice is 0.93), and
+    otherwise matched at normal incidence (F = ((n − 1)/(n + 1))²), at most 1."""
+    if not mat.fresnel or mat.kt == 0.0:
+        return mat.kt
+    f0 = ((mat.ior - 1.0) / (mat.ior + 1.0)) ** 2
+    rest = 1.0 - mat.kr - mat.kt * f0
+    if rest <= 0.0:
+        return mat.kt
+    return min(1.0, mat.kt * (1.0 - f0) / rest)
 
 
 def num(x: float) -> str:
@@ -135,30 +156,18 @@ def mesh_parts(scene: Scene, obj: Mesh) -> MeshParts:
             None if obj.normals is None else np.asarray(obj.normals, dtype=np.float64),
             None if obj.uvs is None else np.asarray(obj.uvs, dtype=np.float64), None, [],
         )
-    path = scene.resolve_path(obj.file)
-    try:
-        from ..assets import load_mesh  # the model loader (OBJ with MTL, PLY, ...)
-    except ImportError:
-        load_mesh = None
-    if load_mesh is not None:
-        data = load_mesh(path)
-        materials = list(getattr(data, "materials", None) or [])
-        face_material = getattr(data, "face_material", None)
-        return MeshParts(
-            np.asarray(data.vertices, dtype=np.float64), np.asarray(data.faces, dtype=np.int64),
-            None if data.normals is None else np.asarray(data.normals, dtype=np.float64),
-            None if data.uvs is None else np.asarray(data.uvs, dtype=np.float64),
-            None if face_material is None or not materials else np.asarray(face_material),
-            materials,
-        )
-    import trimesh  # a fallback while whitted.assets has no model loader
+    from ..assets import load_mesh  # the model loader (OBJ with MTL, PLY, ...)
 
-    try:
-        loaded = trimesh.load(str(path), force="mesh", process=False)
-    except Exception as exc:  # noqa: BLE001 - any reader failure is the file's problem
-        raise SceneError(f"cannot read model {obj.file!r}: {exc}") from None
-    return MeshParts(np.asarray(loaded.vertices, dtype=np.float64),
-                     np.asarray(loaded.faces, dtype=np.int64), None, None, None, [])
+    data = load_mesh(scene.resolve_path(obj.file))
+    materials = list(getattr(data, "materials", None) or [])
+    face_material = getattr(data, "face_material", None)
+    return MeshParts(
+        np.asarray(data.vertices, dtype=np.float64), np.asarray(data.faces, dtype=np.int64),
+        None if data.normals is None else np.asarray(data.normals, dtype=np.float64),
+        None if data.uvs is None else np.asarray(data.uvs, dtype=np.float64),
+        None if face_material is None or not materials else np.asarray(face_material),
+        materials,
+    )
 
 
 def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -219,7 +228,7 @@ class _PovWriter:
 
     def pigment(self, mat: Material, uv: bool) -> str:
         cd = np.asarray(mat.color)
-        kt = mat.kt
+        kt = pov_filter(mat) if self.scene.render.caustics.photons > 0 else mat.kt
         tex = mat.texture
         if tex is None:
             return f"pigment {{ {_colour(cd, kt)} }}"

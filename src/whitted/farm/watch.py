@@ -183,6 +183,11 @@ class Watch:
             raise self.lost(exc if not isinstance(exc, CancelledError) else None) from None
         return set(done)
 
+    def disconnected(self) -> bool:
+        """Whether the client has lost its scheduler (Dask's calls then raise, among others,
+        ``RuntimeError('ConnectionPool is closed')``)."""
+        return self.client.status not in ("running", "newly-created")
+
     def lost(self, exc: BaseException | None = None) -> ClusterLost:
         where = getattr(self.client.scheduler, "address", None) or "the scheduler"
         why = f" ({_first_line(exc)})" if exc is not None and str(exc).strip() else ""
@@ -359,10 +364,10 @@ def run_tasks(watch: Watch, tasks: dict[Future, Any],
     Ctrl-C (KeyboardInterrupt) the finished ones are handled too, then it is raised again."""
 
     def again(items: list[Any], ready: list[str]) -> None:
-        if items and not ready:
-            raise ClusterLost("every worker that could render stalled or was lost")
+        # no ready worker now (a nanny restarting a killed one, a cold one joining): to any
+        # worker; the watch ends the job once none has been there for the stall floor
         for item in items:
-            tasks[submit(item, ready)] = item
+            tasks[submit(item, ready or None)] = item
 
     try:
         while tasks:
@@ -390,6 +395,10 @@ def run_tasks(watch: Watch, tasks: dict[Future, Any],
     except KeyboardInterrupt:
         _finish(watch, tasks, on_done)
         raise
+    except (OSError, distributed.comm.CommClosedError, RuntimeError) as exc:
+        if isinstance(exc, RuntimeError) and not watch.disconnected():
+            raise
+        raise watch.lost(exc) from None
     return True
 
 

@@ -71,14 +71,16 @@ def cell_of(x, inv_cell):
 
 
 @kernel
-def caustic_irradiance(lights, p, n):
+def caustic_irradiance(lights, p, n, shadows):
     """Irradiance (per channel) the photon map gives at point ``p`` of a surface whose unit
     normal ``n`` faces the side being shaded: the photons of each pass within that pass's
     radius of ``p``, arriving on that side and near the tangent plane, weighted by the
-    Epanechnikov kernel ``2 / (pi r^2) (1 - d^2 / r^2)``, averaged over the passes (and
-    faded out where fewer than MIN_PHOTONS per pass are found). The grid's cells are the
-    largest radius: the ball around ``p`` meets at most 3x3x3 of them, each its own row of
-    the hash table (:func:`cell_hash`)."""
+    Epanechnikov kernel ``2 / (pi r^2) (1 - d^2 / r^2)``, averaged over the passes. The
+    caustic photons' estimate fades out where fewer than MIN_PHOTONS per pass are found;
+    with ``shadows`` the shadow photons' (negative: the light the direct term counts and the
+    clear bodies take away) is added, whole. The grid's cells are the largest radius: the
+    ball around ``p`` meets at most 3x3x3 of them, each its own row of the hash table
+    (:func:`cell_hash`)."""
     grid = lights.photon_grid
     photons = lights.photons
     cells = lights.photon_cells
@@ -95,6 +97,9 @@ def caustic_irradiance(lights, p, n):
     e0 = 0.0
     e1 = 0.0
     e2 = 0.0
+    s0 = 0.0
+    s1 = 0.0
+    s2 = 0.0
     found = 0
     for ix in range(ix0, ix1 + 1):
         for iy in range(iy0, iy1 + 1):
@@ -119,15 +124,27 @@ def caustic_irradiance(lights, p, n):
                     if off * off > PLANE_FRACTION * PLANE_FRACTION * r2:
                         continue
                     w = (1.0 - d2 / r2) * grid[s + 1]
+                    c0 = photons[q, PHOTON_POWER]
+                    c1 = photons[q, PHOTON_POWER + 1]
+                    c2 = photons[q, PHOTON_POWER + 2]
+                    if c0 + c1 + c2 < 0.0:  # a shadow photon
+                        s0 += w * c0
+                        s1 += w * c1
+                        s2 += w * c2
+                        continue
                     found += 1
-                    e0 += w * photons[q, PHOTON_POWER]
-                    e1 += w * photons[q, PHOTON_POWER + 1]
-                    e2 += w * photons[q, PHOTON_POWER + 2]
+                    e0 += w * c0
+                    e1 += w * c1
+                    e2 += w * c2
     passes = grid[GRID_PASSES]
     if found < MIN_PHOTONS * passes:
         fade = max(0.0, (found - FEWEST_PHOTONS * passes) / ((MIN_PHOTONS - FEWEST_PHOTONS)
                                                               * passes))
-        return e0 * fade, e1 * fade, e2 * fade
+        e0 *= fade
+        e1 *= fade
+        e2 *= fade
+    if shadows:
+        return e0 + s0, e1 + s1, e2 + s2
     return e0, e1, e2
 
 
@@ -138,18 +155,20 @@ def with_caustic(lights, mats, m, albedo, p, n, local):
     kd = mats[m, MAT_KD]
     if kd == 0.0:
         return local
-    e = caustic_irradiance(lights, p, n)
-    return (local[0] + kd * albedo[0] * e[0], local[1] + kd * albedo[1] * e[1],
-            local[2] + kd * albedo[2] * e[2])
+    e = caustic_irradiance(lights, p, n, True)
+    # the shadow photons take away what the direct term counts: never more, but for noise
+    return (max(0.0, local[0] + kd * albedo[0] * e[0]),
+            max(0.0, local[1] + kd * albedo[1] * e[1]),
+            max(0.0, local[2] + kd * albedo[2] * e[2]))
 
 
 @kernel(entry=True)  # called from Python: the photon map's estimate at given points
-def irradiance_at(lights, points, normals, out):
+def irradiance_at(lights, points, normals, shadows, out):
     """:func:`caustic_irradiance` at each row of ``points`` (with unit ``normals``) into
     ``out`` (tests, docs/caustics.md's validation)."""
     for i in range(points.shape[0]):
         e = caustic_irradiance(lights, (points[i, 0], points[i, 1], points[i, 2]),
-                               (normals[i, 0], normals[i, 1], normals[i, 2]))
+                               (normals[i, 0], normals[i, 1], normals[i, 2]), shadows)
         out[i, 0] = e[0]
         out[i, 1] = e[1]
         out[i, 2] = e[2]

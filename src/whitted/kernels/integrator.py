@@ -168,7 +168,7 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
         tex, albedo = surface_colour(geo, mats, m, prim, tri, b1, b2, p)
         ka = mats[m, MAT_KA]
         amb = params.ambient
-        # with caustics, shadow rays stop at transparent bodies (their light is photons)
+        # with caustics, shadow rays pass clear bodies (photons add and take away)
         shadow_mats = lights.shadow_materials if caustics_on(lights) else mats
         local = direct_light(geo, shadow_mats, lights, params, p, n_shade, v, m, albedo, media,
                              n_media, scratch, stack, hits, listed, counters,

@@ -242,8 +242,10 @@ class LightArrays(NamedTuple):
     dtype NO_CAUSTICS_DTYPE, in renders without caustics: the render kernel is then compiled
     without its gather. With caustics, ``photons`` (float32) are sorted by the hash of their
     grid cell, ``photon_cells[h]:photon_cells[h + 1]`` being the photons of hash ``h``, and
-    ``shadow_materials`` is the material table with every kt zeroed: shadow rays stop at
-    transparent bodies, whose light arrives as photons."""
+    ``shadow_materials`` is the material table shadow rays see: the clear bodies'
+    materials (bounded, kt > 0) pass all the light, as if the bodies were not there; the
+    caustic and shadow photons add and take away what the bodies do to it
+    (compile/photon_map.py shadow_material_table)."""
 
     table: np.ndarray  # (L, N_LIGHT_PARAMS) float64
     buffer_cells: np.ndarray  # (C, 3) int32: CELL_FIRST, CELL_COUNT, CELL_OPAQUE

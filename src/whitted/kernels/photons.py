@@ -3,6 +3,10 @@ bodies that reflect or refract (the *targets*), follow reflections and refractio
 Fresnel, Beer-Lambert absorption and nested media exactly as camera rays do
 (kernels/integrator.py), and are stored where they land on a diffuse surface after at least
 one specular bounce. Rays are traced by the renderer's own ``closest_hit`` and normals.
+A photon whose straight path meets a *clear* body (compile/photon_map.py clear_materials:
+shadow rays pass those as if they were not there) also stores *shadow photons* of negative
+power where that straight path, through the clear bodies, meets diffuse surfaces: the light
+the direct term counts there and the bodies take away.
 
 Each photon's path depends only on the seed, the pass and its index: its emission sample is
 the index's point of the R2 low-discrepancy sequence, shifted per pass and emitter, and its
@@ -63,6 +67,7 @@ SET_DEPTH = 2
 SET_EPSILON = 3
 SET_SLOTS = 4  # records one photon may store
 N_SET = 5
+SHADOW_SLOTS = 2  # of which shadow photons (diffuse surfaces behind clear bodies) at most
 
 
 
@@ -248,16 +253,29 @@ def _interface(geo, mats, prim, m, entering, media, n_media, scratch):
 
 
 @kernel
-def trace_photon(geo, mats, shadow_mats, table, j, o, d, power, directional, settings, photon,
-                 index, emitter, out, slot0, stack, media, scratch):
+def _store(out, row, p, w, f, d, pass_index):
+    out[row, 0] = p[0]
+    out[row, 1] = p[1]
+    out[row, 2] = p[2]
+    out[row, 3] = w[0] * f
+    out[row, 4] = w[1] * f
+    out[row, 5] = w[2] * f
+    out[row, 6] = d[0]
+    out[row, 7] = d[1]
+    out[row, 8] = d[2]
+    out[row, 9] = pass_index
+
+
+@kernel
+def trace_photon(geo, mats, clear, table, j, o, d, power, directional, settings, photon,
+                 index, emitter, out, slot0, slots, stack, media, scratch):
     """Follow one photon; store a record (layout.PHOTON_* columns) at each diffuse surface it
-    reaches after a specular bounce, into ``out[slot0:]``. Returns the records stored. A
-    refraction counts as specular where shadow rays stop (``shadow_mats``' kt is 0): where
-    they pass, they carry that light already."""
+    reaches after a specular bounce, at most ``slots`` into ``out[slot0:]``. Returns the
+    records stored. A refraction counts as specular at a clear material (``clear[m]``):
+    elsewhere shadow rays pass it and carry that light already."""
     seed = int(settings[SET_SEED])
     pass_index = int(settings[SET_PASS])
     eps = settings[SET_EPSILON]
-    slots = int(settings[SET_SLOTS])
     w = power
     n_media = 0
     stored = 0
@@ -286,17 +304,7 @@ def trace_photon(geo, mats, shadow_mats, table, j, o, d, power, directional, set
             n_shade = n
         if specular and mats[m, MAT_KD] > 0.0 and stored < slots:
             f = 1.0 if directional else falloff_scale(table, j, length)
-            row = slot0 + stored
-            out[row, 0] = p[0]
-            out[row, 1] = p[1]
-            out[row, 2] = p[2]
-            out[row, 3] = w[0] * f
-            out[row, 4] = w[1] * f
-            out[row, 5] = w[2] * f
-            out[row, 6] = d[0]
-            out[row, 7] = d[1]
-            out[row, 8] = d[2]
-            out[row, 9] = pass_index
+            _store(out, slot0 + stored, p, w, f, d, pass_index)
             stored += 1
         kr = mats[m, MAT_KR]
         kt = mats[m, MAT_KT]
@@ -333,7 +341,7 @@ def trace_photon(geo, mats, shadow_mats, table, j, o, d, power, directional, set
             n_media = n_out
             for k in range(n_out):
                 media[k] = scratch[k]
-            specular = specular or shadow_mats[m, MAT_KT] == 0.0
+            specular = specular or clear[m] != 0
         else:  # reflected
             w = (w[0] * total, w[1] * total, w[2] * total)
             o = madd(p, n, eps)
@@ -344,8 +352,49 @@ def trace_photon(geo, mats, shadow_mats, table, j, o, d, power, directional, set
     return stored
 
 
+@kernel
+def shadow_photons(geo, mats, clear, table, j, o, d, power, directional, settings, out, slot0,
+                   slots, stack):
+    """The shadow photons of a photon leaving ``o`` along ``d``: where its straight path,
+    passing clear bodies as shadow rays do (as if they were not there), meets a diffuse
+    surface after crossing a clear body, a record of minus the power the direct term counts
+    there (layout.PHOTON_* columns, at most ``slots`` into ``out[slot0:]``). Other
+    transparent surfaces (unbounded planes) dim it by kt·colour as they dim shadow rays; an
+    opaque surface ends it. Returns the records stored."""
+    pass_index = int(settings[SET_PASS])
+    eps = settings[SET_EPSILON]
+    w = (-power[0], -power[1], -power[2])
+    stored = 0
+    crossed = False
+    length = 0.0
+    for _ in range(64):
+        t, prim, tri, b1, b2 = closest_hit(geo, o, d, 0.0, math.inf, stack)
+        if prim < 0:
+            break
+        length += t
+        m = hit_material(geo, prim, tri)
+        p = madd(o, d, t)
+        if crossed and mats[m, MAT_KD] > 0.0:
+            f = 1.0 if directional else falloff_scale(table, j, length)
+            _store(out, slot0 + stored, p, w, f, d, pass_index)
+            stored += 1
+            if stored >= slots:
+                break
+        if clear[m] != 0:
+            crossed = True
+        elif mats[m, MAT_KT] > 0.0:
+            kt = mats[m, MAT_KT]
+            w = (w[0] * kt * mats[m, MAT_COLOR], w[1] * kt * mats[m, MAT_COLOR + 1],
+                 w[2] * kt * mats[m, MAT_COLOR + 2])
+        else:
+            break
+        o = madd(p, d, eps)
+        length += eps
+    return stored
+
+
 @kernel(entry=True)  # called from Python, one call per lane
-def trace_photons(geo, mats, shadow_mats, table, emitters, settings, first, last, out, counts,
+def trace_photons(geo, mats, clear, table, emitters, settings, first, last, out, counts,
                   stack, media, scratch):
     """Photons ``first`` .. ``last - 1`` of a pass (``settings``: SET_* values): photon
     ``i`` writes its records into rows ``i * slots ...`` of ``out`` and their number into
@@ -367,8 +416,10 @@ def trace_photons(geo, mats, shadow_mats, table, emitters, settings, first, last
         counts[i] = 0
         if max(power[0], max(power[1], power[2])) <= 0.0:
             continue
-        counts[i] = trace_photon(geo, mats, shadow_mats, table, int(emitters[e, EMIT_LIGHT]),
-                                 o, d, power, directional, settings, i,
-                                 i - int(emitters[e, EMIT_FIRST]), e, out, i * slots, stack,
-                                 media, scratch)
+        j = int(emitters[e, EMIT_LIGHT])
+        n = shadow_photons(geo, mats, clear, table, j, o, d, power, directional, settings, out,
+                           i * slots, SHADOW_SLOTS, stack)
+        counts[i] = n + trace_photon(geo, mats, clear, table, j, o, d, power, directional,
+                                     settings, i, i - int(emitters[e, EMIT_FIRST]), e, out,
+                                     i * slots + n, slots - n, stack, media, scratch)
 

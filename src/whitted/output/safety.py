@@ -29,8 +29,9 @@ def check_output_place(path: str | os.PathLike[str]) -> None:
         status = os.stat(target)
     except FileNotFoundError:
         status = None
-    except OSError as exc:
-        raise OutputError(f"{name}: cannot write: {exc.strerror or exc}") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the name
+        raise OutputError(f"{name}: cannot write: "
+                          f"{getattr(exc, 'strerror', None) or exc}") from None
     if status is not None:
         kind = kind_of(status.st_mode)
         if kind is not None:

@@ -28,7 +28,7 @@ from ..kernels.layout import (
 )
 from ..output.image import Image
 from ..scene.scene import RenderSettings, Scene
-from .warm_up import warm_up_kernels
+from .warm_up import caustics_compile, warm_up_kernels
 
 RAY_KIND_NAMES = {
     RAY_PRIMARY: "primary",
@@ -269,6 +269,24 @@ class RenderJob:
         eta = elapsed / done * (total - done) if done else None
         self.progress(Progress(done, total, int(counters.sum()), elapsed, eta, chunk))
 
+    def _caustics_stage(self, compiled, params, stats) -> tuple[object, float]:
+        """The photon map, and the render kernel's kind with caustics compiled (the first
+        time) or loaded here rather than in the first tile (its time is compile time).
+        Returns (the lights with the photon map, the seconds shooting photons took)."""
+        from ..compile.photon_map import PhotonStats, photon_lights
+        from ..kernels.tiles import lane_workspace, render_tiles
+
+        stats.photons = PhotonStats()
+        lights = photon_lights(compiled, params, self.settings.caustics, self.threads,
+                               lambda: self.cancel_token.cancelled, stats.photons)
+        stats.warnings.extend(stats.photons.warnings)
+        start = time.perf_counter()
+        render_tiles(np.zeros((0, 4), np.int32), self.framebuffer, compiled.geometry,
+                     compiled.materials, lights, params, np.zeros((0, N_RAY_KINDS), np.int64),
+                     lane_workspace(params.max_depth), 0, 1)
+        stats.compile_seconds += time.perf_counter() - start
+        return lights, stats.photons.seconds
+
     def run(self) -> Image:
         from ..kernels.tiles import lane_workspace, render_tiles
 
@@ -285,20 +303,8 @@ class RenderJob:
         lights = compiled.lights
         photon_seconds = 0.0
         if self.settings.caustics.photons > 0:  # the photon map (compile/photon_map.py)
-            from ..compile.photon_map import PhotonStats, photon_lights
-
-            stats.photons = PhotonStats()
-            lights = photon_lights(compiled, params, self.settings.caustics, self.threads,
-                                   lambda: self.cancel_token.cancelled, stats.photons)
-            photon_seconds = stats.photons.seconds
-            # the render kernel's kind with caustics, compiled (first time) or loaded here,
-            # not in the first tile: its time is compile time
-            start = time.perf_counter()
-            render_tiles(np.zeros((0, 4), np.int32), self.framebuffer, compiled.geometry,
-                         compiled.materials, lights, params, np.zeros((0, N_RAY_KINDS),
-                                                                      np.int64),
-                         lane_workspace(params.max_depth), 0, 1)
-            stats.compile_seconds += time.perf_counter() - start
+            with caustics_compile():  # the first time: compiling, shown as such
+                lights, photon_seconds = self._caustics_stage(compiled, params, stats)
         tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size, self.rows)
         counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
         stats.tiles_total = len(tiles)

@@ -221,6 +221,7 @@ class _CountCompiles:
 
 
 _progress: _CompileCount | None = None
+_label = "the kernels"
 
 
 def compile_progress() -> float | None:
@@ -228,6 +229,58 @@ def compile_progress() -> float | None:
     is running (the kernels load from the cache in a fraction of a second)."""
     count = _progress
     return None if count is None else count.fraction
+
+
+def compile_label() -> str:
+    """What the compile :func:`compile_progress` reports is of: "the kernels", or "the
+    caustics kernels" (the photon tracer and the render kernel's kind with caustics)."""
+    return _label
+
+
+#: functions Numba compiles the first time a scene with caustics is rendered (the photon
+#: tracer, the gather, the render kernel's kind with caustics), once the plain variant is
+#: cached; counted on the 2-core VM. As EXPECTED_COMPILES, it only scales the progress.
+EXPECTED_CAUSTICS_COMPILES = 54
+
+
+@contextlib.contextmanager
+def caustics_compile():
+    """Around the caustics stage of a render (render/api.py): the photon map and the render
+    kernel's kind with caustics are compiled the first time a scene with caustics is
+    rendered. From its first compile on, :func:`compile_progress` counts them (and
+    :func:`compile_label` names them), so the CLI's bar says it is compiling, as for the
+    render kernels; when everything loads from the cache it stays None. Ctrl-C stops it at
+    the next compile, as it does a cold compile."""
+    global _progress, _label
+    from numba.core import event
+
+    from ..kernels.jit import load_numba
+
+    load_numba()
+    count = _CompileCount(EXPECTED_CAUSTICS_COMPILES)
+
+    class Listener(event.Listener):
+        def on_start(self, ev) -> None:
+            global _progress, _label
+            if _progress is None:
+                _label = "the caustics kernels"
+                _progress = count
+            count.check_interrupt()
+
+        def on_end(self, ev) -> None:
+            count.here += 1
+            count.check_interrupt()
+
+    listener = Listener()
+    event.register("numba:compile", listener)
+    try:
+        with _interrupt_at_safe_points(count):
+            yield
+    finally:
+        event.unregister("numba:compile", listener)
+        if _progress is count:
+            _progress = None
+            _label = "the kernels"
 
 
 def _start_helper(instances: bool) -> subprocess.Popen | None:

@@ -57,8 +57,6 @@ def _plain(value: Any) -> Any:
         return {k: _plain(v) for k, v in value.items() if v is not None}
     if isinstance(value, list | tuple):
         return [_plain(v) for v in value]
-    if isinstance(value, Path):
-        return str(value)
     return value
 
 
@@ -78,10 +76,7 @@ def compact_data(model: BaseModel) -> dict[str, Any]:
             continue
         if value is None or value == defaults.get(name, object()):
             continue
-        plain = _plain(value)
-        if plain == {} and isinstance(value, BaseModel):
-            continue
-        out[name] = plain
+        out[name] = _plain(value)  # {} for a table of defaults (``antialias = {}``)
     return out
 
 
@@ -124,24 +119,9 @@ def compact_toml(scene: Scene) -> str:
         items = getattr(scene, name)
         if items:
             doc[name] = _aot(items)
-    for name in _OTHER_FIELDS:  # e.g. the animation table
-        value = getattr(scene, name, None)
-        if value is not None and value != _scene_default(name):
-            doc[name] = _table(compact_data(value)) if isinstance(value, BaseModel) else \
-                _item(_plain(value))
     if scene.animation is not None:
         doc["animation"] = _animation_table(scene.animation)
-    return tomlkit.dumps(doc)
-
-
-_KNOWN_FIELDS = ("render", "camera", "background", "materials", "lights", "objects",
-                 "animation")  # the [animation] table: see below
-_OTHER_FIELDS = tuple(n for n in Scene.model_fields if n not in _KNOWN_FIELDS)
-
-
-def _scene_default(name: str) -> Any:
-    field = Scene.model_fields[name]
-    return field.default_factory() if field.default_factory is not None else field.default
+    return tomlkit.dumps(doc).lstrip("\n")  # a file of only [[objects]] starts with one
 
 
 # ---------------------------------------------------------------------- editing a file
@@ -190,8 +170,8 @@ def _update_list(doc: Any, name: str, old: list, new: list) -> None:
             del doc[name]
         return
     node = doc.get(name)
-    if not isinstance(node, AoT | Array):
-        doc[name] = _aot(new) if node is None or isinstance(node, AoT) else _array(new)
+    if not isinstance(node, AoT | Array):  # none yet (a file that loads has no other form)
+        doc[name] = _aot(new)
         return
     inline = isinstance(node, Array)
     fresh = (lambda it: _item(compact_data(it))) if inline else (
@@ -228,13 +208,6 @@ def _aot(items: list) -> AoT:
     return aot
 
 
-def _array(items: list) -> Array:
-    array = tomlkit.array()
-    for it in items:
-        array.append(_item(compact_data(it)))
-    return array
-
-
 def edit_toml(text: str, old: Scene, new: Scene) -> str:
     """``text`` (a TOML file that loads as ``old``) changed so that it loads as ``new``:
     comments, layout and untouched values stay byte for byte."""
@@ -248,12 +221,8 @@ def edit_toml(text: str, old: Scene, new: Scene) -> str:
         node = doc.get(name)
         if _is_table(node):
             _update_table(node, o, n)
-        else:
-            data = compact_data(n)
-            if data:
-                doc[name] = _table(data)
-            elif name in doc:
-                del doc[name]
+        else:  # not in the file: it was the default, so the new value is not
+            doc[name] = _table(compact_data(n))
     if old.materials != new.materials:
         node = doc.get("materials")
         if not _is_table(node):
@@ -272,19 +241,6 @@ def edit_toml(text: str, old: Scene, new: Scene) -> str:
         o, n = getattr(old, name), getattr(new, name)
         if o != n:
             _update_list(doc, name, list(o), list(n))
-    for name in _OTHER_FIELDS:
-        o, n = getattr(old, name, None), getattr(new, name, None)
-        if o == n:
-            continue
-        node = doc.get(name)
-        if isinstance(n, BaseModel) and isinstance(o, BaseModel) and _is_table(node):
-            _update_table(node, o, n)
-        elif n is None or n == _scene_default(name):
-            if name in doc:
-                del doc[name]
-        else:
-            doc[name] = _table(compact_data(n)) if isinstance(n, BaseModel) else \
-                _item(_plain(n))
     if old.animation != new.animation:
         _update_animation(doc, old.animation, new.animation)
     return tomlkit.dumps(doc)

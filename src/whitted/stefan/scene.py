@@ -24,6 +24,11 @@ ABSORPTION_BOOST = 1.0  # the default: measured absorption (>1 exaggerates it, s
 WATER_ABSORPTION_CM = (0.00340, 0.000565, 0.000092)
 ICE_ABSORPTION_CM = WATER_ABSORPTION_CM
 FILM_SAMPLES = 4
+#: caustics (docs/caustics.md): photons shot per frame through the ice onto the table, what a
+#: photograph shows of the light the piece focuses, per pixel of the frame (200,000 at 400x300):
+#: the default gather radius goes as 1/sqrt(photons), so it stays the same number of pixels
+#: at any frame size and a thumbnail does not pay for a poster's photons
+CAUSTIC_PHOTONS_PER_PIXEL = 5.0 / 3.0
 
 
 LIFT_CM = 0.005  # the piece is lifted a hair so its base does not coincide with the table
@@ -65,13 +70,18 @@ def still_life_scene(outer: str | None, inner: str | None, time_s: float | None,
                      width: int = 480, height: int = 360, samples: int = FILM_SAMPLES,
                      size_cm: float = 4.0, frames: int | None = None, fps: float = 8.0,
                      absorption_boost: float = ABSORPTION_BOOST,
+                     caustic_photons: int | None = None,
                      bubbles: list[tuple[tuple[float, ...], float]] | None = None,
                      puddles: list[float] | None = None) -> str:
     """The scene file's text; ``outer``/``inner`` are PLY paths relative to the scene file.
     With ``frames``, an animated scene whose meshes are sequences (``{frame:04d}`` in the
     names): frame k shows saved time k. ``bubbles``: the void's bubble (:func:`void_bubble`)
     in the cavity's water, one per frame (one for a still), keyed per frame in a film;
-    ``puddles``: the meltwater's disc radius on the table (:func:`puddle_radius`), likewise."""
+    ``puddles``: the meltwater's disc radius on the table (:func:`puddle_radius`), likewise;
+    ``caustic_photons``: photons per frame for the light the piece focuses (0: none; None:
+    CAUSTIC_PHOTONS_PER_PIXEL of the frame)."""
+    if caustic_photons is None:
+        caustic_photons = round(CAUSTIC_PHOTONS_PER_PIXEL * width * height)
     when = ("one frame per saved time (series.csv has the times)" if time_s is None
             else f"t = {time_s:.0f} s ({time_s / 60:.1f} min)")
     lines = [
@@ -85,6 +95,8 @@ def still_life_scene(outer: str | None, inner: str | None, time_s: float | None,
         f"height = {height}",
         f"samples = {samples}",
         "max_depth = 12",
+        *(["", "[render.caustics]  # the light the ice focuses onto the table",
+           f"photons = {caustic_photons}"] if caustic_photons > 0 else []),
         "",
         "[camera]",
         f"position = [{0.7 * size_cm:.3f}, {1.2 * size_cm:.3f}, {2.9 * size_cm:.3f}]",

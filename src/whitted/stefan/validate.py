@@ -202,6 +202,34 @@ def sphere_roundness(props: Properties | None = None, radius_cells: float = 9.0,
             "energy_rel": solver.energy_error() / solver.heat_in}
 
 
+#: de Vahl Davis (1983), "Natural convection of air in a square cavity: a bench mark numerical
+#: solution", Int. J. Numer. Methods Fluids 3, 249-264: the mean Nusselt number Nu of a
+#: square cavity with differentially heated side walls (Pr = 0.71), accurate to better than
+#: 1 % at Ra = 1e6 and to 0.1 % at 1e3 (the paper's estimate).
+DE_VAHL_DAVIS_NU = ((1.0e3, 1.118), (1.0e4, 2.243), (1.0e5, 4.519), (1.0e6, 8.800))
+DE_VAHL_DAVIS_PR = 0.71
+
+
+def enclosure_rows() -> list[dict]:
+    """The cavity's Nusselt law (Catton's enclosure correlation, ``convection.nusselt_enclosure``)
+    against de Vahl Davis's benchmark for the square cavity it is a correlation of: the model's
+    Nu (1 below Catton's range), the correlation's formula itself, the benchmark, the errors
+    and whether Ra Pr / (0.2 + Pr) is in Catton's range (> 10^3)."""
+    from .convection import nusselt_enclosure
+
+    pr = DE_VAHL_DAVIS_PR
+    rows = []
+    for ra, nu in DE_VAHL_DAVIS_NU:
+        x = pr / (0.2 + pr) * ra
+        formula = 0.18 * x ** 0.29
+        model = nusselt_enclosure(ra, pr)
+        rows.append({"ra": ra, "benchmark": nu, "model": model, "formula": formula,
+                     "error_pct": 100.0 * (model / nu - 1.0),
+                     "formula_error_pct": 100.0 * (formula / nu - 1.0),
+                     "in_range": x > 1.0e3})
+    return rows
+
+
 def energy_balance(cells: int = 16, t_end: float = 600.0) -> dict:
     """The default case on a small grid: enthalpy change against boundary heat minus the
     enthalpy that drained, in joules."""

@@ -1,0 +1,86 @@
+"""The farm's task loop (farm/watch.py run_tasks) on a made-up client: what it does when the
+scheduler's connection goes mid-job, or a result has to go again with no ready worker."""
+
+from __future__ import annotations
+
+import pytest
+
+pytest.importorskip("distributed")
+
+from whitted.farm import ClusterLost  # noqa: E402
+from whitted.farm.watch import run_tasks  # noqa: E402
+
+
+class Future:
+    def __init__(self, name: str, status: str = "finished") -> None:
+        self.key = name
+        self.status = status
+
+
+class Watch:
+    """What run_tasks asks of its watch: every task done at once."""
+
+    def __init__(self, status: str) -> None:
+        self.client = type("Client", (), {"status": status,
+                                          "scheduler": type("S", (), {"address": "tcp://h:1"}),
+                                          "scheduler_info": lambda self, **kw: {}})()
+        self.result_seconds = 30.0
+
+    def wait(self, futures):
+        return set(futures)
+
+    def disconnected(self) -> bool:
+        return self.client.status not in ("running", "newly-created")
+
+    def lost(self, exc=None):
+        return ClusterLost(f"lost the connection to the scheduler at tcp://h:1 ({exc})")
+
+    def give_up_on(self, future):
+        return []
+
+    def ready_workers(self, info):
+        return []
+
+    def check(self, keys):
+        return [], set()
+
+
+def failing(exc: BaseException):
+    def on_done(future, item):
+        raise exc
+    return on_done
+
+
+def test_a_closed_connection_pool_after_the_scheduler_went_is_cluster_lost():
+    watch = Watch("closed")
+    with pytest.raises(ClusterLost, match=r"^lost the connection to the scheduler at "
+                                          r"tcp://h:1 \(ConnectionPool is closed\)$"):
+        run_tasks(watch, {Future("a"): 0}, lambda item, workers: Future("b"),
+                  failing(RuntimeError("ConnectionPool is closed")))
+
+
+def test_a_runtime_error_while_connected_is_not_hidden():
+    watch = Watch("running")
+    with pytest.raises(RuntimeError, match="a defect"):
+        run_tasks(watch, {Future("a"): 0}, lambda item, workers: Future("b"),
+                  failing(RuntimeError("a defect")))
+
+
+def test_a_result_to_run_again_with_no_ready_worker_goes_to_any_worker():
+    """Its worker did not hand it over (TimeoutError) and no worker is ready now: it is
+    submitted with no worker restriction (None), not given up on."""
+    watch = Watch("running")
+    submitted = []
+    calls = []
+
+    def on_done(future, item):
+        calls.append(future.key)
+        if future.key == "a":
+            raise TimeoutError
+
+    def submit(item, workers):
+        submitted.append((item, workers))
+        return Future("again")
+
+    assert run_tasks(watch, {Future("a"): 7}, submit, on_done) is True
+    assert submitted == [(7, None)] and calls == ["a", "again"]
