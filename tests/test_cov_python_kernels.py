@@ -5,8 +5,6 @@ in one fresh process with the other JIT mode (plain Python when this run is comp
 
 from __future__ import annotations
 
-import os
-import subprocess
 import sys
 from pathlib import Path
 
@@ -17,8 +15,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
 import python_kernel_scenes as scenes  # noqa: E402
-
-JIT_OFF = os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0")
+from other_jit import in_other_jit_mode  # noqa: E402
 
 pytestmark = pytest.mark.python_kernels
 
@@ -28,12 +25,7 @@ def images(tmp_path_factory):
     """(this process's images, the other JIT mode's images), by scene name."""
     here = scenes.render_all()
     out = tmp_path_factory.mktemp("python_kernels") / "other.npz"
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"),
-               NUMBA_DISABLE_JIT="0" if JIT_OFF else "1")
-    subprocess.run([sys.executable, str(ROOT / "tests" / "python_kernel_scenes.py"), str(out)],
-                   env=env, check=True, timeout=600)
-    with np.load(out) as other:
-        return here, {k: other[k] for k in other.files}
+    return here, in_other_jit_mode("python_kernel_scenes.py", out)
 
 
 def test_python_and_compiled_aovs_agree(images):

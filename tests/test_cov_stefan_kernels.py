@@ -7,8 +7,6 @@ and one that drains the open cavity, the serial and the parallel kernel
 from __future__ import annotations
 
 import math
-import os
-import subprocess
 import sys
 from pathlib import Path
 
@@ -19,8 +17,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
 import stefan_kernel_cases as cases  # noqa: E402
+from other_jit import in_other_jit_mode  # noqa: E402
 
-JIT_OFF = os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0")
 BODY_CELLS = 5 * 5 * 5 + 1
 
 
@@ -29,12 +27,7 @@ def runs(tmp_path_factory):
     """(this process's results, the other JIT mode's results in a fresh process)."""
     here = cases.run()
     out = tmp_path_factory.mktemp("stefan_kernels") / "other.npz"
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"),
-               NUMBA_DISABLE_JIT="0" if JIT_OFF else "1")
-    subprocess.run([sys.executable, str(ROOT / "tests" / "stefan_kernel_cases.py"), str(out)],
-                   env=env, check=True, timeout=600)
-    with np.load(out) as other:
-        return here, {k: other[k] for k in other.files}
+    return here, in_other_jit_mode("stefan_kernel_cases.py", out)
 
 
 def test_plain_python_and_compiled_stefan_kernels_agree(runs):
