@@ -28,7 +28,10 @@ class FakeWorker:
 
 @pytest.fixture
 def sigint():
+    """Python's own Ctrl-C handler for the test (whatever this process inherited: a job
+    started in the background of a shell gets SIGINT ignored), the one before restored."""
     before = signal.getsignal(signal.SIGINT)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     yield
     signal.signal(signal.SIGINT, before)
 
@@ -46,7 +49,7 @@ def test_only_the_main_thread_can_ignore_ctrl_c(sigint):
     thread.start()
     thread.join()
     assert result == [False]
-    assert signal.getsignal(signal.SIGINT) is not signal.SIG_IGN
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 
 def test_a_worker_that_cannot_import_whitted_says_so(monkeypatch):
