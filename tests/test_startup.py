@@ -241,6 +241,9 @@ def test_cold_compile_reports_progress_and_stops_at_once_on_ctrl_c(tmp_path):
     env.pop("NUMBA_CACHE_DIR", None)
     script = textwrap.dedent("""
         import os, signal, threading, time, json
+        # Ctrl-C as in a terminal, whatever this test's parents ignore (a job started in the
+        # background of a shell inherits SIGINT ignored)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         import whitted
         from whitted.render import warm_up
 
