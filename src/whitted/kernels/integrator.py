@@ -7,26 +7,22 @@ import math
 
 from .accel import closest_hit, hit_material, surface_normals
 from .caustics import add_caustic, caustics_on
-from .extras import body_medium
 from .jit import kernel
 from .layout import (
     MAT_AMBIENT,
     MAT_ATTEN,
     MAT_COLOR,
     MAT_FRESNEL,
-    MAT_IOR,
     MAT_KA,
     MAT_KR,
     MAT_KT,
-    MAT_OUTSIDE,
     MAT_TEXTURE,
     MAX_MEDIA,
-    PRIM_SOLID,
     RAY_REFLECTION,
     RAY_REFRACTION,
 )
 from .lighting import direct_light
-from .media import media_enter, media_leave
+from .media import crossing_media
 from .texture import texture_color
 from .uv import surface_uv
 from .vec import dot, madd
@@ -189,37 +185,8 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
         kr_eff = kr
         if kt > 0.0:
             # media on the far side: entering a solid pushes its material, leaving pops it
-            n_out = n_media
-            for k in range(n_media):
-                scratch[k] = media[k]
-            if geo.prim_info[prim, PRIM_SOLID]:  # media are keyed by material row
-                n1 = mats[media[n_media - 1], MAT_IOR] if n_media > 0 else 1.0
-                # a surface between two named media (a water cavity in ice): the outside
-                # medium is left on the way in and entered on the way out
-                outside = int(mats[m, MAT_OUTSIDE])
-                body = body_medium(geo, prim, m)  # a CSG object is one body (extras.py)
-                if entering:
-                    if outside >= 0:
-                        n_out = media_leave(scratch, n_out, outside)
-                        n1 = mats[outside, MAT_IOR]
-                    n_out = media_enter(scratch, n_out, body)
-                    n2 = mats[body, MAT_IOR]
-                else:
-                    n_out = media_leave(scratch, n_out, body)
-                    n1 = mats[body, MAT_IOR]
-                    if n_out < n_media and media[n_media - 1] != body:
-                        # leaving a body that is not the innermost (overlapping bodies: a
-                        # water ball reaching a hair into the ice around it): the ray travels
-                        # in the innermost one, on both sides
-                        n1 = mats[media[n_media - 1], MAT_IOR]
-                    if outside >= 0:
-                        n_out = media_enter(scratch, n_out, outside)
-                        n2 = mats[outside, MAT_IOR]
-                    else:
-                        n2 = mats[scratch[n_out - 1], MAT_IOR] if n_out > 0 else 1.0
-            else:  # a thin sheet: light passes straight through
-                n1 = 1.0
-                n2 = 1.0
+            n1, n2, n_out = crossing_media(geo, mats, prim, m, entering, media, n_media,
+                                           scratch)
             ok, tdir = refract(d, n_shade, n1 / n2)
             if not ok:  # total internal reflection: the reflected ray carries it all
                 kr_eff = kr + kt

@@ -20,7 +20,6 @@ from __future__ import annotations
 import math
 
 from .accel import closest_hit, hit_material, surface_normals
-from .extras import body_medium
 from .integrator import _absorbed, refract, schlick
 from .jit import kernel, numba_object
 from .layout import (
@@ -38,14 +37,11 @@ from .layout import (
     MAT_ATTEN,
     MAT_COLOR,
     MAT_FRESNEL,
-    MAT_IOR,
     MAT_KD,
     MAT_KR,
     MAT_KT,
-    MAT_OUTSIDE,
-    PRIM_SOLID,
 )
-from .media import media_enter, media_leave
+from .media import crossing_media
 from .sampling import concentric_disk, random01, random_pair
 from .vec import dot, madd, normalize, vload
 
@@ -221,38 +217,6 @@ def falloff_scale(table, j, length):
 
 
 @kernel
-def _interface(geo, mats, prim, m, entering, media, n_media, scratch):
-    """Refractive indices on both sides of the surface of material ``m`` a ray crosses, and
-    the media on the far side (into ``scratch``), as kernels/integrator.py's trace_path
-    finds them. Returns (n1, n2, media count on the far side)."""
-    n_out = n_media
-    for k in range(n_media):
-        scratch[k] = media[k]
-    if not geo.prim_info[prim, PRIM_SOLID]:  # a thin sheet: light passes straight through
-        return 1.0, 1.0, n_out
-    n1 = mats[media[n_media - 1], MAT_IOR] if n_media > 0 else 1.0
-    outside = int(mats[m, MAT_OUTSIDE])
-    body = body_medium(geo, prim, m)  # a CSG object is one body (extras.py)
-    if entering:
-        if outside >= 0:
-            n_out = media_leave(scratch, n_out, outside)
-            n1 = mats[outside, MAT_IOR]
-        n_out = media_enter(scratch, n_out, body)
-        n2 = mats[body, MAT_IOR]
-    else:
-        n_out = media_leave(scratch, n_out, body)
-        n1 = mats[body, MAT_IOR]
-        if n_out < n_media and media[n_media - 1] != body:  # not the innermost: as trace_path
-            n1 = mats[media[n_media - 1], MAT_IOR]
-        if outside >= 0:
-            n_out = media_enter(scratch, n_out, outside)
-            n2 = mats[outside, MAT_IOR]
-        else:
-            n2 = mats[scratch[n_out - 1], MAT_IOR] if n_out > 0 else 1.0
-    return n1, n2, n_out
-
-
-@kernel
 def _store(out, row, p, w, f, d, pass_index):
     out[row, 0] = p[0]
     out[row, 1] = p[1]
@@ -316,7 +280,7 @@ def trace_photon(geo, mats, clear, table, j, o, d, power, directional, settings,
         tdir = d
         n_out = n_media
         if kt > 0.0:
-            n1, n2, n_out = _interface(geo, mats, prim, m, entering, media, n_media, scratch)
+            n1, n2, n_out = crossing_media(geo, mats, prim, m, entering, media, n_media, scratch)
             ok, tdir = refract(d, n_shade, n1 / n2)
             if not ok:  # total internal reflection
                 kr_eff = kr + kt
