@@ -390,14 +390,22 @@ class _PovWriter:
         mat = self.scene.material_of(index)
         body, solid, uv, placement = self.primitive(index, obj)
         lines = [body, f"  texture {{ {self.texture_name(mat, uv)}{placement} }}"]
-        interior = self.interior_name(mat) if solid else None
+        lines += self.body_lines(mat if solid else None, mat, obj.transform)
+        return _labelled(index, obj) + "\n".join(lines) + "\n}"
+
+    def body_lines(self, medium: Material | None, photons_of: Material | None,
+                   transform) -> list[str]:
+        """What closes an object's block: its interior (``medium``'s, None: none), its
+        photons block (``photons_of``'s, when caustics are on) and its transform."""
+        lines = []
+        interior = self.interior_name(medium) if medium is not None else None
         if interior is not None:
             lines.append(f"  interior {{ {interior} }}")
-        if (photons := self.photons(mat)) is not None:
+        if photons_of is not None and (photons := self.photons(photons_of)) is not None:
             lines.append(f"  {photons}")
-        if obj.transform is not None and not obj.transform.is_identity():
-            lines.append(f"  {matrix_keyword(obj.transform.matrix())}")
-        return _labelled(index, obj) + "\n".join(lines) + "\n}"
+        if transform is not None and not transform.is_identity():
+            lines.append(f"  {matrix_keyword(transform.matrix())}")
+        return lines
 
     def csg(self, index: int, obj: CSG, inherited: Material, top: bool = True) -> str:
         """POV-Ray's union / intersection / difference / merge of the children, each with its
@@ -412,21 +420,15 @@ class _PovWriter:
                 children.append(self.csg(index, child, mat, top=False))
                 continue
             body, _, uv, placement = self.primitive(index, child)
-            lines = [body, f"  texture {{ {self.texture_name(mat, uv)}{placement} }}"]
-            if child.transform is not None and not child.transform.is_identity():
-                lines.append(f"  {matrix_keyword(child.transform.matrix())}")
+            lines = [body, f"  texture {{ {self.texture_name(mat, uv)}{placement} }}",
+                     *self.body_lines(None, None, child.transform)]
             children.append("\n".join(lines) + "\n}")
         lines = [f"{obj.operation} {{", *("  " + c.replace("\n", "\n  ") for c in children)]
+        medium = None
         if top:
             medium = inherited if obj.material is not None else _first_material(
                 self.scene, obj, inherited)
-            interior = self.interior_name(medium)
-            if interior is not None:
-                lines.append(f"  interior {{ {interior} }}")
-            if (photons := self.photons(medium)) is not None:
-                lines.append(f"  {photons}")
-        if obj.transform is not None and not obj.transform.is_identity():
-            lines.append(f"  {matrix_keyword(obj.transform.matrix())}")
+        lines += self.body_lines(medium, medium, obj.transform)
         return "\n".join(lines) + "\n}"
 
     def primitive(self, index: int, obj) -> tuple[str, bool, bool, str]:
@@ -521,13 +523,7 @@ class _PovWriter:
             material = (self.scene.material_of(index) if obj.material is not None or
                         not parts.materials else parts.materials[0])
             out.append(f"  texture {{ {self.texture_name(material, True)} }}")
-        interior = self.interior_name(material) if obj.solid else None
-        if interior is not None:
-            out.append(f"  interior {{ {interior} }}")
-        if (photons := self.photons(material)) is not None:
-            out.append(f"  {photons}")
-        if obj.transform is not None and not obj.transform.is_identity():
-            out.append(f"  {matrix_keyword(obj.transform.matrix())}")
+        out += self.body_lines(material if obj.solid else None, material, obj.transform)
         return _labelled(index, obj) + "\n".join(out) + "\n}"
 
     def write(self, source: str | None) -> str:
