@@ -32,7 +32,7 @@ def media_leave(media, count, material):
     return count
 
 
-@kernel(inline="always")
+@kernel(numba_inline=True)  # inlined by Numba at each call site (jit.py): a hot path
 def crossing_media(geo, mats, prim, m, entering, media, n_media, scratch):
     """A ray crossing the surface of primitive ``prim`` (material ``m``), inside the media
     ``media[:n_media]`` (material rows, innermost last): the refractive indices on both
