@@ -34,7 +34,14 @@ import math
 
 import numpy as np
 
-from .intersect import INF, intersect_local, intersect_triangle, normal_local
+from .intersect import (
+    INF,
+    box_span,
+    intersect_local,
+    intersect_triangle,
+    normal_local,
+    sphere_span,
+)
 from .jit import kernel, numba_object
 from .layout import (
     CSG_DIFFERENCE,
@@ -44,12 +51,14 @@ from .layout import (
     MESH_TRI_OFFSET,
     PRIM_TYPE,
     PRIM_XFORM,
+    SHAPE_BOX,
     SHAPE_CSG_MESH,
     SHAPE_CSG_OP,
+    SHAPE_SPHERE,
     SHAPE_TORUS,
 )
 from .mesh import mesh_closest_hit
-from .torus import intersect_torus, torus_normal
+from .torus import intersect_torus, torus_crossings, torus_normal
 from .traverse import inverse_direction, slab_entry
 from .vec import dot, madd
 from .xform import normal_to_world, to_object
@@ -106,6 +115,33 @@ def leaf_t(geo, j, o, d, tmin, tmax):
     return intersect_local(typ, geo.prim_params, j, o, d, tmin, tmax), np.int64(j)
 
 
+@kernel(inline="always")
+def leaf_crossings(geo, j, o, d):
+    """Every crossing of the world ray's whole line with analytic leaf row ``j``: (count,
+    t0, t1, t2, t3), sorted, inf-padded. A closed solid's line enters at t0 and leaves at
+    t1 (a torus's again at t2 and t3); a tangent touch (two equal crossings) is none."""
+    xf = geo.prim_info[j, PRIM_XFORM]
+    if xf >= 0:
+        o, d = to_object(geo.xforms, xf, o, d)
+    typ = geo.prim_info[j, PRIM_TYPE]
+    P = geo.prim_params
+    t2 = INF
+    t3 = INF
+    if typ == SHAPE_TORUS:
+        t0, t1, t2, t3 = torus_crossings(P, j, o, d)
+    elif typ == SHAPE_SPHERE:
+        t0, t1 = sphere_span(P, j, o, d)
+    elif typ == SHAPE_BOX:
+        t0, t1 = box_span(P, j, o, d)
+    else:  # the frustum: its first crossing on the line, then the next past it
+        t0 = intersect_local(typ, P, j, o, d, -INF, INF)
+        t1 = intersect_local(typ, P, j, o, d, t0, INF) if t0 < INF else INF
+    if t0 == t1:
+        t0, t1, t2, t3 = t2, t3, INF, INF
+    n = 0 if t0 == INF else (1 if t1 == INF else (2 if t2 == INF else (3 if t3 == INF else 4)))
+    return n, t0, t1, t2, t3
+
+
 @kernel
 def leaf_normal(geo, j, p):
     """Outward unit normal, in world space, of leaf row ``j``'s own solid at world ``p``."""
@@ -123,19 +159,19 @@ def leaf_normal(geo, j, p):
     return n
 
 
-@kernel
+@kernel(inline="always")
 def _bit(bits, k):
     return (bits >> np.int64(k)) & np.int64(1)
 
 
-@kernel
+@kernel(inline="always")
 def _with_bit(bits, k, value):
     """``bits`` with bit k set to ``value`` (0 or 1)."""
     one = np.int64(1) << np.int64(k)
     return (bits | one) if value else (bits & ~one)
 
 
-@kernel
+@kernel(inline="always")
 def _shows_in(geo, start, n_rows, hit_leaf, inside):
     """(inside, shows) of the subtree in rows [start, start + n_rows) (its leaves numbered
     from 0), at a point on leaf number ``hit_leaf``'s surface where the other leaves' inside
@@ -192,7 +228,7 @@ def _shows_in(geo, start, n_rows, hit_leaf, inside):
     return _bit(ins, 0), _bit(vis, 0)
 
 
-@kernel
+@kernel(inline="always")
 def _cut_mask(geo, root):
     """The bits of the leaves that are a difference root's cuts when every cut is one leaf
     (``prim_params[root, 9]``: the rows of its first operand, 0 otherwise), else 0: then the
@@ -206,7 +242,7 @@ def _cut_mask(geo, root):
     return every & ~low
 
 
-@kernel
+@kernel(inline="always")
 def surface_shows(geo, root, hit_leaf, inside, cuts):
     """Is leaf number ``hit_leaf``'s surface, at a point where the other leaves' inside
     states are the bits of ``inside``, a surface of CSG object ``root``? ``cuts``: its
@@ -223,7 +259,7 @@ def surface_shows(geo, root, hit_leaf, inside, cuts):
     return vis == 1
 
 
-@kernel
+@kernel(inline="always")
 def may_show(geo, root, possible, cuts):
     """Can CSG object ``root`` still show a surface, given ``possible``: a bit per leaf, 0
     where the leaf has no crossing left in the walk and the ray is outside it there? (0 for a
@@ -257,7 +293,7 @@ def may_show(geo, root, possible, cuts):
     return _bit(st, 0) == 1
 
 
-@kernel
+@kernel(inline="always")
 def _missed_groups(geo, root, o, inv, tmin, tmax):
     """Bits of the cut leaves in the groups (rows after the tree: first leaf, end leaf,
     box padded) whose box the segment (tmin, tmax) misses: no crossing there, and outside
@@ -275,17 +311,30 @@ def _missed_groups(geo, root, o, inv, tmin, tmax):
     return skip
 
 
+@kernel(inline="always")
+def _crossing(r0, r1, r2, r3, k, c):
+    """Crossing number ``c`` of leaf ``k`` (its sorted crossings are r0..r3[k])."""
+    if c == 0:
+        return r0[k]
+    if c == 1:
+        return r1[k]
+    if c == 2:
+        return r2[k]
+    return r3[k]
+
+
 @kernel
 def csg_hit(geo, root, o, d, tmin, tmax):
     """(t, leaf row) of the nearest visible surface of CSG object ``root`` in (tmin, tmax),
     or (INF, -1).
 
-    Each leaf's next crossing is kept (``next_t``, ``next_part``) and asked for again only
-    once the walk has reached it: a crossing computed from the ray alone is the same whatever
-    ``tmin`` it was asked from, so the walk sees the crossings the leaves would report if
-    all were asked again at each step. The walk stops as soon as no surface can show
-    (``may_show``), first after the leaves of the root's first operand (a die: the rays
-    that miss its rounded cube skip its pips)."""
+    An analytic leaf's crossings with the whole line are found once (:func:`leaf_crossings`)
+    and walked in order: a leaf is inside where an odd number of them lie behind, so the walk
+    needs no normals. A mesh leaf's next crossing is asked for only once the walk has passed
+    its last one (its state from the sign of the normal there, as the module docstring
+    says). The walk stops as soon as no surface can show (``may_show``), first after the
+    leaves of the root's first operand (a die: the rays that miss its rounded cube skip its
+    pips)."""
     P = geo.prim_params
     inv = inverse_direction(d)
     if slab_entry(P[root, 2], P[root, 3], P[root, 4], P[root, 5], P[root, 6], P[root, 7], o,
@@ -295,10 +344,17 @@ def csg_hit(geo, root, o, d, tmin, tmax):
     n_leaves = int(P[root, 1])
     first_leaves = int(P[root, 8])  # leaves of the first operand of a root that needs it
     cuts = _cut_mask(geo, root)
-    next_t = slots(float_slots(), FRAME_SLOTS)
-    next_part = slots(int_slots(), FRAME_SLOTS)
+    # an analytic leaf's crossings r0..r3 and their count (-1: a mesh leaf, whose next
+    # crossing is r0, on triangle row ``part``, with d · normal there ``next_cos``, NaN
+    # until computed); ``cur``: the leaf's next crossing in the walk
+    r0 = slots(float_slots(), FRAME_SLOTS)
+    r1 = slots(float_slots(), FRAME_SLOTS)
+    r2 = slots(float_slots(), FRAME_SLOTS)
+    r3 = slots(float_slots(), FRAME_SLOTS)
+    count = slots(int_slots(), FRAME_SLOTS)
+    cur = slots(int_slots(), FRAME_SLOTS)
     rows = slots(int_slots(), FRAME_SLOTS)
-    # d · the leaf's normal at next_t (NaN: not computed yet)
+    part = slots(int_slots(), FRAME_SLOTS)
     next_cos = slots(float_slots(), FRAME_SLOTS)
     inside = np.int64(0)
     alive = np.int64(0)
@@ -308,20 +364,36 @@ def csg_hit(geo, root, o, d, tmin, tmax):
         if geo.prim_info[r, PRIM_TYPE] == SHAPE_CSG_OP:
             continue
         rows[leaf] = r
+        cur[leaf] = 0
         if _bit(skip, leaf):
-            next_t[leaf] = INF
-            leaf += 1
-            continue
-        t, part = leaf_t(geo, r, o, d, tmin, INF)
-        next_t[leaf] = t
-        next_part[leaf] = part
-        if t < INF:
-            if t < tmax:
+            count[leaf] = 0
+        elif geo.prim_info[r, PRIM_TYPE] == SHAPE_CSG_MESH:
+            t, tri = leaf_t(geo, r, o, d, tmin, INF)
+            count[leaf] = -1
+            r0[leaf] = t
+            part[leaf] = tri
+            if t < INF:
+                if t < tmax:
+                    alive = _with_bit(alive, leaf, 1)
+                cos = dot(d, leaf_normal(geo, tri, madd(o, d, t)))
+                next_cos[leaf] = cos  # the walk's crossing there needs it again
+                if cos > 0.0:
+                    inside = _with_bit(inside, leaf, 1)  # its first crossing leaves it
+        else:
+            n, a0, a1, a2, a3 = leaf_crossings(geo, r, o, d)
+            count[leaf] = n
+            r0[leaf] = a0
+            r1[leaf] = a1
+            r2[leaf] = a2
+            r3[leaf] = a3
+            c = 0
+            while c < n and _crossing(r0, r1, r2, r3, leaf, c) <= tmin:
+                c += 1
+            cur[leaf] = c
+            if c % 2 == 1:
+                inside = _with_bit(inside, leaf, 1)
+            if c < n and _crossing(r0, r1, r2, r3, leaf, c) < tmax:
                 alive = _with_bit(alive, leaf, 1)
-            cos = dot(d, leaf_normal(geo, part, madd(o, d, t)))
-            next_cos[leaf] = cos  # the walk's crossing there needs it again
-            if cos > 0.0:
-                inside = _with_bit(inside, leaf, 1)  # its first crossing leaves it
         leaf += 1
         if leaf == first_leaves and leaf < n_leaves:  # the rest unknown yet: possible
             untested = ~((np.int64(1) << np.int64(leaf)) - np.int64(1))
@@ -332,38 +404,44 @@ def csg_hit(geo, root, o, d, tmin, tmax):
     if not may_show(geo, root, alive | inside, cuts):
         return INF, np.int64(-1)
     d_len = math.sqrt(dot(d, d))
-    t_cur = tmin
     while alive != 0:
         best_t = INF
-        best_row = np.int64(-1)
-        best_leaf = -1
-        died = False
-        for k in range(n_leaves):
-            if _bit(alive, k):
-                t = next_t[k]
-                if t <= t_cur:  # reached: its next crossing past here
-                    t, part = leaf_t(geo, rows[k], o, d, t_cur, tmax)
-                    next_t[k] = t
-                    next_part[k] = part
-                    next_cos[k] = math.nan
-                if t == INF:
-                    alive = _with_bit(alive, k, 0)
-                    died = True
-                elif t < best_t:
+        k = -1
+        for j in range(n_leaves):
+            if _bit(alive, j):
+                t = r0[j] if count[j] < 0 else _crossing(r0, r1, r2, r3, j, cur[j])
+                if t < best_t:
                     best_t = t
-                    best_row = next_part[k]
-                    best_leaf = k
-        if best_row < 0:
+                    k = j
+        if k < 0:
             break
-        if died and not may_show(geo, root, alive | inside, cuts):
-            break
-        cos = next_cos[best_leaf]
-        if math.isnan(cos):
-            cos = dot(d, leaf_normal(geo, best_row, madd(o, d, best_t)))
-        t_cur = best_t
-        if abs(cos) <= GRAZING * d_len:
-            continue  # a touch: no state changes, nothing shows
-        if surface_shows(geo, root, best_leaf, inside, cuts):
-            return best_t, best_row
-        inside = _with_bit(inside, best_leaf, 1 if cos < 0.0 else 0)
+        if count[k] < 0:  # a mesh leaf: which way it crosses from its normal
+            row = np.int64(part[k])
+            cos = next_cos[k]
+            if math.isnan(cos):
+                cos = dot(d, leaf_normal(geo, row, madd(o, d, best_t)))
+            touch = abs(cos) <= GRAZING * d_len  # no state changes, nothing shows
+            entering = cos < 0.0
+        else:
+            row = np.int64(rows[k])
+            touch = False
+            entering = cur[k] % 2 == 0
+        if not touch:
+            if surface_shows(geo, root, k, inside, cuts):
+                return best_t, row
+            inside = _with_bit(inside, k, 1 if entering else 0)
+        # the leaf's next crossing
+        if count[k] < 0:
+            t, tri = leaf_t(geo, rows[k], o, d, best_t, tmax)
+            r0[k] = t
+            part[k] = tri
+            next_cos[k] = math.nan
+            dead = t == INF
+        else:
+            cur[k] += 1
+            dead = cur[k] >= count[k] or _crossing(r0, r1, r2, r3, k, cur[k]) >= tmax
+        if dead:
+            alive = _with_bit(alive, k, 0)
+            if not may_show(geo, root, alive | inside, cuts):
+                break
     return INF, np.int64(-1)

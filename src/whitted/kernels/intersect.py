@@ -58,6 +58,30 @@ def _nearest_root(a, b, c, tmin, tmax):
 
 
 @kernel
+def _roots(a, b, c):
+    """Both roots (t0 <= t1) of a·t² + 2b·t + c = 0, a > 0; (inf, inf) when none."""
+    disc = b * b - a * c
+    if disc < 0.0:
+        return INF, INF
+    sq = math.sqrt(disc)
+    q = -(b + sq) if b >= 0.0 else -(b - sq)
+    if q == 0.0:
+        return -b / a, -b / a
+    t0 = q / a
+    t1 = c / q
+    return (t0, t1) if t0 <= t1 else (t1, t0)
+
+
+@kernel
+def sphere_span(P, i, o, d):
+    """(enter, leave): where the ray's line crosses sphere row ``i`` ((inf, inf): nowhere)."""
+    c = vload(P, i, 0)
+    r = P[i, 3]
+    oc = sub(o, c)
+    return _roots(dot(d, d), dot(oc, d), dot(oc, oc) - r * r)
+
+
+@kernel
 def intersect_sphere(P, i, o, d, tmin, tmax):
     c = vload(P, i, 0)
     r = P[i, 3]
@@ -151,6 +175,30 @@ def _box_local(P, i, x):
         P[i, 6] * x[0] + P[i, 7] * x[1] + P[i, 8] * x[2],
         P[i, 9] * x[0] + P[i, 10] * x[1] + P[i, 11] * x[2],
     )
+
+
+@kernel
+def box_span(P, i, o, d):
+    """(enter, leave): where the ray's line crosses box row ``i`` ((inf, inf): nowhere)."""
+    lo = _box_local(P, i, sub(o, vload(P, i, 0)))
+    ld = _box_local(P, i, d)
+    t_near = -INF
+    t_far = INF
+    for k in range(3):
+        if ld[k] == 0.0:
+            if lo[k] < 0.0 or lo[k] > 1.0:
+                return INF, INF
+            continue
+        inv = 1.0 / ld[k]
+        t0 = -lo[k] * inv
+        t1 = (1.0 - lo[k]) * inv
+        if t0 > t1:
+            t0, t1 = t1, t0
+        t_near = max(t_near, t0)
+        t_far = min(t_far, t1)
+        if t_near > t_far:
+            return INF, INF
+    return t_near, t_far
 
 
 @kernel

@@ -8,14 +8,15 @@ The quartic is solved robustly rather than by Ferrari's formulas, whose cancella
 acne on grazing hits: the ray is first scaled so the torus fits in the unit ball and moved
 along itself to the point nearest the centre (the coefficients stay of order one whatever
 the distance of the eye); the roots can then only lie on the chord of the unit ball,
-[-h, h]. The roots of the quartic's second derivative (a quadratic) split that chord where
-its first derivative (a cubic) may change direction; each such piece holds at most one root
-of the cubic, found by Newton's method kept inside its bracket; the cubic's roots in turn
-split the chord into pieces where the quartic is monotonic, each with at most one root,
-found the same way. A root where the quartic only touches zero (a ray exactly tangent to the
-surface) is no crossing and is not reported. Every root is computed from the ray alone, not
-from ``tmin``: asking again from past one root gives the next one exactly (CSG walks rely on
-it).
+[-h, h]. The roots of the quartic's second derivative (a quadratic, solved in closed form)
+and of its first (a cubic) split that chord into pieces where the quartic is monotonic and
+bends one way only; each piece holds at most one root, and Newton's method started from the
+piece's end where the function and its curvature have the same sign (Fourier's condition)
+walks to it monotonically without leaving the piece, in five or six steps. The cubic's own
+roots are found the same way, on the pieces its derivative's roots and its inflection cut.
+A root where the quartic only touches zero (a ray exactly tangent to the surface) is no
+crossing and is not reported. Every root is computed from the ray alone, not from ``tmin``:
+asking again from past one root gives the next one exactly (CSG walks rely on it).
 """
 
 from __future__ import annotations
@@ -26,96 +27,88 @@ from .jit import kernel
 from .vec import dot, normalize, sub, vload
 
 INF = math.inf
-NEWTON_STEPS = 100  # bracketed Newton steps per root (bisection halves the bracket each)
+NEWTON_STEPS = 60  # at most, per root (monotone convergence: five or six in practice)
+NEWTON_TOL = 1e-13  # a step this small (relative, on the unit-ball chord) ends the search
 
 
 @kernel(inline="always")
-def _quartic(a, b, c, e, x):
-    """(f, f') of x⁴ + a·x³ + b·x² + c·x + e."""
-    f = (((x + a) * x + b) * x + c) * x + e
-    df = ((4.0 * x + 3.0 * a) * x + 2.0 * b) * x + c
-    return f, df
-
-
-@kernel(inline="always")
-def _cubic(a, b, c, x):
-    """(g, g') of g = the quartic's derivative 4x³ + 3a·x² + 2b·x + c."""
-    g = ((4.0 * x + 3.0 * a) * x + 2.0 * b) * x + c
-    dg = (12.0 * x + 6.0 * a) * x + 2.0 * b
-    return g, dg
+def _poly(deg, a, b, c, e, x):
+    """(f, f', f'') at x of the quartic x⁴ + a·x³ + b·x² + c·x + e (deg 4) or of its
+    derivative 4x³ + 3a·x² + 2b·x + c (deg 3)."""
+    if deg == 4:
+        f = (((x + a) * x + b) * x + c) * x + e
+        df = ((4.0 * x + 3.0 * a) * x + 2.0 * b) * x + c
+        ddf = (12.0 * x + 6.0 * a) * x + 2.0 * b
+    else:
+        f = ((4.0 * x + 3.0 * a) * x + 2.0 * b) * x + c
+        df = (12.0 * x + 6.0 * a) * x + 2.0 * b
+        ddf = 24.0 * x + 6.0 * a
+    return f, df, ddf
 
 
 @kernel
-def _bracketed_root(deg, a, b, c, e, lo, hi, f_lo):
-    """The root in [lo, hi] of the quartic (deg 4) or its derivative (deg 3), whose values at
-    the two ends have opposite signs (``f_lo`` at ``lo``): Newton's method, falling back to
-    bisection whenever a step would leave the bracket."""
-    x = 0.5 * (lo + hi)
+def _piece_root(deg, a, b, c, e, lo, hi, f_lo):
+    """The root in [lo, hi] of the quartic (deg 4) or its derivative (deg 3), monotonic there,
+    of one curvature, and of opposite signs at the ends (``f_lo`` at ``lo``): Newton's method
+    from the end where f·f'' > 0, whose steps then approach the root from one side."""
+    _, _, dd_mid = _poly(deg, a, b, c, e, 0.5 * (lo + hi))
+    x = lo if (f_lo > 0.0) == (dd_mid > 0.0) else hi
     for _ in range(NEWTON_STEPS):
-        if deg == 4:
-            f, df = _quartic(a, b, c, e, x)
-        else:
-            f, df = _cubic(a, b, c, x)
-        if f == 0.0:
+        f, df, _ = _poly(deg, a, b, c, e, x)
+        if f == 0.0 or df == 0.0:
             return x
-        if (f < 0.0) == (f_lo < 0.0):
-            lo = x
-            f_lo = f
-        else:
-            hi = x
-        step_ok = df != 0.0
-        xn = x - f / df if step_ok else 0.5 * (lo + hi)
-        if not (lo < xn < hi):
-            xn = 0.5 * (lo + hi)
-        if abs(xn - x) <= 1e-15 * (1.0 + abs(x)) or hi - lo <= 1e-15 * (1.0 + abs(lo)):
+        xn = x - f / df
+        if not (lo <= xn <= hi):  # rounding at the root itself
+            return min(max(xn, lo), hi)
+        if abs(xn - x) <= NEWTON_TOL * (1.0 + abs(x)):
             return xn
         x = xn
     return x
 
 
-@kernel
-def _quadratic_roots(p, q, r):
-    """Real roots (x0 <= x1) of p·x² + q·x + r, p != 0; (inf, inf) when there are none."""
-    disc = q * q - 4.0 * p * r
-    if disc < 0.0:
-        return INF, INF
-    sq = math.sqrt(disc)
-    h = -0.5 * (q + sq) if q >= 0.0 else -0.5 * (q - sq)
-    if h == 0.0:
-        return -q / (2.0 * p), -q / (2.0 * p)
-    x0 = h / p
-    x1 = r / h
-    if x0 > x1:
-        x0, x1 = x1, x0
-    return x0, x1
+@kernel(inline="always")
+def _ordered(x, y):
+    return (x, y) if x <= y else (y, x)
 
 
 @kernel
-def _split_points(deg, a, b, c, e, lo, hi, s0, s1, s2):
+def _roots_between(deg, a, b, c, e, lo, hi, s0, s1, s2, s3, s4):
     """Roots in (lo, hi) of the quartic (deg 4) or its derivative (deg 3), given sorted split
-    points s0, s1, s2 (inf: unused) between which it is monotonic: up to four, sorted,
-    inf-padded."""
+    points s0..s4 (inf: unused) cutting it into monotonic pieces of one curvature: up to four,
+    sorted, inf-padded."""
     out0 = INF
     out1 = INF
     out2 = INF
     out3 = INF
     n = 0
     x0 = lo
-    if deg == 4:
-        f0, _ = _quartic(a, b, c, e, x0)
-    else:
-        f0, _ = _cubic(a, b, c, x0)
-    for k in range(4):
-        x1 = s0 if k == 0 else (s1 if k == 1 else (s2 if k == 2 else hi))
+    f0, _, _ = _poly(deg, a, b, c, e, x0)
+    zero = INF  # a split point where the function is exactly 0 (pending)
+    for k in range(6):
+        if k == 0:
+            x1 = s0
+        elif k == 1:
+            x1 = s1
+        elif k == 2:
+            x1 = s2
+        elif k == 3:
+            x1 = s3
+        elif k == 4:
+            x1 = s4
+        else:
+            x1 = hi
         x1 = min(x1, hi)
         if x1 <= x0:
             continue
-        if deg == 4:
-            f1, _ = _quartic(a, b, c, e, x1)
-        else:
-            f1, _ = _cubic(a, b, c, x1)
+        f1, _, _ = _poly(deg, a, b, c, e, x1)
+        root = INF
+        if f1 == 0.0:  # a root on a split point (a symmetric ray): a crossing only if the
+            zero = x1  # sign differs on the two sides, decided at the next piece's end
+            continue
         if (f0 < 0.0 and f1 > 0.0) or (f0 > 0.0 and f1 < 0.0):
-            root = _bracketed_root(deg, a, b, c, e, x0, x1, f0)
+            root = zero if zero < INF else _piece_root(deg, a, b, c, e, x0, x1, f0)
+        zero = INF
+        if root < INF:
             if n == 0:
                 out0 = root
             elif n == 1:
@@ -128,6 +121,19 @@ def _split_points(deg, a, b, c, e, lo, hi, s0, s1, s2):
         x0 = x1
         f0 = f1
     return out0, out1, out2, out3
+
+
+@kernel
+def _quadratic_roots(p, q, r):
+    """Real roots (x0 <= x1) of p·x² + q·x + r, p != 0; (inf, inf) when there are none."""
+    disc = q * q - 4.0 * p * r
+    if disc < 0.0:
+        return INF, INF
+    sq = math.sqrt(disc)
+    h = -0.5 * (q + sq) if q >= 0.0 else -0.5 * (q - sq)
+    if h == 0.0:
+        return -q / (2.0 * p), -q / (2.0 * p)
+    return _ordered(h / p, r / h)
 
 
 @kernel
@@ -165,14 +171,26 @@ def torus_roots(o, d, major, minor):
     b = 4.0 * bb * bb + 2.0 * k - 4.0 * r2 * dxz
     c = 4.0 * bb * k - 8.0 * r2 * oxz
     e = k * k - 4.0 * r2 * pxz
-    # the cubic's turning points (the quartic's second derivative 12x² + 6a·x + 2b = 0)
+    # the quartic's inflections (the roots of 12x² + 6a·x + 2b) and the cubic's (x = -a/4)
     q0, q1 = _quadratic_roots(12.0, 6.0 * a, 2.0 * b)
-    q0 = _clip(q0, -h, h)
-    q1 = _clip(q1, -h, h)
-    if q0 == INF:  # split points sorted, inf-padded
-        q0, q1 = q1, INF
-    c0, c1, c2, _ = _split_points(3, a, b, c, e, -h, h, q0, q1, INF)
-    r0, r1, r2_, r3 = _split_points(4, a, b, c, e, -h, h, c0, c1, c2)
+    q0, q1 = _ordered(_clip(q0, -h, h), _clip(q1, -h, h))
+    m = _clip(-0.25 * a, -h, h)
+    # the cubic's pieces: cut at q0, m, q1 (sorted)
+    p0, p1 = _ordered(q0, m)
+    p1, p2 = _ordered(p1, q1)
+    p0, p1 = _ordered(p0, p1)
+    c0, c1, c2, _ = _roots_between(3, a, b, c, e, -h, h, p0, p1, p2, INF, INF)
+    # the quartic's pieces: cut at c0, c1, c2, q0, q1, sorted by a five-input network
+    v0, v1 = _ordered(c0, c1)
+    v3, v4 = _ordered(q0, q1)
+    v2, v4 = _ordered(c2, v4)
+    v2, v3 = _ordered(v2, v3)
+    v0, v3 = _ordered(v0, v3)
+    v0, v2 = _ordered(v0, v2)
+    v1, v4 = _ordered(v1, v4)
+    v1, v3 = _ordered(v1, v3)
+    v1, v2 = _ordered(v1, v2)
+    r0, r1, r2_, r3 = _roots_between(4, a, b, c, e, -h, h, v0, v1, v2, v3, v4)
     inv = 1.0 / length
     return ((r0 + shift) * inv, (r1 + shift) * inv, (r2_ + shift) * inv, (r3 + shift) * inv)
 
@@ -185,6 +203,13 @@ def torus_local(P, i, o, d):
     y = vload(P, i, 6)
     z = vload(P, i, 9)
     return (dot(q, x), dot(q, y), dot(q, z)), (dot(d, x), dot(d, y), dot(d, z))
+
+
+@kernel
+def torus_crossings(P, i, o, d):
+    """The four crossings (sorted, inf-padded) of the ray's line with torus row ``i``."""
+    lo, ld = torus_local(P, i, o, d)
+    return torus_roots(lo, ld, P[i, 12], P[i, 13])
 
 
 @kernel
