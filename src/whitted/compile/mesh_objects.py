@@ -84,12 +84,18 @@ def add_flat_mesh(b: PrimitiveRows, meshes: MeshTable, src: MeshSource, rows: np
     return t
 
 
+def geometry_key(scene: Scene, shape: Mesh) -> tuple:
+    """Mesh objects with equal keys have the same triangles: one model file, or one set of
+    inline arrays (the same Python arrays, as a Mesh reused or copied with ``model_copy``)."""
+    if shape.file is not None:
+        return ("file", str(scene.resolve_path(shape.file).resolve()))
+    return ("arrays", id(shape.vertices), id(shape.faces), id(shape.normals), id(shape.uvs))
+
+
 def mesh_key(scene: Scene, shape: Mesh) -> tuple:
-    """Objects with equal keys share one stored mesh (instancing)."""
+    """Objects with equal keys share one stored mesh (instancing): the same triangles
+    (:func:`geometry_key`) shaded the same way."""
     # the medium outside is part of the stored mesh's material rows
     outside = None if shape.outside is None else repr(shape.outside)
     shading = (shape.smooth, shape.crease_angle if shape.smooth else None, outside)
-    if shape.file is not None:
-        return ("file", str(scene.resolve_path(shape.file).resolve()), *shading)
-    return ("arrays", id(shape.vertices), id(shape.faces), id(shape.normals), id(shape.uvs),
-            *shading)
+    return (*geometry_key(scene, shape), *shading)

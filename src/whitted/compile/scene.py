@@ -36,7 +36,7 @@ from .geometry import box_corners, corners_bounds
 from .light_buffers import LIGHT_BUFFER_RES, build_light_buffers
 from .lights import light_rows
 from .materials import MaterialTable
-from .mesh_objects import FLATTEN_LIMIT, add_flat_mesh, mesh_key, mesh_source
+from .mesh_objects import FLATTEN_LIMIT, add_flat_mesh, geometry_key, mesh_key, mesh_source
 from .meshes import MeshSource, MeshTable
 from .primitives import PrimitiveRows
 from .reuse import cached_build_bvh
@@ -91,22 +91,45 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
     b = PrimitiveRows()
     materials = MaterialTable()
     meshes = MeshTable(mesh_tracer or scene.render.mesh_tracer)
+    # One mesh table entry per distinct mesh (mesh_key), shared by every object using it:
+    # plain instances and big CSG leaves alike (a CSG leaf needs only the triangles and
+    # their BVH, so it also takes an entry of the same triangles shaded otherwise).
     mesh_of: dict[tuple, object] = {}
+    mesh_of_geometry: dict[tuple, object] = {}
+    loaded: dict[tuple, MeshSource] = {}  # each model file read once
     sources: dict[tuple, tuple[MeshSource, np.ndarray]] = {}
     warnings: list[str] = []
     instanced = 0
     flat = 0
+
+    def source_of(obj_index: int, shape: Mesh) -> MeshSource:
+        key = geometry_key(scene, shape)
+        if key not in loaded:
+            loaded[key] = mesh_source(scene, obj_index, shape, warnings)
+        return loaded[key]
+
+    def stored_mesh(key: tuple, shape: Mesh, src: MeshSource, rows: np.ndarray):
+        """The mesh table entry of ``key`` (stored now if it is new), or None when the mesh
+        has no triangle to draw."""
+        if key not in mesh_of:
+            mesh_of[key] = meshes.add(src, rows, shape.smooth, shape.crease_angle)
+            mesh_of_geometry.setdefault(geometry_key(scene, shape), mesh_of[key])
+        return mesh_of[key]
+
+    def outside_row(shape: Mesh) -> int:
+        return -1 if shape.outside is None else materials.add(
+            scene.resolve_material(shape.outside))
+
     uses = Counter(mesh_key(scene, s) for s in scene.objects if isinstance(s, Mesh))
     for obj_index, shape in enumerate(scene.objects):
         m = shape.transform.matrix() if shape.transform is not None else np.eye(4)
         if isinstance(shape, Mesh):
             key = mesh_key(scene, shape)
-            outside = -1 if shape.outside is None else materials.add(
-                scene.resolve_material(shape.outside))
+            outside = outside_row(shape)
             override = -1 if shape.material is None else materials.add(
                 scene.material_of(obj_index), outside)
             if key not in sources:
-                src = mesh_source(scene, obj_index, shape, warnings)
+                src = source_of(obj_index, shape)
                 rows = np.array([materials.add(mat, outside) for mat in src.materials],
                                 np.int32)
                 sources[key] = (src, rows)
@@ -116,9 +139,7 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
                 flat += added
                 instanced += added
                 continue
-            if key not in mesh_of:
-                mesh_of[key] = meshes.add(src, rows, shape.smooth, shape.crease_angle)
-            stored = mesh_of[key]
+            stored = stored_mesh(key, shape, src, rows)
             if stored is None:
                 continue
             identity = np.array_equal(m, np.eye(4))
@@ -136,14 +157,19 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
                                       -1 if own else materials.add(mat), obj_index)
                 return first, count
 
-            def store_mesh(src, child):  # a big mesh leaf's crossings: its BVH
-                stored = meshes.add(src, np.array([materials.add(x) for x in src.materials],
-                                                  np.int32), child.smooth, child.crease_angle)
+            def store_mesh(src, child):  # a big mesh leaf's crossings: its BVH, shared
+                key, same = mesh_key(scene, child), geometry_key(scene, child)
+                if key not in mesh_of and same in mesh_of_geometry:
+                    stored = mesh_of_geometry[same]
+                else:
+                    outside = outside_row(child)
+                    stored = stored_mesh(key, child, src, np.array(
+                        [materials.add(x, outside) for x in src.materials], np.int32))
                 return None if stored is None else (stored.index, stored.triangles)
 
             add_csg(b, shape, m, materials.add, scene.resolve_material, obj_index,
                     scene.material_of(obj_index),
-                    lambda child, where, i=obj_index: mesh_source(scene, i, child, warnings),
+                    lambda child, where, i=obj_index: source_of(i, child),
                     emit_mesh, store_mesh)
             continue
         add_shape(b, shape, m, materials.add(scene.material_of(obj_index)), obj_index)
