@@ -6,6 +6,10 @@ Materials follow POV-Ray: a child without a material takes the nearest enclosing
 object's, and every surface shows its own leaf's material (so the cut of a difference shows
 the material of the object that cut it). The whole object is one body for refraction and
 absorption: its medium is its own material, or, when it has none, its first leaf's.
+
+A mesh leaf's triangles are rows after the tree, placed in the scene (one copy per leaf: the
+walk shades them); a big one's crossings come through the mesh stored for it, which
+``store_mesh`` shares with every other use of the same mesh (compile/scene.py).
 """
 
 from __future__ import annotations
