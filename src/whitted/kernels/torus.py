@@ -8,15 +8,16 @@ The quartic is solved robustly rather than by Ferrari's formulas, whose cancella
 acne on grazing hits: the ray is first scaled so the torus fits in the unit ball and moved
 along itself to the point nearest the centre (the coefficients stay of order one whatever
 the distance of the eye); the roots can then only lie on the chord of the unit ball,
-[-h, h]. The roots of the quartic's second derivative (a quadratic, solved in closed form)
-and of its first (a cubic) split that chord into pieces where the quartic is monotonic and
-bends one way only; each piece holds at most one root, and Newton's method started from the
-piece's end where the function and its curvature have the same sign (Fourier's condition)
-walks to it monotonically without leaving the piece, in five or six steps. The cubic's own
-roots are found the same way, on the pieces its derivative's roots and its inflection cut.
-A root where the quartic only touches zero (a ray exactly tangent to the surface) is no
-crossing and is not reported. Every root is computed from the ray alone, not from ``tmin``:
-asking again from past one root gives the next one exactly (CSG walks rely on it).
+[-h, h], on its part inside the slab that holds the tube (|y| <= the minor radius). The
+roots of the quartic's second derivative (a quadratic, solved in closed form) and of its
+first (a cubic) split that part into pieces where the quartic is monotonic and bends one
+way only; each piece holds at most one root, and Newton's method started from the piece's
+end where the function and its curvature have the same sign (Fourier's condition) walks to
+it monotonically without leaving the piece, in five or six steps. The cubic's own roots are
+found the same way, on the pieces its derivative's roots and its inflection cut. A root
+where the quartic only touches zero (a ray exactly tangent to the surface) is no crossing
+and is not reported. Every root is computed from the ray alone, not from ``tmin``: asking
+again from past one root gives the next one exactly (CSG walks rely on it).
 """
 
 from __future__ import annotations
@@ -160,6 +161,20 @@ def torus_roots(o, d, major, minor):
     h = math.sqrt(h2) * (1.0 + 1e-12) + 1e-12
     big = major * scale
     small = minor * scale
+    # the tube lies in the slab |y| <= small: the roots lie on the part of the chord in it
+    lo = -h
+    hi = h
+    pad = 1e-9 * small  # past the slab's faces the quartic is positive: clear ends
+    if dn[1] != 0.0:
+        y0 = (-small - pad - os[1]) / dn[1]
+        y1 = (small + pad - os[1]) / dn[1]
+        y0, y1 = _ordered(y0, y1)
+        lo = max(lo, y0)
+        hi = min(hi, y1)
+        if lo >= hi:
+            return INF, INF, INF, INF
+    elif abs(os[1]) > small:
+        return INF, INF, INF, INF
     r2 = big * big
     k = dot(os, os) + r2 - small * small
     bb = dot(os, dn)
@@ -173,13 +188,13 @@ def torus_roots(o, d, major, minor):
     e = k * k - 4.0 * r2 * pxz
     # the quartic's inflections (the roots of 12x² + 6a·x + 2b) and the cubic's (x = -a/4)
     q0, q1 = _quadratic_roots(12.0, 6.0 * a, 2.0 * b)
-    q0, q1 = _ordered(_clip(q0, -h, h), _clip(q1, -h, h))
-    m = _clip(-0.25 * a, -h, h)
+    q0, q1 = _ordered(_clip(q0, lo, hi), _clip(q1, lo, hi))
+    m = _clip(-0.25 * a, lo, hi)
     # the cubic's pieces: cut at q0, m, q1 (sorted)
     p0, p1 = _ordered(q0, m)
     p1, p2 = _ordered(p1, q1)
     p0, p1 = _ordered(p0, p1)
-    c0, c1, c2, _ = _roots_between(3, a, b, c, e, -h, h, p0, p1, p2, INF, INF)
+    c0, c1, c2, _ = _roots_between(3, a, b, c, e, lo, hi, p0, p1, p2, INF, INF)
     # the quartic's pieces: cut at c0, c1, c2, q0, q1, sorted by a five-input network
     v0, v1 = _ordered(c0, c1)
     v3, v4 = _ordered(q0, q1)
@@ -190,7 +205,7 @@ def torus_roots(o, d, major, minor):
     v1, v4 = _ordered(v1, v4)
     v1, v3 = _ordered(v1, v3)
     v1, v2 = _ordered(v1, v2)
-    r0, r1, r2_, r3 = _roots_between(4, a, b, c, e, -h, h, v0, v1, v2, v3, v4)
+    r0, r1, r2_, r3 = _roots_between(4, a, b, c, e, lo, hi, v0, v1, v2, v3, v4)
     inv = 1.0 / length
     return ((r0 + shift) * inv, (r1 + shift) * inv, (r2_ + shift) * inv, (r3 + shift) * inv)
 

@@ -45,13 +45,15 @@ from .._cache import HELPER_ENV, prepare
 from ..assets.mesh import load_obj_bytes
 from ..compile.params import render_params
 from ..compile.scene import CompiledScene, compile_scene
+from ..kernels.features import EXTRAS_DTYPE
 from ..kernels.layout import N_RAY_KINDS
 from ..scene.lights import PointLight
 from ..scene.scene import Scene
 from ..scene.shapes import Mesh, Sphere
 
 _lock = threading.Lock()
-_ready: set[bool] = set()  # render kernel variants loaded here: with / without mesh instances
+#: render kernel variants loaded here: (with mesh instances, with tori or CSG objects)
+_ready: set[tuple[bool, bool]] = set()
 _builders_ready = False
 HELPER_WAIT_SECONDS = 120.0  # a helper still busy after this is stopped (never expected)
 #: functions Numba compiles in a cold compile of each variant, this process and the helper
@@ -75,6 +77,15 @@ f 1/1/1 2/2/1 3/3/1
 def kernel_variant(compiled: CompiledScene) -> bool:
     """True for the variant of the kernels compiled for scenes with mesh instances."""
     return compiled.geometry.inst_box.dtype == np.float64
+
+
+def _loaded_key(compiled: CompiledScene | None) -> tuple[bool, bool]:
+    """Which render kernel a scene like ``compiled`` runs: (with mesh instances, with tori or
+    CSG objects). Each is its own specialisation, loaded (or compiled) by the warm-up, not by
+    the render's first call, whose time would then include it."""
+    if compiled is None:
+        return False, False
+    return kernel_variant(compiled), compiled.geometry.unbounded.dtype == np.dtype(EXTRAS_DTYPE)
 
 
 def stand_in_scene(instances: bool) -> CompiledScene:
@@ -327,9 +338,10 @@ def warm_up_kernels(compiled: CompiledScene | None = None) -> float:
     instances; without when None); on the first run also the builders and the AOV kernel.
     Returns the seconds it took; 0 when all of it was already loaded in this process."""
     with _lock:
-        instances = kernel_variant(compiled) if compiled is not None else False
-        if instances in _ready:
+        key = _loaded_key(compiled)
+        if key in _ready:
             return 0.0
+        instances = key[0]
         start = time.perf_counter()
         cache = prepare()
         marker = _marker(instances)
@@ -350,7 +362,7 @@ def warm_up_kernels(compiled: CompiledScene | None = None) -> float:
                 _mark(marker)
         if cache.unsealed:
             cache.seal()
-        _ready.add(instances)
+        _ready.add(key)
         return time.perf_counter() - start
 
 
