@@ -162,7 +162,7 @@ def _mesh_normals_if_instances(geo, mesh, tri, b1, b2):
     return lambda geo, mesh, tri, b1, b2: mesh_normals(geo, mesh, tri, b1, b2)
 
 
-@kernel
+@kernel(inline="always")
 def surface_normals(geo, prim, tri, b1, b2, p):
     """(geometric, shading) unit normals in world space of a hit at ``p``. They differ only on
     smooth-shaded meshes; the geometric one decides which side a ray is on."""
@@ -230,7 +230,7 @@ def _closest_instance_hit_if_instances(geo, o, d, inv, tmin, tmax, stack):
                                                                           tmax, stack)
 
 
-@kernel
+@kernel(inline="always")
 def closest_hit(geo, o, d, tmin, tmax, stack):
     """Nearest hit in (tmin, tmax): (t, primitive, triangle, b1, b2), or (tmax, -1, -1, 0, 0).
     ``stack`` is caller-owned int32 scratch space (128 entries: two levels of 64).

@@ -108,7 +108,7 @@ def _mesh_uv_if_instances(geo, mesh, tri, b1, b2):
     return lambda geo, mesh, tri, b1, b2: mesh_uv(geo, mesh, tri, b1, b2)
 
 
-@kernel
+@kernel(inline="always")
 def surface_uv(geo, prim, tri, b1, b2, p):
     """Texture coordinates of the hit at world point ``p`` (see the module docstring)."""
     typ = geo.prim_info[prim, PRIM_TYPE]
