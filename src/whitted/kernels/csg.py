@@ -312,6 +312,46 @@ def _missed_groups(geo, root, o, inv, tmin, tmax):
 
 
 @kernel(inline="always")
+def _flat_shows(op, k, inside, every):
+    """:func:`surface_shows` for a tree of one operation on leaves (``every``: their bits):
+    the rules of the module docstring as masks."""
+    others = inside & ~(np.int64(1) << np.int64(k))
+    if op == CSG_MERGE:
+        return others == 0
+    if op == CSG_INTERSECTION:
+        return others == every & ~(np.int64(1) << np.int64(k))
+    if op == CSG_DIFFERENCE:
+        if k == 0:
+            return others == 0
+        return (inside & np.int64(1)) == 1 and (others & ~np.int64(1)) == 0
+    return True  # union
+
+
+@kernel(inline="always")
+def _flat_may_show(op, possible, every):
+    """:func:`may_show` for a tree of one operation on leaves."""
+    if op == CSG_INTERSECTION:
+        return (possible & every) == every
+    if op == CSG_DIFFERENCE:
+        return (possible & np.int64(1)) == 1
+    return (possible & every) != 0
+
+
+@kernel(inline="always")
+def _shows(geo, root, flat, k, inside, cuts, every):
+    if flat >= 0:
+        return _flat_shows(flat, k, inside, every)
+    return surface_shows(geo, root, k, inside, cuts)
+
+
+@kernel(inline="always")
+def _may_show(geo, root, flat, possible, cuts, every):
+    if flat >= 0:
+        return _flat_may_show(flat, possible, every)
+    return may_show(geo, root, possible, cuts)
+
+
+@kernel(inline="always")
 def _crossing(r0, r1, r2, r3, k, c):
     """Crossing number ``c`` of leaf ``k`` (its sorted crossings are r0..r3[k])."""
     if c == 0:
@@ -344,6 +384,9 @@ def csg_hit(geo, root, o, d, tmin, tmax):
     n_leaves = int(P[root, 1])
     first_leaves = int(P[root, 8])  # leaves of the first operand of a root that needs it
     cuts = _cut_mask(geo, root)
+    every = (np.int64(1) << np.int64(n_leaves)) - np.int64(1) if n_leaves < 63 else ~np.int64(0)
+    # a tree of one operation on leaves (rows: the leaves, then it) is tested with masks
+    flat = int(P[root + n_rows, 0]) if n_rows == n_leaves + 1 else -1
     # an analytic leaf's crossings r0..r3 and their count (-1: a mesh leaf, whose next
     # crossing is r0, on triangle row ``part``, with d · normal there ``next_cos``, NaN
     # until computed); ``cur``: the leaf's next crossing in the walk
@@ -397,11 +440,11 @@ def csg_hit(geo, root, o, d, tmin, tmax):
         leaf += 1
         if leaf == first_leaves and leaf < n_leaves:  # the rest unknown yet: possible
             untested = ~((np.int64(1) << np.int64(leaf)) - np.int64(1))
-            if not may_show(geo, root, alive | inside | untested, cuts):
+            if not _may_show(geo, root, flat, alive | inside | untested, cuts, every):
                 return INF, np.int64(-1)
             if P[root, 10] > 0.0:
                 skip = _missed_groups(geo, root, o, inv, tmin, tmax)
-    if not may_show(geo, root, alive | inside, cuts):
+    if not _may_show(geo, root, flat, alive | inside, cuts, every):
         return INF, np.int64(-1)
     d_len = math.sqrt(dot(d, d))
     while alive != 0:
@@ -427,7 +470,7 @@ def csg_hit(geo, root, o, d, tmin, tmax):
             touch = False
             entering = cur[k] % 2 == 0
         if not touch:
-            if surface_shows(geo, root, k, inside, cuts):
+            if _shows(geo, root, flat, k, inside, cuts, every):
                 return best_t, row
             inside = _with_bit(inside, k, 1 if entering else 0)
         # the leaf's next crossing
@@ -442,6 +485,6 @@ def csg_hit(geo, root, o, d, tmin, tmax):
             dead = cur[k] >= count[k] or _crossing(r0, r1, r2, r3, k, cur[k]) >= tmax
         if dead:
             alive = _with_bit(alive, k, 0)
-            if not may_show(geo, root, alive | inside, cuts):
+            if not _may_show(geo, root, flat, alive | inside, cuts, every):
                 break
     return INF, np.int64(-1)
