@@ -10,12 +10,20 @@ a visible surface is reported as the row it belongs to (a mesh's triangle), so s
 its material and normal as anywhere else.
 
 The walk follows the ray through the leaves' crossings in order, keeping each leaf's inside
-state as one bit of an int64: a leaf's state where the ray starts is whether its first
-crossing past ``tmin`` leaves it (bounded solids: no crossing ahead, outside), and each
-crossing sets it to whether the ray enters there (the sign of the leaf's normal). A ray
-that only grazes a surface (normal perpendicular to it, to 1e-9) changes no state and shows
-nothing. A crossing of leaf k is a surface of the object when POV-Ray's rules keep it, given
-the states of the other leaves at that point (evaluated up the tree in one postfix pass):
+state as one bit of an int64. An analytic leaf (sphere, box, frustum, torus) gives every
+crossing of the ray's whole line at once, sorted. For a sphere, a box or a torus the line
+enters at the first, leaves at the second (a torus: again at the third and fourth), so the
+leaf is inside where an odd number of its crossings lie behind, and a tangent touch (two
+equal crossings) is none. A mesh leaf is asked for its next crossing past the last one the
+walk used. It, a frustum (whose cap and side both report a ray through the cap's rim, a
+rounding apart) and any leaf with an odd number of crossings (one lost to rounding at an
+edge) are walked by their normals: the state where the ray starts is whether its first
+crossing past ``tmin`` leaves it (no crossing ahead: outside), and each crossing sets it to
+whether the ray enters there (the sign of the normal; a crossing that only grazes, normal
+perpendicular to the ray to 1e-9, changes no state and shows nothing). A crossing of leaf k
+is a surface of the object when POV-Ray's rules keep it, given the states of the other
+leaves at that point (evaluated up the tree in one postfix pass, or, for a tree of one
+operation on leaves, as bit masks):
 
 - union: every surface of every operand;
 - merge: an operand's surfaces outside every other operand;
@@ -23,9 +31,9 @@ the states of the other leaves at that point (evaluated up the tree in one postf
 - difference: the first operand's surfaces outside all the others, and the others' surfaces
   inside the first and outside the rest (shown turned inside out: ``PRIM_FLIP``).
 
-Every crossing of a leaf is computed from the ray alone, so asking again from past one
-crossing finds the next one exactly; leaves the ray no longer crosses before ``tmax`` drop
-out of the walk (the pips of a die that a ray misses cost one test each).
+Every crossing of a leaf is computed from the ray alone, so the walk sees the same crossings
+whatever ``tmin`` it starts from; leaves the ray no longer crosses before ``tmax`` drop out
+of the walk (the pips of a die that a ray misses cost one test each).
 """
 
 from __future__ import annotations
@@ -54,6 +62,7 @@ from .layout import (
     SHAPE_BOX,
     SHAPE_CSG_MESH,
     SHAPE_CSG_OP,
+    SHAPE_FRUSTUM,
     SHAPE_SPHERE,
     SHAPE_TORUS,
 )
@@ -133,9 +142,15 @@ def leaf_crossings(geo, j, o, d):
         t0, t1 = sphere_span(P, j, o, d)
     elif typ == SHAPE_BOX:
         t0, t1 = box_span(P, j, o, d)
-    else:  # the frustum: its first crossing on the line, then the next past it
+    else:  # the frustum: each crossing on the line past the one before (a ray through a
+        # cap's rim meets the cap and the side there, a rounding apart: up to four)
         t0 = intersect_local(typ, P, j, o, d, -INF, INF)
         t1 = intersect_local(typ, P, j, o, d, t0, INF) if t0 < INF else INF
+        t2 = intersect_local(typ, P, j, o, d, t1, INF) if t1 < INF else INF
+        t3 = intersect_local(typ, P, j, o, d, t2, INF) if t2 < INF else INF
+        n = 0 if t0 == INF else (1 if t1 == INF else (2 if t2 == INF else (
+            3 if t3 == INF else 4)))
+        return n, t0, t1, t2, t3
     if t0 == t1:
         t0, t1, t2, t3 = t2, t3, INF, INF
     n = 0 if t0 == INF else (1 if t1 == INF else (2 if t2 == INF else (3 if t3 == INF else 4)))
@@ -402,6 +417,7 @@ def csg_hit(geo, root, o, d, tmin, tmax):
     inside = np.int64(0)
     alive = np.int64(0)
     skip = np.int64(0)  # cut leaves in groups the ray misses: outside, no crossing
+    odd = np.int64(0)  # analytic leaves walked by their normals (see below)
     leaf = 0
     for r in range(root + 1, root + 1 + n_rows):
         if geo.prim_info[r, PRIM_TYPE] == SHAPE_CSG_OP:
@@ -433,7 +449,14 @@ def csg_hit(geo, root, o, d, tmin, tmax):
             while c < n and _crossing(r0, r1, r2, r3, leaf, c) <= tmin:
                 c += 1
             cur[leaf] = c
-            if c % 2 == 1:
+            # a frustum (whose crossings at a rim may come twice) or an odd count (one lost
+            # to rounding): the normals say which way each crossing goes, as for a mesh
+            if n % 2 == 1 or geo.prim_info[r, PRIM_TYPE] == SHAPE_FRUSTUM:
+                odd = _with_bit(odd, leaf, 1)
+                if c < n and dot(d, leaf_normal(geo, r, madd(
+                        o, d, _crossing(r0, r1, r2, r3, leaf, c)))) > 0.0:
+                    inside = _with_bit(inside, leaf, 1)
+            elif c % 2 == 1:
                 inside = _with_bit(inside, leaf, 1)
             if c < n and _crossing(r0, r1, r2, r3, leaf, c) < tmax:
                 alive = _with_bit(alive, leaf, 1)
@@ -464,6 +487,11 @@ def csg_hit(geo, root, o, d, tmin, tmax):
             if math.isnan(cos):
                 cos = dot(d, leaf_normal(geo, row, madd(o, d, best_t)))
             touch = abs(cos) <= GRAZING * d_len  # no state changes, nothing shows
+            entering = cos < 0.0
+        elif _bit(odd, k):
+            row = np.int64(rows[k])
+            cos = dot(d, leaf_normal(geo, row, madd(o, d, best_t)))
+            touch = abs(cos) <= GRAZING * d_len
             entering = cos < 0.0
         else:
             row = np.int64(rows[k])
