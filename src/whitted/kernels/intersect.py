@@ -30,36 +30,9 @@ EDGE_TOL = 1e-9
 
 
 @kernel
-def _nearest_root(a, b, c, tmin, tmax):
-    """Nearest root in (tmin, tmax) of a·t² + 2b·t + c = 0 (numerically stable form)."""
-    if a == 0.0:
-        if b == 0.0:
-            return INF
-        t = -c / (2.0 * b)
-        return t if tmin < t < tmax else INF
-    disc = b * b - a * c
-    if disc < 0.0:
-        return INF
-    sq = math.sqrt(disc)
-    q = -(b + sq) if b >= 0.0 else -(b - sq)
-    if q == 0.0:
-        t0 = -b / a
-        t1 = t0
-    else:
-        t0 = q / a
-        t1 = c / q
-    if t0 > t1:
-        t0, t1 = t1, t0
-    if tmin < t0 < tmax:
-        return t0
-    if tmin < t1 < tmax:
-        return t1
-    return INF
-
-
-@kernel
 def _roots(a, b, c):
-    """Both roots (t0 <= t1) of a·t² + 2b·t + c = 0, a > 0; (inf, inf) when none."""
+    """Both roots (t0 <= t1) of a·t² + 2b·t + c = 0, a != 0 (numerically stable form);
+    (inf, inf) when there are none."""
     disc = b * b - a * c
     if disc < 0.0:
         return INF, INF
@@ -70,6 +43,22 @@ def _roots(a, b, c):
     t0 = q / a
     t1 = c / q
     return (t0, t1) if t0 <= t1 else (t1, t0)
+
+
+@kernel
+def _nearest_root(a, b, c, tmin, tmax):
+    """Nearest root in (tmin, tmax) of a·t² + 2b·t + c = 0."""
+    if a == 0.0:
+        if b == 0.0:
+            return INF
+        t = -c / (2.0 * b)
+        return t if tmin < t < tmax else INF
+    t0, t1 = _roots(a, b, c)
+    if tmin < t0 < tmax:
+        return t0
+    if tmin < t1 < tmax:
+        return t1
+    return INF
 
 
 @kernel
@@ -204,24 +193,7 @@ def box_span(P, i, o, d):
 @kernel
 def intersect_box(P, i, o, d, tmin, tmax):
     """Slab test in the box's own coordinates, where it is the unit cube [0, 1]^3."""
-    lo = _box_local(P, i, sub(o, vload(P, i, 0)))
-    ld = _box_local(P, i, d)
-    t_near = -INF
-    t_far = INF
-    for k in range(3):
-        if ld[k] == 0.0:
-            if lo[k] < 0.0 or lo[k] > 1.0:
-                return INF
-            continue
-        inv = 1.0 / ld[k]
-        t0 = -lo[k] * inv
-        t1 = (1.0 - lo[k]) * inv
-        if t0 > t1:
-            t0, t1 = t1, t0
-        t_near = max(t_near, t0)
-        t_far = min(t_far, t1)
-        if t_near > t_far:
-            return INF
+    t_near, t_far = box_span(P, i, o, d)
     if tmin < t_near < tmax:
         return t_near
     if tmin < t_far < tmax:
