@@ -192,12 +192,22 @@ def test_first_surface_matches_the_exact_intervals(origin, target):
     if box and ball:
         lo, hi = max(box[0], ball[0]), min(box[1], ball[1])
         if lo < hi:
-            pieces = [(lo, hi)]
-            if cut:
-                pieces = [p for p in ((lo, min(hi, cut[0])), (max(lo, cut[1]), hi))
-                          if p[0] < p[1]]
+            pieces = _minus([(lo, hi)], cut)
+    _assert_first_surface(SCULPT, o, d, pieces)
+
+
+def _minus(pieces, cut):
+    """The intervals ``pieces`` less the interval ``cut`` (None: nothing)."""
+    if cut is None:
+        return pieces
+    return [q for p in pieces for q in ((p[0], min(p[1], cut[0])), (max(p[0], cut[1]), p[1]))
+            if q[0] < q[1]]
+
+
+def _assert_first_surface(compiled, o, d, pieces):
+    """The first hit of the ray is the first end past 0 of the solid's intervals along it."""
     ends = sorted(x for p in pieces for x in p if x > 1e-9)
-    h = SCULPT.hit(o, d)
+    h = compiled.hit(o, d)
     if not ends:
         assert h is None
         return
@@ -235,13 +245,6 @@ def _frustum_interval(o, d, axis, lo, hi, r_lo, r_hi):
     return (min(p[0] for p in pieces), max(p[1] for p in pieces)) if pieces else None
 
 
-def _minus(pieces, cut):
-    if cut is None:
-        return pieces
-    return [q for p in pieces for q in ((p[0], min(p[1], cut[0])), (max(p[0], cut[1]), p[1]))
-            if q[0] < q[1]]
-
-
 DRILLED = Compiled(CSG(operation="difference", objects=[
     CUBE,
     Cylinder(base=(0, -1.5, 0), top=(0, 0.5, 0), radius=0.5),
@@ -269,14 +272,7 @@ def test_first_surface_of_a_drilled_cube_matches_the_exact_intervals(origin, tar
     cone = _frustum_interval(o, d, 0, -1.5, 1.5, 0.6, 0.2)
     if cone is None and abs(sum(d[j] ** 2 for j in (1, 2)) - (0.4 / 3 * d[0]) ** 2) < 1e-12:
         return
-    pieces = _minus(pieces, cone)
-    ends = sorted(x for p in pieces for x in p if x > 1e-9)
-    h = DRILLED.hit(o, d)
-    if not ends:
-        assert h is None
-        return
-    assert h is not None
-    assert h[0] == pytest.approx(ends[0], rel=1e-9, abs=1e-9)
+    _assert_first_surface(DRILLED, o, d, _minus(pieces, cone))
 
 
 def test_csg_children_must_bound_a_volume():

@@ -67,7 +67,7 @@ from .layout import (
     SHAPE_TORUS,
 )
 from .mesh import mesh_closest_hit
-from .torus import intersect_torus, torus_crossings, torus_normal
+from .torus import torus_crossings, torus_normal
 from .traverse import inverse_direction, slab_entry
 from .vec import dot, madd
 from .xform import normal_to_world, to_object
@@ -82,7 +82,7 @@ GRAZING = 1e-9  # |cos| between ray and normal below which a crossing is only a 
 
 
 @kernel
-def _mesh_t(geo, j, o, d, tmin, tmax):
+def mesh_leaf_t(geo, j, o, d, tmin, tmax):
     """Nearest crossing in (tmin, tmax) with the triangles of mesh leaf ``j``, and the
     triangle's row: through the BVH of the mesh stored for it (``prim_params[j, 2]``: its
     mesh_info row + 1, in its own space: ``PRIM_XFORM``), whose triangle k is row first + k,
@@ -107,21 +107,6 @@ def _mesh_t(geo, j, o, d, tmin, tmax):
             best_t = t
             best = np.int64(r)
     return best_t, best
-
-
-@kernel
-def leaf_t(geo, j, o, d, tmin, tmax):
-    """Nearest crossing in (tmin, tmax) of the world ray with leaf row ``j`` (INF: none), and
-    the row whose surface it is (``j``, or a mesh leaf's triangle)."""
-    typ = geo.prim_info[j, PRIM_TYPE]
-    if typ == SHAPE_CSG_MESH:
-        return _mesh_t(geo, j, o, d, tmin, tmax)
-    xf = geo.prim_info[j, PRIM_XFORM]
-    if xf >= 0:
-        o, d = to_object(geo.xforms, xf, o, d)
-    if typ == SHAPE_TORUS:
-        return intersect_torus(geo.prim_params, j, o, d, tmin, tmax), np.int64(j)
-    return intersect_local(typ, geo.prim_params, j, o, d, tmin, tmax), np.int64(j)
 
 
 @kernel(inline="always")
@@ -427,7 +412,7 @@ def csg_hit(geo, root, o, d, tmin, tmax):
         if _bit(skip, leaf):
             count[leaf] = 0
         elif geo.prim_info[r, PRIM_TYPE] == SHAPE_CSG_MESH:
-            t, tri = leaf_t(geo, r, o, d, tmin, INF)
+            t, tri = mesh_leaf_t(geo, r, o, d, tmin, INF)
             count[leaf] = -1
             r0[leaf] = t
             part[leaf] = tri
@@ -503,7 +488,7 @@ def csg_hit(geo, root, o, d, tmin, tmax):
             inside = _with_bit(inside, k, 1 if entering else 0)
         # the leaf's next crossing
         if count[k] < 0:
-            t, tri = leaf_t(geo, rows[k], o, d, best_t, tmax)
+            t, tri = mesh_leaf_t(geo, rows[k], o, d, best_t, tmax)
             r0[k] = t
             part[k] = tri
             next_cos[k] = math.nan
