@@ -345,6 +345,35 @@ def test_a_killed_lone_worker_costs_retries_not_the_film(film_scene, local_frame
         assert (tmp_path / "frames" / f"{k:04d}.png").read_bytes() == local_frames[k]
 
 
+def test_a_finished_frame_lost_with_its_worker_before_it_came_is_rendered_again(
+        film_scene, local_frames, tmp_path, monkeypatch):
+    """The race CI met: Dask says a task finished, then its lone worker dies before the
+    result is fetched, and the future turns "lost" (Dask computes it again). That is no
+    failed frame: the film waits for the new result."""
+    from whitted.farm import farm_client
+    from whitted.farm.watch import Watch
+
+    killed: list[str] = []
+    wait = Watch.wait
+
+    def wait_then_kill(self, futures):
+        done = wait(self, futures)
+        if done and not killed:
+            os.kill(next(iter(pid.values())), signal.SIGKILL)
+            # the event: the client hears that the finished result is gone with its worker
+            wait_for(lambda: any(f.status != "finished" for f in done), "a lost result", 60)
+            killed.extend(f.status for f in done)
+        return done
+
+    monkeypatch.setattr(Watch, "wait", wait_then_kill)
+    with farm_client("local:1", threads=1) as client:
+        pid = client.run(os.getpid)
+        result = render_film(client, film_scene, tmp_path / "frames", chunk=1)
+    assert "lost" in killed and not result.failed and sorted(result.rendered) == list(range(8))
+    for k in range(8):
+        assert (tmp_path / "frames" / f"{k:04d}.png").read_bytes() == local_frames[k]
+
+
 def test_a_local_worker_restarted_by_its_nanny_ignores_ctrl_c_too():
     """The workers of ``--cluster local:N`` ignore a terminal's Ctrl-C (the client stops
     them); one its nanny starts again after a kill is a new process, and ignores it too."""

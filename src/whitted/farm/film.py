@@ -242,12 +242,15 @@ def _render_missing(client, scene, stills, chosen, digests, paths, todo, result,
         def on_done(future, run: list[int]) -> None:
             if future.status == "cancelled":  # by the scheduler: it is going
                 raise watch.lost()
-            if future.status != "finished":  # the task itself failed, after its retries
-                exc = future.exception() if future.status == "error" else None
-                for i in run:
+            try:  # "finished"; or "lost": finished, then its worker died before the result
+                # came here, and Dask computes it again (watch.result waits, or gives it back)
+                outcomes = watch.result(future)
+            except Exception as exc:
+                if future.status != "error":
+                    raise
+                for i in run:  # the task itself failed, after its retries
                     result.failed[chosen[i]] = _reason(exc)
                 return
-            outcomes = watch.result(future)
             watch.record(o.seconds for o in outcomes if o.png is not None)
             interrupt = None
             for outcome in outcomes:  # each written, even after a Ctrl-C in the progress
@@ -292,6 +295,6 @@ def _render_missing(client, scene, stills, chosen, digests, paths, todo, result,
         cancel_quietly(client, tasks)
 
 
-def _reason(exc: BaseException | None) -> str:
-    text = str(exc).strip().splitlines()[0] if exc is not None and str(exc).strip() else ""
-    return text or type(exc).__name__
+def _reason(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
