@@ -42,6 +42,7 @@ import math
 
 import numpy as np
 
+from .hit_list import keep_nearest
 from .intersect import (
     INF,
     box_span,
@@ -366,7 +367,27 @@ def _crossing(r0, r1, r2, r3, k, c):
 @kernel
 def csg_hit(geo, root, o, d, tmin, tmax):
     """(t, leaf row) of the nearest visible surface of CSG object ``root`` in (tmin, tmax),
-    or (INF, -1).
+    or (INF, -1) (:func:`_walk`)."""
+    t, row, _, _ = _walk(geo, root, o, d, tmin, tmax, False, slots(float_slots(), FRAME_SLOTS),
+                         0, False)
+    return t, row
+
+
+@kernel
+def csg_surfaces(geo, root, o, d, tmin, tmax, hits, n, full):
+    """Every visible surface of CSG object ``root`` in (tmin, tmax), as (t, leaf row) pairs
+    kept in the shadow ray's ``hits`` list (hit_list.py; its n and full in and out): one walk
+    where asking :func:`csg_hit` again from past each surface walked once a surface."""
+    _, _, n, full = _walk(geo, root, o, d, tmin, tmax, True, hits, n, full)
+    return n, full
+
+
+@kernel(inline="always")
+def _walk(geo, root, o, d, tmin, tmax, collect, hits, n_hits, full):
+    """The walk: (t, leaf row) of the nearest visible surface of CSG object ``root`` in
+    (tmin, tmax), or (INF, -1); with ``collect``, every visible surface is put in ``hits``
+    instead (:func:`.hit_list.keep_nearest`) and the walk goes on past it. Returns those two
+    and the list's (n_hits, full).
 
     An analytic leaf's crossings with the whole line are found once (:func:`leaf_crossings`)
     and walked in order: a leaf is inside where an odd number of them lie behind, so the walk
@@ -379,7 +400,8 @@ def csg_hit(geo, root, o, d, tmin, tmax):
     inv = inverse_direction(d)
     if slab_entry(P[root, 2], P[root, 3], P[root, 4], P[root, 5], P[root, 6], P[root, 7], o,
                   inv, tmin, tmax) == INF:
-        return INF, np.int64(-1)  # (shadow rays test listed objects without their boxes)
+        # (shadow rays test listed objects without their boxes)
+        return INF, np.int64(-1), n_hits, full
     n_rows = int(P[root, 0])
     n_leaves = int(P[root, 1])
     first_leaves = int(P[root, 8])  # leaves of the first operand of a root that needs it
@@ -449,11 +471,11 @@ def csg_hit(geo, root, o, d, tmin, tmax):
         if leaf == first_leaves and leaf < n_leaves:  # the rest unknown yet: possible
             untested = ~((np.int64(1) << np.int64(leaf)) - np.int64(1))
             if not _may_show(geo, root, flat, alive | inside | untested, cuts, every):
-                return INF, np.int64(-1)
+                return INF, np.int64(-1), n_hits, full
             if P[root, 10] > 0.0:
                 skip = _missed_groups(geo, root, o, inv, tmin, tmax)
     if not _may_show(geo, root, flat, alive | inside, cuts, every):
-        return INF, np.int64(-1)
+        return INF, np.int64(-1), n_hits, full
     d_len = math.sqrt(dot(d, d))
     while alive != 0:
         best_t = INF
@@ -484,7 +506,9 @@ def csg_hit(geo, root, o, d, tmin, tmax):
             entering = cur[k] % 2 == 0
         if not touch:
             if _shows(geo, root, flat, k, inside, cuts, every):
-                return best_t, row
+                if not collect:
+                    return best_t, row, n_hits, full
+                n_hits, full = keep_nearest(hits, n_hits, best_t, row, full)
             inside = _with_bit(inside, k, 1 if entering else 0)
         # the leaf's next crossing
         if count[k] < 0:
@@ -500,4 +524,4 @@ def csg_hit(geo, root, o, d, tmin, tmax):
             alive = _with_bit(alive, k, 0)
             if not _may_show(geo, root, flat, alive | inside, cuts, every):
                 break
-    return INF, np.int64(-1)
+    return INF, np.int64(-1), n_hits, full

@@ -14,16 +14,16 @@ from .accel import (
     occludes,
     surface_normals,
 )
-from .csg import csg_hit
+from .csg import csg_surfaces
 from .extras import body_medium
 from .features import extras_possible, has_extras, has_instances, instances_possible
+from .hit_list import keep_nearest
 from .intersect import INF
 from .jit import kernel, overload
 from .layout import (
     CELL_COUNT,
     CELL_FIRST,
     CELL_OPAQUE,
-    CSG_MAX_LEAVES,
     FIRST_EXTRA_SHAPE,
     LIGHT_BUFFER,
     LIGHT_BUFFER_SIDE,
@@ -137,7 +137,6 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
     return seen_transparent
 
 
-MAX_SHADOW_HITS = 32  # transparent surfaces one shadow ray gathers in one walk (hits buffer)
 SHADOW_LIST_CAP = 48  # primitives a soft-shadow bundle may list; past that its rays walk the BVH
 MIN_BUNDLE_SAMPLES = 4  # area lights with fewer samples per point skip the bundle listing
 
@@ -222,26 +221,6 @@ def list_cone_leaves(geo, mats, apex, axis, radius, stack, out, n, cap, opaque):
     return n, opaque
 
 
-@kernel
-def _keep_nearest(hits, n, t, prim, full):
-    """Insert (t, prim) into the first n pairs of ``hits``, kept sorted by t and at most
-    MAX_SHADOW_HITS long (the farthest pair drops out). Returns (n, full): full once a pair
-    was dropped or refused."""
-    if n == MAX_SHADOW_HITS:
-        if t >= hits[2 * (n - 1)]:
-            return n, True
-        n -= 1
-        full = True
-    k = n
-    while k > 0 and hits[2 * (k - 1)] > t:
-        hits[2 * k] = hits[2 * (k - 1)]
-        hits[2 * k + 1] = hits[2 * (k - 1) + 1]
-        k -= 1
-    hits[2 * k] = t
-    hits[2 * k + 1] = prim
-    return n + 1, full
-
-
 @kernel(inline="always")
 def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, listed, list_first,
                             n_listed):
@@ -269,57 +248,54 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
                                                              j, leaf, leaf_end, top, False)
             if i < 0:
                 break
+        clear = mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] >= OPAQUE_KT
+        if clear and has_extras(geo) and geo.prim_info[i, PRIM_TYPE] >= FIRST_EXTRA_SHAPE:
+            # a torus or a CSG object: every crossing (a CSG object's as its leaves)
+            n, full = gather_extra_hits_if_extras(geo, i, o, d, tmin, tmax, step, hits, n,
+                                                  full)
+            continue
         t = hit_analytic(geo, i, o, d, tmin, tmax)
         if t == INF:
             continue
-        if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT:
+        if not clear:
             hits[1] = i
             return -1, False
-        if has_extras(geo) and geo.prim_info[i, PRIM_TYPE] >= FIRST_EXTRA_SHAPE:
-            # a torus or a CSG object: every crossing (a CSG object's as its leaves)
-            n, full = gather_extra_hits_if_extras(geo, i, o, d, t, tmin, tmax, step, hits, n,
-                                                  full)
-            continue
-        n, full = _keep_nearest(hits, n, t, i, full)
+        n, full = keep_nearest(hits, n, t, i, full)
         # a closed analytic body is crossed twice (the triangles of a flattened solid mesh
         # are each crossed once: their body's other side is other triangles)
         if geo.prim_info[i, PRIM_SOLID] and geo.prim_info[i, PRIM_TYPE] != SHAPE_TRIANGLE:
             t = hit_analytic(geo, i, o, d, t * (1.0 + 1e-12) + step, tmax)
             if t < INF:
-                n, full = _keep_nearest(hits, n, t, i, full)
+                n, full = keep_nearest(hits, n, t, i, full)
     return n, full
 
 
 @kernel
-def gather_extra_hits(geo, i, o, d, t, tmin, tmax, step, hits, n, full):
-    """:func:`gather_transparent_hits` for a torus or CSG object ``i`` first crossed at
-    ``t``: that crossing and every later one before ``tmax`` (up to four on a torus; a CSG
-    object's as (t, leaf) pairs, each found from past the one before)."""
-    for _ in range(4 * CSG_MAX_LEAVES):
-        part = i
-        if geo.prim_info[i, PRIM_TYPE] == SHAPE_CSG:
-            t, part = csg_hit(geo, i, o, d, tmin, tmax)
-            if part < 0:
-                break
-        elif t == INF:
+def gather_extra_hits(geo, i, o, d, tmin, tmax, step, hits, n, full):
+    """:func:`gather_transparent_hits` for a torus or CSG object ``i``: its crossings in
+    (tmin, tmax), a CSG object's as (t, leaf) pairs from one walk (:func:`.csg.csg_surfaces`),
+    a torus's each found from past the one before (up to four)."""
+    if geo.prim_info[i, PRIM_TYPE] == SHAPE_CSG:
+        return csg_surfaces(geo, i, o, d, tmin, tmax, hits, n, full)
+    t = hit_analytic(geo, i, o, d, tmin, tmax)
+    for _ in range(4):
+        if t == INF:
             break
-        n, full = _keep_nearest(hits, n, t, part, full)
-        tmin = t * (1.0 + 1e-12) + step
-        if geo.prim_info[i, PRIM_TYPE] != SHAPE_CSG:
-            t = hit_analytic(geo, i, o, d, tmin, tmax)
+        n, full = keep_nearest(hits, n, t, i, full)
+        t = hit_analytic(geo, i, o, d, t * (1.0 + 1e-12) + step, tmax)
     return n, full
 
 
-def gather_extra_hits_if_extras(geo, i, o, d, t, tmin, tmax, step, hits, n, full):
-    return gather_extra_hits(geo, i, o, d, t, tmin, tmax, step, hits, n, full)
+def gather_extra_hits_if_extras(geo, i, o, d, tmin, tmax, step, hits, n, full):
+    return gather_extra_hits(geo, i, o, d, tmin, tmax, step, hits, n, full)
 
 
 @overload(gather_extra_hits_if_extras)
-def _gather_extra_hits_if_extras(geo, i, o, d, t, tmin, tmax, step, hits, n, full):
+def _gather_extra_hits_if_extras(geo, i, o, d, tmin, tmax, step, hits, n, full):
     if not extras_possible(geo):
-        return lambda geo, i, o, d, t, tmin, tmax, step, hits, n, full: (n, full)
-    return lambda geo, i, o, d, t, tmin, tmax, step, hits, n, full: gather_extra_hits(
-        geo, i, o, d, t, tmin, tmax, step, hits, n, full)
+        return lambda geo, i, o, d, tmin, tmax, step, hits, n, full: (n, full)
+    return lambda geo, i, o, d, tmin, tmax, step, hits, n, full: gather_extra_hits(
+        geo, i, o, d, tmin, tmax, step, hits, n, full)
 
 
 @kernel(specialise_constants=True)  # a variant per call site: LLVM inlines each

@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from .accel import closest_hit, surface_normals
+from .hit_list import MAX_SHADOW_HITS
 from .integrator import N_STACK_F, N_STACK_I, trace_path
 from .jit import kernel, numba_object
 from .layout import (
@@ -21,7 +22,7 @@ from .layout import (
     PRIM_OBJECT,
     RAY_PRIMARY,
 )
-from .lighting import MAX_SHADOW_HITS, SHADOW_LIST_CAP
+from .lighting import SHADOW_LIST_CAP
 from .sampling import concentric_disk, random_pair, stratum
 from .vec import dot, madd, normalize, sub
 
