@@ -122,17 +122,15 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
     r = 0.0
     g = 0.0
     b = 0.0
-    top = _push(st_f, st_i, -1, o, d, (1.0, 1.0, 1.0), 0, media, 0)
+    # the ray being followed lives in these locals, not on the stack: a row written to the
+    # stack and read back at once (the camera ray, the reflection ray, next in line) made
+    # the CPU wait for each of its stores (store forwarding fails on the wider loads)
+    w = (1.0, 1.0, 1.0)
+    depth = 0
+    n_media = 0
+    top = -1
     vertex = 0
-    while top >= 0:
-        o = (st_f[top, 0], st_f[top, 1], st_f[top, 2])
-        d = (st_f[top, 3], st_f[top, 4], st_f[top, 5])
-        w = (st_f[top, 6], st_f[top, 7], st_f[top, 8])
-        depth = st_i[top, I_DEPTH]
-        n_media = st_i[top, I_NMEDIA]
-        for k in range(n_media):
-            media[k] = st_i[top, I_MEDIA + k]
-        top -= 1
+    while True:
         t, prim, tri, b1, b2 = closest_hit(geo, o, d, 0.0, math.inf, stack)
         if n_media > 0:  # Beer-Lambert absorption in the medium the ray crossed
             cur = media[n_media - 1]
@@ -143,72 +141,87 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
                 _absorbed(w[1], mats[cur, MAT_ATTEN + 1], t),
                 _absorbed(w[2], mats[cur, MAT_ATTEN + 2], t),
             )
+        reflected = False  # the reflection ray, followed next (in o, d, w, depth)
         if prim < 0:
             bg = background(params, d)
             r += w[0] * bg[0]
             g += w[1] * bg[1]
             b += w[2] * bg[2]
-            continue
-        m = hit_material(geo, prim, tri)
-        p = madd(o, d, t)
-        n_geo, n_shade = surface_normals(geo, prim, tri, b1, b2, p)
-        entering = dot(d, n_geo) < 0.0
-        if entering:  # both normals turned to face the ray
-            n = n_geo
         else:
-            n = (-n_geo[0], -n_geo[1], -n_geo[2])
-            n_shade = (-n_shade[0], -n_shade[1], -n_shade[2])
-        v = (-d[0], -d[1], -d[2])
-        if dot(n_shade, v) <= 0.0:  # interpolated normal turned away from the eye
-            n_shade = n
-        tex, albedo = surface_colour(geo, mats, m, prim, tri, b1, b2, p)
-        ka = mats[m, MAT_KA]
-        amb = params.ambient
-        # with caustics, shadow rays pass clear bodies (photons add and take away)
-        shadow_mats = lights.shadow_materials if caustics_on(lights) else mats
-        local = direct_light(geo, shadow_mats, lights, params, p, n_shade, v, m, albedo, media,
-                             n_media, scratch, stack, hits, listed, counters,
-                             (pixel, sample, 2 + vertex * RNG_DIMS_PER_HIT))
-        local = add_caustic(lights, mats, m, albedo, p, n, local)  # caustics.py
-        vertex += 1
-        r += w[0] * (ka * amb[0] * tex[0] * mats[m, MAT_AMBIENT] + local[0])
-        g += w[1] * (ka * amb[1] * tex[1] * mats[m, MAT_AMBIENT + 1] + local[1])
-        b += w[2] * (ka * amb[2] * tex[2] * mats[m, MAT_AMBIENT + 2] + local[2])
-        if depth >= params.max_depth:
-            continue
-        kr = mats[m, MAT_KR]
-        kt = mats[m, MAT_KT]
-        if kr == 0.0 and kt == 0.0:
-            continue
-        cos_i = -dot(d, n_shade)
-        reflect_dir = madd(d, n_shade, 2.0 * cos_i)
-        kr_eff = kr
-        if kt > 0.0:
-            # media on the far side: entering a solid pushes its material, leaving pops it
-            n1, n2, n_out = crossing_media(geo, mats, prim, m, entering, media, n_media,
-                                           scratch)
-            ok, tdir = refract(d, n_shade, n1 / n2)
-            if not ok:  # total internal reflection: the reflected ray carries it all
-                kr_eff = kr + kt
+            m = hit_material(geo, prim, tri)
+            p = madd(o, d, t)
+            n_geo, n_shade = surface_normals(geo, prim, tri, b1, b2, p)
+            entering = dot(d, n_geo) < 0.0
+            if entering:  # both normals turned to face the ray
+                n = n_geo
             else:
-                kt_eff = kt
-                if mats[m, MAT_FRESNEL] != 0.0:
-                    f = schlick(cos_i, n1, n2, -dot(tdir, n_shade))
-                    kr_eff = kr + kt * f
-                    kt_eff = kt * (1.0 - f)
-                wt = (
-                    w[0] * kt_eff * mats[m, MAT_COLOR],
-                    w[1] * kt_eff * mats[m, MAT_COLOR + 1],
-                    w[2] * kt_eff * mats[m, MAT_COLOR + 2],
-                )
-                if max(wt[0], max(wt[1], wt[2])) >= params.min_weight:
-                    counters[RAY_REFRACTION] += 1
-                    top = _push(st_f, st_i, top, madd(p, n, -params.epsilon), tdir, wt,
-                                depth + 1, scratch, n_out)
-        if kr_eff > 0.0:
-            wr = (w[0] * kr_eff, w[1] * kr_eff, w[2] * kr_eff)
-            if max(wr[0], max(wr[1], wr[2])) >= params.min_weight:
-                counters[RAY_REFLECTION] += 1
-                top = _push(st_f, st_i, top, madd(p, n, params.epsilon), reflect_dir, wr,
-                            depth + 1, media, n_media)
+                n = (-n_geo[0], -n_geo[1], -n_geo[2])
+                n_shade = (-n_shade[0], -n_shade[1], -n_shade[2])
+            v = (-d[0], -d[1], -d[2])
+            if dot(n_shade, v) <= 0.0:  # interpolated normal turned away from the eye
+                n_shade = n
+            tex, albedo = surface_colour(geo, mats, m, prim, tri, b1, b2, p)
+            ka = mats[m, MAT_KA]
+            amb = params.ambient
+            # with caustics, shadow rays pass clear bodies (photons add and take away)
+            shadow_mats = lights.shadow_materials if caustics_on(lights) else mats
+            local = direct_light(geo, shadow_mats, lights, params, p, n_shade, v, m, albedo,
+                                 media, n_media, scratch, stack, hits, listed, counters,
+                                 (pixel, sample, 2 + vertex * RNG_DIMS_PER_HIT))
+            local = add_caustic(lights, mats, m, albedo, p, n, local)  # caustics.py
+            vertex += 1
+            r += w[0] * (ka * amb[0] * tex[0] * mats[m, MAT_AMBIENT] + local[0])
+            g += w[1] * (ka * amb[1] * tex[1] * mats[m, MAT_AMBIENT + 1] + local[1])
+            b += w[2] * (ka * amb[2] * tex[2] * mats[m, MAT_AMBIENT + 2] + local[2])
+            kr = mats[m, MAT_KR]
+            kt = mats[m, MAT_KT]
+            if depth < params.max_depth and (kr != 0.0 or kt != 0.0):
+                cos_i = -dot(d, n_shade)
+                reflect_dir = madd(d, n_shade, 2.0 * cos_i)
+                kr_eff = kr
+                if kt > 0.0:
+                    # media on the far side: entering a solid pushes its material, leaving
+                    # pops it
+                    n1, n2, n_out = crossing_media(geo, mats, prim, m, entering, media,
+                                                   n_media, scratch)
+                    ok, tdir = refract(d, n_shade, n1 / n2)
+                    if not ok:  # total internal reflection: the reflected ray carries it all
+                        kr_eff = kr + kt
+                    else:
+                        kt_eff = kt
+                        if mats[m, MAT_FRESNEL] != 0.0:
+                            f = schlick(cos_i, n1, n2, -dot(tdir, n_shade))
+                            kr_eff = kr + kt * f
+                            kt_eff = kt * (1.0 - f)
+                        wt = (
+                            w[0] * kt_eff * mats[m, MAT_COLOR],
+                            w[1] * kt_eff * mats[m, MAT_COLOR + 1],
+                            w[2] * kt_eff * mats[m, MAT_COLOR + 2],
+                        )
+                        if max(wt[0], max(wt[1], wt[2])) >= params.min_weight:
+                            counters[RAY_REFRACTION] += 1
+                            top = _push(st_f, st_i, top, madd(p, n, -params.epsilon), tdir,
+                                        wt, depth + 1, scratch, n_out)
+                if kr_eff > 0.0:
+                    wr = (w[0] * kr_eff, w[1] * kr_eff, w[2] * kr_eff)
+                    if max(wr[0], max(wr[1], wr[2])) >= params.min_weight:
+                        counters[RAY_REFLECTION] += 1
+                        # in the media of this ray (``media`` is unchanged)
+                        o = madd(p, n, params.epsilon)
+                        d = reflect_dir
+                        w = wr
+                        depth += 1
+                        reflected = True
+        if reflected:
+            continue
+        if top < 0:
+            break
+        o = (st_f[top, 0], st_f[top, 1], st_f[top, 2])
+        d = (st_f[top, 3], st_f[top, 4], st_f[top, 5])
+        w = (st_f[top, 6], st_f[top, 7], st_f[top, 8])
+        depth = st_i[top, I_DEPTH]
+        n_media = st_i[top, I_NMEDIA]
+        for k in range(n_media):
+            media[k] = st_i[top, I_MEDIA + k]
+        top -= 1
     return r, g, b
