@@ -139,7 +139,7 @@ def start_scene_walk(geo, stack):
     return 0, 0, 0, 0
 
 
-@kernel
+@kernel(inline="always")
 def next_scene_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top, ordered):
     """The next analytic primitive a ray on (tmin, tmax) may hit: first the unbounded ones,
     then those of the scene BVH's leaves whose boxes it meets. The walk's state is the cursor
