@@ -244,7 +244,7 @@ def intersect_frustum(P, i, o, d, tmin, tmax):
     return best
 
 
-@kernel
+@kernel(inline="always")
 def intersect_local(typ, P, i, o, d, tmin, tmax):
     """Dispatch on the shape code; ``o`` and ``d`` in the primitive's own space."""
     i = np.uint64(i)  # unsigned: no negative-index wraparound code on the parameter loads
