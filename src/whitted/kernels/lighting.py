@@ -468,7 +468,7 @@ def highlight_power(c, shininess):
         base *= base
 
 
-@kernel
+@kernel(inline="always")
 def _brdf(mats, m, albedo, n, v, ldir):
     """Diffuse + specular response (per channel) for unit light direction ``ldir``; n·l > 0.
     ``albedo`` is the diffuse colour at the point (the material's, times its texture)."""
