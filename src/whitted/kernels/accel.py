@@ -61,11 +61,11 @@ def hit_analytic(geo, i, o, d, tmin, tmax):
 
 
 @kernel(inline="always")
-def hit_part(geo, i, o, d, tmin, tmax):
+def hit_part(geo, i, o, d, inv, tmin, tmax):
     """(t, the primitive whose surface it is) for analytic primitive ``i``: ``i`` itself, or
-    for a CSG object the leaf whose surface shows."""
+    for a CSG object the leaf whose surface shows (``inv``: the ray's inverse direction)."""
     if has_extras(geo) and geo.prim_info[i, PRIM_TYPE] == SHAPE_CSG:
-        return csg_hit_if_extras(geo, i, o, d, tmin, tmax)
+        return csg_hit_if_extras(geo, i, o, d, inv, tmin, tmax)
     return hit_analytic(geo, i, o, d, tmin, tmax), np.int64(i)
 
 
@@ -247,7 +247,7 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
                                                          leaf, leaf_end, top, True)
         if i < 0:
             break
-        t, part = hit_part(geo, i, o, d, tmin, best_t)
+        t, part = hit_part(geo, i, o, d, inv, tmin, best_t)
         if t < best_t:
             best_t = t
             best = part

@@ -365,25 +365,25 @@ def _crossing(r0, r1, r2, r3, k, c):
 
 
 @kernel
-def csg_hit(geo, root, o, d, tmin, tmax):
+def csg_hit(geo, root, o, d, inv, tmin, tmax):
     """(t, leaf row) of the nearest visible surface of CSG object ``root`` in (tmin, tmax),
-    or (INF, -1) (:func:`_walk`)."""
-    t, row, _, _ = _walk(geo, root, o, d, tmin, tmax, False, slots(float_slots(), FRAME_SLOTS),
-                         0, False)
+    or (INF, -1) (:func:`_walk`; ``inv``: the ray's inverse direction)."""
+    t, row, _, _ = _walk(geo, root, o, d, inv, tmin, tmax, False,
+                         slots(float_slots(), FRAME_SLOTS), 0, False)
     return t, row
 
 
 @kernel
-def csg_surfaces(geo, root, o, d, tmin, tmax, hits, n, full):
+def csg_surfaces(geo, root, o, d, inv, tmin, tmax, hits, n, full):
     """Every visible surface of CSG object ``root`` in (tmin, tmax), as (t, leaf row) pairs
     kept in the shadow ray's ``hits`` list (hit_list.py; its n and full in and out): one walk
     where asking :func:`csg_hit` again from past each surface walked once a surface."""
-    _, _, n, full = _walk(geo, root, o, d, tmin, tmax, True, hits, n, full)
+    _, _, n, full = _walk(geo, root, o, d, inv, tmin, tmax, True, hits, n, full)
     return n, full
 
 
 @kernel(inline="always")
-def _walk(geo, root, o, d, tmin, tmax, collect, hits, n_hits, full):
+def _walk(geo, root, o, d, inv, tmin, tmax, collect, hits, n_hits, full):
     """The walk: (t, leaf row) of the nearest visible surface of CSG object ``root`` in
     (tmin, tmax), or (INF, -1); with ``collect``, every visible surface is put in ``hits``
     instead (:func:`.hit_list.keep_nearest`) and the walk goes on past it. Returns those two
@@ -397,7 +397,6 @@ def _walk(geo, root, o, d, tmin, tmax, collect, hits, n_hits, full):
     leaves of the root's first operand (a die: the rays that miss its rounded cube skip its
     pips)."""
     P = geo.prim_params
-    inv = inverse_direction(d)
     if slab_entry(P[root, 2], P[root, 3], P[root, 4], P[root, 5], P[root, 6], P[root, 7], o,
                   inv, tmin, tmax) == INF:
         # (shadow rays test listed objects without their boxes)

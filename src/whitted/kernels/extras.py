@@ -15,6 +15,7 @@ from .intersect import INF
 from .jit import kernel, overload
 from .layout import PRIM_FLIP, PRIM_MEDIUM, PRIM_TYPE, SHAPE_CSG, SHAPE_TORUS
 from .torus import intersect_torus, torus_normal, torus_uv
+from .traverse import inverse_direction
 
 
 @kernel
@@ -25,7 +26,7 @@ def extra_t(geo, i, o, d, tmin, tmax):
     if typ == SHAPE_TORUS:
         return intersect_torus(geo.prim_params, i, o, d, tmin, tmax)
     if typ == SHAPE_CSG:
-        t, _ = csg_hit(geo, i, o, d, tmin, tmax)
+        t, _ = csg_hit(geo, i, o, d, inverse_direction(d), tmin, tmax)
         return t
     return INF
 
@@ -41,15 +42,15 @@ def _extra_t_if_extras(geo, i, o, d, tmin, tmax):
     return lambda geo, i, o, d, tmin, tmax: extra_t(geo, i, o, d, tmin, tmax)
 
 
-def csg_hit_if_extras(geo, i, o, d, tmin, tmax):
-    return csg_hit(geo, i, o, d, tmin, tmax)
+def csg_hit_if_extras(geo, i, o, d, inv, tmin, tmax):
+    return csg_hit(geo, i, o, d, inv, tmin, tmax)
 
 
 @overload(csg_hit_if_extras)
-def _csg_hit_if_extras(geo, i, o, d, tmin, tmax):
+def _csg_hit_if_extras(geo, i, o, d, inv, tmin, tmax):
     if not extras_possible(geo):
-        return lambda geo, i, o, d, tmin, tmax: (INF, np.int64(-1))
-    return lambda geo, i, o, d, tmin, tmax: csg_hit(geo, i, o, d, tmin, tmax)
+        return lambda geo, i, o, d, inv, tmin, tmax: (INF, np.int64(-1))
+    return lambda geo, i, o, d, inv, tmin, tmax: csg_hit(geo, i, o, d, inv, tmin, tmax)
 
 
 @kernel

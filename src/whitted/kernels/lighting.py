@@ -251,8 +251,8 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
         clear = mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] >= OPAQUE_KT
         if clear and has_extras(geo) and geo.prim_info[i, PRIM_TYPE] >= FIRST_EXTRA_SHAPE:
             # a torus or a CSG object: every crossing (a CSG object's as its leaves)
-            n, full = gather_extra_hits_if_extras(geo, i, o, d, tmin, tmax, step, hits, n,
-                                                  full)
+            n, full = gather_extra_hits_if_extras(geo, i, o, d, inv, tmin, tmax, step, hits,
+                                                  n, full)
             continue
         t = hit_analytic(geo, i, o, d, tmin, tmax)
         if t == INF:
@@ -271,12 +271,12 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
 
 
 @kernel
-def gather_extra_hits(geo, i, o, d, tmin, tmax, step, hits, n, full):
+def gather_extra_hits(geo, i, o, d, inv, tmin, tmax, step, hits, n, full):
     """:func:`gather_transparent_hits` for a torus or CSG object ``i``: its crossings in
     (tmin, tmax), a CSG object's as (t, leaf) pairs from one walk (:func:`.csg.csg_surfaces`),
     a torus's each found from past the one before (up to four)."""
     if geo.prim_info[i, PRIM_TYPE] == SHAPE_CSG:
-        return csg_surfaces(geo, i, o, d, tmin, tmax, hits, n, full)
+        return csg_surfaces(geo, i, o, d, inv, tmin, tmax, hits, n, full)
     t = hit_analytic(geo, i, o, d, tmin, tmax)
     for _ in range(4):
         if t == INF:
@@ -286,16 +286,16 @@ def gather_extra_hits(geo, i, o, d, tmin, tmax, step, hits, n, full):
     return n, full
 
 
-def gather_extra_hits_if_extras(geo, i, o, d, tmin, tmax, step, hits, n, full):
-    return gather_extra_hits(geo, i, o, d, tmin, tmax, step, hits, n, full)
+def gather_extra_hits_if_extras(geo, i, o, d, inv, tmin, tmax, step, hits, n, full):
+    return gather_extra_hits(geo, i, o, d, inv, tmin, tmax, step, hits, n, full)
 
 
 @overload(gather_extra_hits_if_extras)
-def _gather_extra_hits_if_extras(geo, i, o, d, tmin, tmax, step, hits, n, full):
+def _gather_extra_hits_if_extras(geo, i, o, d, inv, tmin, tmax, step, hits, n, full):
     if not extras_possible(geo):
-        return lambda geo, i, o, d, tmin, tmax, step, hits, n, full: (n, full)
-    return lambda geo, i, o, d, tmin, tmax, step, hits, n, full: gather_extra_hits(
-        geo, i, o, d, tmin, tmax, step, hits, n, full)
+        return lambda geo, i, o, d, inv, tmin, tmax, step, hits, n, full: (n, full)
+    return lambda geo, i, o, d, inv, tmin, tmax, step, hits, n, full: gather_extra_hits(
+        geo, i, o, d, inv, tmin, tmax, step, hits, n, full)
 
 
 @kernel(specialise_constants=True)  # a variant per call site: LLVM inlines each
