@@ -1333,3 +1333,44 @@ def test_peeling_every_shape_in_any_order(seed):
         assert_hit(hit, t, (0, 0, 20 - t), (0, 0, nz))
         tmin = hit.t + 1e-9
     assert scene.hit((0, 0, 20), (0, 0, -1), tmin=tmin) is None
+
+
+_FRUSTA = [
+    Cylinder(base=(1, 2, 3), top=(2, 4, 5), radius=0.7),
+    Cone(base=(-1, 0, 1), top=(1, 1, -1), radius=1.0, top_radius=0.0),
+    Cone(base=(0, 0, 0), top=(0, 1, 1), radius=0.3, top_radius=1.0),
+    Cylinder(base=(0, -1, 0), top=(0, 1, 0), radius=0.5, capped=False),
+]
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, len(_FRUSTA) - 1), st.tuples(*[st.floats(-4, 4)] * 3),
+       st.tuples(*[st.floats(-1.5, 1.5)] * 3), st.booleans())
+def test_all_crossings_of_a_frustum_are_the_nearest_asked_again(which, origin, aim, at_rim):
+    """``frustum_crossings`` (every crossing of the line at once, for CSG walks) lists what
+    ``intersect_frustum`` returns when asked again from past each crossing: the same values
+    in the same order, each once, including rays aimed exactly at a cap's rim."""
+    from whitted.kernels.intersect import frustum_crossings, intersect_frustum
+    from whitted.kernels.layout import PRIM_TYPE, SHAPE_FRUSTUM
+
+    shape = _FRUSTA[which]
+    geo = compile_scene(Scene(objects=[shape])).geometry
+    i = [r for r in range(len(geo.prim_info)) if geo.prim_info[r, PRIM_TYPE] == SHAPE_FRUSTUM][0]
+    P = geo.prim_params
+    if at_rim:  # aim at a point of the top cap's rim
+        axis = np.subtract(shape.top, shape.base)
+        side = unit(np.cross(axis, (0.3, 1.0, 0.2)))
+        r_top = getattr(shape, "top_radius", None)
+        aim = np.add(shape.top, (shape.radius if r_top is None else r_top) * side)
+    d = np.subtract(aim, origin)
+    if np.linalg.norm(d) < 1e-3:
+        return
+    o = tuple(map(float, origin))
+    d = tuple(map(float, d))
+    asked = []
+    t = -math.inf
+    while len(asked) < 4 and (t := intersect_frustum(P, i, o, d, t, math.inf)) < math.inf:
+        asked.append(t)
+    found = [x for x in frustum_crossings(P, i, o, d) if x < math.inf]
+    assert found == pytest.approx(asked, rel=1e-12, abs=1e-12)
+    assert found == sorted(set(found))

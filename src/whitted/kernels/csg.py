@@ -46,7 +46,7 @@ from .hit_list import keep_nearest
 from .intersect import (
     INF,
     box_span,
-    intersect_local,
+    frustum_crossings,
     intersect_triangle,
     normal_local,
     sphere_span,
@@ -128,12 +128,9 @@ def leaf_crossings(geo, j, o, d):
         t0, t1 = sphere_span(P, j, o, d)
     elif typ == SHAPE_BOX:
         t0, t1 = box_span(P, j, o, d)
-    else:  # the frustum: each crossing on the line past the one before (a ray through a
-        # cap's rim meets the cap and the side there, a rounding apart: up to four)
-        t0 = intersect_local(typ, P, j, o, d, -INF, INF)
-        t1 = intersect_local(typ, P, j, o, d, t0, INF) if t0 < INF else INF
-        t2 = intersect_local(typ, P, j, o, d, t1, INF) if t1 < INF else INF
-        t3 = intersect_local(typ, P, j, o, d, t2, INF) if t2 < INF else INF
+    else:  # the frustum: all its crossings (a ray through a cap's rim meets the cap and the
+        # side there, a rounding apart: up to four)
+        t0, t1, t2, t3 = frustum_crossings(P, j, o, d)
         n = 0 if t0 == INF else (1 if t1 == INF else (2 if t2 == INF else (
             3 if t3 == INF else 4)))
         return n, t0, t1, t2, t3

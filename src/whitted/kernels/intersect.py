@@ -201,6 +201,76 @@ def intersect_box(P, i, o, d, tmin, tmax):
     return INF
 
 
+@kernel(inline="always")
+def _sorted4(a, b, c, d):
+    """(a, b, c, d) in increasing order (five compare-exchanges)."""
+    a, b = (a, b) if a <= b else (b, a)
+    c, d = (c, d) if c <= d else (d, c)
+    a, c = (a, c) if a <= c else (c, a)
+    b, d = (b, d) if b <= d else (d, b)
+    b, c = (b, c) if b <= c else (c, b)
+    return a, b, c, d
+
+
+@kernel
+def frustum_crossings(P, i, o, d):
+    """Every crossing of the ray's whole line with frustum row ``i``, sorted, each once,
+    inf-padded: the values :func:`intersect_frustum` gives when asked again from each one
+    (the same formulas; fast-math may round a fused step differently), found in one pass."""
+    base = vload(P, i, 0)
+    axis = vload(P, i, 3)
+    h = P[i, 6]
+    r0 = P[i, 7]
+    k = (P[i, 8] - r0) / h
+    q = sub(o, base)
+    oz = dot(q, axis)
+    dz = dot(d, axis)
+    qp = (q[0] - oz * axis[0], q[1] - oz * axis[1], q[2] - oz * axis[2])
+    dp = (d[0] - dz * axis[0], d[1] - dz * axis[1], d[2] - dz * axis[2])
+    rq = r0 + k * oz
+    a = dot(dp, dp) - k * k * dz * dz
+    b = dot(qp, dp) - k * rq * dz
+    c = dot(qp, qp) - rq * rq
+    if a == 0.0:
+        s0 = -c / (2.0 * b) if b != 0.0 else INF
+        s1 = INF
+    else:
+        s0, s1 = _roots(a, b, c)
+    z = oz + s0 * dz
+    if not (0.0 <= z <= h and r0 + k * z >= 0.0):
+        s0 = INF
+    z = oz + s1 * dz
+    if not (0.0 <= z <= h and r0 + k * z >= 0.0):
+        s1 = INF
+    c0 = INF
+    c1 = INF
+    if P[i, 9] != 0.0 and dz != 0.0:
+        if r0 > 0.0:
+            t = (0.0 - oz) / dz
+            x = qp[0] + t * dp[0]
+            y = qp[1] + t * dp[1]
+            w = qp[2] + t * dp[2]
+            if x * x + y * y + w * w <= r0 * r0:
+                c0 = t
+        r1 = P[i, 8]
+        if r1 > 0.0:
+            t = (h - oz) / dz
+            x = qp[0] + t * dp[0]
+            y = qp[1] + t * dp[1]
+            w = qp[2] + t * dp[2]
+            if x * x + y * y + w * w <= r1 * r1:
+                c1 = t
+    t0, t1, t2, t3 = _sorted4(s0, s1, c0, c1)
+    # each value once (asked again from a crossing, the next one must lie strictly past it)
+    if t3 == t2:
+        t3 = INF
+    if t2 == t1:
+        t2, t3 = t3, INF
+    if t1 == t0:
+        t1, t2, t3 = t2, t3, INF
+    return t0, t1, t2, t3
+
+
 @kernel
 def intersect_frustum(P, i, o, d, tmin, tmax):
     """A finite cone/cylinder about ``axis``: radius r(z) = r0 + k·z for z in [0, h], plus caps."""
