@@ -29,6 +29,7 @@ from ..kernels.layout import (
 )
 from ..kernels.mesh import OPAQUE_KT
 from ..scene.shapes import CSG, Mesh
+from .csg_bounds import clipped_bounds
 from .primitives import PrimitiveRows
 from .shapes import add_shape
 
@@ -103,6 +104,7 @@ def add_csg(b: PrimitiveRows, shape: CSG, m: np.ndarray, material_row, resolve, 
         return los.min(axis=0), his.max(axis=0)
 
     lo, hi = walk(shape, m, default_material, 0, f"objects[{obj}]")
+    lo, hi = clipped_bounds(shape, m, lo, hi)  # box cutters take slabs off (csg_bounds.py)
     tree_rows = b.rows - root - 1  # the walk reads these; mesh leaves' triangles come after
     groups = []
     if shape.operation == "difference" and not any(isinstance(c, CSG) for c in shape.objects[1:]):
