@@ -701,7 +701,11 @@ _PAIRS = [
     for op in ("union", "intersection", "difference", "merge")
     for first, second in ((CUBE, Sphere(center=(0.6, 0.6, 0.6), radius=0.9)),
                           (Sphere(center=(-0.5, 0.0, 0.0), radius=1.0), _LENS),
-                          (_RING, Box(min=(-1.5, -1.0, -1.5), max=(0.0, 1.0, 1.5))))
+                          (_RING, Box(min=(-1.5, -1.0, -1.5), max=(0.0, 1.0, 1.5))),
+                          (CUBE, Cylinder(base=(0.0, -2.0, 0.0), top=(0.0, 1.0, 0.0),
+                                          radius=0.4)),
+                          (Cone(base=(0.0, -1.2, 0.0), top=(0.3, 1.2, 0.2), radius=1.0,
+                                top_radius=0.3), _LENS))
 ]
 _PAIR_SCENES = [
     (Compiled(CSG(operation=op, objects=[a, b])),

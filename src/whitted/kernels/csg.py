@@ -14,16 +14,17 @@ state as one bit of an int64. An analytic leaf (sphere, box, frustum, torus) giv
 crossing of the ray's whole line at once, sorted. For a sphere, a box or a torus the line
 enters at the first, leaves at the second (a torus: again at the third and fourth), so the
 leaf is inside where an odd number of its crossings lie behind, and a tangent touch (two
-equal crossings) is none. A mesh leaf is asked for its next crossing past the last one the
-walk used. It, a frustum (whose cap and side both report a ray through the cap's rim, a
-rounding apart) and any leaf with an odd number of crossings (one lost to rounding at an
-edge) are walked by their normals: the state where the ray starts is whether its first
-crossing past ``tmin`` leaves it (no crossing ahead: outside), and each crossing sets it to
-whether the ray enters there (the sign of the normal; a crossing that only grazes, normal
-perpendicular to the ray to 1e-9, changes no state and shows nothing). A crossing of leaf k
-is a surface of the object when POV-Ray's rules keep it, given the states of the other
-leaves at that point (evaluated up the tree in one postfix pass, or, for a tree of one
-operation on leaves, as bit masks):
+equal crossings) is none. A frustum is convex: its first crossing and its last are kept (a
+ray through a cap's rim meets the cap and the side there, a rounding apart: the crossings
+between are that rim met twice). A mesh leaf is asked for its next crossing past the last
+one the walk used. It and any leaf with an odd number of crossings (one lost to rounding at
+an edge, or a frustum only touched) are walked by their normals: the state where the ray
+starts is whether its first crossing past ``tmin`` leaves it (no crossing ahead: outside),
+and each crossing sets it to whether the ray enters there (the sign of the normal; a
+crossing that only grazes, normal perpendicular to the ray to 1e-9, changes no state and
+shows nothing). A crossing of leaf k is a surface of the object when POV-Ray's rules keep
+it, given the states of the other leaves at that point (evaluated up the tree in one postfix
+pass, or, for a tree of one operation on leaves, as bit masks):
 
 - union: every surface of every operand;
 - merge: an operand's surfaces outside every other operand;
@@ -114,7 +115,8 @@ def mesh_leaf_t(geo, j, o, d, tmin, tmax):
 def leaf_crossings(geo, j, o, d):
     """Every crossing of the world ray's whole line with analytic leaf row ``j``: (count,
     t0, t1, t2, t3), sorted, inf-padded. A closed solid's line enters at t0 and leaves at
-    t1 (a torus's again at t2 and t3); a tangent touch (two equal crossings) is none."""
+    t1 (a torus's again at t2 and t3); a tangent touch (two equal crossings) is none; a
+    frustum's are its first and last (module docstring)."""
     xf = geo.prim_info[j, PRIM_XFORM]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
@@ -128,12 +130,13 @@ def leaf_crossings(geo, j, o, d):
         t0, t1 = sphere_span(P, j, o, d)
     elif typ == SHAPE_BOX:
         t0, t1 = box_span(P, j, o, d)
-    else:  # the frustum: all its crossings (a ray through a cap's rim meets the cap and the
-        # side there, a rounding apart: up to four)
+    else:  # the frustum: convex, so the line enters at its first crossing and leaves at its
+        # last; those between are a rim met twice (cap and side, a rounding apart). One
+        # crossing alone (a touch, or one lost to rounding) goes to the walk by normals
         t0, t1, t2, t3 = frustum_crossings(P, j, o, d)
-        n = 0 if t0 == INF else (1 if t1 == INF else (2 if t2 == INF else (
-            3 if t3 == INF else 4)))
-        return n, t0, t1, t2, t3
+        if t1 == INF:
+            return (0 if t0 == INF else 1), t0, INF, INF, INF
+        return 2, t0, (t1 if t2 == INF else (t2 if t3 == INF else t3)), INF, INF
     if t0 == t1:
         t0, t1, t2, t3 = t2, t3, INF, INF
     n = 0 if t0 == INF else (1 if t1 == INF else (2 if t2 == INF else (3 if t3 == INF else 4)))
@@ -364,8 +367,10 @@ def _crossing(r0, r1, r2, r3, k, c):
 @kernel(inline="always")
 def _parity_leaf(typ):
     """Whether a leaf of this shape is walked by the parity of its crossings (a sphere, a
-    box, a torus: no rim where two of its surfaces meet)."""
-    return typ == SHAPE_SPHERE or typ == SHAPE_BOX or typ == SHAPE_TORUS
+    box, a torus, a frustum: :func:`leaf_crossings` gives them in entering and leaving
+    pairs, or an odd count that the general walk takes by normals)."""
+    return (typ == SHAPE_SPHERE or typ == SHAPE_BOX or typ == SHAPE_TORUS
+            or typ == SHAPE_FRUSTUM)
 
 
 @kernel(inline="always")
@@ -522,9 +527,9 @@ def _walk(geo, root, o, d, inv, tmin, tmax, collect, hits, n_hits, full):
             while c < n and _crossing(r0, r1, r2, r3, leaf, c) <= tmin:
                 c += 1
             cur[leaf] = c
-            # a frustum (whose crossings at a rim may come twice) or an odd count (one lost
-            # to rounding): the normals say which way each crossing goes, as for a mesh
-            if n % 2 == 1 or geo.prim_info[r, PRIM_TYPE] == SHAPE_FRUSTUM:
+            # an odd count (one lost to rounding, or a touch): the normals say which way each
+            # crossing goes, as for a mesh
+            if n % 2 == 1:
                 odd = _with_bit(odd, leaf, 1)
                 if c < n and dot(d, leaf_normal(geo, r, madd(
                         o, d, _crossing(r0, r1, r2, r3, leaf, c)))) > 0.0:
