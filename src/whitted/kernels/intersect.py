@@ -340,8 +340,10 @@ def normal_local(typ, P, i, p):
     """Outward unit normal at point ``p`` (in the primitive's own space): the flat shapes'
     and the sphere's written in place, a box's or frustum's through a call (inlining those
     too slowed the analytic benchmark by a tenth)."""
-    if typ == SHAPE_SPHERE:
-        return normalize(sub(p, vload(P, i, 0)))
+    if typ == SHAPE_SPHERE:  # p lies on it: |p - c| is the radius (no square root)
+        q = sub(p, vload(P, i, 0))
+        s = 1.0 / P[i, 3]
+        return (q[0] * s, q[1] * s, q[2] * s)
     if typ == SHAPE_TRIANGLE or typ == SHAPE_RECTANGLE:
         return vload(P, i, 9)
     if typ == SHAPE_PLANE or typ == SHAPE_DISK:
