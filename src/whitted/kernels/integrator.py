@@ -77,6 +77,23 @@ def schlick(cos_i, n1, n2, cos_t):
 
 
 @kernel(inline="always")
+def split_at_surface(geo, mats, prim, m, entering, media, n_media, scratch, d, n_shade, kr,
+                     kt):
+    """How a surface of material ``m`` with kt > 0 splits a ray arriving along ``d``:
+    (refracted, transmitted direction, kr, kt as they share the light (total internal
+    reflection gives kt to kr; Fresnel moves some of kt to kr), the media count past the
+    surface, whose media crossing_media wrote to ``scratch``)."""
+    n1, n2, n_out = crossing_media(geo, mats, prim, m, entering, media, n_media, scratch)
+    ok, tdir = refract(d, n_shade, n1 / n2)
+    if not ok:  # total internal reflection: the reflected ray carries it all
+        return False, tdir, kr + kt, 0.0, n_out
+    if mats[m, MAT_FRESNEL] != 0.0:
+        f = schlick(-dot(d, n_shade), n1, n2, -dot(tdir, n_shade))
+        return True, tdir, kr + kt * f, kt * (1.0 - f), n_out
+    return True, tdir, kr, kt, n_out
+
+
+@kernel(inline="always")
 def surface_colour(geo, mats, m, prim, tri, b1, b2, p):
     """(texture factor, diffuse colour) at a hit: the material's colour times its texture's
     value at the point's (u, v); the factor is white when the material has no texture."""
@@ -176,23 +193,15 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
             kr = mats[m, MAT_KR]
             kt = mats[m, MAT_KT]
             if depth < params.max_depth and (kr != 0.0 or kt != 0.0):
-                cos_i = -dot(d, n_shade)
-                reflect_dir = madd(d, n_shade, 2.0 * cos_i)
+                reflect_dir = madd(d, n_shade, -2.0 * dot(d, n_shade))
                 kr_eff = kr
                 if kt > 0.0:
                     # media on the far side: entering a solid pushes its material, leaving
                     # pops it
-                    n1, n2, n_out = crossing_media(geo, mats, prim, m, entering, media,
-                                                   n_media, scratch)
-                    ok, tdir = refract(d, n_shade, n1 / n2)
-                    if not ok:  # total internal reflection: the reflected ray carries it all
-                        kr_eff = kr + kt
-                    else:
-                        kt_eff = kt
-                        if mats[m, MAT_FRESNEL] != 0.0:
-                            f = schlick(cos_i, n1, n2, -dot(tdir, n_shade))
-                            kr_eff = kr + kt * f
-                            kt_eff = kt * (1.0 - f)
+                    ok, tdir, kr_eff, kt_eff, n_out = split_at_surface(
+                        geo, mats, prim, m, entering, media, n_media, scratch, d, n_shade, kr,
+                        kt)
+                    if ok:
                         wt = (
                             w[0] * kt_eff * mats[m, MAT_COLOR],
                             w[1] * kt_eff * mats[m, MAT_COLOR + 1],

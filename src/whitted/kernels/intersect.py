@@ -212,11 +212,11 @@ def _sorted4(a, b, c, d):
     return a, b, c, d
 
 
-@kernel
-def frustum_crossings(P, i, o, d):
-    """Every crossing of the ray's whole line with frustum row ``i``, sorted, each once,
-    inf-padded: the values :func:`intersect_frustum` gives when asked again from each one
-    (the same formulas; fast-math may round a fused step differently), found in one pass."""
+@kernel(inline="always")
+def _frustum_quadric(P, i, o, d):
+    """The ray in frustum row ``i``'s terms: (oz, dz, qp, dp, h, r0, k, a, b, c): height and
+    its rate along the axis, the parts across it, the body's height, base radius and radius
+    slope, and the side's quadratic a·t² + 2b·t + c."""
     base = vload(P, i, 0)
     axis = vload(P, i, 3)
     h = P[i, 6]
@@ -231,6 +231,26 @@ def frustum_crossings(P, i, o, d):
     a = dot(dp, dp) - k * k * dz * dz
     b = dot(qp, dp) - k * rq * dz
     c = dot(qp, qp) - rq * rq
+    return oz, dz, qp, dp, h, r0, k, a, b, c
+
+
+@kernel(inline="always")
+def _cap_t(z_cap, r_cap, oz, dz, qp, dp):
+    """Where the ray crosses the cap at height ``z_cap`` of radius ``r_cap`` (INF: past its
+    rim); dz != 0."""
+    t = (z_cap - oz) / dz
+    x = qp[0] + t * dp[0]
+    y = qp[1] + t * dp[1]
+    w = qp[2] + t * dp[2]
+    return t if x * x + y * y + w * w <= r_cap * r_cap else INF
+
+
+@kernel
+def frustum_crossings(P, i, o, d):
+    """Every crossing of the ray's whole line with frustum row ``i``, sorted, each once,
+    inf-padded: the values :func:`intersect_frustum` gives when asked again from each one
+    (the same formulas; fast-math may round a fused step differently), found in one pass."""
+    oz, dz, qp, dp, h, r0, k, a, b, c = _frustum_quadric(P, i, o, d)
     if a == 0.0:
         s0 = -c / (2.0 * b) if b != 0.0 else INF
         s1 = INF
@@ -246,20 +266,9 @@ def frustum_crossings(P, i, o, d):
     c1 = INF
     if P[i, 9] != 0.0 and dz != 0.0:
         if r0 > 0.0:
-            t = (0.0 - oz) / dz
-            x = qp[0] + t * dp[0]
-            y = qp[1] + t * dp[1]
-            w = qp[2] + t * dp[2]
-            if x * x + y * y + w * w <= r0 * r0:
-                c0 = t
-        r1 = P[i, 8]
-        if r1 > 0.0:
-            t = (h - oz) / dz
-            x = qp[0] + t * dp[0]
-            y = qp[1] + t * dp[1]
-            w = qp[2] + t * dp[2]
-            if x * x + y * y + w * w <= r1 * r1:
-                c1 = t
+            c0 = _cap_t(0.0, r0, oz, dz, qp, dp)
+        if P[i, 8] > 0.0:
+            c1 = _cap_t(h, P[i, 8], oz, dz, qp, dp)
     t0, t1, t2, t3 = _sorted4(s0, s1, c0, c1)
     # each value once (asked again from a crossing, the next one must lie strictly past it)
     if t3 == t2:
@@ -274,20 +283,7 @@ def frustum_crossings(P, i, o, d):
 @kernel
 def intersect_frustum(P, i, o, d, tmin, tmax):
     """A finite cone/cylinder about ``axis``: radius r(z) = r0 + k·z for z in [0, h], plus caps."""
-    base = vload(P, i, 0)
-    axis = vload(P, i, 3)
-    h = P[i, 6]
-    r0 = P[i, 7]
-    k = (P[i, 8] - r0) / h
-    q = sub(o, base)
-    oz = dot(q, axis)
-    dz = dot(d, axis)
-    qp = (q[0] - oz * axis[0], q[1] - oz * axis[1], q[2] - oz * axis[2])
-    dp = (d[0] - dz * axis[0], d[1] - dz * axis[1], d[2] - dz * axis[2])
-    rq = r0 + k * oz
-    a = dot(dp, dp) - k * k * dz * dz
-    b = dot(qp, dp) - k * rq * dz
-    c = dot(qp, qp) - rq * rq
+    oz, dz, qp, dp, h, r0, k, a, b, c = _frustum_quadric(P, i, o, d)
     best = INF
     # side: up to two roots, keep the nearest whose height lies on the body
     lo = tmin
@@ -304,13 +300,9 @@ def intersect_frustum(P, i, o, d, tmin, tmax):
         for z_cap, r_cap in ((0.0, r0), (h, P[i, 8])):
             if r_cap <= 0.0:
                 continue
-            t = (z_cap - oz) / dz
+            t = _cap_t(z_cap, r_cap, oz, dz, qp, dp)
             if tmin < t < min(best, tmax):
-                x = qp[0] + t * dp[0]
-                y = qp[1] + t * dp[1]
-                w = qp[2] + t * dp[2]
-                if x * x + y * y + w * w <= r_cap * r_cap:
-                    best = t
+                best = t
     return best
 
 

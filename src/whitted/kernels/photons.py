@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 
 from .accel import closest_hit, hit_material, surface_normals
-from .integrator import _absorbed, refract, schlick
+from .integrator import _absorbed, split_at_surface
 from .jit import kernel, numba_object
 from .layout import (
     LIGHT_DIRECTION,
@@ -36,12 +36,10 @@ from .layout import (
     LIGHT_TYPE,
     MAT_ATTEN,
     MAT_COLOR,
-    MAT_FRESNEL,
     MAT_KD,
     MAT_KR,
     MAT_KT,
 )
-from .media import crossing_media
 from .sampling import concentric_disk, random01, random_pair
 from .vec import dot, madd, normalize, vload
 
@@ -274,22 +272,14 @@ def trace_photon(geo, mats, clear, table, j, o, d, power, directional, settings,
         kt = mats[m, MAT_KT]
         if kr == 0.0 and kt == 0.0:
             break
-        cos_i = -dot(d, n_shade)
         kr_eff = kr
         bt = (0.0, 0.0, 0.0)
         tdir = d
         n_out = n_media
         if kt > 0.0:
-            n1, n2, n_out = crossing_media(geo, mats, prim, m, entering, media, n_media, scratch)
-            ok, tdir = refract(d, n_shade, n1 / n2)
-            if not ok:  # total internal reflection
-                kr_eff = kr + kt
-            else:
-                kt_eff = kt
-                if mats[m, MAT_FRESNEL] != 0.0:
-                    fr = schlick(cos_i, n1, n2, -dot(tdir, n_shade))
-                    kr_eff = kr + kt * fr
-                    kt_eff = kt * (1.0 - fr)
+            ok, tdir, kr_eff, kt_eff, n_out = split_at_surface(
+                geo, mats, prim, m, entering, media, n_media, scratch, d, n_shade, kr, kt)
+            if ok:
                 bt = (kt_eff * mats[m, MAT_COLOR], kt_eff * mats[m, MAT_COLOR + 1],
                       kt_eff * mats[m, MAT_COLOR + 2])
         b_mean = (bt[0] + bt[1] + bt[2]) / 3.0
@@ -309,7 +299,7 @@ def trace_photon(geo, mats, clear, table, j, o, d, power, directional, settings,
         else:  # reflected
             w = (w[0] * total, w[1] * total, w[2] * total)
             o = madd(p, n, eps)
-            d = madd(d, n_shade, 2.0 * cos_i)
+            d = madd(d, n_shade, -2.0 * dot(d, n_shade))
             specular = True
         if max(w[0], max(w[1], w[2])) < MIN_POWER:
             break
