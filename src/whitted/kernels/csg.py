@@ -429,10 +429,44 @@ def _pair_walk(geo, root, op, o, d, tmin, tmax, collect, hits, n_hits, full):
     return True, INF, np.int64(-1), n_hits, full
 
 
+@kernel(inline="always")
+def _box_met(geo, root, o, inv, tmin, tmax):
+    """Does the segment (tmin, tmax) meet the box of CSG object ``root``? (Shadow rays test
+    listed objects without their boxes.)"""
+    P = geo.prim_params
+    return slab_entry(P[root, 2], P[root, 3], P[root, 4], P[root, 5], P[root, 6], P[root, 7],
+                      o, inv, tmin, tmax) != INF
+
+
+@kernel(inline="always")
+def _is_pair(geo, root):
+    """Is CSG object ``root`` one operation on two leaves walked by parity, with no groups
+    of cuts (:func:`_pair_walk`)?"""
+    P = geo.prim_params
+    return (P[root, 0] == 3.0 and P[root, 1] == 2.0 and P[root, 10] <= 0.0
+            and _parity_leaf(geo.prim_info[root + 1, PRIM_TYPE])
+            and _parity_leaf(geo.prim_info[root + 2, PRIM_TYPE]))
+
+
 @kernel
 def csg_hit(geo, root, o, d, inv, tmin, tmax):
     """(t, leaf row) of the nearest visible surface of CSG object ``root`` in (tmin, tmax),
-    or (INF, -1) (:func:`_walk`; ``inv``: the ray's inverse direction)."""
+    or (INF, -1) (``inv``: the ray's inverse direction). Two leaves are walked here
+    (:func:`_pair_walk`), in registers; any other tree through a call (:func:`_walk`), whose
+    frame holds the slots of up to 63 leaves."""
+    if not _box_met(geo, root, o, inv, tmin, tmax):
+        return INF, np.int64(-1)
+    if _is_pair(geo, root):
+        done, t, row, _, _ = _pair_walk(geo, root, int(geo.prim_params[root + 3, 0]), o, d,
+                                        tmin, tmax, False, slots(float_slots(), FRAME_SLOTS),
+                                        0, False)
+        if done:
+            return t, row
+    return _general_hit(geo, root, o, d, inv, tmin, tmax)
+
+
+@kernel
+def _general_hit(geo, root, o, d, inv, tmin, tmax):
     t, row, _, _ = _walk(geo, root, o, d, inv, tmin, tmax, False,
                          slots(float_slots(), FRAME_SLOTS), 0, False)
     return t, row
@@ -443,6 +477,19 @@ def csg_surfaces(geo, root, o, d, inv, tmin, tmax, hits, n, full):
     """Every visible surface of CSG object ``root`` in (tmin, tmax), as (t, leaf row) pairs
     kept in the shadow ray's ``hits`` list (hit_list.py; its n and full in and out): one walk
     where asking :func:`csg_hit` again from past each surface walked once a surface."""
+    if not _box_met(geo, root, o, inv, tmin, tmax):
+        return n, full
+    if _is_pair(geo, root):
+        done, _, _, n_pair, full_pair = _pair_walk(
+            geo, root, int(geo.prim_params[root + 3, 0]), o, d, tmin, tmax, True, hits, n,
+            full)
+        if done:
+            return n_pair, full_pair
+    return _general_surfaces(geo, root, o, d, inv, tmin, tmax, hits, n, full)
+
+
+@kernel
+def _general_surfaces(geo, root, o, d, inv, tmin, tmax, hits, n, full):
     _, _, n, full = _walk(geo, root, o, d, inv, tmin, tmax, True, hits, n, full)
     return n, full
 
@@ -462,10 +509,6 @@ def _walk(geo, root, o, d, inv, tmin, tmax, collect, hits, n_hits, full):
     leaves of the root's first operand (a die: the rays that miss its rounded cube skip its
     pips)."""
     P = geo.prim_params
-    if slab_entry(P[root, 2], P[root, 3], P[root, 4], P[root, 5], P[root, 6], P[root, 7], o,
-                  inv, tmin, tmax) == INF:
-        # (shadow rays test listed objects without their boxes)
-        return INF, np.int64(-1), n_hits, full
     n_rows = int(P[root, 0])
     n_leaves = int(P[root, 1])
     first_leaves = int(P[root, 8])  # leaves of the first operand of a root that needs it
@@ -473,13 +516,6 @@ def _walk(geo, root, o, d, inv, tmin, tmax, collect, hits, n_hits, full):
     every = (np.int64(1) << np.int64(n_leaves)) - np.int64(1) if n_leaves < 63 else ~np.int64(0)
     # a tree of one operation on leaves (rows: the leaves, then it) is tested with masks
     flat = int(P[root + n_rows, 0]) if n_rows == n_leaves + 1 else -1
-    if (n_rows == 3 and n_leaves == 2 and P[root, 10] <= 0.0
-            and _parity_leaf(geo.prim_info[root + 1, PRIM_TYPE])
-            and _parity_leaf(geo.prim_info[root + 2, PRIM_TYPE])):
-        done, t, row, n_hits, full = _pair_walk(geo, root, flat, o, d, tmin, tmax, collect,
-                                                hits, n_hits, full)
-        if done:
-            return t, row, n_hits, full
     # an analytic leaf's crossings r0..r3 and their count (-1: a mesh leaf, whose next
     # crossing is r0, on triangle row ``part``, with d · normal there ``next_cos``, NaN
     # until computed); ``cur``: the leaf's next crossing in the walk
