@@ -124,6 +124,91 @@ def _roots_between(deg, a, b, c, e, lo, hi, s0, s1, s2, s3, s4):
     return out0, out1, out2, out3
 
 
+@kernel(inline="always")
+def _least_slope(a, b, c, e, x0, x1, df0):
+    """Where the quartic's slope (the cubic) crosses zero in (x0, x1), a piece where it is
+    monotonic and is ``df0`` at x0: Newton on its pieces of one curvature (cut at -a/4)."""
+    m = -0.25 * a
+    if x0 < m < x1:
+        dm, _, _ = _poly(3, a, b, c, e, m)
+        if dm == 0.0:
+            return m
+        if (dm > 0.0) == (df0 > 0.0):  # the same sign as at x0: the zero lies past m
+            return _piece_root(3, a, b, c, e, m, x1, dm)
+        return _piece_root(3, a, b, c, e, x0, m, df0)
+    return _piece_root(3, a, b, c, e, x0, x1, df0)
+
+
+@kernel
+def _curved_piece_roots(a, b, c, e, x0, x1, f0, df0, f1, df1, convex):
+    """The quartic's roots in (x0, x1), a piece where it bends one way (``convex``: f'' >
+    0), neither end a root: up to two, sorted, inf-padded. With g = ±f convex: below zero at
+    both ends, g is below all along; one sign change is one root, found by Newton from the
+    end where g > 0 (Fourier's); above zero at both ends there are none unless g falls below
+    zero between, which the tangents at the ends bound from below, and then the least value's
+    place (the cubic's root) splits the piece in two with a root each."""
+    s = 1.0 if convex else -1.0
+    g0 = s * f0
+    g1 = s * f1
+    if g0 < 0.0 and g1 < 0.0:
+        return INF, INF
+    if g0 < 0.0 or g1 < 0.0:
+        return _piece_root(4, a, b, c, e, x0, x1, f0), INF
+    dg0 = s * df0
+    dg1 = s * df1
+    if dg0 >= 0.0 or dg1 <= 0.0:  # monotonic: its least value is at an end
+        return INF, INF
+    xc = (g1 - g0 + dg0 * x0 - dg1 * x1) / (dg0 - dg1)
+    if g0 + dg0 * (xc - x0) > 0.0:  # the tangents meet above zero: so does g
+        return INF, INF
+    xm = _least_slope(a, b, c, e, x0, x1, df0)
+    fm, _, _ = _poly(4, a, b, c, e, xm)
+    if s * fm >= 0.0:  # above zero, or a touch: no crossing
+        return INF, INF
+    return _piece_root(4, a, b, c, e, x0, xm, f0), _piece_root(4, a, b, c, e, xm, x1, fm)
+
+
+@kernel(inline="always")
+def _roots_by_curvature(a, b, c, e, lo, hi, q0, q1):
+    """(ok, r0, r1, r2, r3): the quartic's roots in (lo, hi), piece by piece between its
+    inflections q0 <= q1 (inf: none there), where it bends one way
+    (:func:`_curved_piece_roots`); not ok when a piece's end is itself a root or a piece has
+    no curvature at its middle (the general path decides those)."""
+    out0 = INF
+    out1 = INF
+    out2 = INF
+    out3 = INF
+    n = 0
+    x0 = lo
+    f0, df0, _ = _poly(4, a, b, c, e, x0)
+    if f0 == 0.0:
+        return False, INF, INF, INF, INF
+    for k in range(3):
+        x1 = min(q0 if k == 0 else (q1 if k == 1 else hi), hi)
+        if x1 <= x0:
+            continue
+        f1, df1, _ = _poly(4, a, b, c, e, x1)
+        _, _, dd_mid = _poly(4, a, b, c, e, 0.5 * (x0 + x1))
+        if f1 == 0.0 or dd_mid == 0.0:
+            return False, INF, INF, INF, INF
+        ra, rb = _curved_piece_roots(a, b, c, e, x0, x1, f0, df0, f1, df1, dd_mid > 0.0)
+        for r in (ra, rb):
+            if r < INF:
+                if n == 0:
+                    out0 = r
+                elif n == 1:
+                    out1 = r
+                elif n == 2:
+                    out2 = r
+                elif n == 3:
+                    out3 = r
+                n += 1
+        x0 = x1
+        f0 = f1
+        df0 = df1
+    return True, out0, out1, out2, out3
+
+
 @kernel
 def _quadratic_roots(p, q, r):
     """Real roots (x0 <= x1) of p·x² + q·x + r, p != 0; (inf, inf) when there are none."""
@@ -154,18 +239,35 @@ def _axis_distance2(o, d, s):
 def torus_roots(o, d, major, minor):
     """The crossings of the ray (o, d) (torus space: centre 0, axis y) with the torus: four
     ray parameters, sorted, inf-padded (a tangent touch is no crossing)."""
+    near, shift, inv, a, b, c, e, lo, hi, q0, q1 = torus_quartic(o, d, major, minor)
+    if not near:
+        return INF, INF, INF, INF
+    ok, r0, r1, r2, r3 = _roots_by_curvature(a, b, c, e, lo, hi, q0, q1)
+    if not ok:
+        r0, r1, r2, r3 = _roots_by_cubic(a, b, c, e, lo, hi, q0, q1)
+    return ((r0 + shift) * inv, (r1 + shift) * inv, (r2 + shift) * inv, (r3 + shift) * inv)
+
+
+@kernel(inline="always")
+def torus_quartic(o, d, major, minor):
+    """The ray (o, d) as the torus's quartic x⁴ + a·x³ + b·x² + c·x + e in x, the distance
+    along the unit ray (scaled so the torus fits the unit ball) from the point nearest the
+    centre: (near, shift, inv, a, b, c, e, lo, hi, q0, q1), where the roots can only lie in
+    (lo, hi), q0 <= q1 are the quartic's inflections there (inf: none), and a root x is the
+    ray parameter (x + shift)·inv. ``near`` is False when the ray cannot meet the torus."""
+    none = (False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, INF, INF)
     scale = 1.0 / (major + minor)
     ol = (o[0] * scale, o[1] * scale, o[2] * scale)
     dl = (d[0] * scale, d[1] * scale, d[2] * scale)
     length = math.sqrt(dot(dl, dl))
     if length == 0.0:
-        return INF, INF, INF, INF
+        return none
     dn = (dl[0] / length, dl[1] / length, dl[2] / length)
     shift = -dot(ol, dn)  # to the point of the ray nearest the centre
     os = (ol[0] + shift * dn[0], ol[1] + shift * dn[1], ol[2] + shift * dn[2])
     h2 = 1.0 - dot(os, os)
     if h2 <= 0.0:
-        return INF, INF, INF, INF
+        return none
     h = math.sqrt(h2) * (1.0 + 1e-12) + 1e-12
     big = major * scale
     small = minor * scale
@@ -180,9 +282,9 @@ def torus_roots(o, d, major, minor):
         lo = max(lo, y0)
         hi = min(hi, y1)
         if lo >= hi:
-            return INF, INF, INF, INF
+            return none
     elif abs(os[1]) > small:
-        return INF, INF, INF, INF
+        return none
     # through the hole: the tube has no point nearer the axis than big - small, and the
     # squared distance from the axis is convex along the ray, so below that at both ends of
     # the part in the slab it is below it all along (a face-on torus: a fifth of the rays
@@ -190,7 +292,7 @@ def torus_roots(o, d, major, minor):
     inner2 = (big - small) * (big - small) * (1.0 - 1e-12)
     if (big > small and _axis_distance2(os, dn, lo) < inner2
             and _axis_distance2(os, dn, hi) < inner2):
-        return INF, INF, INF, INF
+        return none
     r2 = big * big
     k = dot(os, os) + r2 - small * small
     bb = dot(os, dn)
@@ -202,9 +304,18 @@ def torus_roots(o, d, major, minor):
     b = 4.0 * bb * bb + 2.0 * k - 4.0 * r2 * dxz
     c = 4.0 * bb * k - 8.0 * r2 * oxz
     e = k * k - 4.0 * r2 * pxz
-    # the quartic's inflections (the roots of 12x² + 6a·x + 2b) and the cubic's (x = -a/4)
+    # the quartic's inflections (the roots of 12x² + 6a·x + 2b)
     q0, q1 = _quadratic_roots(12.0, 6.0 * a, 2.0 * b)
     q0, q1 = _ordered(_clip(q0, lo, hi), _clip(q1, lo, hi))
+    return True, shift, 1.0 / length, a, b, c, e, lo, hi, q0, q1
+
+
+@kernel
+def _roots_by_cubic(a, b, c, e, lo, hi, q0, q1):
+    """The quartic's roots in (lo, hi), sorted, inf-padded, with every root of its slope (the
+    cubic) found first: they and the inflections q0 <= q1 cut it into monotonic pieces of one
+    curvature. Slower than :func:`_roots_by_curvature`, and it decides the rays that one
+    leaves (a root exactly on an inflection, as on rays symmetric about the centre)."""
     m = _clip(-0.25 * a, lo, hi)
     # the cubic's pieces: cut at q0, m, q1 (sorted)
     p0, p1 = _ordered(q0, m)
@@ -221,9 +332,7 @@ def torus_roots(o, d, major, minor):
     v1, v4 = _ordered(v1, v4)
     v1, v3 = _ordered(v1, v3)
     v1, v2 = _ordered(v1, v2)
-    r0, r1, r2_, r3 = _roots_between(4, a, b, c, e, lo, hi, v0, v1, v2, v3, v4)
-    inv = 1.0 / length
-    return ((r0 + shift) * inv, (r1 + shift) * inv, (r2_ + shift) * inv, (r3 + shift) * inv)
+    return _roots_between(4, a, b, c, e, lo, hi, v0, v1, v2, v3, v4)
 
 
 @kernel
