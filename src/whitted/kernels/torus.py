@@ -8,14 +8,18 @@ The quartic is solved robustly rather than by Ferrari's formulas, whose cancella
 acne on grazing hits: the ray is first scaled so the torus fits in the unit ball and moved
 along itself to the point nearest the centre (the coefficients stay of order one whatever
 the distance of the eye); the roots can then only lie on the chord of the unit ball,
-[-h, h], on its part inside the slab that holds the tube (|y| <= the minor radius). The
-roots of the quartic's second derivative (a quadratic, solved in closed form) and of its
-first (a cubic) split that part into pieces where the quartic is monotonic and bends one
-way only; each piece holds at most one root, and Newton's method started from the piece's
-end where the function and its curvature have the same sign (Fourier's condition) walks to
-it monotonically without leaving the piece, in five or six steps. The cubic's own roots are
-found the same way, on the pieces its derivative's roots and its inflection cut. A root
-where the quartic only touches zero (a ray exactly tangent to the surface) is no crossing
+[-h, h], on its part inside the slab that holds the tube (|y| <= the minor radius), less
+a ray through the hole. The roots of the quartic's second derivative (a quadratic, solved
+in closed form) split that part into at most three pieces where it bends one way only. On
+such a piece a sign change between the ends is one root, and Newton's method started from
+the end where the function and its curvature have the same sign (Fourier's condition) walks
+to it monotonically without leaving the piece, in five or six steps; both ends on the far
+side of zero from the bend are no root; both ends on its side are none unless the function
+dips across zero between, which the tangents at the ends bound, and only then is the
+slope's root (the cubic's, found the same way) solved and the piece cut in two with a root
+each. A piece whose end is exactly a root (rays symmetric about the centre) goes the older
+way: every root of the cubic first, cutting monotonic pieces. A root where the quartic only
+touches zero (a ray exactly tangent to the surface) is no crossing
 and is not reported. Every root is computed from the ray alone, not from ``tmin``: asking
 again from past one root gives the next one exactly (CSG walks rely on it).
 """
