@@ -72,6 +72,21 @@ def _piece_root(deg, a, b, c, e, lo, hi, f_lo):
 
 
 @kernel(inline="always")
+def _append(n, r, out0, out1, out2, out3):
+    """(n + 1, the four slots with ``r`` in slot n) when r is finite and a slot is left,
+    else (n, the slots as they were)."""
+    if r == INF or n > 3:
+        return n, out0, out1, out2, out3
+    if n == 0:
+        return 1, r, out1, out2, out3
+    if n == 1:
+        return 2, out0, r, out2, out3
+    if n == 2:
+        return 3, out0, out1, r, out3
+    return 4, out0, out1, out2, r
+
+
+@kernel(inline="always")
 def _ordered(x, y):
     return (x, y) if x <= y else (y, x)
 
@@ -81,11 +96,7 @@ def _roots_between(deg, a, b, c, e, lo, hi, s0, s1, s2, s3, s4):
     """Roots in (lo, hi) of the quartic (deg 4) or its derivative (deg 3), given sorted split
     points s0..s4 (inf: unused) cutting it into monotonic pieces of one curvature: up to four,
     sorted, inf-padded."""
-    out0 = INF
-    out1 = INF
-    out2 = INF
-    out3 = INF
-    n = 0
+    n, out0, out1, out2, out3 = 0, INF, INF, INF, INF  # the roots found so far
     x0 = lo
     f0, _, _ = _poly(deg, a, b, c, e, x0)
     zero = INF  # a split point where the function is exactly 0 (pending)
@@ -113,16 +124,7 @@ def _roots_between(deg, a, b, c, e, lo, hi, s0, s1, s2, s3, s4):
         if (f0 < 0.0 and f1 > 0.0) or (f0 > 0.0 and f1 < 0.0):
             root = zero if zero < INF else _piece_root(deg, a, b, c, e, x0, x1, f0)
         zero = INF
-        if root < INF:
-            if n == 0:
-                out0 = root
-            elif n == 1:
-                out1 = root
-            elif n == 2:
-                out2 = root
-            else:
-                out3 = root
-            n += 1
+        n, out0, out1, out2, out3 = _append(n, root, out0, out1, out2, out3)
         x0 = x1
         f0 = f1
     return out0, out1, out2, out3
@@ -178,11 +180,7 @@ def _roots_by_curvature(a, b, c, e, lo, hi, q0, q1):
     inflections q0 <= q1 (inf: none there), where it bends one way
     (:func:`_curved_piece_roots`); not ok when a piece's end is itself a root or a piece has
     no curvature at its middle (the general path decides those)."""
-    out0 = INF
-    out1 = INF
-    out2 = INF
-    out3 = INF
-    n = 0
+    n, out0, out1, out2, out3 = 0, INF, INF, INF, INF  # the roots found so far
     x0 = lo
     f0, df0, _ = _poly(4, a, b, c, e, x0)
     if f0 == 0.0:
@@ -196,17 +194,8 @@ def _roots_by_curvature(a, b, c, e, lo, hi, q0, q1):
         if f1 == 0.0 or dd_mid == 0.0:
             return False, INF, INF, INF, INF
         ra, rb = _curved_piece_roots(a, b, c, e, x0, x1, f0, df0, f1, df1, dd_mid > 0.0)
-        for r in (ra, rb):
-            if r < INF:
-                if n == 0:
-                    out0 = r
-                elif n == 1:
-                    out1 = r
-                elif n == 2:
-                    out2 = r
-                elif n == 3:
-                    out3 = r
-                n += 1
+        n, out0, out1, out2, out3 = _append(n, ra, out0, out1, out2, out3)
+        n, out0, out1, out2, out3 = _append(n, rb, out0, out1, out2, out3)
         x0 = x1
         f0 = f1
         df0 = df1
