@@ -142,6 +142,12 @@ def test_surfaces_keep_their_childs_material_and_the_cut_shows_the_cutters():
     assert tuple(mats[int(geo.prim_info[leaves[0], PRIM_MEDIUM]), 0:3]) == glass.color
 
 
+def _ray(origin, target):
+    """(o, d) of the ray from ``origin`` toward ``target``; d is None when they nearly meet."""
+    d = np.subtract(target, origin)
+    return np.array(origin), (d if np.linalg.norm(d) >= 1e-3 else None)
+
+
 def _interval(lo, hi):
     return (lo, hi) if lo < hi else None
 
@@ -179,10 +185,9 @@ SCULPT = Compiled(CSG(operation="difference", objects=[
 def test_first_surface_matches_the_exact_intervals(origin, target):
     # (cube ∩ ball) − small ball: the solid along the ray is ([box] ∩ [ball]) minus (cut);
     # its first boundary point past 0 is the first hit
-    d = np.subtract(target, origin)
-    if np.linalg.norm(d) < 1e-3:
+    o, d = _ray(origin, target)
+    if d is None:
         return
-    o = np.array(origin)
     if any(abs(d[k]) < 1e-9 and abs(abs(o[k]) - 1) < 1e-9 for k in range(3)):
         return  # a ray in the plane of a face: which side it is on is not defined
     box = _box_interval(o, d)
@@ -255,11 +260,10 @@ DRILLED = Compiled(CSG(operation="difference", objects=[
 @given(st.tuples(*[st.floats(-3, 3)] * 3), st.tuples(*[st.floats(-1, 1)] * 3))
 def test_first_surface_of_a_drilled_cube_matches_the_exact_intervals(origin, target):
     # cube − cylinder (its top cap inside the cube) − cone (through the cube along x): the
-    # walk of frustum leaves by their normals gives the first boundary point past 0
-    d = np.subtract(target, origin)
-    if np.linalg.norm(d) < 1e-3:
+    # walk of frustum leaves (their first and last crossings) gives the first boundary point
+    o, d = _ray(origin, target)
+    if d is None:
         return
-    o = np.array(origin)
     if any(abs(d[k]) < 1e-9 for k in range(3)):
         return  # rays parallel to a face or a cap: whether they graze it is not defined
     for axis, plane, r in ((1, -1.5, 0.5), (1, 0.5, 0.5), (0, -1.5, 0.6), (0, 1.5, 0.2)):
