@@ -21,22 +21,22 @@ import numpy as np
 
 from .integrator import trace_path
 from .jit import kernel, numba_object
-from .layout import RAY_PRIMARY
-from .tiles import camera_ray, lens_ray
+from .layout import N_RAY_KINDS, RAY_PRIMARY
+from .tiles import camera_ray, lens_ray, own_lines
 
 geometry_ref_if_instances = numba_object(".geometry_ref", "geometry_ref_if_instances")
 def adaptive_workspace(tile_width: int, tile_height: int, levels: int):
     """Scratch memory of one lane: the corners of a tile's pixels, one pixel's sample grid
     and its marks, and the stack of squares to visit (three per level and the first)."""
     side = (1 << levels) + 1
-    return (np.empty((tile_height + 1, tile_width + 1, 3)), np.empty((side, side, 3)),
-            np.zeros((side, side), np.int8), np.empty((3 * levels + 2, 3), np.int32))
+    return (own_lines((tile_height + 1, tile_width + 1, 3)), own_lines((side, side, 3)),
+            own_lines((side, side), np.int8), own_lines((3 * levels + 2, 3), np.int32))
 
 
 @kernel  # one call site of trace_path (which Numba inlines into it)
 def _sample(geo, mats, lights, params, gx, gy, fine, work, cnt):
     """Radiance through the point (gx, gy) of the image's finest grid."""
-    st_f, st_i, media, scratch, stack, hits, listed = work
+    st_f, st_i, media, scratch, stack, hits, listed, _ = work
     key = gy * (params.width * fine + 1) + gx
     o, d = camera_ray(params, gx / fine, gy / fine)
     if params.focal_distance > 0.0:
@@ -139,8 +139,10 @@ def render_tiles_adaptive(tiles, framebuffer, geo, mats, lights, params, counter
     geo = geometry_ref_if_instances(geo)
     corners, grid, known, squares = aa
     fine = 1 << levels
+    cnt = work[7]  # the lane's own counts, stored in counters[t] once a tile (render_tiles)
     for t in range(lane, tiles.shape[0], lanes):
-        cnt = counters[t]
+        for k in range(N_RAY_KINDS):
+            cnt[k] = 0
         x0 = tiles[t, 0]
         y0 = tiles[t, 1]
         x1 = tiles[t, 2]
@@ -183,3 +185,5 @@ def render_tiles_adaptive(tiles, framebuffer, geo, mats, lights, params, counter
                 framebuffer[py, px, 0] = col[0]
                 framebuffer[py, px, 1] = col[1]
                 framebuffer[py, px, 2] = col[2]
+        for k in range(N_RAY_KINDS):
+            counters[t, k] = cnt[k]

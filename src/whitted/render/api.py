@@ -11,7 +11,7 @@ import os
 import threading
 import time
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -148,13 +148,19 @@ def available_threads() -> int:
 
 
 def run_lanes(fn: Callable[[int, int], object], lanes: int, pool: ThreadPoolExecutor | None):
-    """Call ``fn(lane, lanes)`` for every lane, concurrently on ``pool`` (the kernels release
-    the GIL), and wait for all of them."""
+    """Call ``fn(lane, lanes)`` for every lane and wait for all of them: lane 0 on the
+    calling thread, the others concurrently on ``pool`` (the kernels release the GIL). When
+    a lane raises, the others are still waited for (none writes after this returns)."""
     if lanes == 1 or pool is None:
         for lane in range(lanes):
             fn(lane, lanes)
         return
-    for future in [pool.submit(fn, lane, lanes) for lane in range(lanes)]:
+    futures = [pool.submit(fn, lane, lanes) for lane in range(1, lanes)]
+    try:
+        fn(0, lanes)
+    finally:
+        wait(futures)
+    for future in futures:
         future.result()
 
 
@@ -351,7 +357,7 @@ class RenderJob:
                 size = most_per_call
                 if tile_seconds[0] > 0.0:
                     size = max(size, int(RUN_SECONDS / tile_seconds[0]))
-                count = min(left, size, max(1, left // (4 * n)))
+                count = min(left, size, max(1, left // (2 * n)))
                 start = next_tile
                 next_tile += count
             return np.arange(start, start + count)
@@ -387,7 +393,8 @@ class RenderJob:
                     done += len(idx)
                     self._report(done, len(tiles), counters, render_start, part)
 
-        pool = ThreadPoolExecutor(lanes, thread_name_prefix="whitted-lane") if lanes > 1 else None
+        pool = (ThreadPoolExecutor(lanes - 1, thread_name_prefix="whitted-lane") if lanes > 1
+                else None)
         try:
             run_lanes(lane_work, lanes, pool)
         finally:
@@ -452,6 +459,6 @@ def render_aovs(scene: Scene, **overrides: object) -> dict[str, np.ndarray]:
     def lane_work(lane: int, n: int) -> None:
         aov_kernel(compiled.geometry, params, depth, normal, ids, lane_workspace(0), lane, n)
 
-    with ThreadPoolExecutor(lanes) as pool:
+    with ThreadPoolExecutor(max(1, lanes - 1)) as pool:
         run_lanes(lane_work, lanes, pool)
     return {"depth": depth, "normal": normal, "id": ids}
