@@ -358,3 +358,38 @@ def test_a_failing_povray_is_a_bench_error(monkeypatch):
                                          "Error$"):
         run_bench(BenchOptions(scenes=["lecture"], quick=True, size=(8, 4), compare="povray"),
                   log=lambda s: None)
+
+
+def test_beside_povray_the_runs_alternate_and_the_ratios_are_medians_of_the_pairs(monkeypatch):
+    """whitted, POV-Ray, whitted, ... after a warm-up of each; a machine that drifts (here:
+    whitted's runs 1, 2, 9 s beside POV-Ray's 4, 1, 3 s) gives the pairs' ratios 0.25, 2, 3,
+    whose median is 2 (the ratio of the medians, 2/3, mixes runs made at different times)."""
+    from types import SimpleNamespace
+
+    order: list[str] = []
+    whitted_s = iter([5.0, 1.0, 2.0, 9.0])  # the warm-up first
+    povray_s = iter([5.0, 4.0, 1.0, 3.0])
+
+    def whitted_run(scene, threads, folder):
+        order.append("whitted")
+        t = next(whitted_s)
+        return {"rays": {"primary": 1}, "compile_s": 0.0, "build_s": 0.0, "render_s": t,
+                "wall_s": 2 * t, "startup_s": t, "peak_mib": 1.0}
+
+    def runner_for(spec, scene, threads, folder):
+        def once():
+            order.append("povray")
+            t = next(povray_s)
+            return SimpleNamespace(trace_s=t, parse_s=0.0, bounding_s=0.0, wall_s=t,
+                                   peak_mib=1.0, rays={"primary": 1})
+        return once
+
+    monkeypatch.setattr(runner, "_process_run", whitted_run)
+    monkeypatch.setattr(runner, "_povray_runner", runner_for)
+    result = run_bench(BenchOptions(scenes=["lecture"], runs=3, threads=[1], size=(8, 4),
+                                    compare="povray"), log=lambda s: None)
+    (row,) = result.rows
+    assert order == ["whitted", "povray"] * 4
+    assert row["render_s"] == 2.0 and row["povray_trace_s"] == 3.0
+    assert row["ratio_render"] == 2.0
+    assert row["ratio_wall"] == 4.0  # wall: 2, 4, 18 s against 4, 1, 3 s

@@ -5,6 +5,8 @@ operating system's file cache; not counted), then ``runs`` times; every number r
 median over those runs. By default every run is a fresh process (:mod:`whitted.bench.worker`,
 which does what ``whitted render`` does), so the wall time is a user's wall time; ``--quick``
 and ``in_process`` render inside this process instead (start-up is then just the scene load).
+Beside POV-Ray (``--compare povray``) the two renderers' runs alternate, and each ratio is the
+median of the ratios of the pairs (a run of whitted and the POV-Ray run after it).
 
 The columns (also the JSON keys, see docs/performance.md):
 
@@ -102,7 +104,10 @@ def run_bench(options: BenchOptions, log: Callable[[str], None] = print) -> Benc
             for threads in threads_list:
                 log(f"{spec.name} {width}x{height}, {threads} thread(s)")
                 try:
-                    row = _bench_whitted(spec, scene, threads, options, folder)
+                    if options.compare == "povray":
+                        row = _bench_side_by_side(spec, scene, threads, options, folder)
+                    else:
+                        row = _bench_whitted(spec, scene, threads, options, folder)
                 except BenchError as exc:
                     if not has_meshes(scene):
                         raise
@@ -110,8 +115,6 @@ def run_bench(options: BenchOptions, log: Callable[[str], None] = print) -> Benc
                     result.skipped.append((spec.name, f"its meshes do not render: {exc}"))
                     log(f"  skipped {spec.name}: {exc}")
                     break
-                if options.compare == "povray":
-                    row.update(_bench_povray(spec, scene, threads, options, folder, row))
                 result.rows.append(row)
         if options.compare == "embree" and spec.meshes and result.rows \
                 and result.rows[-1]["scene"] == spec.name:
@@ -141,6 +144,11 @@ def _bench_whitted(spec: BenchScene, scene: Scene, threads: int, options: BenchO
     measure = _in_process_run if options.in_process else _process_run
     warmup = measure(scene, threads, folder) if options.warmup else None
     runs = [measure(scene, threads, folder) for _ in range(options.runs)]
+    return _whitted_row(spec, scene, threads, options, runs, warmup)
+
+
+def _whitted_row(spec: BenchScene, scene: Scene, threads: int, options: BenchOptions,
+                 runs: list[dict[str, Any]], warmup: dict[str, Any] | None) -> dict[str, Any]:
     row: dict[str, Any] = {
         "scene": spec.name, "width": scene.render.width, "height": scene.render.height,
         "threads": threads, "runs": len(runs),
@@ -155,6 +163,27 @@ def _bench_whitted(spec: BenchScene, scene: Scene, threads: int, options: BenchO
         row["compile_s"] = max(row["compile_s"], warmup["compile_s"])
     row["mrays_per_s"] = (row["rays_total"] / row["render_s"] / 1e6
                           if row["render_s"] > 0 else 0.0)
+    return row
+
+
+def _bench_side_by_side(spec: BenchScene, scene: Scene, threads: int, options: BenchOptions,
+                        folder: Path) -> dict[str, Any]:
+    """whitted and POV-Ray on the same scene, their runs alternating (whitted, POV-Ray,
+    whitted, ...) after a warm-up of each, so a machine that speeds up or slows down while
+    the bench runs (another process, the clock) weighs on both alike. The ratios are the
+    medians of each pair's ratio."""
+    measure = _in_process_run if options.in_process else _process_run
+    povray_once = _povray_runner(spec, scene, threads, folder)
+    warmup = None
+    if options.warmup:
+        warmup = measure(scene, threads, folder)
+        povray_once()
+    runs, pov_runs = [], []
+    for _ in range(options.runs):
+        runs.append(measure(scene, threads, folder))
+        pov_runs.append(povray_once())
+    row = _whitted_row(spec, scene, threads, options, runs, warmup)
+    row.update(_povray_columns(runs, pov_runs))
     return row
 
 
@@ -194,8 +223,9 @@ def _process_run(scene: Scene, threads: int, folder: Path) -> dict[str, Any]:
     }
 
 
-def _bench_povray(spec: BenchScene, scene: Scene, threads: int, options: BenchOptions,
-                  folder: Path, row: dict[str, Any]) -> dict[str, Any]:
+def _povray_runner(spec: BenchScene, scene: Scene, threads: int,
+                   folder: Path) -> Callable[[], Any]:
+    """One POV-Ray render of the scene (exported once, into ``folder``) per call."""
     from ..export.pov import export_pov
     from .povray import PovrayError, run_povray
 
@@ -211,21 +241,29 @@ def _bench_povray(spec: BenchScene, scene: Scene, threads: int, options: BenchOp
         except PovrayError as exc:
             raise BenchError(str(exc)) from None
 
-    if options.warmup:
-        once()
-    runs = [once() for _ in range(options.runs)]
-    trace = _median([r.trace_s for r in runs])
-    wall = _median([r.wall_s for r in runs])
+    return once
+
+
+def _ratio(a: float, b: float) -> float:
+    return a / b if b > 0 else float("inf")
+
+
+def _povray_columns(runs: list[dict[str, Any]], pov_runs: list[Any]) -> dict[str, Any]:
+    """POV-Ray's columns, from its runs made alternately with whitted's ``runs``."""
+    trace = _median([r.trace_s for r in pov_runs])
     return {
         "povray_trace_s": trace,
-        "povray_parse_s": _median([r.parse_s for r in runs]),
-        "povray_bounding_s": _median([r.bounding_s for r in runs]),
-        "povray_wall_s": wall,
-        "povray_peak_mib": _median([r.peak_mib for r in runs]),
-        "povray_rays": runs[0].rays,
-        "povray_mrays_per_s": sum(runs[0].rays.values()) / trace / 1e6 if trace > 0 else 0.0,
-        "ratio_render": row["render_s"] / trace if trace > 0 else float("inf"),
-        "ratio_wall": row["wall_s"] / wall if wall > 0 else float("inf"),
+        "povray_parse_s": _median([r.parse_s for r in pov_runs]),
+        "povray_bounding_s": _median([r.bounding_s for r in pov_runs]),
+        "povray_wall_s": _median([r.wall_s for r in pov_runs]),
+        "povray_peak_mib": _median([r.peak_mib for r in pov_runs]),
+        "povray_rays": pov_runs[0].rays,
+        "povray_mrays_per_s": (sum(pov_runs[0].rays.values()) / trace / 1e6 if trace > 0
+                               else 0.0),
+        "ratio_render": _median([_ratio(w["render_s"], p.trace_s)
+                                 for w, p in zip(runs, pov_runs, strict=True)]),
+        "ratio_wall": _median([_ratio(w["wall_s"], p.wall_s)
+                               for w, p in zip(runs, pov_runs, strict=True)]),
     }
 
 
