@@ -22,7 +22,7 @@ from .layout import (
     RAY_REFRACTION,
 )
 from .lighting import direct_light
-from .media import crossing_media
+from .media import absorbed, crossing_media
 from .texture import texture_color
 from .uv import surface_uv
 from .vec import dot, madd
@@ -123,14 +123,6 @@ def _push(st_f, st_i, top, o, d, w, depth, media_src, n_media):
     return top
 
 
-@kernel(inline="always")
-def _absorbed(weight, attenuation, length):
-    """``weight`` after ``length`` in a medium of this attenuation (Beer-Lambert)."""
-    if attenuation > 0.0:
-        return weight * math.exp(-attenuation * length)
-    return weight
-
-
 @kernel(numba_inline=True)  # Numba inlines it into render_tiles, its one caller (jit.py)
 def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media, scratch,
                stack, hits, listed, counters):
@@ -154,9 +146,9 @@ def trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media
             # a clear medium absorbs nothing, even over the infinite path of a ray that leaves
             # the scene inside it (0 * inf would be NaN)
             w = (
-                _absorbed(w[0], mats[cur, MAT_ATTEN], t),
-                _absorbed(w[1], mats[cur, MAT_ATTEN + 1], t),
-                _absorbed(w[2], mats[cur, MAT_ATTEN + 2], t),
+                absorbed(w[0], mats[cur, MAT_ATTEN], t),
+                absorbed(w[1], mats[cur, MAT_ATTEN + 1], t),
+                absorbed(w[2], mats[cur, MAT_ATTEN + 2], t),
             )
         reflected = False  # the reflection ray, followed next (in o, d, w, depth)
         if prim < 0:

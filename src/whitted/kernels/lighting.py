@@ -57,7 +57,7 @@ from .layout import (
     SHAPE_TRIANGLE,
 )
 from .light_buffer import cube_cell
-from .media import media_enter, media_leave
+from .media import absorbed, media_enter, media_leave
 from .mesh import OPAQUE_KT
 from .sampling import concentric_disk, random_pair, stratum
 from .traverse import (
@@ -325,9 +325,9 @@ def _absorb(mats, scratch, count, length, trans):
     if count == 0:
         return trans
     m = scratch[count - 1]
-    return (trans[0] * math.exp(-mats[m, MAT_ATTEN] * length),
-            trans[1] * math.exp(-mats[m, MAT_ATTEN + 1] * length),
-            trans[2] * math.exp(-mats[m, MAT_ATTEN + 2] * length))
+    return (absorbed(trans[0], mats[m, MAT_ATTEN], length),
+            absorbed(trans[1], mats[m, MAT_ATTEN + 1], length),
+            absorbed(trans[2], mats[m, MAT_ATTEN + 2], length))
 
 
 @kernel(inline="always")  # as when it was written inside shadow_transmittance

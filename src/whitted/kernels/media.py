@@ -7,9 +7,20 @@ air (n = 1, no absorption) when it is empty.
 
 from __future__ import annotations
 
+import math
+
 from .extras import body_medium
 from .jit import kernel
 from .layout import MAT_IOR, MAT_OUTSIDE, MAX_MEDIA, PRIM_SOLID
+
+
+@kernel(inline="always")
+def absorbed(weight, attenuation, length):
+    """``weight`` after ``length`` in a medium of this attenuation (Beer-Lambert); a clear
+    medium (attenuation 0, glass by default) costs no exponential."""
+    if attenuation > 0.0:
+        return weight * math.exp(-attenuation * length)
+    return weight
 
 
 @kernel

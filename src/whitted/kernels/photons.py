@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 
 from .accel import closest_hit, hit_material, surface_normals
-from .integrator import _absorbed, split_at_surface
+from .integrator import split_at_surface
 from .jit import kernel, numba_object
 from .layout import (
     LIGHT_DIRECTION,
@@ -40,6 +40,7 @@ from .layout import (
     MAT_KR,
     MAT_KT,
 )
+from .media import absorbed
 from .sampling import concentric_disk, random01, random_pair
 from .vec import dot, madd, normalize, vload
 
@@ -249,9 +250,9 @@ def trace_photon(geo, mats, clear, table, j, o, d, power, directional, settings,
             break
         if n_media > 0:  # Beer-Lambert absorption in the medium it crossed
             cur = media[n_media - 1]
-            w = (_absorbed(w[0], mats[cur, MAT_ATTEN], t),
-                 _absorbed(w[1], mats[cur, MAT_ATTEN + 1], t),
-                 _absorbed(w[2], mats[cur, MAT_ATTEN + 2], t))
+            w = (absorbed(w[0], mats[cur, MAT_ATTEN], t),
+                 absorbed(w[1], mats[cur, MAT_ATTEN + 1], t),
+                 absorbed(w[2], mats[cur, MAT_ATTEN + 2], t))
         length += t
         m = hit_material(geo, prim, tri)
         p = madd(o, d, t)
