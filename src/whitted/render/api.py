@@ -348,9 +348,10 @@ class RenderJob:
         def take_tiles(n: int) -> np.ndarray:
             """The next run of tiles for a lane: ``most_per_call``, or more where that would
             take less than RUN_SECONDS (the lane's Python between runs waits for the GIL
-            while other lanes hold it); shorter as the image nears its end (a quarter of what
-            is left per lane), so the lanes finish together however unevenly the work is
-            spread over the image."""
+            while other lanes hold it); shorter as the image nears its end (what is left
+            over twice the lanes: a quarter of it with two), so the lanes finish together
+            however unevenly the work is spread over the image. (An eighth with two lanes
+            made 26 runs a lane of a 1200-tile image, and its two-thread render 7 % slower.)"""
             nonlocal next_tile
             with lock:
                 left = len(tiles) - next_tile
