@@ -393,3 +393,12 @@ def test_beside_povray_the_runs_alternate_and_the_ratios_are_medians_of_the_pair
     assert row["render_s"] == 2.0 and row["povray_trace_s"] == 3.0
     assert row["ratio_render"] == 2.0
     assert row["ratio_wall"] == 4.0  # wall: 2, 4, 18 s against 4, 1, 3 s
+
+
+def test_the_scene_option_names_every_bench_scene():
+    from whitted.bench.scenes import SCENES
+    from whitted.cli.bench import SCENE_HELP
+
+    names = list(SCENES)
+    listed = SCENE_HELP.split(":", 1)[1].split("(")[0].replace(" ", "").split(",")
+    assert listed == names

@@ -11,19 +11,25 @@ from ..errors import WhittedError, shorten
 from .app import app, fail
 from .console import err, out
 
+# written out (the command's help must not import the bench); tests/test_bench_command.py
+# checks it names every scene of bench/scenes.py
+SCENE_HELP = ("Scene(s): seed000, softshadow, ice, mesh1m, lecture, sphere1m, bunny1m, vase1m, "
+              "instances100, csg, dice100, caustics (default: all)")
+
 
 @app.command()
 def bench(
     scene: Annotated[
-        list[str] | None, typer.Option("--scene", help="Scene(s): seed000, softshadow, ice, "
-                                       "mesh1m, lecture (default: all)")
+        list[str] | None, typer.Option("--scene", help=SCENE_HELP)
     ] = None,
     runs: Annotated[int, typer.Option("--runs", "-n", help="Timed runs; the median")] = 5,
     threads: Annotated[
         str | None, typer.Option("--threads", "-t", help="Thread counts, e.g. 1,2 (all cores)")
     ] = None,
     quick: Annotated[bool, typer.Option("--quick", help="Tiny images, one run (CI)")] = False,
-    compare: Annotated[str | None, typer.Option("--compare", help="Also time: povray")] = None,
+    compare: Annotated[str | None, typer.Option(
+        "--compare", help="Also time povray (its runs alternate with whitted's) or embree "
+                          "(the mesh scenes' rays)")] = None,
     study: Annotated[str | None, typer.Option("--study", help="threads or size")] = None,
     json_path: Annotated[Path | None, typer.Option("--json", help="Write results")] = None,
     plot: Annotated[Path | None, typer.Option("--plot", help="Study plot (PNG)")] = None,
