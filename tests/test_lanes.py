@@ -133,3 +133,30 @@ def test_a_failing_other_lane_is_raised_after_lane_zero_ends():
     with ThreadPoolExecutor(1) as pool, pytest.raises(ValueError, match="lane 1 failed"):
         run_lanes(fn, 2, pool)
     assert order == ["lane 0 done"]
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_a_failing_lane_stops_the_others_before_the_image_is_done():
+    """The progress callback raises at its first report (and not again): the error comes
+    back, and the other lane stops at its next run instead of rendering the rest of the image
+    first."""
+    from whitted.render import RenderJob
+
+    scene = _scene().model_copy(update={
+        "render": whitted.RenderSettings(width=512, height=512, max_depth=3),
+        "background": whitted.Background(color=(0.5, 0.5, 0.5))})
+    reports = []
+
+    def progress(p):
+        reports.append(p.tiles_done)
+        if len(reports) == 1:
+            raise _Stop
+
+    job = RenderJob(scene, threads=2, progress=progress)
+    with pytest.raises(_Stop):
+        job.run()
+    tiles = job.framebuffer.reshape(32, 16, 32, 16, 3).any(axis=(1, 3, 4))
+    assert 0 < tiles.sum() < tiles.size  # before: the other lane rendered all that was left

@@ -363,16 +363,27 @@ class RenderJob:
                 next_tile += count
             return np.arange(start, start + count)
 
+        failed = threading.Event()  # a lane raised: the others stop
+
         def lane_work(_lane: int, n: int) -> None:
             """A lane takes runs of tiles (in image order) until none is left, with no
             barrier between lanes, checking for cancellation and reporting progress between
-            runs. Pixels do not depend on which lane renders them."""
+            runs. Pixels do not depend on which lane renders them. A lane that fails (the
+            progress callback raising, Ctrl-C in a script) stops the others at their next
+            run: the error comes back without the rest of the image being rendered first."""
+            try:
+                render_runs(n)
+            except BaseException:
+                failed.set()
+                raise
+
+        def render_runs(n: int) -> None:
             nonlocal done
             work = lane_workspace(params.max_depth)
             aa = None if antialias is None else adaptive_workspace(
                 self.tile_size, self.tile_size, levels)
             while True:
-                if self.cancel_token.cancelled:
+                if self.cancel_token.cancelled or failed.is_set():
                     return
                 idx = take_tiles(n)
                 if len(idx) == 0:
