@@ -20,6 +20,7 @@ from ..render.api import available_threads
 from ._dask import Client, LocalCluster
 from .errors import ClusterLost, FarmError
 from .probe import WhittedProbe
+from .security import client_security, connect
 from .watch import (
     FIRST_TASK_LIMIT,
     POLL_SECONDS,
@@ -241,12 +242,9 @@ def farm_client(cluster: str | None = None, scheduler: str | None = None, *,
         client = Client(owned)
     else:
         threads = threads or 1
+        client_security(scheduler)  # TLS settings checked before any connection
         reach_scheduler(scheduler)
-        try:
-            client = Client(scheduler, timeout=f"{CONNECT_SECONDS}s")
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise ClusterLost(f"--scheduler {scheduler}: cannot reach the scheduler ({exc})"
-                              ) from None
+        client = connect(scheduler, CONNECT_SECONDS)
     try:
         link = dashboard_link(client)
         if note is not None:
