@@ -28,17 +28,18 @@ import copy
 import difflib
 import math
 import re
+import tomllib
 from collections.abc import Iterable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import tomlkit
-from pydantic import BaseModel
+from pydantic import BaseModel, ValidationError
 from tomlkit.items import AoT, Array, Comment, InlineTable, Table
 
-from ..errors import SceneError
-from .io import parse_scene_text, scene_from_dict
 from .materials import Material
-from .scene import Scene
+
+if TYPE_CHECKING:
+    from .scene import Scene
 
 # ---------------------------------------------------------------------- compact data
 
@@ -576,17 +577,18 @@ def _close(a: Any, b: Any, tolerance: float) -> bool:
     return a == b
 
 
-def _loads(text: str) -> Scene | None:
+def _loads(text: str, like: Scene) -> Scene | None:
+    """The scene the TOML ``text`` holds (read as ``whitted.load_scene`` reads it), or None."""
     try:
-        return scene_from_dict(parse_scene_text(text, ".toml"))
-    except (SceneError, ValueError):
+        return type(like).model_validate(tomllib.loads(text), strict=True)
+    except (tomllib.TOMLDecodeError, ValidationError, ValueError, RecursionError):
         return None
 
 
 def read_toml(text: str, scene: Scene) -> Scene:
     """The scene the TOML ``text`` (just written for ``scene``) holds: ``scene`` with the
     numbers as the file rounded them."""
-    loaded = _loads(text)
+    loaded = _loads(text, scene)
     return scene if loaded is None or loaded == scene else loaded.with_base_dir(
         getattr(scene, "_base_dir", None))
 
@@ -611,7 +613,7 @@ def edited_toml(scene: Scene, text: str, loaded: Scene, *,
         edited = edit_toml(text, loaded, scene, history=history)
     except (KeyError, TypeError, ValueError, tomlkit.exceptions.TOMLKitError):
         return None
-    return edited if same_scene(_loads(edited), scene, file_decimals(text)) else None
+    return edited if same_scene(_loads(edited, scene), scene, file_decimals(text)) else None
 
 
 def scene_toml(scene: Scene, *, text: str | None = None, loaded: Scene | None = None,
@@ -623,6 +625,6 @@ def scene_toml(scene: Scene, *, text: str | None = None, loaded: Scene | None = 
         if edited is not None:
             return edited
     compact = compact_toml(scene)
-    if _loads(compact) == scene:
+    if _loads(compact, scene) == scene:
         return compact
     return tomlkit.dumps(scene.model_dump(mode="json", exclude_none=True))  # every value
