@@ -83,6 +83,7 @@ class LiveRender:
         self._display = np.zeros((self.height, self.width, 3), np.uint8)
         self.updates = 0  # picture updates sent
         self.view_seconds = 0.0  # the watching thread's time in update()
+        self.longest_update = 0.0  # the longest update() (seconds)
         self._next = 0.0  # perf_counter() of the next allowed picture update
         self.started = time.perf_counter()
         self.stop_requested = False
@@ -155,6 +156,7 @@ class LiveRender:
             self._paint()
         spent = time.perf_counter() - now
         self.view_seconds += spent
+        self.longest_update = max(self.longest_update, spent)
         self._next = now + max(1.0 / MAX_RATE, spent / BUDGET)
 
     def _paint(self, final: bool = False) -> None:
@@ -219,7 +221,9 @@ class _Box:
             def __repr__(self) -> str:
                 return f"whitted render: {view.status.value}"
 
-        return RenderBox(children)
+        box = RenderBox(children)
+        box.view = view  # the LiveRender behind it (its counters: updates, view_seconds)
+        return box
 
 
 def _start(job: RenderJob, view: LiveRender) -> None:

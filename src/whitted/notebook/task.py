@@ -74,26 +74,29 @@ def run_watched(work: Callable[[], Any], view: TaskView | None, cancel: Any) -> 
     next safe point and returns what it finished); a second one returns at once (None),
     leaving the work to stop on its own. ``work``'s error is raised here."""
     box: dict[str, Any] = {}
+    ended = threading.Event()  # waited on, not Thread.join: an interrupt in it is harmless
 
     def target() -> None:
         try:
             box["value"] = work()
         except BaseException as exc:  # noqa: BLE001 - raised on the notebook's thread
             box["error"] = exc
+        finally:
+            ended.set()
 
-    thread = threading.Thread(target=target, name="whitted-task", daemon=True)
-    thread.start()
+    threading.Thread(target=target, name="whitted-task", daemon=True).start()
     try:
-        while thread.is_alive():
-            thread.join(INTERVAL)
+        while not ended.wait(INTERVAL):
             if view is not None:
                 view.update()
+        if view is not None:
+            view.update()
     except KeyboardInterrupt:
         cancel.cancel()
         if view is not None:
             view.status.value = "stopping at the next safe point"
         try:
-            thread.join()
+            ended.wait()
         except KeyboardInterrupt:
             return None
     if "error" in box:

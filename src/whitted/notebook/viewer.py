@@ -85,6 +85,17 @@ def _slider(path: str, spec: Any, value: Any):
                          layout=layout, continuous_update=True, readout_format=".3g")
 
 
+def _fits(slider, value: Any) -> bool:
+    """``value`` is one the slider can show as it is (sliders clamp what is outside)."""
+    options = getattr(slider, "options", None)
+    if options is not None:
+        return value in options
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return False
+    return slider.min <= value <= slider.max and (
+        not isinstance(slider.value, int) or float(value).is_integer())
+
+
 class Viewer:
     """The viewer's state and widgets (``widget``). :meth:`set` changes a value as a slider
     does; :meth:`wait` waits for the renders of the last change; ``image`` is the last full
@@ -111,6 +122,7 @@ class Viewer:
         self._job: RenderJob | None = None
         self._busy = False
         self._closed = False
+        self._quiet = False
         self.sliders = {}
         for path, spec in sliders.items():
             try:
@@ -119,7 +131,7 @@ class Viewer:
                 raise WhittedError(f"{path}: {exc}") from None
             slider = _slider(path, spec, value)
             self.values[path] = slider.value
-            slider.observe(lambda change, p=path: self.set(p, change["new"]), names="value")
+            slider.observe(lambda change, p=path: self._moved(p, change["new"]), names="value")
             self.sliders[path] = slider
         r = self.base.render
         self.picture = w.Image(format="png", layout=w.Layout(width=f"{r.width}px",
@@ -138,17 +150,22 @@ class Viewer:
 
     # ------------------------------------------------------------------ changes
     def set(self, path: str, value: Any) -> None:
-        """Set ``path`` to ``value`` and re-render (a bad value: its message, no render)."""
+        """Set ``path`` to ``value`` and re-render (a bad value: its message, no render).
+        A slider of ``path`` follows when the value is one it can show."""
         self.values[path] = value
         slider = self.sliders.get(path)
-        if slider is not None and slider.value != value:
+        if slider is not None and slider.value != value and _fits(slider, value):
+            self._quiet = True  # its observer would come back here
             try:
-                slider.value = value  # observed: comes back here with the same value
-            except Exception:  # noqa: BLE001 - a value outside the slider's range: kept as is
-                pass
-            else:
-                return
+                slider.value = value
+            finally:
+                self._quiet = False
         self._request()
+
+    def _moved(self, path: str, value: Any) -> None:
+        if not self._quiet:
+            self.values[path] = value
+            self._request()
 
     def _request(self) -> None:
         from ..animation.overrides import apply_overrides

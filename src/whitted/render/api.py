@@ -247,6 +247,7 @@ class RenderJob:
         self.tiles_done = 0
         self.tiles_total = 0
         self._thread: threading.Thread | None = None
+        self._ended = threading.Event()  # set when the background thread has ended
 
     def cancel(self) -> None:
         self.cancel_token.cancel()
@@ -302,8 +303,11 @@ class RenderJob:
 
         def target() -> None:
             # what it raises is kept in self.error (state FAILED), handed to whoever waits
-            with contextlib.suppress(BaseException):
-                self.run()
+            try:
+                with contextlib.suppress(BaseException):
+                    self.run()
+            finally:
+                self._ended.set()
 
         self._thread = threading.Thread(target=target, name="whitted-render", daemon=True)
         self._thread.start()
@@ -311,10 +315,10 @@ class RenderJob:
 
     def join(self, timeout: float | None = None) -> bool:
         """Wait for the background thread (if any) without raising its error; True when it
-        has finished."""
+        has finished. (It waits on an event, not ``Thread.join``: a KeyboardInterrupt in the
+        wait leaves the job's state true.)"""
         if self._thread is not None:
-            self._thread.join(timeout)
-            return not self._thread.is_alive()
+            return self._ended.wait(timeout)
         return True
 
     def wait(self, timeout: float | None = None) -> Image | None:
@@ -325,8 +329,7 @@ class RenderJob:
             if self.image is not None:  # finished by run()
                 return self.image
             raise JobStateError("wait() before start(): start the job first (or call run())")
-        self._thread.join(timeout)
-        if self._thread.is_alive():
+        if not self._ended.wait(timeout):
             return None
         if self.error is not None:
             raise self.error
@@ -334,7 +337,7 @@ class RenderJob:
 
     @property
     def running(self) -> bool:
-        return self._thread is not None and self._thread.is_alive()
+        return self._thread is not None and not self._ended.is_set()
 
     def _report(self, done, total, counters, start, chunk) -> None:
         if self.progress is None:

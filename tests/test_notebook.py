@@ -1,0 +1,308 @@
+"""whitted in a notebook, without a kernel: the live render view (progress, picture, Stop,
+the interrupt), films inline, sweeps as contact sheets, the viewer, Stefan results. The
+widgets are real ipywidgets objects; ``IPython.display.display`` is replaced by a list."""
+
+from __future__ import annotations
+
+import asyncio
+import base64
+import io
+import os
+import signal
+import time
+
+import numpy as np
+import pytest
+
+pytest.importorskip("ipywidgets")
+
+import whitted  # noqa: E402
+from whitted.errors import OutputError, SceneError  # noqa: E402
+from whitted.notebook import detect, live  # noqa: E402
+
+
+@pytest.fixture
+def shown(monkeypatch):
+    """What the code under test displayed."""
+    import IPython.display
+
+    items = []
+    monkeypatch.setattr(IPython.display, "display", lambda *objs, **_: items.extend(objs))
+    return items
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return whitted.default_scene().with_settings(width=64, height=40, threads=2)
+
+
+def _until(condition, seconds: float = 30.0) -> None:
+    """Wait (on the render's thread) until the watcher has acted."""
+    end = time.monotonic() + seconds
+    while not condition() and time.monotonic() < end:
+        time.sleep(0.005)
+
+
+def _png(data: bytes) -> np.ndarray:
+    from PIL import Image as PILImage
+
+    return np.asarray(PILImage.open(io.BytesIO(data)).convert("RGB"))
+
+
+# ------------------------------------------------------------------ detection
+def test_detection_outside_a_kernel(monkeypatch):
+    monkeypatch.delenv("WHITTED_NOTEBOOK", raising=False)
+    assert not detect.in_notebook()  # pytest is no notebook
+    monkeypatch.setenv("WHITTED_NOTEBOOK", "1")
+    assert detect.in_notebook()
+    monkeypatch.setenv("WHITTED_NOTEBOOK", "0")
+    assert not detect.in_notebook()
+    monkeypatch.setenv("WHITTED_NOTEBOOK", "1")
+    monkeypatch.setattr(detect, "widgets_installed", lambda: False)
+    assert not detect.in_notebook()  # forced on, but no extra: the plain path
+
+
+def test_plain_render_outside_a_notebook_shows_nothing(scene, shown):
+    image = whitted.render(scene)
+    assert shown == []
+    reference = whitted.render(scene, live=False)
+    np.testing.assert_array_equal(image.pixels, reference.pixels)
+
+
+# ------------------------------------------------------------------ live render
+def test_live_render_fills_in_and_ends_at_100_percent(scene, shown):
+    image = whitted.render(scene, live=True, width=96, height=64)
+    assert len(shown) == 1
+    box = shown[0]
+    view = box.view
+    assert view.bar.value == 100.0 and view.bar.bar_style == "success"
+    assert "96x64" in view.status.value and "rays" in view.status.value
+    assert len(box.children) == 2  # the picture went: the Image returned shows itself
+    # the same picture as a render without the view (pixels do not depend on watching)
+    np.testing.assert_array_equal(image.pixels,
+                                  whitted.render(scene, live=False, width=96,
+                                                 height=64).pixels)
+    # the view's own work stays within its budget (one update may take it over)
+    wall = image.meta["stats"].wall_seconds
+    assert view.view_seconds <= live.BUDGET * wall + view.longest_update + 1e-3
+    assert "whitted render" in repr(box)
+
+
+def test_live_picture_shows_the_tiles_finished(scene):
+    from whitted.render import RenderJob
+
+    job = RenderJob(scene.with_settings(width=48, height=32), tile_size=8)
+    view = live.LiveRender(job, picture=True)
+    image = live.watch(job, view, keep_picture=True)
+    assert view.picture.format == "png"
+    np.testing.assert_array_equal(_png(view.picture.value), image.to_srgb8())
+
+
+def test_interrupt_stops_and_returns_the_picture_so_far(scene, shown):
+    interrupted = []
+
+    def interrupt_once(progress):
+        if not interrupted:
+            interrupted.append(progress.tiles_done)
+            os.kill(os.getpid(), signal.SIGINT)  # as the notebook's ■ does
+            _until(lambda: shown and shown[0].view.stop_requested)
+
+    big = scene.with_settings(width=160, height=120, threads=1)
+    image = whitted.render(big, live=True, progress=interrupt_once)
+    stats = image.meta["stats"]
+    assert stats.cancelled and 0 < stats.tiles_done < stats.tiles_total
+    view = shown[0].view
+    assert view.bar.bar_style == "warning" and "stopped at" in view.status.value
+    assert view.job.cancelled
+    np.testing.assert_array_equal(image.to_srgb8(), view.job.srgb())
+
+
+def test_stop_button_of_an_awaited_render(scene, shown):
+    clicked = []
+
+    def click_stop(progress):
+        if not clicked and shown:
+            clicked.append(1)
+            hbox = shown[0].children[0]
+            hbox.children[1].click()  # the Stop button, as a user's click arrives
+
+    big = scene.with_settings(width=160, height=120, threads=1)
+    image = asyncio.run(whitted.render_async(big, live=True, progress=click_stop))
+    assert clicked
+    view = shown[0].view
+    assert view.stop_requested and view.job.cancelled
+    assert image.meta["stats"].cancelled
+    assert view.bar.description == "stopped"
+
+
+def test_failed_live_render_says_why(scene, shown):
+    def broken(_progress):
+        raise RuntimeError("broken callback")
+
+    with pytest.raises(RuntimeError, match="broken callback"):
+        whitted.render(scene, live=True, progress=broken)
+    view = shown[0].view
+    assert view.bar.bar_style == "danger" and "broken callback" in view.status.value
+
+
+def test_bad_settings_raise_one_line_before_any_view(scene, shown):
+    with pytest.raises(whitted.WhittedError) as info:
+        whitted.render(scene, live=True, width=-3)
+    assert "\n" not in str(info.value)
+    assert shown == []
+
+
+# ------------------------------------------------------------------ films
+def _frames(folder, n=3, size=(9, 6)):
+    from PIL import Image as PILImage
+
+    folder.mkdir()
+    for k in range(n):
+        pixels = np.full((size[1], size[0], 3), 40 * k, np.uint8)
+        PILImage.fromarray(pixels).save(folder / f"{k:04d}.png")
+    return folder
+
+
+def test_film_from_frames_plays_as_html5_video(tmp_path):
+    film = whitted.film_from_frames(_frames(tmp_path / "frames"), fps=12)
+    assert film.kind == "mp4" and film.frames == 3 and film.fps == 12.0
+    assert film.size == (10, 6)  # H.264 wants even sides: one column more
+    assert repr(film) == "<Film in memory, MP4: 3 frames at 12 fps, 10x6, 0.2 s>"
+    html = film._repr_html_()
+    assert "<video" in html and 'src="data:video/mp4;base64,' in html
+    data = base64.b64decode(html.split("base64,")[1].split('"')[0])
+    assert data[4:8] == b"ftyp" and data == film.data
+    saved = film.save(tmp_path / "film.mp4")
+    assert saved.read_bytes() == film.data
+    with pytest.raises(OutputError, match="use a .mp4 name"):
+        film.save(tmp_path / "film.gif")
+
+
+def test_film_is_a_gif_without_an_encoder(tmp_path, monkeypatch):
+    from whitted.output import inline_film
+
+    monkeypatch.setattr(inline_film, "mp4_encoder", lambda: False)
+    film = whitted.Film.from_frames(_frames(tmp_path / "frames", n=2), fps=5)
+    assert film.kind == "gif" and film.size == (9, 6) and film.data[:4] == b"GIF8"
+    assert "<img" in film._repr_html_() and "image/gif" in film._repr_html_()
+
+
+@pytest.mark.parametrize("case", ["missing", "file", "empty", "foreign"])
+def test_film_from_frames_bad_folders_are_one_line(tmp_path, case):
+    folder = tmp_path / "frames"
+    if case == "file":
+        folder.write_text("not a folder")
+    elif case == "empty":
+        folder.mkdir()
+    elif case == "foreign":
+        folder.mkdir()
+        (folder / "notes.txt").write_text("x")
+    with pytest.raises(OutputError) as info:
+        whitted.film_from_frames(folder)
+    assert "\n" not in str(info.value) and str(folder) in str(info.value)
+
+
+def test_frames_of_different_sizes_are_refused(tmp_path):
+    from PIL import Image as PILImage
+
+    folder = _frames(tmp_path / "frames", n=2)
+    PILImage.new("RGB", (4, 4)).save(folder / "0002.png")
+    with pytest.raises(OutputError, match="cannot make a film"):
+        whitted.film_from_frames(folder)
+
+
+def test_render_film_returns_a_film_that_plays(tmp_path, shown, examples_dir):
+    film = whitted.render_film(examples_dir / "camera_orbit.toml", tmp_path / "orbit.mp4",
+                               frames=range(0, 48, 24), width=32, height=18, fps=4,
+                               live=True)
+    assert film.path == tmp_path / "orbit.mp4" and film.path.is_file()
+    assert (film.frames, film.fps, film.size) == (2, 4.0, (32, 18))
+    assert "<video" in film._repr_html_()
+    assert film.result.rendered == [0, 24]
+    view = shown[0]
+    assert "2 rendered" in view.children[1].value
+    # again: every frame is kept (resume), the film encoded again
+    again = whitted.render_film(examples_dir / "camera_orbit.toml", tmp_path / "orbit.mp4",
+                                frames=range(0, 48, 24), width=32, height=18, fps=4)
+    assert again.result.kept == [0, 24] and again.result.rendered == []
+
+
+# ------------------------------------------------------------------ sweeps
+def test_sweep_returns_a_contact_sheet_of_real_renders(scene, shown):
+    path = "objects[glass sphere].material.ior"
+    sheet = whitted.sweep(scene, {path: [1.0, 1.5]}, width=32, height=20, live=True)
+    assert sheet.complete and sheet.labels == ["ior = 1", "ior = 1.5"]
+    reference = whitted.render(scene.with_settings(width=32, height=20), live=False)
+    # ior 1.5 is the default scene's own value: that cell is the scene's render
+    np.testing.assert_array_equal(sheet.images[1].pixels, reference.pixels)
+    assert _png(sheet._repr_png_()).shape == sheet.pixels.shape
+    assert "ContactSheet" in repr(sheet) and "(2)" in repr(sheet)
+    assert shown[0].children[0].value == 100.0
+
+
+def test_sweep_bad_path_is_one_line_before_rendering(scene):
+    with pytest.raises(SceneError) as info:
+        whitted.sweep(scene, {"objects[no such].radius": [1, 2]}, live=False)
+    assert "\n" not in str(info.value) and "no such" in str(info.value)
+
+
+# ------------------------------------------------------------------ viewer
+def test_viewer_renders_coarse_then_full_and_shows_bad_values(scene):
+    path = "objects[glass sphere].material.ior"
+    v = whitted.viewer(scene, {path: (1.0, 2.5), "camera.aperture": (0.0, 0.3)},
+                       width=48, height=32)
+    try:
+        assert v.wait(120)
+        assert v.renders == 2  # a quarter size, then the full picture
+        plain = whitted.render(scene, live=False, width=48, height=32)
+        np.testing.assert_array_equal(v.image.pixels, plain.pixels)
+        np.testing.assert_array_equal(_png(v.picture.value), plain.to_srgb8())
+        v.set(path, -1.0)  # refused by the scene: one line, no render, no exception
+        assert v.wait(60)
+        assert v.error is not None and "\n" not in v.error and "ior" in v.error
+        assert v.status.value.startswith("⚠") and v.renders == 2
+        v.sliders[path].value = 1.0  # as a user drags the slider
+        assert v.wait(120)
+        assert v.error is None and v.renders == 4
+        expected = whitted.render(scene.with_settings(width=48, height=32).model_copy(),
+                                  live=False)
+        assert not np.array_equal(v.image.pixels, expected.pixels)  # ior 1: a different image
+    finally:
+        v.close()
+
+
+def test_viewer_bad_slider_is_one_line(scene):
+    with pytest.raises(whitted.WhittedError, match="min < max"):
+        whitted.viewer(scene, {"camera.aperture": (0.3, 0.0)})
+    with pytest.raises(whitted.WhittedError, match="nothing|unknown|no "):
+        whitted.viewer(scene, {"camera.no_such": (0.0, 1.0)})
+
+
+# ------------------------------------------------------------------ Stefan
+def test_stefan_results_plot_and_balance(tmp_path, shown, examples_dir):
+    results = whitted.run_stefan(examples_dir / "stefan" / "hollow_ice.toml",
+                                 tmp_path / "melt", grid={"cells": 16},
+                                 time={"end": 240.0, "save_every": 120.0}, live=True)
+    assert list(results.time_s) == [0.0, 120.0, 240.0]
+    melt = results.melt_fraction
+    assert melt[0] == 0.0 and np.all(np.diff(melt) > 0) and melt[-1] < 1
+    assert np.all(results.heat_in_J[1:] > 0) and results.heat_in_J[0] == 0.0
+    # the budget closes: stored = heat in - drained + the solver's imbalance (round-off)
+    assert np.all(np.abs(results.imbalance_J) < 1e-6 * np.maximum(1.0, results.heat_in_J))
+    assert results.min_shell_mm[-1] < results.min_shell_mm[0]
+    picture = _png(results._repr_png_())
+    assert picture.shape[1] > 2 * picture.shape[0]  # three panels side by side
+    assert shown[0].children[0].value == 100.0
+    assert "melted" in repr(results)
+    from whitted.stefan.results import load_results
+
+    again = load_results(tmp_path / "melt")
+    np.testing.assert_array_equal(again.heat_in_J, results.heat_in_J)
+
+
+def test_stefan_results_of_a_folder_without_a_run(tmp_path):
+    from whitted.stefan.case import CaseError
+    from whitted.stefan.results import load_results
+
+    with pytest.raises(CaseError, match="no series.csv"):
+        load_results(tmp_path)
