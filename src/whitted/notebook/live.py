@@ -37,6 +37,9 @@ __all__ = ["BUDGET", "MAX_RATE", "LiveRender", "watch", "watch_async"]
 
 #: Picture updates a second at most.
 MAX_RATE = 4.0
+#: The live picture's longest side in pixels at most: a bigger render is shown every n-th
+#: pixel while it runs (the browser scales it up), so an update costs the same at any size.
+PREVIEW_SIDE = 512
 #: The watching thread's own work (converting, encoding, sending) takes at most this part of
 #: the time: an update that took 10 ms waits 0.5 s for the next.
 BUDGET = 0.02
@@ -80,7 +83,10 @@ class LiveRender:
         self.width, self.height = s.width, s.height
         self._lock = threading.Lock()
         self._rows: list[tuple[int, int]] = []  # image rows with tiles finished, not painted
-        self._display = np.zeros((self.height, self.width, 3), np.uint8)
+        #: every ``step``-th pixel of each row and column makes the live picture
+        self.step = max(1, -(-max(self.width, self.height) // PREVIEW_SIDE))
+        self._display = np.zeros((-(-self.height // self.step), -(-self.width // self.step), 3),
+                                 np.uint8)
         self.updates = 0  # picture updates sent
         self.view_seconds = 0.0  # the watching thread's time in update()
         self.longest_update = 0.0  # the longest update() (seconds)
@@ -165,17 +171,20 @@ class LiveRender:
         if not rows and not final:
             return
         job = self.job
-        if rows:
-            top = min(r[0] for r in rows)
-            bottom = max(r[1] for r in rows)
-            s = job.settings
-            self._display[top:bottom] = encode_ldr(job.framebuffer[top:bottom], bits=8,
-                                                   transfer=s.transfer, tonemap=s.tonemap)
         if final:
             self.picture.format = "png"
-            self.picture.value = _png(self._display)
-        else:
-            self.picture.value = _jpeg(self._display)
+            self.picture.value = _png(job.srgb())
+            self.updates += 1
+            return
+        if rows:
+            n = self.step
+            top = min(r[0] for r in rows) // n  # preview rows
+            bottom = -(-max(r[1] for r in rows) // n)
+            s = job.settings
+            self._display[top:bottom] = encode_ldr(
+                job.framebuffer[top * n:bottom * n:n, ::n], bits=8, transfer=s.transfer,
+                tonemap=s.tonemap)
+        self.picture.value = _jpeg(self._display)
         self.updates += 1
 
     def finish(self, keep_picture: bool = False) -> None:
