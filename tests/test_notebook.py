@@ -306,3 +306,118 @@ def test_stefan_results_of_a_folder_without_a_run(tmp_path):
 
     with pytest.raises(CaseError, match="no series.csv"):
         load_results(tmp_path)
+
+
+# ------------------------------------------------------------------ probes
+@pytest.mark.parametrize("fps", [0, -1, float("nan"), float("inf"), 1e300])
+def test_film_from_frames_bad_rates_are_one_line(tmp_path, fps):
+    with pytest.raises(OutputError) as info:
+        whitted.film_from_frames(_frames(tmp_path / "frames", n=2), fps=fps)
+    assert "\n" not in str(info.value) and "fps" in str(info.value).lower()
+
+
+def test_film_save_into_a_place_that_cannot_take_it(tmp_path):
+    film = whitted.film_from_frames(_frames(tmp_path / "frames", n=2), kind="gif")
+    with pytest.raises(OutputError, match="cannot write"):
+        film.save(tmp_path / "missing" / "film.gif")
+    (tmp_path / "taken.gif").mkdir()
+    with pytest.raises(OutputError, match="cannot write"):
+        film.save(tmp_path / "taken.gif")
+    assert (tmp_path / "taken.gif").is_dir()
+
+
+def test_render_film_keeps_files_it_did_not_write(tmp_path, examples_dir):
+    from PIL import Image as PILImage
+
+    folder = tmp_path / "orbit_frames"
+    folder.mkdir()
+    PILImage.new("RGB", (4, 4)).save(folder / "0000.png")  # someone else's
+    before = (folder / "0000.png").read_bytes()
+    with pytest.raises(whitted.WhittedError, match="whitted did not write it"):
+        whitted.render_film(examples_dir / "camera_orbit.toml", tmp_path / "orbit.mp4",
+                            frames=[0], width=16, height=10, live=False)
+    assert (folder / "0000.png").read_bytes() == before
+    with pytest.raises(whitted.WhittedError):
+        whitted.render_film(examples_dir / "camera_orbit.toml", examples_dir / "die.toml",
+                            frames=[0], width=16, height=10, live=False)
+
+
+def test_sheet_save_refuses_other_formats_and_bad_places(tmp_path, scene):
+    sheet = whitted.sweep(scene, {"camera.aperture": [0.0, 0.1]}, width=16, height=10,
+                          live=False)
+    with pytest.raises(OutputError, match="PNG"):
+        sheet.save(tmp_path / "sheet.jpg")
+    with pytest.raises(OutputError, match="cannot write"):
+        sheet.save(tmp_path / "no" / "sheet.png")
+    assert _png(sheet.save(tmp_path / "sheet.png").read_bytes()).shape == sheet.pixels.shape
+
+
+def test_viewer_render_errors_are_one_line(scene):
+    v = whitted.viewer(scene, {"render.width": (8, 64)}, width=16, height=10)
+    try:
+        assert v.wait(60)
+        v.set("render.width", 10 ** 9)  # refused by the render settings
+        assert v.wait(60)
+        assert v.error is not None and "\n" not in v.error and "width" in v.error
+        assert v.error.startswith("render.width: ")  # the path, no command-line option
+        v.set("render.width", 32)
+        v.set("render.samples", "many")  # text is parsed as --set parses it: refused
+        assert "samples" in v.error
+        v.set("render.samples", 1)
+        assert v.wait(60) and v.error is None and v.image.width == 32
+    finally:
+        v.close()
+
+
+def test_stefan_into_a_file_is_one_line(tmp_path, examples_dir):
+    from whitted.stefan.case import CaseError
+
+    target = tmp_path / "taken"
+    target.write_text("mine")
+    with pytest.raises(CaseError) as info:
+        whitted.run_stefan(examples_dir / "stefan" / "hollow_ice.toml", target,
+                           grid={"cells": 16}, time={"end": 120.0, "save_every": 120.0},
+                           live=False)
+    assert "\n" not in str(info.value)
+    assert target.read_text() == "mine"
+    with pytest.raises(CaseError, match="cells"):
+        whitted.run_stefan(examples_dir / "stefan" / "hollow_ice.toml", tmp_path / "x",
+                           grid={"cells": 2}, live=False)
+
+
+from hypothesis import given  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+_numbers = st.one_of(st.integers(-10**6, 10**6), st.floats(allow_nan=True, allow_infinity=True),
+                     st.booleans(), st.text(max_size=3), st.none())
+
+
+@given(st.one_of(st.tuples(_numbers, _numbers), st.tuples(_numbers, _numbers, _numbers),
+                 st.lists(_numbers, max_size=4), _numbers,
+                 st.dictionaries(st.sampled_from(["min", "max", "step", "x"]), _numbers)))
+def test_slider_specs_make_a_slider_or_one_line(spec):
+    from whitted.notebook.viewer import _slider
+
+    try:
+        slider = _slider("camera.aperture", spec, 0.1)
+    except whitted.WhittedError as exc:
+        assert "\n" not in str(exc)
+    else:
+        assert slider.description
+
+
+def test_viewer_slider_of_values(scene):
+    path = "objects[glass sphere].material.ior"
+    v = whitted.viewer(scene, {path: [1.0, 1.5, None]}, width=16, height=10)
+    try:
+        assert v.wait(60) and v.values[path] == 1.5  # the scene's own value is among them
+        slider = v.sliders[path]
+        assert slider.value == 1 and slider.label == "1.5"
+        slider.value = 0  # as a user moves it: the value is 1.0
+        assert v.wait(60) and v.values[path] == 1.0 and v.error is None
+        slider.value = 2  # None: refused by the material, one line
+        assert v.wait(60) and v.values[path] is None and "ior" in v.error
+        v.set(path, 1.5)
+        assert slider.value == 1 and v.wait(60) and v.error is None
+    finally:
+        v.close()

@@ -88,8 +88,11 @@ class ContactSheet:
         path = Path(path)
         if path.suffix.lower() != ".png":
             raise OutputError(f"{path}: the sheet is a PNG (use a .png name)")
-        return atomic_write(path, lambda tmp: PILImage.fromarray(self.pixels).save(
-            tmp, format="PNG"))
+        try:
+            return atomic_write(path, lambda tmp: PILImage.fromarray(self.pixels).save(
+                tmp, format="PNG"))
+        except OSError as exc:
+            raise OutputError(f"{path}: cannot write: {exc.strerror or exc}") from None
 
     def __repr__(self) -> str:
         swept = " x ".join(f"{path} ({len(values)})" for path, values in self.axes)

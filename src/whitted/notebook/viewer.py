@@ -44,7 +44,9 @@ def one_line(exc: BaseException) -> str:
 
         return shorten(validation_message(exc), 300)
     if isinstance(exc, WhittedError):
-        return shorten(str(exc), 300)
+        text = str(exc)
+        # a value set here is no command-line option: its path alone says where
+        return shorten(text.removeprefix("--set: "), 300)
     return shorten(f"{type(exc).__name__}: {exc}", 300)
 
 
@@ -57,12 +59,24 @@ def _slider(path: str, spec: Any, value: Any):
     style = {"description_width": "initial"}
     layout = w.Layout(width="460px", max_width="100%")
     if isinstance(spec, Mapping):
-        spec = (spec["min"], spec["max"], spec.get("step"))
+        if "min" not in spec or "max" not in spec:
+            raise WhittedError(f"{path}: a slider given as a dict needs min and max, got "
+                               f"{spec!r}")
+        spec = (spec["min"], spec["max"]) + ((spec["step"],) if "step" in spec else ())
     if isinstance(spec, list):
-        options = list(spec)
-        start = value if value in options else options[0]
-        return w.SelectionSlider(options=options, value=start, description=short,
-                                 style=style, layout=layout, continuous_update=False)
+        from ..animation.sweep import format_value
+
+        values = list(spec)
+        if not values:
+            raise WhittedError(f"{path}: a slider of values needs at least one value")
+        labels = [shorten(format_value(v), 24) for v in values]
+        start = values.index(value) if _among(value, values) else 0
+        # the slider's value is the index: any value (None, a list) can be one of them
+        slider = w.SelectionSlider(options=[(label, k) for k, label in enumerate(labels)],
+                                   value=start, description=short, style=style,
+                                   layout=layout, continuous_update=False)
+        slider.whitted_values = values
+        return slider
     if not isinstance(spec, tuple) or len(spec) not in (2, 3):
         raise WhittedError(f"{path}: a slider is (min, max), (min, max, step) or a list of "
                            f"values, got {spec!r}")
@@ -85,11 +99,24 @@ def _slider(path: str, spec: Any, value: Any):
                          layout=layout, continuous_update=True, readout_format=".3g")
 
 
+def _among(value: Any, values: list) -> bool:
+    try:
+        return value in values
+    except Exception:  # noqa: BLE001 - a value that cannot be compared is not among them
+        return False
+
+
+def _slider_value(slider) -> Any:
+    """The scene value a slider shows (a slider of values holds its index)."""
+    values = getattr(slider, "whitted_values", None)
+    return slider.value if values is None else values[slider.value]
+
+
 def _fits(slider, value: Any) -> bool:
     """``value`` is one the slider can show as it is (sliders clamp what is outside)."""
-    options = getattr(slider, "options", None)
-    if options is not None:
-        return value in options
+    values = getattr(slider, "whitted_values", None)
+    if values is not None:
+        return _among(value, values)
     if isinstance(value, bool) or not isinstance(value, int | float):
         return False
     return slider.min <= value <= slider.max and (
@@ -130,7 +157,7 @@ class Viewer:
             except WhittedError as exc:
                 raise WhittedError(f"{path}: {exc}") from None
             slider = _slider(path, spec, value)
-            self.values[path] = slider.value
+            self.values[path] = _slider_value(slider)
             slider.observe(lambda change, p=path: self._moved(p, change["new"]), names="value")
             self.sliders[path] = slider
         r = self.base.render
@@ -154,17 +181,18 @@ class Viewer:
         A slider of ``path`` follows when the value is one it can show."""
         self.values[path] = value
         slider = self.sliders.get(path)
-        if slider is not None and slider.value != value and _fits(slider, value):
+        if slider is not None and _fits(slider, value):
+            values = getattr(slider, "whitted_values", None)
             self._quiet = True  # its observer would come back here
             try:
-                slider.value = value
+                slider.value = value if values is None else values.index(value)
             finally:
                 self._quiet = False
         self._request()
 
-    def _moved(self, path: str, value: Any) -> None:
+    def _moved(self, path: str, _index_or_value: Any) -> None:
         if not self._quiet:
-            self.values[path] = value
+            self.values[path] = _slider_value(self.sliders[path])
             self._request()
 
     def _request(self) -> None:

@@ -83,7 +83,7 @@ class Film:
         or a frame rate the format does not take."""
         from PIL import Image as PILImage
 
-        from .video import encode_film
+        from .video import check_fps, encode_film
 
         files = frame_files(folder) if not isinstance(folder, list) else [Path(f) for f in folder]
         if not files:
@@ -91,6 +91,10 @@ class Film:
         kind = kind or ("mp4" if mp4_encoder() else "gif")
         if kind not in ("mp4", "gif"):
             raise OutputError(f"a film is mp4 or gif, not {kind!r}")
+        try:
+            fps = check_fps(fps, kind)
+        except ValueError as exc:
+            raise OutputError(f"fps: {exc}") from None
         with PILImage.open(files[0]) as first:
             size = first.size
         with tempfile.TemporaryDirectory(prefix="whitted-film-") as tmp:
@@ -124,7 +128,10 @@ class Film:
             raise OutputError(f"{path}: this film is {self.kind.upper()}: "
                               f"use a .{self.kind} name")
         data = self.data
-        return atomic_write(path, lambda tmp: Path(tmp).write_bytes(data))
+        try:
+            return atomic_write(path, lambda tmp: Path(tmp).write_bytes(data))
+        except OSError as exc:
+            raise OutputError(f"{path}: cannot write: {exc.strerror or exc}") from None
 
     @property
     def seconds(self) -> float:
