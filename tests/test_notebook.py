@@ -98,6 +98,17 @@ def test_live_picture_shows_the_tiles_finished(scene):
     np.testing.assert_array_equal(_png(view.picture.value), image.to_srgb8())
 
 
+def test_live_preview_of_a_wide_render_is_every_nth_pixel(scene):
+    from whitted.render import RenderJob
+
+    job = RenderJob(scene.with_settings(width=1100, height=24), tile_size=16)
+    view = live.LiveRender(job, picture=True)
+    assert view.step == 3 and view._display.shape == (8, 367, 3)
+    image = live.watch(job, view)
+    view._paint()  # the rows finished after the last update
+    np.testing.assert_array_equal(view._display, image.to_srgb8()[::3, ::3])
+
+
 def test_interrupt_stops_and_returns_the_picture_so_far(scene, shown):
     interrupted = []
 

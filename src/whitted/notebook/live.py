@@ -108,6 +108,8 @@ class LiveRender:
                                             "the picture so far is kept")
         self.stop_button.on_click(lambda _button: self.request_stop())
         self.title = name
+        #: said after the progress while it runs (how to stop it when there is no button)
+        self.hint = "" if stop else ": interrupt the kernel (■) to stop, keeping the picture"
         children = [w.HBox([self.bar, self.stop_button] if stop else [self.bar]), self.status]
         if picture:
             children.append(self.picture)
@@ -158,7 +160,7 @@ class LiveRender:
             left = f", {_seconds(self._eta)} left" if self._eta and fraction < 1 else ""
             self.status.value = (f"{self.title}{self.width}x{self.height}: "
                                  f"{100 * fraction:.0f} % ({job.tiles_done}/{job.tiles_total} "
-                                 f"tiles), {_seconds(elapsed)}{left}")
+                                 f"tiles), {_seconds(elapsed)}{left}{self.hint}")
             self._paint()
         spent = time.perf_counter() - now
         self.view_seconds += spent
