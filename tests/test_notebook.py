@@ -432,3 +432,41 @@ def test_viewer_slider_of_values(scene):
         assert slider.value == 1 and v.wait(60) and v.error is None
     finally:
         v.close()
+
+
+def test_interrupted_sweep_returns_the_cells_finished(scene, shown, monkeypatch):
+    token = whitted.CancelToken()
+    sent = []
+
+    def interrupt_in_second_cell(progress):
+        if progress.done == 1 and progress.tiles is not None and not sent:
+            sent.append(1)
+            os.kill(os.getpid(), signal.SIGINT)
+            _until(lambda: token.cancelled)
+
+    from whitted.animation import sheet as sheet_module
+
+    original = sheet_module.render_sweep
+
+    def with_probe(*args, **kwargs):
+        user = kwargs["progress"]
+
+        def both(p):
+            user(p)
+            interrupt_in_second_cell(p)
+
+        kwargs["progress"] = both
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(sheet_module, "render_sweep", with_probe)  # sweep() imports it
+    sheet = whitted.sweep(scene, {"camera.aperture": [0.0, 0.1, 0.2]}, width=64, height=48,
+                          threads=1, cancel=token, live=True)
+    assert sent and not sheet.complete and len(sheet.images) == 1
+    assert "stopped: 1 of 3 images" in shown[0].children[1].value
+
+
+def test_render_film_into_a_folder_makes_the_film_in_memory(tmp_path, examples_dir):
+    film = whitted.render_film(examples_dir / "camera_orbit.toml", tmp_path / "frames",
+                               frames=[0, 1], width=16, height=10, fps=2, live=False)
+    assert film.path is None and film.frames == 2 and film.kind in ("mp4", "gif")
+    assert sorted(p.name for p in (tmp_path / "frames").iterdir()) == ["0000.png", "0001.png"]
