@@ -1,4 +1,4 @@
-"""The kernel cache's list of checksums (whitted/_cache.py ``KernelCache``) on a folder of
+"""The kernel cache's list of checksums (jit/cache.py ``KernelCache``) on a folder of
 stand-in cache files: a list of the wrong shape, a list that cannot be written, a missing
 folder, a read-only folder's one warning; and the renderer's fingerprint built from the
 kernel sources' hash (whitted/fingerprint.py)."""
@@ -9,8 +9,8 @@ import hashlib
 import json
 import re
 
-from whitted import _cache
-from whitted._cache import SUMS, KernelCache
+from whitted.jit import cache as _cache
+from whitted.jit.cache import SUMS, KernelCache
 
 
 def _folder(tmp_path):

@@ -242,7 +242,7 @@ def test_the_container_recipe_renders_from_its_read_only_cache_as_another_user(o
     in memory with one warning line, and the render still succeeds."""
     import shutil
 
-    from whitted import _cache
+    from whitted.jit import cache as _cache
     from whitted.render.warm_up import warm_up_kernels
 
     if os.geteuid() != 0 or shutil.which("setpriv") is None:

@@ -17,7 +17,11 @@ import sys
 import types
 from typing import TYPE_CHECKING
 
-from . import _lean_numba
+from . import marks as _marks
+
+_marks.mark("interpreter")  # the interpreter has started and reached whitted
+
+from .jit import lean_numba as _lean_numba  # noqa: E402
 
 _lean_numba.install()  # Numba's import without its SciPy and PyYAML probes
 

@@ -20,6 +20,6 @@ def renderer_fingerprint() -> str:
     """``whitted <version> kernels <16 hex digits>`` of this process (computed once)."""
     import whitted
 
-    from ._cache import kernel_source_hash
+    from .jit.cache import kernel_source_hash
 
     return f"whitted {whitted.__version__} kernels {kernel_source_hash()}"

@@ -94,6 +94,7 @@ class MainWindow(QMainWindow):
         self.editing = Editing(self)
         self.overlays = Overlays(self)
         self.ids = IdBuffer(self)
+        self.child_ids = IdBuffer(self)  # a CSG child's own outline
         self.acts = make_actions(self)
         self.render_control = RenderControl(self)
         self._make_menus()
@@ -109,6 +110,7 @@ class MainWindow(QMainWindow):
         self.doc.undo_stack.cleanChanged.connect(self._update_title)
         self.autosave.saved.connect(self._status)
         self.ids.ready.connect(self.overlays.update_outline)
+        self.child_ids.ready.connect(self.overlays.update_outline)
         self.doc.selection_changed.connect(self._selection_changed)
         self.navigation.changed.connect(self._view_changed)
         self.viewport.clicked.connect(self.editing.pick)

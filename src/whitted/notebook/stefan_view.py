@@ -32,7 +32,7 @@ def _merge(base: dict, changes: Mapping[str, Any]) -> dict:
 
 def _case(case: Case | str | os.PathLike[str] | Mapping, changes: Mapping[str, Any]):
     """(the case, the text written as the run's case.toml, the case file read or None)."""
-    import tomli_w
+    import tomlkit
 
     from ..stefan.case import Case, CaseError, case_from_dict, load_case
 
@@ -50,7 +50,7 @@ def _case(case: Case | str | os.PathLike[str] | Mapping, changes: Mapping[str, A
     else:
         raise CaseError(f"a case is a Case, a case file or a dict, got {type(case).__name__}")
     data = _merge(data, changes)
-    text = tomli_w.dumps(data)
+    text = tomlkit.dumps(data)
     return case_from_dict(data, file=None if path is None else str(path), text=text), text, path
 
 
