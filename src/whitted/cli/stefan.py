@@ -142,7 +142,7 @@ def validate(
     from ..stefan import validate as v
 
     t0 = time.perf_counter()
-    table = Table(title="Similarity constants (root-found) against the issue's numbers")
+    table = Table(title="Similarity constants (root-found) against quoted values")
     for col in ("case", "computed", "quoted", "difference"):
         table.add_column(col)
     for r in v.lambda_rows():
@@ -163,7 +163,7 @@ def validate(
                       f"{r['far_change']:.1e}", f"{r['energy_rel']:.1e}")
     out.print(table)
 
-    table = Table(title=f"Three more 1-D cases (issue 30) after {t_end:.0f} s")
+    table = Table(title=f"Three more 1-D cases after {t_end:.0f} s")
     for col in ("case", "dx (mm)", "steps", "front (mm)", "exact (mm)", "error", "order",
                 "energy (rel.)"):
         table.add_column(col, justify="right")

@@ -17,8 +17,10 @@ from .properties import Properties
 from .solver import Air, EnthalpySolver, Faces
 
 AXES = ("x", "y", "z")
-ISSUE_ONE_PHASE = {0.1: 0.220016, 1.0: 0.620063}
-ISSUE_TWO_PHASE = {"lambda": 0.2089, "front_mm": 9.14}  # +10 °C wall, -10 °C ice, 1 h
+#: Published similarity constants to check the root-finding against (one phase: lambda for
+#: each Stefan number; two phase: +10 °C wall, -10 °C ice, front after 1 h)
+QUOTED_ONE_PHASE = {0.1: 0.220016, 1.0: 0.620063}
+QUOTED_TWO_PHASE = {"lambda": 0.2089, "front_mm": 9.14}  # +10 °C wall, -10 °C ice, 1 h
 
 
 def line_shape(n: int, axis: int, width: int = 1) -> tuple[int, int, int]:
@@ -72,21 +74,21 @@ def neumann_run(props: Properties, wall: float, initial: float, t_end: float, dx
 
 
 def lambda_rows(props: Properties | None = None) -> list[dict]:
-    """The similarity constants, root-found, beside the issue's numbers."""
+    """The similarity constants, root-found, beside the quoted values."""
     props = props or Properties()
     rows = []
-    for st, quoted in ISSUE_ONE_PHASE.items():
+    for st, quoted in QUOTED_ONE_PHASE.items():
         lam = exact.one_phase_lambda(st)
         rows.append({"case": f"one phase, St = {st:g}", "lambda": lam, "quoted": quoted,
                      "difference": lam - quoted})
     lam = exact.two_phase_lambda(props, 10.0, -10.0)
     front = float(exact.front(lam, props, 3600.0)) * 1e3
-    quoted = ISSUE_TWO_PHASE["lambda"]
+    quoted = QUOTED_TWO_PHASE["lambda"]
     rows.append({"case": "two phase, +10 / -10 °C", "lambda": lam, "quoted": quoted,
                  "difference": lam - quoted})
     rows.append({"case": "two phase front after 1 h (mm)", "lambda": front,
-                 "quoted": ISSUE_TWO_PHASE["front_mm"],
-                 "difference": front - ISSUE_TWO_PHASE["front_mm"]})
+                 "quoted": QUOTED_TWO_PHASE["front_mm"],
+                 "difference": front - QUOTED_TWO_PHASE["front_mm"]})
     return rows
 
 
@@ -109,7 +111,7 @@ def convergence_rows(props: Properties | None = None, t_end: float = 3600.0,
     return rows
 
 
-#: Issue 30's independent 1-D cases: (wall °C, initial ice °C); 0 °C ice is the one-phase case
+#: Three further independent 1-D cases: (wall °C, initial ice °C); 0 °C ice is the one-phase case
 MORE_CASES = ((25.0, -3.0), (3.0, -20.0), (15.0, 0.0))
 
 
