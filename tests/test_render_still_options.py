@@ -199,3 +199,17 @@ def test_continue_with_a_damaged_or_foreign_state(tmp_path, ball, monkeypatch):
     # --continue with nothing kept: the whole picture, and a note
     code, _, err = run_main(*args, "-o", "new.png", "--continue", cwd=tmp_path)
     assert code == 0 and "no kept tiles" in err
+
+
+def test_a_file_of_someone_elses_by_the_state_files_name_is_never_touched(tmp_path, ball,
+                                                                           monkeypatch):
+    args = ("render", ball, "-q", "-t", "1", "-W", "64", "-H", "48")
+    theirs = state_path(tmp_path / "cut.png")
+    theirs.write_text("my notes\n", encoding="utf-8")
+    with monkeypatch.context() as m:
+        _interrupt_after_first_tile(m)
+        code, _, err = run_main(*args, "-o", "cut.png", cwd=tmp_path)
+    assert code == 130 and "is not whitted's" in err
+    assert theirs.read_text(encoding="utf-8") == "my notes\n"
+    assert run_main(*args, "-o", "cut.png", cwd=tmp_path)[0] == 0  # whole: not removed
+    assert theirs.read_text(encoding="utf-8") == "my notes\n"

@@ -89,10 +89,9 @@ def render(
     scheduler: SchedulerOption = None,
 ) -> None:
     """Render SCENE (or the built-in default scene) to an image: PNG, JPEG, TIFF, WebP,
-    EXR, PFM or NPY, chosen by the name given to -o.
-
-    An animated scene renders frame 0, or the frame --frame names. An interrupted render
-    (Ctrl-C) keeps its finished tiles; --continue finishes it."""
+    EXR, PFM or NPY, chosen by the name given to -o. An animated scene renders frame 0, or
+    the frame --frame names; an interrupted render (Ctrl-C) keeps its finished tiles, and
+    --continue finishes it."""
     from .. import marks
 
     marks.mark("command")  # the imports and the command line's parsing are done
@@ -245,10 +244,14 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
     try:
         whole = not interrupted.is_set() and stats.tiles_done == stats.tiles_total
         if not whole:  # what finishing it needs, beside the picture (cli/tile_state.py)
-            from .tile_state import TileState, save_state
+            from .tile_state import TileState, foreign, save_state
 
-            save_state(finish.state, TileState(finish.digest, job.tiles_finished.copy(),
-                                               job.framebuffer))
+            if foreign(finish.state):  # a file of someone else's by that name: kept
+                err.line(f"warning: {finish.state} is not whitted's: the tiles are kept in "
+                         f"{output} only (--continue cannot finish it)")
+            else:
+                save_state(finish.state, TileState(finish.digest, job.tiles_finished.copy(),
+                                                   job.framebuffer))
         if frame is not None and whole and plain and bit_depth == 8 \
                 and image_format(output) == "png":  # the very file the film's frame K is
             from ..animation.frames import frame_digest, write_frame_png

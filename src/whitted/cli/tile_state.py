@@ -23,7 +23,7 @@ import numpy as np
 from ..errors import WhittedError
 from ..files import atomic_write
 
-__all__ = ["TileState", "job_digest", "load_state", "remove_state", "save_state",
+__all__ = ["TileState", "foreign", "job_digest", "load_state", "remove_state", "save_state",
            "state_path"]
 
 SUFFIX = ".whitted-tiles"
@@ -97,8 +97,25 @@ def load_state(path: Path, max_bytes: int) -> TileState | None:
     return state
 
 
+def foreign(path: Path) -> bool:
+    """Whether something other than a tile state of whitted's is at ``path`` (a file of
+    someone else's that whitted neither writes over nor removes)."""
+    if not path.exists() and not path.is_symlink():
+        return False
+    try:
+        with open(path, "rb") as f:
+            head = f.read(4096)
+    except OSError:
+        return True
+    # a zip (np.savez) whose first member is the magic string's array
+    return not (head.startswith(b"PK") and b"magic.npy" in head)
+
+
 def remove_state(path: Path) -> None:
+    """Remove the state file, when it is one of whitted's."""
     import contextlib
 
+    if foreign(path):
+        return
     with contextlib.suppress(FileNotFoundError, IsADirectoryError, PermissionError):
         path.unlink()

@@ -403,9 +403,10 @@ def read_image(path: PathLike, *, transfer: str = "srgb") -> np.ndarray:
     """Read an image file as a float32 (H, W, 3) linear array, row 0 at the top.
 
     ``.exr``, ``.pfm`` and ``.npy`` are returned as stored. ``.png`` (8- or 16-bit, any colour
-    type) and ``.jpg``/``.jpeg`` are normalised to [0, 1] and decoded with ``transfer``: the
-    sRGB curve by default, or ``"linear"`` for files holding linear data (e.g. written with
-    ``transfer="linear"``). Grey images are expanded to RGB and alpha is dropped.
+    type), ``.jpg``/``.jpeg``, ``.tif``/``.tiff`` and ``.webp`` are normalised to [0, 1] and
+    decoded with ``transfer``: the sRGB curve by default, or ``"linear"`` for files holding
+    linear data (e.g. written with ``transfer="linear"``). Grey images are expanded to RGB
+    and alpha is dropped.
     """
     check_transfer(transfer)
     fmt = image_format(path)
