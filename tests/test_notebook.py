@@ -470,3 +470,44 @@ def test_render_film_into_a_folder_makes_the_film_in_memory(tmp_path, examples_d
                                frames=[0, 1], width=16, height=10, fps=2, live=False)
     assert film.path is None and film.frames == 2 and film.kind in ("mp4", "gif")
     assert sorted(p.name for p in (tmp_path / "frames").iterdir()) == ["0000.png", "0001.png"]
+
+
+def test_a_script_never_imports_the_widgets():
+    import subprocess
+    import sys
+
+    code = ("import sys, whitted\n"
+            "image = whitted.render(whitted.Scene(), width=4, height=4, threads=1)\n"
+            "print(image.width, 'ipywidgets' in sys.modules, 'IPython' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=600, env={**os.environ, "WHITTED_NOTEBOOK": ""})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["4", "False", "False"]
+    assert out.stderr == ""
+
+
+def test_a_big_film_is_linked_not_embedded(tmp_path, monkeypatch):
+    from whitted.output import inline_film
+
+    film = whitted.film_from_frames(_frames(tmp_path / "frames", n=2), kind="gif")
+    path = film.save(tmp_path / "film.gif")
+    on_disk = whitted.Film(path, frames=2, fps=24, size=(9, 6))
+    monkeypatch.setattr(inline_film, "EMBED_LIMIT", 10)
+    html = on_disk._repr_html_()
+    assert f'src="{path.as_posix()}"' in html and "base64" not in html
+    assert repr(on_disk) == "<Film film.gif: 2 frames at 24 fps, 9x6, 0.1 s>"
+
+
+def test_the_first_compile_shows_in_the_bar(scene, monkeypatch):
+    from whitted.render import RenderJob, warm_up
+
+    job = RenderJob(scene)
+    view = live.LiveRender(job, stop=False)
+    monkeypatch.setattr(warm_up, "compile_progress", lambda: 0.4)
+    view.update()
+    assert view.bar.description == "compiling" and view.bar.value == 40.0
+    assert "compiling the kernels" in view.status.value
+    monkeypatch.setattr(warm_up, "compile_progress", lambda: None)
+    view._next = 0.0
+    view.update()
+    assert "preparing the scene" in view.status.value
