@@ -511,3 +511,9 @@ def test_the_first_compile_shows_in_the_bar(scene, monkeypatch):
     view._next = 0.0
     view.update()
     assert "preparing the scene" in view.status.value
+
+
+def test_render_async_outside_a_notebook_is_the_plain_render(scene, shown):
+    image = asyncio.run(whitted.render_async(scene, live=False))
+    assert shown == []
+    np.testing.assert_array_equal(image.pixels, whitted.render(scene, live=False).pixels)
