@@ -309,6 +309,18 @@ def test_stefan_results_plot_and_balance(tmp_path, shown, examples_dir):
 
     again = load_results(tmp_path / "melt")
     np.testing.assert_array_equal(again.heat_in_J, results.heat_in_J)
+    # a damaged saved state: that time's budget is unknown (NaN), the rest stands
+    (tmp_path / "melt" / "fields" / "state_0001.npz").write_bytes(b"not a state")
+    damaged = load_results(tmp_path / "melt")
+    assert np.isnan(damaged.heat_in_J[1]) and damaged.heat_in_J[2] == results.heat_in_J[2]
+    assert _png(damaged._repr_png_()).size
+    # a damaged series: one line naming the folder
+    from whitted.stefan.case import CaseError
+
+    (tmp_path / "melt" / "series.csv").write_text("time_s,ice_volume_cm3\nzero,1\n")
+    with pytest.raises(CaseError) as info:
+        load_results(tmp_path / "melt")
+    assert "\n" not in str(info.value) and "series.csv" in str(info.value)
 
 
 def test_stefan_results_of_a_folder_without_a_run(tmp_path):
