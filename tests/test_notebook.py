@@ -60,6 +60,9 @@ def test_detection_outside_a_kernel(monkeypatch):
     monkeypatch.setenv("WHITTED_NOTEBOOK", "1")
     monkeypatch.setattr(detect, "widgets_installed", lambda: False)
     assert not detect.in_notebook()  # forced on, but no extra: the plain path
+    assert not detect.live_view(None)
+    with pytest.raises(whitted.WhittedError, match=r"whitted\[notebook\]"):
+        detect.live_view(True)  # asked for by name: one line naming the extra
 
 
 def test_plain_render_outside_a_notebook_shows_nothing(scene, shown):
