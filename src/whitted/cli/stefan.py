@@ -142,7 +142,7 @@ def validate(
     from ..stefan import validate as v
 
     t0 = time.perf_counter()
-    table = Table(title="Similarity constants (root-found) against the quoted reference numbers")
+    table = Table(title="Similarity constants (root-found) against quoted values")
     for col in ("case", "computed", "quoted", "difference"):
         table.add_column(col)
     for r in v.lambda_rows():
@@ -260,7 +260,7 @@ def _check_film_options(case_path: Path, output: Path, gif: Path | None, width: 
     except ValidationError as exc:
         from .app import override_error
 
-        raise _fail(override_error(exc)) from None
+        raise _fail(override_error(exc, {"width": width, "height": height})) from None
     films = [output, *([gif] if gif is not None else [])]
     formats = []
     for option, path in zip(("-o", "--gif"), films, strict=False):

@@ -16,14 +16,13 @@ cell; its face value the mean of the two cells') taken implicitly: u* = (u + dt 
 
 from __future__ import annotations
 
-from .._cache import configure_kernel_cache
+from ..jit import builder, numba_object
 
-configure_kernel_cache()
+#: Numba's parallel range, in the kernels' globals once Numba is loaded (jit/decorators.py)
+prange = numba_object("numba", "prange")
 
-from numba import njit, prange  # noqa: E402
 
-
-@njit(cache=True, parallel=True, error_model="numpy")
+@builder(parallel=True, error_model="numpy")
 def predict(q, p, r, nu, dt, dx, force, sink, out, flat):
     """``out`` = the predicted component ``q`` (along axis 0 of these views; ``p`` and ``r``
     the components along axes 1 and 2) after one explicit step of advection, diffusion,
@@ -66,7 +65,7 @@ def predict(q, p, r, nu, dt, dx, force, sink, out, flat):
             out[n0, j, k] = 0.0
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@builder(parallel=True, error_model="numpy")
 def divergence(u, v, w, dx, out, flat):
     """The net outflow of each cell over dx (1/s)."""
     n0, n1, n2 = out.shape
@@ -79,7 +78,7 @@ def divergence(u, v, w, dx, out, flat):
                 out[i, j, k] = d / dx
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@builder(parallel=True, error_model="numpy")
 def correct(u, v, w, phi, dt, dx, flat):
     """u -= dt grad(phi) on the interior faces (the projection's correction)."""
     n0, n1, n2 = phi.shape
@@ -95,7 +94,7 @@ def correct(u, v, w, phi, dt, dx, flat):
                     w[i, j, k] -= g * (phi[i, j, k] - phi[i, j, k - 1])
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@builder(parallel=True, error_model="numpy")
 def temperature_step(T, u, v, w, alpha, dt, dx, t_low, t_high, out, flat):
     """One explicit step of dT/dt + div(u T) = alpha lap T in the box: the walls across axis
     0 held at ``t_low`` (first) and ``t_high`` (last), the others adiabatic; central fluxes
@@ -131,7 +130,7 @@ def temperature_step(T, u, v, w, alpha, dt, dx, t_low, t_high, out, flat):
                 out[i, j, k] = tc + g * s
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@builder(parallel=True, error_model="numpy")
 def advect_enthalpy(H, box0, u, v, w, frac, heat, dt, dx, flat, out):
     """The liquid's sensible heat carried across the faces of the box (first upwind: the
     heat ``heat`` (J/m³, per cell of the box) of the cell the flow comes from, through a face

@@ -17,6 +17,8 @@ from .properties import Properties
 from .solver import Air, EnthalpySolver, Faces
 
 AXES = ("x", "y", "z")
+#: Published similarity constants to check the root-finding against (one phase: lambda for
+#: each Stefan number; two phase: +10 °C wall, -10 °C ice, front after 1 h)
 QUOTED_ONE_PHASE = {0.1: 0.220016, 1.0: 0.620063}
 QUOTED_TWO_PHASE = {"lambda": 0.2089, "front_mm": 9.14}  # +10 °C wall, -10 °C ice, 1 h
 
@@ -72,7 +74,7 @@ def neumann_run(props: Properties, wall: float, initial: float, t_end: float, dx
 
 
 def lambda_rows(props: Properties | None = None) -> list[dict]:
-    """The similarity constants, root-found, beside the quoted reference numbers."""
+    """The similarity constants, root-found, beside the quoted values."""
     props = props or Properties()
     rows = []
     for st, quoted in QUOTED_ONE_PHASE.items():
@@ -109,7 +111,7 @@ def convergence_rows(props: Properties | None = None, t_end: float = 3600.0,
     return rows
 
 
-#: Three independent 1-D cases: (wall °C, initial ice °C); 0 °C ice is the one-phase case
+#: Three further independent 1-D cases: (wall °C, initial ice °C); 0 °C ice is the one-phase case
 MORE_CASES = ((25.0, -3.0), (3.0, -20.0), (15.0, 0.0))
 
 
