@@ -322,6 +322,10 @@ class RenderJob:
         and transfer (sRGB by default), tiles not rendered yet black."""
         return self.partial_image().to_srgb8()
 
+    def _repr_png_(self) -> bytes:
+        """The picture so far, for a notebook's rich display."""
+        return self.partial_image()._repr_png_()
+
     def __repr__(self) -> str:
         s = self.settings
         state = f"failed: {self.error!r}" if self.failed else str(self._state)
