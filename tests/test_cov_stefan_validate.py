@@ -1,4 +1,4 @@
-"""stefan/validate.py: the similarity constants beside the issue's numbers, and the plot of the
+"""stefan/validate.py: the similarity constants beside the quoted values, and the plot of the
 computed front beside the exact one."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ def test_lambda_rows_match_the_issues_numbers():
     assert list(rows) == ["one phase, St = 0.1", "one phase, St = 1",
                           "two phase, +10 / -10 °C", "two phase front after 1 h (mm)"]
     # the one-phase constants are quoted to 6 digits; the two-phase ones (0.2089, 9.14 mm)
-    # differ from the root, 0.20908, within the issue's rounding of the properties
+    # differ from the root, 0.20908, within the rounding of the quoted properties
     assert rows["one phase, St = 0.1"]["lambda"] == pytest.approx(0.220016, abs=1e-6)
     assert rows["one phase, St = 1"]["lambda"] == pytest.approx(0.620063, abs=1e-6)
     assert rows["two phase, +10 / -10 °C"]["lambda"] == pytest.approx(0.2089, abs=2e-4)

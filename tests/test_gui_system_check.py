@@ -1,5 +1,5 @@
 """``whitted gui`` on a Linux desktop without Qt's X11 libraries: one line naming what to
-install, before Qt starts (issue 14, defect 8)."""
+install, before Qt starts; without a display, one line naming what to set."""
 
 from __future__ import annotations
 
@@ -57,3 +57,31 @@ def test_the_command_stops_before_qt(tmp_path):
     assert status == "2" and qt == "False"
     assert output.count("\n") == 1 and "libxcb-cursor0" in output
 
+
+
+def test_no_display_is_one_line():
+    from whitted.gui.system_check import no_display
+
+    line = no_display({}, "linux")
+    assert line is not None and "\n" not in line and "DISPLAY" in line and "xvfb" in line
+    assert display_problem({}, "linux", cache_without()) == line
+    assert no_display({"QT_QPA_PLATFORM": "xcb"}, "linux") == line
+    assert no_display({"QT_QPA_PLATFORM": "wayland", "DISPLAY": ":0"}, "linux") == line
+    assert no_display({"DISPLAY": ":0"}, "linux") is None
+    assert no_display({"WAYLAND_DISPLAY": "wayland-0"}, "linux") is None
+    assert no_display({"QT_QPA_PLATFORM": "offscreen"}, "linux") is None
+    assert no_display({}, "darwin") is None and no_display({}, "win32") is None
+
+
+def test_the_command_without_a_display_exits_2_before_qt():
+    """The real command in a fresh process with no display: exit 2, one line on stderr, no
+    Qt abort (SIGABRT, exit 134)."""
+    import os
+
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("DISPLAY", "WAYLAND_DISPLAY", "QT_QPA_PLATFORM")}
+    done = subprocess.run([sys.executable, "-m", "whitted", "gui"], capture_output=True,
+                          text=True, env=env, timeout=120)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.count("\n") == 1 and "DISPLAY" in done.stderr
+    assert "xvfb" in done.stderr and done.stdout == ""

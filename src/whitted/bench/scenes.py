@@ -26,7 +26,7 @@ class BenchScene:
     file: str
     description: str
     quick: bool = True  # part of `whitted bench --quick` (with small versions of big models)
-    mesh_bench: bool = False  # one of the mesh benchmarks (issue 18); mesh1m is one too
+    mesh_bench: bool = False  # one of the mesh benchmarks; mesh1m is one too
 
     @property
     def meshes(self) -> bool:

@@ -19,6 +19,7 @@ from .app import (
     load_scene_argument,
     out,
     override_error,
+    with_options,
 )
 from .farm import ClusterOption, SchedulerOption, animate_on_farm
 from .interrupt import InterruptGuard
@@ -66,8 +67,8 @@ def animate(
     try:
         scene, name = load_scene_argument(scene_path)
         scene = apply_set_options(scene, set_values)
-        scene = scene.with_settings(width=width, height=height, samples=samples,
-                                    max_depth=max_depth, threads=threads, seed=seed)
+        scene = with_options(scene, width=width, height=height, samples=samples,
+                             max_depth=max_depth, threads=threads, seed=seed)
         chosen = parse_frame_range(frames, scene.frame_count)
         plan = prepare_film(scene, output, frames=chosen, fps=fps, crf=crf,
                             scene_path=scene_path,
@@ -77,9 +78,7 @@ def animate(
     except ValidationError as exc:
         raise fail(override_error(exc)) from None
     if cluster is not None or scheduler is not None:  # frames on a Dask cluster (cli/farm.py)
-        plan.paths.frames.mkdir(exist_ok=True)
-        animate_on_farm(scene, chosen, plan.paths.frames, plan.paths.film, fps=plan.fps,
-                        crf=plan.crf, force=force, quiet=quiet, cluster=cluster,
+        animate_on_farm(scene, plan, force=force, quiet=quiet, cluster=cluster,
                         scheduler=scheduler, threads=threads)
 
     cancel = CancelToken()

@@ -24,6 +24,7 @@ from .app import (
     override_error,
     resume_collector,
     save_npy,
+    with_options,
     with_scene_key,
 )
 from .console import err, out
@@ -72,6 +73,9 @@ def render(
 ) -> None:
     """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG).
     An animated scene renders frame 0, or the frame --frame names."""
+    from .. import marks
+
+    marks.mark("command")  # the imports and the command line's parsing are done
     from pydantic import ValidationError
 
     from ..output.formats import check_bit_depth, image_format
@@ -92,13 +96,12 @@ def render(
         scene = apply_set_options(scene, set_values)
     except WhittedError as exc:
         raise fail(str(exc)) from None
+    scene = with_options(scene, width=width, height=height, samples=samples,
+                         max_depth=max_depth, threads=threads, seed=seed, transfer=transfer)
     try:
-        scene = scene.with_settings(width=width, height=height, samples=samples,
-                                    max_depth=max_depth, threads=threads, seed=seed,
-                                    transfer=transfer)
         if frame is not None or scene.is_animated:
             scene = scene.at_frame(frame or 0)
-    except ValidationError as exc:  # a command-line override out of range
+    except ValidationError as exc:
         raise fail(override_error(exc)) from None
     except WhittedError as exc:
         raise fail(str(exc)) from None
@@ -131,11 +134,12 @@ def render(
 
 def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
                       guard: InterruptGuard, process_start, frame: int | None) -> None:
+    from .. import marks
     from ..output.formats import image_format
     from ..render.api import render_aovs
 
     interrupted = guard.event
-
+    marks.mark("job")
     try:
         _run_with_progress(job, quiet, interrupted)
     except WhittedError as exc:  # a model or texture file the scene names is unusable
@@ -150,6 +154,7 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
                          "unchanged)")
     image = job.image
     assert image is not None
+    marks.mark("rendered")
     for warning in stats.warnings:
         err.line(f"warning: {warning}")
     written = [str(output)]
@@ -174,6 +179,14 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
     stats.wall_seconds = time.perf_counter() - process_start
     if not quiet or interrupted.is_set():
         out.line(f"{stats.summary()} -> {', '.join(written)}")
+    if marks.enabled():  # whitted bench --startup: the moments, and the job's own figures
+        marks.note("build", stats.build_seconds)
+        marks.note("kernels", stats.compile_seconds)
+        marks.note("render", stats.render_seconds)
+        if stats.photons is not None:
+            marks.note("photons", stats.photons.seconds)
+        marks.mark("written")
+        marks.write()
     if interrupted.is_set():  # (a signal may have come during the write)
         raise guard.exit(f"kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")
 

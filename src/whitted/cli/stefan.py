@@ -142,7 +142,7 @@ def validate(
     from ..stefan import validate as v
 
     t0 = time.perf_counter()
-    table = Table(title="Similarity constants (root-found) against the issue's numbers")
+    table = Table(title="Similarity constants (root-found) against quoted values")
     for col in ("case", "computed", "quoted", "difference"):
         table.add_column(col)
     for r in v.lambda_rows():
@@ -163,7 +163,7 @@ def validate(
                       f"{r['far_change']:.1e}", f"{r['energy_rel']:.1e}")
     out.print(table)
 
-    table = Table(title=f"Three more 1-D cases (issue 30) after {t_end:.0f} s")
+    table = Table(title=f"Three more 1-D cases after {t_end:.0f} s")
     for col in ("case", "dx (mm)", "steps", "front (mm)", "exact (mm)", "error", "order",
                 "energy (rel.)"):
         table.add_column(col, justify="right")
@@ -189,6 +189,19 @@ def validate(
     for r in v.enclosure_rows():
         table.add_row(f"{r['ra']:.0e}", f"{r['benchmark']:.3f}", f"{r['model']:.3f}",
                       f"{r['error_pct']:+.1f} %", "yes" if r["in_range"] else "below (Nu = 1)")
+    out.print(table)
+
+    grids = (32, 64, 128) if full else (32,)
+    table = Table(title="The flow solver on de Vahl Davis's square cavity (Pr 0.71; reference, "
+                  "whitted, error)")
+    for col in ("Ra", "grid", "Nu ref", "Nu", "error", "u_max ref", "u_max", "error",
+                "v_max ref", "v_max", "error"):
+        table.add_column(col, justify="right")
+    for r in v.flow_cavity_rows(grids):
+        table.add_row(f"{r['ra']:.0e}", r["grid"], f"{r['nu_ref']:.3f}", f"{r['nu']:.4f}",
+                      f"{r['nu_error_pct']:+.2f} %", f"{r['u_ref']:.3f}", f"{r['u_max']:.3f}",
+                      f"{r['u_error_pct']:+.2f} %", f"{r['v_ref']:.3f}", f"{r['v_max']:.3f}",
+                      f"{r['v_error_pct']:+.2f} %")
     out.print(table)
 
     slab = v.convective_slab()
@@ -247,7 +260,7 @@ def _check_film_options(case_path: Path, output: Path, gif: Path | None, width: 
     except ValidationError as exc:
         from .app import override_error
 
-        raise _fail(override_error(exc)) from None
+        raise _fail(override_error(exc, {"width": width, "height": height})) from None
     films = [output, *([gif] if gif is not None else [])]
     formats = []
     for option, path in zip(("-o", "--gif"), films, strict=False):

@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import math
 import os
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -429,6 +430,11 @@ class _PovWriter:
             if isinstance(child, CSG):
                 children.append(self.csg(index, child, mat, top=False))
                 continue
+            if isinstance(child, Mesh):  # POV-Ray takes a closed mesh2 in CSG
+                lines, _ = self.mesh2(child, mat)
+                children.append("\n".join([*lines, *self.body_lines(None, None,
+                                                                      child.transform)]) + "\n}")
+                continue
             body, _, uv, placement = self.primitive(index, child)
             lines = [body, f"  texture {{ {self.texture_name(mat, uv)}{placement} }}",
                      *self.body_lines(None, None, child.transform)]
@@ -498,6 +504,16 @@ class _PovWriter:
         return body, solid, uv, placement
 
     def mesh(self, index: int, obj: Mesh) -> str:
+        lines, material = self.mesh2(obj, None, index)
+        lines += self.body_lines(material if obj.solid else None, material, obj.transform)
+        return _labelled(index, obj) + "\n".join(lines) + "\n}"
+
+    def mesh2(self, obj: Mesh, material: Material | None,
+              index: int | None = None) -> tuple[list[str], Material]:
+        """The lines of a ``mesh2`` block up to its texture (the block left open), and the
+        material that fills it. ``material``: one material for every triangle (a mesh in
+        CSG, which whitted shades with its child's or the CSG object's material); None: the
+        object's own, or the file's per triangle."""
         parts = mesh_parts(self.scene, obj)
         normals = parts.normals
         if obj.smooth is False:
@@ -513,8 +529,8 @@ class _PovWriter:
         if parts.uvs is not None:
             block = _vector_block(parts.uvs, False)
             out.append(f"  uv_vectors {{ {len(parts.uvs)},\n{block}\n  }}")
-        per_face = (obj.material is None and parts.face_material is not None
-                    and len(parts.materials) > 1)
+        per_face = (material is None and obj.material is None
+                    and parts.face_material is not None and len(parts.materials) > 1)
         if per_face:
             names = [self.texture_name(m, True) for m in parts.materials]
             out.append(f"  texture_list {{ {len(names)}, "
@@ -530,11 +546,11 @@ class _PovWriter:
             candidates = [m for m in parts.materials if m.kt > 0.0] or parts.materials[:1]
             material = candidates[0]
         else:
-            material = (self.scene.material_of(index) if obj.material is not None or
-                        not parts.materials else parts.materials[0])
+            if material is None:
+                material = (self.scene.material_of(index) if obj.material is not None or
+                            not parts.materials else parts.materials[0])
             out.append(f"  texture {{ {self.texture_name(material, True)} }}")
-        out += self.body_lines(material if obj.solid else None, material, obj.transform)
-        return _labelled(index, obj) + "\n".join(out) + "\n}"
+        return out, material
 
     def write(self, source: str | None) -> str:
         r = self.scene.render
@@ -542,8 +558,7 @@ class _PovWriter:
         body += [t for t in (self.light(light) for light in self.scene.lights) if t]
         shapes = [self.shape(i, obj) for i, obj in enumerate(self.scene.objects)]
         header = [
-            "// POV-Ray 3.7 scene written by whitted"
-            + (f" from {source}" if source else ""),
+            WHITTED_HEADER + (f" from {source}" if source else ""),
             f"// render: povray +I<this file> +W{self.width} +H{self.height} "
             f"{povray_antialias_options(self.scene)} +FN"
             + (" File_Gamma=1.0" if r.transfer == "linear" else "")
@@ -605,19 +620,51 @@ def scene_to_pov(
     return writer.write(source)
 
 
+#: The first line of every file whitted exports (then `` from SOURCE``): how whitted tells
+#: its own exports, which it may replace, from anyone else's files, which it never does.
+WHITTED_HEADER = "// POV-Ray 3.7 scene written by whitted"
+
+
+def written_by_whitted(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` is a file whose first line says whitted wrote it (an export)."""
+    try:
+        with open(path, "rb") as file:
+            start = file.read(len(WHITTED_HEADER) + 1)
+    except OSError:
+        return False
+    return start.decode("utf-8", "replace").startswith(WHITTED_HEADER)
+
+
+def foreign_file(path: str | os.PathLike[str]) -> bool:
+    """Whether something that whitted did not export is at ``path`` (a file of someone
+    else's, which an export must not replace unless asked to). A folder, a device or a pipe
+    is left to the output checks, which refuse them whatever is asked."""
+    try:
+        status = os.stat(path)
+    except (OSError, ValueError):
+        return False
+    return stat.S_ISREG(status.st_mode) and not written_by_whitted(path)
+
+
 def export_pov(
     scene: Scene, path: str | os.PathLike[str], *, width: int | None = None,
-    height: int | None = None, source: str | None = None,
+    height: int | None = None, source: str | None = None, force: bool = False,
 ) -> Path:
     """Write the scene as a POV-Ray 3.7 file at ``path`` (atomically). Returns the path.
     :class:`~whitted.errors.OutputError` when ``path`` is the scene file (``source``) or a
-    file the scene reads, or cannot be written."""
+    file the scene reads, or cannot be written, or when a file whitted did not write is
+    there (whitted's exports start with :data:`WHITTED_HEADER`): ``force=True`` replaces
+    that one."""
+    from ..errors import OutputError
     from ..files import atomic_write
     from ..output.safety import check_outputs
 
     path = Path(path)
     source_file = source if source and Path(source).suffix.lower() in (".toml", ".json") else None
     check_outputs([path], scene, source_file)
+    if not force and foreign_file(path):
+        raise OutputError(f"{path}: is not a file whitted exported; it is kept (force=True "
+                          "replaces it)")
     text = scene_to_pov(scene, width=width, height=height, source=source)
     atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
     return path

@@ -33,5 +33,5 @@ def run_editor(scene: Scene | None = None, path: Path | None = None) -> int:
     if path is not None and path.exists():
         window.offer_recovery()
     elif path is None:
-        window.offer_recovery()  # the untitled autosave of a crashed session
+        window.offer_recovery()  # the untitled autosave left by a crashed editor
     return app.exec()

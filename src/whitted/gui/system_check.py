@@ -1,7 +1,8 @@
-"""Before Qt starts: can it open a window here? On Linux, Qt's xcb platform needs a few
-system libraries that a desktop may lack; without them Qt aborts with a long message of its
-own. This finds what is missing (like ``scripts/install-qt-deps.sh --check --desktop``) and
-says in one line what to install. No Qt import here."""
+"""Before Qt starts: can it open a window here? There must be a display (an X11 or Wayland
+server), and on Linux Qt's xcb platform needs a few system libraries that a desktop may lack;
+without either, Qt aborts the process with a long message of its own. This finds what is
+missing (like ``scripts/install-qt-deps.sh --check --desktop``) and says in one line what to
+set or install. No Qt import here."""
 
 from __future__ import annotations
 
@@ -58,10 +59,33 @@ def missing_libraries(cache: str) -> list[str]:
     return [lib for lib in XCB_LIBRARIES if lib not in present]
 
 
+def no_display(environ=os.environ, platform: str = sys.platform) -> str | None:
+    """One line saying what to set when Qt has no display to open a window on (Linux and the
+    BSDs: no ``DISPLAY`` for X11, no ``WAYLAND_DISPLAY`` for Wayland), or None. Qt itself
+    would abort the process (SIGABRT) with a message of several lines."""
+    if platform.startswith(("darwin", "win", "cygwin")):
+        return None
+    chosen = environ.get("QT_QPA_PLATFORM", "").split(";")[0].split(":")[0]
+    if chosen and chosen not in ("xcb", "wayland", "wayland-egl"):
+        return None  # offscreen, vnc, eglfs, linuxfb...: no display server needed
+    if chosen == "xcb" and environ.get("DISPLAY"):
+        return None
+    if chosen.startswith("wayland") and environ.get("WAYLAND_DISPLAY"):
+        return None
+    if not chosen and (environ.get("DISPLAY") or environ.get("WAYLAND_DISPLAY")):
+        return None
+    return ("the editor needs a display and there is none here (DISPLAY and WAYLAND_DISPLAY "
+            "are unset): run it on a desktop, over `ssh -X`, or under a virtual display "
+            "(`sudo apt-get install xvfb`, then `xvfb-run whitted gui`)")
+
+
 def display_problem(environ=os.environ, platform: str = sys.platform,
                     cache: str | None = None) -> str | None:
-    """One line saying what to install for Qt to open a window here, or None when nothing is
-    missing (or it cannot be told)."""
+    """One line saying what to set or install for Qt to open a window here, or None when
+    nothing is missing (or it cannot be told)."""
+    problem = no_display(environ, platform)
+    if problem is not None:
+        return problem
     if not uses_xcb(environ, platform):
         return None
     cache = library_cache() if cache is None else cache

@@ -52,6 +52,16 @@ def _local_points(obj) -> np.ndarray | None:
         r = obj.radius if t == "cylinder" else max(obj.radius, obj.top_radius or 0.0)
         b, top = np.asarray(obj.base, np.float64), np.asarray(obj.top, np.float64)
         return np.array([b - r, b + r, top - r, top + r])
+    if t == "torus":
+        a = obj.major_radius + obj.minor_radius
+        return np.array([(-a, -obj.minor_radius, -a), (a, obj.minor_radius, a)])
+    if t == "csg":  # the children's boxes, in the CSG object's space
+        boxes = [b for c in obj.objects if (b := item_bounds(c, None)) is not None]
+        if not boxes:
+            return None
+        lo, hi = np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
+        return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                         for z in (lo[2], hi[2])])
     return None
 
 
@@ -60,11 +70,13 @@ def object_bounds(scene: Scene, index: int) -> tuple[np.ndarray, np.ndarray] | N
     return item_bounds(scene.objects[index], scene)
 
 
-def item_bounds(obj, scene: Scene) -> tuple[np.ndarray, np.ndarray] | None:
+def item_bounds(obj, scene: Scene | None) -> tuple[np.ndarray, np.ndarray] | None:
     """World-space box (lo, hi) around ``obj`` (its files found from ``scene``'s folder)."""
     pts = _local_points(obj)
     if pts is None and obj.type == "mesh":
         try:
+            if scene is None and obj.file is not None:
+                return None
             if obj.file is not None:
                 from ..assets import load_mesh
 

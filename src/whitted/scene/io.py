@@ -16,10 +16,10 @@ from pydantic import ValidationError
 
 from ..errors import ArgumentError, SceneError, shorten
 from ..files import path_problem, read_limited
+from .file_names import named_files
 from .messages import format_path, json_line, scene_error, toml_line
 from .scene import Scene
 from .types import MAX_MAGNITUDE
-from .writing import named_files
 
 SCENE_SUFFIXES = (".toml", ".json")
 
@@ -193,6 +193,13 @@ def _check_values(data: Any, keys: list[str | int], name: str | None, text: str,
                 shown = shorten(repr(node), 24)
                 raise error(f"number {shown} is too large (scene values are limited to "
                             f"{MAX_MAGNITUDE:.0e} in magnitude)")
+
+
+def check_value_numbers(value: Any, keys: list[str | int]) -> None:
+    """What a scene file's reader checks of every number, for one value that lands at
+    ``keys`` (a ``--set`` or sweep value): SceneError naming the key (``camera.position[1]:
+    number 1e+20 is too large ...``), so that the message is the file's."""
+    _check_values(value, list(keys), None, "", ".toml")
 
 
 def _json_key_line(text: str, key: str) -> int | None:

@@ -72,7 +72,7 @@ def describe_validation_error(exc: ValidationError,
 
 def scene_error(
     exc: ValidationError, file: str | None, text: str | None, data: Any = None,
-    root: type[BaseModel] | None = None,
+    root: Any = None,
 ) -> SceneError:
     errors = exc.errors()
     # Unions report one error per member; the deepest location is the informative one.
@@ -129,8 +129,15 @@ def clean_message(error: dict[str, Any]) -> str:
         in_list = bool(error["loc"]) and isinstance(error["loc"][-1], int)
         return "missing list item" if in_list else "missing required value"
     if kind == "union_tag_invalid":
-        tag = error.get("input", {}).get("type") if isinstance(error.get("input"), dict) else None
+        given = error.get("input")
         expected = error.get("ctx", {}).get("expected_tags", "")
+        if isinstance(given, BaseModel):  # a whole object of the wrong kind (Python)
+            name = shorten(type(given).__name__, 40)
+            if name.endswith("Light"):
+                return (f"a {name} is a light, not a shape (lights go in the scene's "
+                        f"lights; expected one of {expected})")
+            return f"a {name} cannot go here (expected one of {expected})"
+        tag = given.get("type") if isinstance(given, dict) else None
         shown = shorten(repr(tag), 40)
         return f"unknown type {shown} (expected one of {expected})"
     if kind == "union_tag_not_found":
@@ -159,7 +166,7 @@ def _short(value: Any) -> bool:
     return isinstance(value, int | float | str | bool) and len(repr(value)) <= 40
 
 
-def known_keys_hint(keys: list[str | int], data: Any, root: type[BaseModel]) -> str:
+def known_keys_hint(keys: list[str | int], data: Any, root: Any) -> str:
     """`` (did you mean 'radius'?)`` for a misspelt key, else the keys that are allowed there."""
     if not keys or not isinstance(keys[-1], str):
         return ""
@@ -175,11 +182,13 @@ def known_keys_hint(keys: list[str | int], data: Any, root: type[BaseModel]) -> 
     return ""
 
 
-def _allowed_keys(parent: list[str | int], data: Any, root: type[BaseModel]) -> list[str]:
-    """The keys the scene model accepts at ``parent`` (a cleaned location), or [] if unknown."""
-    models: list[type[BaseModel]] = [root]
+def _allowed_keys(parent: list[str | int], data: Any, root: Any) -> list[str]:
+    """The keys the scene model accepts at ``parent`` (a cleaned location), or [] if unknown.
+    ``root``: a model class, or an annotation naming models (the shapes' union)."""
+    models: list[type[BaseModel]] = _models_in(root)
     node = data
-    container = False  # the next key indexes a list or names a dict entry
+    # the next key indexes a list or names a dict entry
+    container = typing.get_origin(root) in (list, dict)
     for key in parent:
         node = _child(node, key)
         if container:

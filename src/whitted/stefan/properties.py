@@ -1,6 +1,6 @@
 """Material properties of ice and liquid water near 0 °C (SI units), with their sources.
 
-The defaults are the values the issue names and the two-phase validation uses:
+The defaults are the values the two-phase validation uses:
 
 ========================  ==========  ====================================================
 quantity                  value       source
@@ -9,7 +9,7 @@ ice density               917 kg/m³   Engineering ToolBox, "Ice - Thermal Prope
                                       (0 °C); CRC Handbook of Chemistry and Physics
 ice heat capacity         2100 J/kgK  Engineering ToolBox (2.09 kJ/kgK at 0 °C, rounded)
 ice conductivity          2.14 W/mK   Engineering ToolBox, "Ice - Thermal Properties"
-                                      (2.22 at 0 °C; 2.14 is the value the issue quotes)
+                                      (2.22 at 0 °C; 2.14 is the value commonly quoted)
 water density             1000 kg/m³  CRC Handbook (999.8 kg/m³ at 0 °C)
 water heat capacity       4220 J/kgK  CRC Handbook (4.219 kJ/kgK at 0 °C)
 water conductivity        0.56 W/mK   CRC Handbook (0.561 W/mK at 0 °C)

@@ -17,8 +17,10 @@ from .properties import Properties
 from .solver import Air, EnthalpySolver, Faces
 
 AXES = ("x", "y", "z")
-ISSUE_ONE_PHASE = {0.1: 0.220016, 1.0: 0.620063}
-ISSUE_TWO_PHASE = {"lambda": 0.2089, "front_mm": 9.14}  # +10 °C wall, -10 °C ice, 1 h
+#: Published similarity constants to check the root-finding against (one phase: lambda for
+#: each Stefan number; two phase: +10 °C wall, -10 °C ice, front after 1 h)
+QUOTED_ONE_PHASE = {0.1: 0.220016, 1.0: 0.620063}
+QUOTED_TWO_PHASE = {"lambda": 0.2089, "front_mm": 9.14}  # +10 °C wall, -10 °C ice, 1 h
 
 
 def line_shape(n: int, axis: int, width: int = 1) -> tuple[int, int, int]:
@@ -72,21 +74,21 @@ def neumann_run(props: Properties, wall: float, initial: float, t_end: float, dx
 
 
 def lambda_rows(props: Properties | None = None) -> list[dict]:
-    """The similarity constants, root-found, beside the issue's numbers."""
+    """The similarity constants, root-found, beside the quoted values."""
     props = props or Properties()
     rows = []
-    for st, quoted in ISSUE_ONE_PHASE.items():
+    for st, quoted in QUOTED_ONE_PHASE.items():
         lam = exact.one_phase_lambda(st)
         rows.append({"case": f"one phase, St = {st:g}", "lambda": lam, "quoted": quoted,
                      "difference": lam - quoted})
     lam = exact.two_phase_lambda(props, 10.0, -10.0)
     front = float(exact.front(lam, props, 3600.0)) * 1e3
-    quoted = ISSUE_TWO_PHASE["lambda"]
+    quoted = QUOTED_TWO_PHASE["lambda"]
     rows.append({"case": "two phase, +10 / -10 °C", "lambda": lam, "quoted": quoted,
                  "difference": lam - quoted})
     rows.append({"case": "two phase front after 1 h (mm)", "lambda": front,
-                 "quoted": ISSUE_TWO_PHASE["front_mm"],
-                 "difference": front - ISSUE_TWO_PHASE["front_mm"]})
+                 "quoted": QUOTED_TWO_PHASE["front_mm"],
+                 "difference": front - QUOTED_TWO_PHASE["front_mm"]})
     return rows
 
 
@@ -109,7 +111,7 @@ def convergence_rows(props: Properties | None = None, t_end: float = 3600.0,
     return rows
 
 
-#: Issue 30's independent 1-D cases: (wall °C, initial ice °C); 0 °C ice is the one-phase case
+#: Three further independent 1-D cases: (wall °C, initial ice °C); 0 °C ice is the one-phase case
 MORE_CASES = ((25.0, -3.0), (3.0, -20.0), (15.0, 0.0))
 
 
@@ -228,6 +230,42 @@ def enclosure_rows() -> list[dict]:
                      "formula_error_pct": 100.0 * (formula / nu - 1.0),
                      "in_range": x > 1.0e3})
     return rows
+
+
+def flow_cavity_rows(grids: tuple[int, ...] = (32,), ras: tuple[float, ...] = (1e3, 1e4, 1e5, 1e6),
+                     progress=None) -> list[dict]:
+    """The flow solver (:mod:`whitted.stefan.flow`) on de Vahl Davis's square cavity at each
+    Ra and grid: mean Nusselt number and the centre lines' velocity maxima against the
+    benchmark, their errors; with two grids or more, the Richardson extrapolation of the
+    last two (second order: (4 f_fine - f_coarse) / 3) as a row of its own."""
+    from .flow import DE_VAHL_DAVIS, heated_cavity
+
+    rows = []
+    for ra in ras:
+        ref = DE_VAHL_DAVIS[ra]
+        found = []
+        for n in grids:
+            r = heated_cavity(ra, n)
+            if progress is not None:
+                progress(ra, n, r)
+            found.append(r)
+            rows.append(_cavity_row(ra, f"{n}²", r.nu, r.u_max, r.v_max, ref, r.steps,
+                                    r.seconds))
+        if len(found) >= 2 and found[-1].cells == 2 * found[-2].cells:
+            a, b = found[-2], found[-1]
+            ext = [(4.0 * getattr(b, q) - getattr(a, q)) / 3.0 for q in ("nu", "u_max", "v_max")]
+            rows.append(_cavity_row(ra, f"{a.cells}²/{b.cells}² extrapolated", *ext, ref,
+                                    None, None))
+    return rows
+
+
+def _cavity_row(ra, grid, nu, u_max, v_max, ref, steps, seconds) -> dict:
+    return {"ra": ra, "grid": grid, "nu": nu, "nu_ref": ref["nu"],
+            "nu_error_pct": 100.0 * (nu / ref["nu"] - 1.0), "u_max": u_max,
+            "u_ref": ref["u_max"], "u_error_pct": 100.0 * (u_max / ref["u_max"] - 1.0),
+            "v_max": v_max, "v_ref": ref["v_max"],
+            "v_error_pct": 100.0 * (v_max / ref["v_max"] - 1.0), "steps": steps,
+            "seconds": seconds}
 
 
 def energy_balance(cells: int = 16, t_end: float = 600.0) -> dict:
