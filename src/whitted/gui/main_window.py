@@ -13,8 +13,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from PySide6.QtCore import QSettings, Qt
-from PySide6.QtGui import QAction, QCloseEvent
+from PySide6.QtCore import QSettings, Qt, QTimer
+from PySide6.QtGui import QAction, QCloseEvent, QCursor
 from PySide6.QtWidgets import (
     QApplication,
     QDialog,
@@ -127,8 +127,8 @@ class MainWindow(QMainWindow):
         self.viewport.set_aspect(scene.render.width, scene.render.height)
         self.render_control.update_preview_target()
         if warm_up:
-            self.viewport.caption = "Loading the render kernels (the first run compiles them)…"
             self.controller.warm_up()
+            self.render_control.show_warm_up()
             self.ids.warm_up(self.doc.scene)
         self.navigation.reset()
         self.controller.request_preview(self.shown_scene())
@@ -143,7 +143,32 @@ class MainWindow(QMainWindow):
                          | QDockWidget.DockWidgetFeature.DockWidgetFloatable)
         self.addDockWidget(area, dock)
         self.resizeDocks([dock], [width], Qt.Orientation.Horizontal)
+        if not hasattr(self, "_dock_widths"):
+            self._dock_widths: list[tuple[QDockWidget, int]] = []
+        self._dock_widths.append((dock, width))
         return dock
+
+    def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        super().resizeEvent(event)
+        QTimer.singleShot(0, self.restore_docks)
+
+    def restore_docks(self) -> None:
+        """The panels' widths at the window's largest size are remembered; when the window
+        comes back to that size (after it was made small and the panels squeezed), the
+        panels get those widths back (Qt would give all the new room to the picture)."""
+        docks = [d for d, _ in getattr(self, "_dock_widths", [])]
+        if not docks:
+            return
+        width = self.width()
+        memory = getattr(self, "_dock_memory", None)
+        widths = [d.width() for d in docks]
+        if memory is None or width > memory[0]:
+            self._dock_memory = (width, widths)
+        elif width >= memory[0] - 2:
+            if widths != memory[1] and all(d.isVisible() and not d.isFloating()
+                                           for d in docks):
+                self.resizeDocks(docks, memory[1], Qt.Orientation.Horizontal)
+            self._dock_memory = (width, [d.width() for d in docks])
 
     def _fit_window(self) -> None:
         w, h = WINDOW_SIZE
@@ -163,6 +188,7 @@ class MainWindow(QMainWindow):
         file.insertMenu(self.acts["save"], self.recent_menu)
         self.recent_menu.aboutToShow.connect(self.files.fill_recent)
         add = bar.addMenu("&Add")
+        self.add_menu = add
         bar.insertMenu(menus["Object"].menuAction(), add)
         self.add_object_menu = add.addMenu("&Object")
         self.object_actions: dict[str, QAction] = {}
@@ -311,6 +337,14 @@ class MainWindow(QMainWindow):
 
     def _start_dir(self) -> str:
         return str(self.doc.path.parent if self.doc.path else Path.cwd())
+
+    def show_add_menu(self) -> None:
+        """Shift+A: the Add menu (objects, lights) under the pointer, as Blender's; at the
+        picture's centre when the pointer is not over the window."""
+        pos = QCursor.pos()
+        if not self.rect().contains(self.mapFromGlobal(pos)):
+            pos = self.viewport.mapToGlobal(self.viewport.rect().center())
+        self.add_menu.popup(pos)
 
     def show_controls(self) -> None:
         """Help > Controls: made from the actions table, so it lists every shortcut."""

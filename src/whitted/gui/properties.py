@@ -44,6 +44,7 @@ from .widgets import (
     ChoiceEditor,
     CoefficientEditor,
     ColourEditor,
+    ElidedLabel,
     FieldEditor,
     FieldRow,
     FileEditor,
@@ -99,7 +100,7 @@ class PropertyPanel(QWidget):
         self._signature: object = None
         #: the item this panel shows, and the only one its edits go to
         self.key: tuple | None = None
-        self.title = QLabel(self)
+        self.title = ElidedLabel("", self)
         self.title.setStyleSheet("font-weight: bold; font-size: 11pt;")
         self.scroll = QScrollArea(self)
         self.scroll.setWidgetResizable(True)
@@ -197,7 +198,15 @@ class PropertyPanel(QWidget):
         if key == BACKGROUND:
             return "Background"
         kind = "Light" if key[0] == "lights" else "Object"
-        return f"{kind}: {label_of(item)} ({item.type})"
+        one = f"{kind}: {label_of(item)} ({item.type})"
+        keys = self.doc.selected_keys()
+        if len(keys) < 2:
+            return one
+        counts = [(sum(k[0] == kind for k in keys), word) for kind, word in
+                  (("objects", "object"), ("lights", "light"))]
+        parts = [f"{n} {word}{'s' if n > 1 else ''}" for n, word in counts if n]
+        # the panel edits the active one: say which
+        return f"{' and '.join(parts)} selected · {label_of(item)} ({item.type})"
 
     def _rebuild(self, key: tuple, specs: list[F.Spec]) -> None:
         # the focus must not stay in the old form (a window of its own once taken out of
