@@ -191,6 +191,19 @@ def validate(
                       f"{r['error_pct']:+.1f} %", "yes" if r["in_range"] else "below (Nu = 1)")
     out.print(table)
 
+    grids = (32, 64, 128) if full else (32,)
+    table = Table(title="The flow solver on de Vahl Davis's square cavity (Pr 0.71; reference, "
+                  "whitted, error)")
+    for col in ("Ra", "grid", "Nu ref", "Nu", "error", "u_max ref", "u_max", "error",
+                "v_max ref", "v_max", "error"):
+        table.add_column(col, justify="right")
+    for r in v.flow_cavity_rows(grids):
+        table.add_row(f"{r['ra']:.0e}", r["grid"], f"{r['nu_ref']:.3f}", f"{r['nu']:.4f}",
+                      f"{r['nu_error_pct']:+.2f} %", f"{r['u_ref']:.3f}", f"{r['u_max']:.3f}",
+                      f"{r['u_error_pct']:+.2f} %", f"{r['v_ref']:.3f}", f"{r['v_max']:.3f}",
+                      f"{r['v_error_pct']:+.2f} %")
+    out.print(table)
+
     slab = v.convective_slab()
     out.print(f"convective slab (h = 20 W/m²K, air 20 °C, 3000 s): receded "
               f"{slab['receded_mm']:.4f} mm, h dT t / (rho_i L) = {slab['expected_mm']:.4f} mm, "

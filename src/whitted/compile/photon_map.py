@@ -12,7 +12,6 @@ the gather averages the passes' estimates in one render.
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -267,13 +266,6 @@ def fitted_radius(positions: np.ndarray, guess: float,
     return r
 
 
-def _available_memory() -> int | None:
-    try:
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        return None
-
-
 def check_photon_memory(settings: CausticsSettings, threads: int = 1) -> int:
     """The bytes a photon map of these settings may take (each pass's output slots and
     counts; the photons stored, one per photon shot on average, three copies while the grid
@@ -281,13 +273,41 @@ def check_photon_memory(settings: CausticsSettings, threads: int = 1) -> int:
     :class:`SceneError` naming the key when that is more than half the memory available."""
     need = (settings.photons * (SLOTS * PHOTON_BYTES + 4)
             + settings.photons * settings.passes * (3 * PHOTON_BYTES + 8 + 8))
-    have = _available_memory()
-    if have is not None and need > MEMORY_SHARE * have:
+    from ..files.memory import memory_room
+
+    room = memory_room()
+    if room is not None and need > MEMORY_SHARE * room.bytes:
         raise SceneError(
             f"render.caustics: {settings.photons:,} photons x {settings.passes:,} passes need "
-            f"about {need / 2**30:.1f} GiB of memory, more than half the "
-            f"{have / 2**30:.1f} GiB available (shoot fewer photons or passes)")
+            f"about {need / 2**30:.1f} GiB of memory, more than half of what this process "
+            f"may take: {room.describe()} (shoot fewer photons or passes)")
     return need
+
+
+#: The smallest gather radius, in units in the last place of the photons' float32 positions
+#: at the scene's size: below it no two positions differ by less than the radius, and its
+#: square would underflow the gather's arithmetic (1e-300 squared is 0).
+RADIUS_ULPS = 16
+
+
+def smallest_radius(compiled: CompiledScene) -> float:
+    """The smallest gather radius the scene's size allows (:data:`RADIUS_ULPS`)."""
+    lo, hi = compiled.bounds_min, compiled.bounds_max
+    size = float(max(np.abs(lo).max(), np.abs(hi).max())) if np.all(np.isfinite(lo)) \
+        and np.all(np.isfinite(hi)) else 1.0
+    return RADIUS_ULPS * float(np.spacing(np.float32(max(size, 1.0))))
+
+
+def check_radius(compiled: CompiledScene, settings: CausticsSettings) -> None:
+    """:class:`SceneError` naming ``render.caustics.radius`` when it is set below what the
+    photons' positions can resolve in this scene (0, the default, chooses one)."""
+    if settings.radius == 0.0:
+        return
+    floor = smallest_radius(compiled)
+    if settings.radius < floor:
+        raise SceneError(f"{settings.radius:g} is smaller than the photons' positions can "
+                         f"resolve in this scene (at least {floor:.2g}; 0 chooses one)",
+                         where="render.caustics.radius")
 
 
 @builder
@@ -380,6 +400,7 @@ def photon_lights(compiled: CompiledScene, params: RenderParams, settings: Caust
 
     start = time.perf_counter()
     check_photon_memory(settings, threads)
+    check_radius(compiled, settings)
     stats = stats if stats is not None else PhotonStats()
     targets = caustic_targets(compiled)
     stats.warnings = [f"objects[{i}] reflects or refracts but is unbounded: it casts no "

@@ -420,6 +420,11 @@ class _PovWriter:
             if isinstance(child, CSG):
                 children.append(self.csg(index, child, mat, top=False))
                 continue
+            if isinstance(child, Mesh):  # POV-Ray takes a closed mesh2 in CSG
+                lines, _ = self.mesh2(child, mat)
+                children.append("\n".join([*lines, *self.body_lines(None, None,
+                                                                      child.transform)]) + "\n}")
+                continue
             body, _, uv, placement = self.primitive(index, child)
             lines = [body, f"  texture {{ {self.texture_name(mat, uv)}{placement} }}",
                      *self.body_lines(None, None, child.transform)]
@@ -489,6 +494,16 @@ class _PovWriter:
         return body, solid, uv, placement
 
     def mesh(self, index: int, obj: Mesh) -> str:
+        lines, material = self.mesh2(obj, None, index)
+        lines += self.body_lines(material if obj.solid else None, material, obj.transform)
+        return _labelled(index, obj) + "\n".join(lines) + "\n}"
+
+    def mesh2(self, obj: Mesh, material: Material | None,
+              index: int | None = None) -> tuple[list[str], Material]:
+        """The lines of a ``mesh2`` block up to its texture (the block left open), and the
+        material that fills it. ``material``: one material for every triangle (a mesh in
+        CSG, which whitted shades with its child's or the CSG object's material); None: the
+        object's own, or the file's per triangle."""
         parts = mesh_parts(self.scene, obj)
         normals = parts.normals
         if obj.smooth is False:
@@ -504,8 +519,8 @@ class _PovWriter:
         if parts.uvs is not None:
             block = _vector_block(parts.uvs, False)
             out.append(f"  uv_vectors {{ {len(parts.uvs)},\n{block}\n  }}")
-        per_face = (obj.material is None and parts.face_material is not None
-                    and len(parts.materials) > 1)
+        per_face = (material is None and obj.material is None
+                    and parts.face_material is not None and len(parts.materials) > 1)
         if per_face:
             names = [self.texture_name(m, True) for m in parts.materials]
             out.append(f"  texture_list {{ {len(names)}, "
@@ -521,11 +536,11 @@ class _PovWriter:
             candidates = [m for m in parts.materials if m.kt > 0.0] or parts.materials[:1]
             material = candidates[0]
         else:
-            material = (self.scene.material_of(index) if obj.material is not None or
-                        not parts.materials else parts.materials[0])
+            if material is None:
+                material = (self.scene.material_of(index) if obj.material is not None or
+                            not parts.materials else parts.materials[0])
             out.append(f"  texture {{ {self.texture_name(material, True)} }}")
-        out += self.body_lines(material if obj.solid else None, material, obj.transform)
-        return _labelled(index, obj) + "\n".join(out) + "\n}"
+        return out, material
 
     def write(self, source: str | None) -> str:
         r = self.scene.render
