@@ -312,6 +312,20 @@ def test_stefan_results_plot_and_balance(tmp_path, shown, examples_dir):
 
     again = load_results(tmp_path / "melt")
     np.testing.assert_array_equal(again.heat_in_J, results.heat_in_J)
+    # a run written before series.csv had the budget's columns: from the saved states
+    import csv
+
+    series = tmp_path / "melt" / "series.csv"
+    rows = list(csv.DictReader(io.StringIO(series.read_text())))
+    older = [c for c in rows[0] if c not in ("heat_in_J", "heat_drained_J", "condensed_cm3")]
+    out = io.StringIO()
+    writer = csv.DictWriter(out, fieldnames=older, extrasaction="ignore", lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    series.write_text(out.getvalue())
+    from_states = load_results(tmp_path / "melt")
+    np.testing.assert_allclose(from_states.heat_in_J, results.heat_in_J, rtol=1e-12)
+    np.testing.assert_allclose(from_states.drained_J, results.drained_J, rtol=0, atol=1e-9)
     # a damaged saved state: that time's budget is unknown (NaN), the rest stands
     (tmp_path / "melt" / "fields" / "state_0001.npz").write_bytes(b"not a state")
     damaged = load_results(tmp_path / "melt")
