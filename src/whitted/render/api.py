@@ -7,12 +7,14 @@ cancellable, with progress callbacks.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
+from enum import StrEnum
 
 import numpy as np
 
@@ -65,6 +67,20 @@ def _as_scene(scene: object, what: str = "scene") -> Scene:
         return load_scene(scene)
     raise ArgumentError(f"{what} must be a whitted.Scene or the path of a scene file, "
                         f"got {type(scene).__name__}")
+
+
+class JobState(StrEnum):
+    """Where a :class:`RenderJob` is: not started, running, or how it ended. A str, so
+    ``job.state == "finished"`` reads as well as ``job.state is JobState.FINISHED``."""
+
+    READY = "ready"  # made, not started
+    RUNNING = "running"  # compiling or rendering
+    FINISHED = "finished"  # every tile rendered
+    CANCELLED = "cancelled"  # stopped by its CancelToken: the tiles finished are in the image
+    FAILED = "failed"  # raised: ``job.error`` is what
+
+    def __str__(self) -> str:
+        return self.value
 
 
 class CancelToken:
@@ -168,13 +184,17 @@ def run_lanes(fn: Callable[[int, int], object], lanes: int, pool: ThreadPoolExec
 
 
 def tile_grid(width: int, height: int, tile: int = DEFAULT_TILE,
-              rows: tuple[int, int] | None = None) -> np.ndarray:
+              rows: tuple[int, int] | None = None,
+              region: tuple[int, int, int, int] | None = None) -> np.ndarray:
     """All tiles of the image in row-major order, rows of (x0, y0, x1, y1); only those of the
-    image rows ``rows = (start, stop)`` when given."""
-    y_start, y_stop = (0, height) if rows is None else rows
-    xs = np.arange(0, width, tile)
+    image rows ``rows = (start, stop)`` when given, and only those covering ``region = (x0,
+    y0, x1, y1)`` (pixels, ends excluded), cut to it, when given."""
+    x_start, y_start, x_stop, y_stop = (0, 0, width, height) if region is None else region
+    if rows is not None:
+        y_start, y_stop = max(y_start, rows[0]), min(y_stop, rows[1])
+    xs = np.arange(x_start, x_stop, tile)
     ys = np.arange(y_start, y_stop, tile)
-    grid = [(x, y, min(x + tile, width), min(y + tile, y_stop)) for y in ys for x in xs]
+    grid = [(x, y, min(x + tile, x_stop), min(y + tile, y_stop)) for y in ys for x in xs]
     return np.array(grid, dtype=np.int32).reshape(-1, 4)
 
 
@@ -192,10 +212,18 @@ class RenderJob:
         tile_size: int = DEFAULT_TILE,
         compiled: CompiledScene | None = None,
         rows: tuple[int, int] | None = None,
+        region: tuple[int, int, int, int] | None = None,
+        resume: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> None:
         """``scene``: a Scene (or the path of a scene file); ``threads``: 1..1024, 0 or None
         for the scene's setting (0 there: every core); ``tile_size``: pixels per tile side,
-        1..4096. Bad arguments raise :class:`~whitted.errors.ArgumentError`."""
+        1..4096; ``region``: render only the pixels (x0, y0, x1, y1) (ends excluded) of the
+        full-size image, the rest black; ``resume``: (the tiles already finished, a bool per
+        tile of :attr:`tiles`, and the framebuffer holding them) of an earlier job of the
+        same scene, region and tile size: only the others are rendered, and the image is the
+        one an uninterrupted job makes, byte for byte (a pixel does not depend on the tile or
+        the lane that renders it). Bad arguments raise
+        :class:`~whitted.errors.ArgumentError`."""
         scene = _as_scene(scene)
         if scene.is_animated:  # an animated scene renders as its first frame
             scene = scene.at_frame(0)
@@ -218,7 +246,25 @@ class RenderJob:
         self.rendering = False  # True while tiles are being rendered (after the compile)
         #: render only the image rows [start, stop) (the farm's bands); the other rows stay 0
         self.rows = None if rows is None else _checked_rows(rows, self.settings.height)
+        self.region = None if region is None else _checked_region(
+            region, self.settings.width, self.settings.height)
+        #: the job's tiles, rows of (x0, y0, x1, y1), in the order they are taken
+        self.tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size,
+                               self.rows, self.region)
+        #: which of :attr:`tiles` are finished (kept in the framebuffer)
+        self.tiles_finished = np.zeros(len(self.tiles), bool)
         self.framebuffer = np.zeros((self.settings.height, self.settings.width, 3), np.float32)
+        if resume is not None:
+            finished, framebuffer = resume
+            finished = np.asarray(finished, dtype=bool)
+            if finished.shape != self.tiles_finished.shape or \
+                    np.shape(framebuffer) != self.framebuffer.shape:
+                raise ArgumentError(f"resume: {finished.shape[0] if finished.ndim else 0} "
+                                    f"tiles and a {np.shape(framebuffer)} framebuffer do not "
+                                    f"fit this job's {len(self.tiles)} tiles of a "
+                                    f"{self.framebuffer.shape} image")
+            self.tiles_finished[:] = finished
+            self.framebuffer[:] = framebuffer
         self.stats = RenderStats(
             width=self.settings.width,
             height=self.settings.height,
@@ -227,23 +273,78 @@ class RenderJob:
             max_depth=self.settings.max_depth,
         )
         self.image: Image | None = None
+        #: what the job raised (its state is then FAILED), None otherwise
         self.error: BaseException | None = None
+        self._state = JobState.READY
+        #: tiles rendered so far, of ``tiles_total`` (0 until the tiles are laid out)
+        self.tiles_done = 0
+        self.tiles_total = 0
         self._thread: threading.Thread | None = None
+        self._ended = threading.Event()  # set when the background thread has ended
 
     def cancel(self) -> None:
         self.cancel_token.cancel()
 
+    @property
+    def state(self) -> JobState:
+        """:class:`JobState`: READY, RUNNING, then FINISHED, CANCELLED or FAILED."""
+        return self._state
+
+    @property
+    def finished(self) -> bool:
+        """Every tile was rendered."""
+        return self._state is JobState.FINISHED
+
+    @property
+    def cancelled(self) -> bool:
+        """The job ended because it was cancelled (its image holds the tiles finished)."""
+        return self._state is JobState.CANCELLED
+
+    @property
+    def failed(self) -> bool:
+        """The job raised; :attr:`error` is the exception."""
+        return self._state is JobState.FAILED
+
+    @property
+    def fraction(self) -> float:
+        """The part of the image rendered so far, 0..1 (0 while compiling)."""
+        return self.tiles_done / self.tiles_total if self.tiles_total else 0.0
+
+    def partial_image(self) -> Image:
+        """The picture as it is now, at any time (running or ended): a copy of the
+        framebuffer as an :class:`Image` with the scene's transfer and tone map (tiles not
+        rendered yet are black)."""
+        return Image(self.framebuffer.copy(), transfer=self.settings.transfer,
+                     tonemap=self.settings.tonemap, meta={"stats": self.stats})
+
+    def srgb(self) -> np.ndarray:
+        """The picture as it is now as display values: uint8 (H, W, 3), the scene's tone map
+        and transfer (sRGB by default), tiles not rendered yet black."""
+        return self.partial_image().to_srgb8()
+
+    def _repr_png_(self) -> bytes:
+        """The picture so far, for a notebook's rich display."""
+        return self.partial_image()._repr_png_()
+
+    def __repr__(self) -> str:
+        s = self.settings
+        state = f"failed: {self.error!r}" if self.failed else str(self._state)
+        done = f", {self.tiles_done}/{self.tiles_total} tiles" if self.tiles_total else ""
+        return f"<RenderJob {s.width}x{s.height} {state}{done}>"
+
     def start(self) -> threading.Thread:
         """Run the job on a background thread (once: :class:`JobStateError` when started
         again)."""
-        if self._thread is not None:
+        if self._thread is not None or self._state is not JobState.READY:
             raise JobStateError("this render job was already started (make a new RenderJob)")
 
         def target() -> None:
+            # what it raises is kept in self.error (state FAILED), handed to whoever waits
             try:
-                self.run()
-            except BaseException as exc:  # noqa: BLE001 - handed to whoever joins
-                self.error = exc
+                with contextlib.suppress(BaseException):
+                    self.run()
+            finally:
+                self._ended.set()
 
         self._thread = threading.Thread(target=target, name="whitted-render", daemon=True)
         self._thread.start()
@@ -251,10 +352,10 @@ class RenderJob:
 
     def join(self, timeout: float | None = None) -> bool:
         """Wait for the background thread (if any) without raising its error; True when it
-        has finished."""
+        has finished. (It waits on an event, not ``Thread.join``: a KeyboardInterrupt in the
+        wait leaves the job's state true.)"""
         if self._thread is not None:
-            self._thread.join(timeout)
-            return not self._thread.is_alive()
+            return self._ended.wait(timeout)
         return True
 
     def wait(self, timeout: float | None = None) -> Image | None:
@@ -265,8 +366,7 @@ class RenderJob:
             if self.image is not None:  # finished by run()
                 return self.image
             raise JobStateError("wait() before start(): start the job first (or call run())")
-        self._thread.join(timeout)
-        if self._thread.is_alive():
+        if not self._ended.wait(timeout):
             return None
         if self.error is not None:
             raise self.error
@@ -274,7 +374,7 @@ class RenderJob:
 
     @property
     def running(self) -> bool:
-        return self._thread is not None and self._thread.is_alive()
+        return self._thread is not None and not self._ended.is_set()
 
     def _report(self, done, total, counters, start, chunk, chunk_rays=None) -> None:
         if self.progress is None:
@@ -303,6 +403,22 @@ class RenderJob:
         return lights, stats.photons.seconds
 
     def run(self) -> Image:
+        """Render (blocking) and return the :class:`Image`; a cancelled job returns the
+        tiles it finished (``state`` CANCELLED). What it raises is kept in :attr:`error`
+        (``state`` FAILED) and raised. :class:`JobStateError` when run a second time."""
+        if self._state is not JobState.READY:
+            raise JobStateError("this render job has already run (make a new RenderJob)")
+        self._state = JobState.RUNNING
+        try:
+            image = self._run()
+        except BaseException as exc:
+            self.error = exc
+            self._state = JobState.FAILED
+            raise
+        self._state = JobState.CANCELLED if self.stats.cancelled else JobState.FINISHED
+        return image
+
+    def _run(self) -> Image:
         from ..kernels.tiles import lane_workspace, render_tiles
 
         wall_start = time.perf_counter()
@@ -320,9 +436,10 @@ class RenderJob:
         if self.settings.caustics.photons > 0:  # the photon map (compile/photon_map.py)
             with caustics_compile():  # the first time: compiling, shown as such
                 lights, photon_seconds = self._caustics_stage(compiled, params, stats)
-        tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size, self.rows)
+        tiles = self.tiles
+        todo = np.flatnonzero(~self.tiles_finished)  # all of them, unless resumed
         counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
-        stats.tiles_total = len(tiles)
+        stats.tiles_total = self.tiles_total = len(tiles)
         lanes = self.threads
         antialias = self.settings.antialias
         levels = 0
@@ -341,12 +458,13 @@ class RenderJob:
                                   float(antialias.threshold), levels, 0, 1)
             stats.compile_seconds += time.perf_counter() - start
         render_start = time.perf_counter() - photon_seconds  # shooting photons is rendering
-        done = 0
+        done = len(tiles) - len(todo)
+        self.tiles_done = done
         lock = threading.Lock()
         self.rendering = True
 
         next_tile = 0
-        most_per_call = max(1, -(-len(tiles) // (64 * lanes)))  # ~64 progress updates a lane
+        most_per_call = max(1, -(-len(todo) // (64 * lanes)))  # ~64 progress updates a lane
         tile_seconds = [0.0]  # the last run's seconds a tile (0: none yet)
 
         def take_tiles(n: int) -> np.ndarray:
@@ -358,14 +476,14 @@ class RenderJob:
             made 26 runs a lane of a 1200-tile image, and its two-thread render 7 % slower.)"""
             nonlocal next_tile
             with lock:
-                left = len(tiles) - next_tile
+                left = len(todo) - next_tile
                 size = most_per_call
                 if tile_seconds[0] > 0.0:
                     size = max(size, int(RUN_SECONDS / tile_seconds[0]))
                 count = min(left, size, max(1, left // (2 * n)))
                 start = next_tile
                 next_tile += count
-            return np.arange(start, start + count)
+            return todo[start:start + count]
 
         failed = threading.Event()  # a lane raised: the others stop
 
@@ -406,7 +524,9 @@ class RenderJob:
                 with lock:
                     tile_seconds[0] = (time.perf_counter() - run_start) / len(idx)
                     counters[idx] = part_counters
+                    self.tiles_finished[idx] = True
                     done += len(idx)
+                    self.tiles_done = done
                     self._report(done, len(tiles), counters, render_start, part,
                                  part_counters.sum(axis=1))
 
@@ -427,6 +547,19 @@ class RenderJob:
         self.image = Image(self.framebuffer, transfer=self.settings.transfer,
                            tonemap=self.settings.tonemap, meta={"stats": stats})
         return self.image
+
+
+def _checked_region(region: tuple[int, int, int, int], width: int,
+                    height: int) -> tuple[int, int, int, int]:
+    try:
+        x0, y0, x1, y1 = (_whole_number("region", v, 0, max(width, height)) for v in region)
+    except (TypeError, ValueError):
+        raise ArgumentError(f"region must be (x0, y0, x1, y1) in pixels, got {region!r}") \
+            from None
+    if not (0 <= x0 < x1 <= width and 0 <= y0 < y1 <= height):
+        raise ArgumentError(f"region ({x0}, {y0}, {x1}, {y1}) is not a part of the "
+                            f"{width}x{height} image")
+    return x0, y0, x1, y1
 
 
 def _checked_rows(rows: tuple[int, int], height: int) -> tuple[int, int]:
