@@ -79,3 +79,22 @@ def test_the_flow_keeps_the_energy_and_melts_where_it_goes():
     solver, top, bottom = _melt(3.0)
     assert abs(solver.energy_error()) < 1e-9 * abs(solver.heat_in) + 1e-9
     assert bottom > top
+
+
+def test_the_estimate_counts_the_flow_and_refuses_what_cannot_finish(tmp_path):
+    from whitted.stefan.budget import FLOW_CELL_COST, check, estimate
+
+    eff = estimate(case_from_dict({"grid": {"cells": 48}}))
+    flow = estimate(case_from_dict({"grid": {"cells": 48}, "cavity": {"convection": "flow"}}))
+    assert eff.flow_cells == 0 and flow.flow_cells > 0
+    # the box: the 24 mm cavity and two margins of half the 5 mm shell and two cells, inside
+    # the 50-cell grid
+    assert 30 ** 3 < flow.flow_cells < 50 ** 3
+    assert flow.flow_substeps >= 1
+    assert flow.cell_updates == pytest.approx(
+        (flow.cells + FLOW_CELL_COST * flow.flow_cells * flow.flow_substeps) * flow.steps)
+    huge = case_from_dict({"grid": {"cells": 400}, "cavity": {"convection": "flow"},
+                           "time": {"end": 36000.0, "save_every": 3600.0}})
+    with pytest.raises(CaseError) as err:
+        check(huge, tmp_path)
+    assert "\n" not in str(err.value)
