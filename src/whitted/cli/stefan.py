@@ -301,7 +301,7 @@ def film(
     from ..output.video import encode_film
     from ..render.api import CancelToken
     from ..scene import load_scene
-    from ..stefan.run import film_bubbles, film_frames, film_puddles
+    from ..stefan.run import film_bubbles, film_frames, film_puddles, film_tracers
     from ..stefan.scene import ABSORPTION_BOOST, still_life_scene, write_scene
 
     started = time.perf_counter()
@@ -327,7 +327,8 @@ def film(
                 "surfaces/outer_{frame:04d}.ply", "surfaces/inner_{frame:04d}.ply", None,
                 width=width, height=height, size_cm=100 * max(case.block.size), frames=count,
                 fps=fps, bubbles=film_bubbles(work, shown),
-                puddles=film_puddles(work, shown, case)))
+                puddles=film_puddles(work, shown, case),
+                tracers=film_tracers(work, shown)))
             try:
                 scene = load_scene(scene_path)
                 frames = render_film(scene, FilmPaths(None, work / "frames"), fps=fps,
