@@ -32,6 +32,7 @@ class RenderControl(QObject):
         c.finished.connect(self._finished)
         c.failed.connect(self._failed)
         c.kernels_ready.connect(self._kernels_ready)
+        c.kernels_progress.connect(self._kernels_progress)
         self.viewport.installEventFilter(self)  # laid out, resized: a new preview size
 
     @property
@@ -113,10 +114,23 @@ class RenderControl(QObject):
             self.progress.hide()
         self.update_actions()
 
+    def _kernels_progress(self, fraction: float, left) -> None:
+        """The first run compiles the kernels: how far along, and the time left."""
+        text = f"{fraction:.0%}" + (f", about {left:.0f} s left" if left is not None else "")
+        self.viewport.caption = f"Loading the render kernels: compiling (first run only) {text}"
+        self.viewport.update()
+        if not self.controller.rendering:
+            self.progress.setValue(round(fraction * 1000))
+            self.progress.show()
+            self.eta.setText(f"compiling kernels: {text}")
+
     def _kernels_ready(self, seconds: float) -> None:
         if self.viewport.caption.startswith("Loading"):
             self.viewport.caption = ""
             self.viewport.update()
+        if not self.controller.rendering:
+            self.progress.hide()
+            self.eta.setText("")
         if seconds > 1:
             self.window_.statusBar().showMessage(f"Render kernels ready ({seconds:.0f} s)", 4000)
 
