@@ -83,3 +83,18 @@ def test_bench_startup_refuses_what_is_no_scene(tmp_path):
     assert result.returncode == 2
     assert result.stderr.strip().count("\n") == 0
     assert "neither a benchmark scene nor a scene file" in result.stderr
+
+
+def test_numba_s_import_counts_with_the_imports():
+    """Numba comes in with the first kernel (in the job, before the kernels' own figure):
+    the budget moves that time from the job's other work to the imports."""
+    base = {"interpreter": 10.05, "command": 10.30, "job": 10.45, "rendered": 10.95,
+            "written": 11.00, "build:seconds": 0.04, "kernels:seconds": 0.10,
+            "render:seconds": 0.30}
+    got = phases({**base, "numba:start": 10.46, "numba:end": 10.51}, 10.0, 11.02)
+    assert got["imports"] == pytest.approx(0.30)
+    assert got["other work"] == pytest.approx(0.01)
+    assert got["kernels"] == pytest.approx(0.10)
+    assert sum(got[p] for p in PHASES) == pytest.approx(got["whole process"])
+    early = phases({**base, "numba:start": 10.35, "numba:end": 10.40}, 10.0, 11.02)
+    assert early["imports"] == pytest.approx(0.30) and early["scene"] == pytest.approx(0.14)

@@ -7,7 +7,7 @@ launch and the exit from outside. The budget, each phase the median of the runs:
 
 - **interpreter**: from the launch to whitted's first line (Python's start, site packages);
 - **imports**: to the command's first line (whitted, typer, the command modules; the command
-  line parsed);
+  line parsed), and Numba's import wherever the first kernel needs it;
 - **scene**: the scene file read and validated, the output checks, the scene compiled to
   arrays and BVHs (``build``);
 - **kernels**: the kernels loaded from the cache (or compiled: the first run);
@@ -84,13 +84,25 @@ def phases(marks: dict[str, float], launched: float, ended: float) -> dict[str, 
     build, kernels, render = (marks["build:seconds"], marks["kernels:seconds"],
                               marks["render:seconds"])
     job = marks["rendered"] - marks["job"]
+    scene = marks["job"] - marks["command"]
+    other = max(0.0, job - build - kernels - render)
+    # Numba's import, wherever it fell (the first kernel a scene needs), is an import
+    numba = 0.0
+    if "numba:start" in marks and "numba:end" in marks:
+        numba = marks["numba:end"] - marks["numba:start"]
+        if marks["numba:start"] < marks["job"]:
+            scene -= numba
+        else:  # in the job, before its first kernel: not in the kernels' own figure
+            taken = min(other, numba)
+            other -= taken
+            kernels -= numba - taken
     return {
         "interpreter": marks["interpreter"] - launched,
-        "imports": marks["command"] - marks["interpreter"],
-        "scene": marks["job"] - marks["command"] + build,
+        "imports": marks["command"] - marks["interpreter"] + numba,
+        "scene": scene + build,
         "kernels": kernels,
         "render": render,
-        "other work": max(0.0, job - build - kernels - render),
+        "other work": other,
         "encoding": marks["written"] - marks["rendered"],
         "exit": ended - marks["written"],
         "whole process": ended - launched,

@@ -98,9 +98,14 @@ def _user_base() -> str:
 def toolchain() -> str:
     """The Numba and llvmlite versions that compile the kernels (imports Numba, through
     lean_numba.py's hook)."""
+    from .. import marks
+
+    if "numba" not in sys.modules:
+        marks.mark("numba:start")  # whitted bench --startup counts it with the imports
     import llvmlite
     import numba
 
+    marks.mark("numba:end")
     return f"numba{numba.__version__}-llvmlite{llvmlite.__version__}"
 
 
