@@ -34,13 +34,16 @@ def test_the_editor_shows_how_far_the_first_compile_is(qtbot, tmp_path, monkeypa
     controller._tick()
     assert seen and seen[-1][0] == 0.25
     assert seen[-1][1] == pytest.approx(30.0, rel=0.05)  # 10 s for a quarter: 30 s left
+    window.render_control.show_warm_up()  # the picture's caption, as MainWindow starts it
     caption = window.viewport.caption
-    assert caption.startswith("Loading the render kernels") and "25%" in caption
-    assert "s left" in caption
+    assert caption.startswith("Compiling the kernels (the first run only): 25%")
+    assert caption.endswith("s left")
     bar = window.render_control.progress
     assert bar.isVisible() and bar.value() == 250
+    assert "s left" in window.render_control.eta.text()
     controller._warm_seconds = 12.0
     controller._warm.set()  # compiled: the caption and the bar go
     controller._tick()
-    assert not window.viewport.caption.startswith("Loading")
+    window.render_control._kernels_ready(12.0)
+    assert window.viewport.caption == ""
     assert not bar.isVisible()

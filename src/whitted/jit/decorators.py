@@ -61,6 +61,10 @@ _swapped = False  # dispatchers put in the kernels' globals (before the first co
 _swapping = False
 _deferred: list = []  # registrations waiting for Numba: callables, run in order
 _defining_modules: set[str] = set()  # modules that defined kernels (swapped by load_numba)
+#: every kernel made, by its Python function, and every overload registered, by the function
+#: it implements: (implementation, options) (kernels/strict.py makes IEEE twins from them)
+kernels_by_function: dict = {}
+overloads_by_function: dict = {}
 
 
 def _jit_disabled() -> bool:
@@ -278,6 +282,8 @@ def overload(function, **options):
     """Numba's ``numba.extending.overload``, registered when Numba is loaded."""
 
     def decorate(implementation):
+        overloads_by_function[function] = (implementation, options)
+
         def register():
             from numba.extending import overload as numba_overload
 
@@ -315,6 +321,7 @@ def kernel(fn=None, *, entry: bool = False, **options):
         if _jit_disabled():
             return f
         made = Kernel(f, opts, specialise_constants, cache, entry)
+        kernels_by_function[f] = made
         if _swapped and not entry:
             return made.dispatcher
         _defining_modules.add(f.__module__)
