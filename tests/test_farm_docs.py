@@ -40,7 +40,7 @@ def commands() -> list[list[str]]:
             for args in re.findall(r"args: \[(.*?)\]", text, flags=re.S):
                 found.append([w.strip().strip('"') for w in args.replace("\n", " ").split(",")])
             continue
-        if language == "python":
+        if language in ("python", "text"):  # code; what a program prints
             continue
         for line in text.splitlines():
             line = line.split(" #")[0].strip()
