@@ -105,7 +105,9 @@ def local_cluster(workers: int, threads: int, dask_threads: int = 1) -> LocalClu
     its nanny starts again after a kill is spawned by the nanny, in this process, once the
     caller's handler is back: :func:`farm_client` registers the
     :class:`~whitted.farm.probe.WhittedProbe` with ``quiet_interrupt``, which ignores SIGINT
-    in every worker that (re)joins. They log errors only."""
+    in every worker that (re)joins. They log only what is critical: a worker stopped while it
+    readies or renders (the client closing the cluster after a Ctrl-C) logs its cancelled
+    work as errors, and the client says what happened in its own lines."""
     main = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
     try:
@@ -114,7 +116,7 @@ def local_cluster(workers: int, threads: int, dask_threads: int = 1) -> LocalClu
             host="127.0.0.1",
             dashboard_address="127.0.0.1:0",  # a free port (a page only with bokeh)
             env={"NUMBA_NUM_THREADS": str(threads)},
-            silence_logs=logging.ERROR,  # a worker stopped mid-task says so as a WARNING
+            silence_logs=logging.CRITICAL,  # not a stopped worker's cancelled work
         )
     finally:
         if main:  # the caller's handler (the interrupt guard's) again
