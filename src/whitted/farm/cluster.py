@@ -230,11 +230,13 @@ def _states(client: Client, workers: list[str], wait: float = 2.0) -> dict[str, 
 @contextmanager
 def farm_client(cluster: str | None = None, scheduler: str | None = None, *,
                 threads: int | None = None, warm: bool = True,
-                note: Callable[[str], None] | None = None) -> Iterator[Client]:
+                note: Callable[[str], None] | None = None,
+                status: Callable[[str], None] | None = None) -> Iterator[Client]:
     """A client of a new local cluster (``cluster="local:N"``) or of the scheduler at
     ``scheduler``, with every worker readied (kernels warm, ``threads`` render threads each:
     by default the cores shared out among a local cluster's workers, one on a remote one).
-    Workers that cannot render are named through ``note`` and get no tasks."""
+    Workers that cannot render are named through ``note`` and get no tasks; the cluster's
+    size and address are told through ``status`` (default: ``note``)."""
     check_farm_options(cluster, scheduler)
     owned = None
     if cluster is not None:
@@ -249,11 +251,12 @@ def farm_client(cluster: str | None = None, scheduler: str | None = None, *,
         client = connect(scheduler, CONNECT_SECONDS)
     try:
         link = dashboard_link(client)
-        if note is not None:
+        status = status or note
+        if status is not None:
             info = client.scheduler_info(n_workers=-1).get("workers", {})
             n = len(info)
             total = sum(w.get("nthreads", 1) for w in info.values())
-            note(f"farm: {n} worker{'s' if n != 1 else ''} ({total} Dask thread"
+            status(f"farm: {n} worker{'s' if n != 1 else ''} ({total} Dask thread"
                  f"{'s' if total != 1 else ''}) at {client.scheduler.address}, "
                  f"{threads} render thread{'s' if threads != 1 else ''} a task"
                  + (f"; dashboard {link}" if link else ""))
