@@ -233,6 +233,7 @@ def test_render_film_returns_a_film_that_plays(tmp_path, shown, examples_dir):
     assert (film.frames, film.fps, film.size) == (2, 4.0, (32, 18))
     assert "<video" in film._repr_html_()
     assert film.result.rendered == [0, 24]
+    assert film.frames_folder == tmp_path / "orbit_frames"
     view = shown[0]
     assert "2 rendered" in view.children[1].value
     # again: every frame is kept (resume), the film encoded again
@@ -312,6 +313,20 @@ def test_stefan_results_plot_and_balance(tmp_path, shown, examples_dir):
 
     again = load_results(tmp_path / "melt")
     np.testing.assert_array_equal(again.heat_in_J, results.heat_in_J)
+    # a run written before series.csv had the budget's columns: from the saved states
+    import csv
+
+    series = tmp_path / "melt" / "series.csv"
+    rows = list(csv.DictReader(io.StringIO(series.read_text())))
+    older = [c for c in rows[0] if c not in ("heat_in_J", "heat_drained_J", "condensed_cm3")]
+    out = io.StringIO()
+    writer = csv.DictWriter(out, fieldnames=older, extrasaction="ignore", lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    series.write_text(out.getvalue())
+    from_states = load_results(tmp_path / "melt")
+    np.testing.assert_allclose(from_states.heat_in_J, results.heat_in_J, rtol=1e-12)
+    np.testing.assert_allclose(from_states.drained_J, results.drained_J, rtol=0, atol=1e-9)
     # a damaged saved state: that time's budget is unknown (NaN), the rest stands
     (tmp_path / "melt" / "fields" / "state_0001.npz").write_bytes(b"not a state")
     damaged = load_results(tmp_path / "melt")
@@ -484,6 +499,7 @@ def test_render_film_into_a_folder_makes_the_film_in_memory(tmp_path, examples_d
     film = whitted.render_film(examples_dir / "camera_orbit.toml", tmp_path / "frames",
                                frames=[0, 1], width=16, height=10, fps=2, live=False)
     assert film.path is None and film.frames == 2 and film.kind in ("mp4", "gif")
+    assert film.frames_folder == tmp_path / "frames"
     assert sorted(p.name for p in (tmp_path / "frames").iterdir()) == ["0000.png", "0001.png"]
 
 

@@ -69,6 +69,8 @@ from .scene import CompiledScene
 
 SLOTS = 6  # records one photon may store: SHADOW_SLOTS shadow photons, caustic photons
 #: (diffuse surfaces that also reflect or refract) in the rest
+#: the offset (in cells) of the grid the default radius counts photons in
+GRID_SHIFT = np.array([0.5, 0.5, 0.5])
 DEFAULT_NEIGHBOURS = 256  # photons the default radius gathers where light is not focused
 MAX_TARGETS = 64  # more bodies than this are aimed at as one bounding sphere
 PHOTON_BYTES = PHOTON_WIDTH * 4
@@ -258,7 +260,9 @@ def fitted_radius(positions: np.ndarray, guess: float,
     pos = positions.astype(np.float64)
     for _ in range(2):
         h = 2.0 * r
-        cells = np.floor(pos / h).astype(np.int64)
+        # the cells shifted off the origin: a floor at y = 0 would lie on their boundary,
+        # its photons split between two rows of cells by their last bits
+        cells = np.floor(pos / h + GRID_SHIFT).astype(np.int64)
         keys = (cells[:, 0] * 73856093) ^ (cells[:, 1] * 19349663) ^ (cells[:, 2] * 83492791)
         _, inverse, counts = np.unique(keys, return_inverse=True, return_counts=True)
         density = float(np.median(counts[inverse])) / (h * h)
@@ -360,7 +364,11 @@ def shoot_pass(compiled: CompiledScene, rows: np.ndarray, clear: np.ndarray,
     """The records the photons of one pass store, in photon order (chunks of photons not
     started once ``cancelled()`` is true are left out: the render is being cancelled)."""
     from ..kernels.photons import trace_photons
+    from ..kernels.strict import strict
 
+    # compiled without fast-math (kernels/strict.py): the same photons on every CPU target,
+    # cold compiled or loaded from the cache
+    tracer = strict(trace_photons)
     settings = np.zeros(N_SET)
     settings[SET_SEED] = params.seed
     settings[SET_PASS] = pass_index
@@ -376,7 +384,7 @@ def shoot_pass(compiled: CompiledScene, rows: np.ndarray, clear: np.ndarray,
     def run(k: int) -> None:
         if cancelled():
             return
-        trace_photons(compiled.geometry, compiled.materials, clear,
+        tracer(compiled.geometry, compiled.materials, clear,
                       compiled.lights.table, rows, settings, int(bounds[k]),
                       int(bounds[k + 1]), out, counts,
                       np.empty(BVH_STACK, np.int32), np.empty(MAX_MEDIA, np.int32),

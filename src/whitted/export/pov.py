@@ -81,6 +81,10 @@ IMAGE_TYPES = {".png": "png", ".jpg": "jpeg", ".jpeg": "jpeg", ".tga": "tga", ".
                ".exr": "exr"}
 
 
+#: the largest photon ``count`` POV-Ray reads (a C int; a larger one wraps round)
+POV_MAX_COUNT = 2**31 - 1
+
+
 def pov_filter(mat: Material) -> float:
     """The pigment's ``filter`` that makes POV-Ray transmit what whitted does. Without
     ``fresnel`` it is ``kt``. With it, POV-Ray's ``conserve_energy`` passes
@@ -310,7 +314,13 @@ class _PovWriter:
         if c.photons == 0:
             return ""
         radius = f" radius {num(c.radius)}" if c.radius > 0 else ""
-        return (f"  photons {{ count {c.photons * c.passes} autostop 0 jitter 0.4 "
+        count = c.photons * c.passes
+        note = ""
+        if count > POV_MAX_COUNT:  # POV-Ray keeps the count in a C int: more wraps round
+            note = (f"  // whitted shoots {count} photons ({c.photons} x {c.passes} passes); "
+                    f"POV-Ray's count holds at most {POV_MAX_COUNT}\n")
+            count = POV_MAX_COUNT
+        return (f"{note}  photons {{ count {count} autostop 0 jitter 0.4 "
                 f"max_trace_level {self.scene.render.max_depth + 1} gather 20, 100"
                 f"{radius} }}\n")
 
