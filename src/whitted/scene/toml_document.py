@@ -425,6 +425,10 @@ def edit_toml(text: str, old: Scene, new: Scene, *,
     the file's are; ``history`` (earlier versions: text and scene) lends its spellings."""
     if old == new:
         return text
+    history = list(history)
+    for version_text, version in reversed(history):
+        if version == new:  # everything set back to what a version said: its very text
+            return version_text
     doc = tomlkit.parse(text)
     _own_comments(doc)
     memory = _Memory([*history, (text, old)])
