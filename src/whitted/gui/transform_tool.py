@@ -55,11 +55,18 @@ def _local_points(obj) -> np.ndarray | None:
     if t == "torus":
         a = obj.major_radius + obj.minor_radius
         return np.array([(-a, -obj.minor_radius, -a), (a, obj.minor_radius, a)])
-    if t == "csg":  # the children's boxes, in the CSG object's space
-        boxes = [b for c in obj.objects if (b := item_bounds(c, None)) is not None]
+    if t == "csg":  # from the children's boxes, in the CSG object's space
+        children = obj.objects[:1] if obj.operation == "difference" else obj.objects
+        boxes = [b for c in children if (b := item_bounds(c, None)) is not None]
         if not boxes:
             return None
-        lo, hi = np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
+        if obj.operation == "intersection" and len(boxes) == len(children):
+            lo = np.max([b[0] for b in boxes], axis=0)
+            hi = np.min([b[1] for b in boxes], axis=0)
+            hi = np.maximum(hi, lo)
+        else:
+            lo = np.min([b[0] for b in boxes], axis=0)
+            hi = np.max([b[1] for b in boxes], axis=0)
         return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
                          for z in (lo[2], hi[2])])
     return None
