@@ -69,7 +69,7 @@ from .layout import (
     SHAPE_TORUS,
 )
 from .mesh import mesh_closest_hit
-from .torus import torus_crossings, torus_normal
+from .shapes.torus import torus_crossings, torus_normal
 from .traverse import inverse_direction, slab_entry
 from .vec import dot, madd
 from .xform import normal_to_world, to_object

@@ -138,6 +138,6 @@ def surface_uv(geo, prim, tri, b1, b2, p):
         return _box_uv(P, prim, p)
     if typ == SHAPE_FRUSTUM:
         return _frustum_uv(P, prim, p)
-    if has_extras(geo) and typ >= FIRST_EXTRA_SHAPE:  # the torus (kernels/torus.py)
+    if has_extras(geo) and typ >= FIRST_EXTRA_SHAPE:  # the torus (kernels/shapes/torus.py)
         return extra_uv_if_extras(geo, prim, p)
     return 0.0, 0.0
