@@ -29,6 +29,7 @@ _LAZY = {
     "CancelToken": ".render", "Progress": ".render", "RenderJob": ".render",
     "RenderStats": ".render", "render": ".render", "render_aovs": ".render",
     "default_scene": ".scene.default",
+    "framed": ".studio", "model_scene": ".studio", "turntable": ".studio",
     **dict.fromkeys((
         "CSG", "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera",
         "CheckerTexture", "Cone", "Cylinder", "DirectionalLight", "Disk", "DiskLight",
@@ -44,7 +45,8 @@ __all__ = [
     "GradientTexture", "Image", "ImageTexture", "Material", "Mesh", "Plane",
     "PointLight", "Progress", "Rectangle", "RenderJob", "RenderSettings", "RenderStats", "Scene",
     "SceneError", "Sphere", "Torus", "Transform", "Triangle", "WhittedError", "__version__",
-    "default_scene", "load_scene", "render", "render_aovs", "save_scene",
+    "default_scene", "framed", "load_scene", "model_scene", "render", "render_aovs",
+    "save_scene", "turntable",
 ]
 
 

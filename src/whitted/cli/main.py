@@ -21,6 +21,7 @@ except ImportError:  # pragma: no cover - depends on the installed typer
 from ..errors import WhittedError
 from . import animate as _animate  # noqa: F401
 from . import bench as _bench  # noqa: F401
+from . import examples as _examples  # noqa: F401
 from . import export as _export  # noqa: F401
 from . import info as _info  # noqa: F401
 from . import render as _render  # noqa: F401

@@ -46,9 +46,8 @@ def _parse_aovs(text: str | None) -> list[str]:
 @app.command()
 def render(
     scene_path: SceneArgument = None,
-    output: Annotated[Path, typer.Option("-o", "--output", help="Image to write")] = Path(
-        "render.png"
-    ),
+    output: Annotated[Path | None, typer.Option(
+        "-o", "--output", help="Image to write [default: render.png]")] = None,
     width: Annotated[int | None, typer.Option("--width", "-W", help="Image width")] = None,
     height: Annotated[int | None, typer.Option("--height", "-H", help="Image height")] = None,
     samples: Annotated[int | None, typer.Option("--samples", "-s", help="Samples/pixel")] = None,
@@ -67,12 +66,23 @@ def render(
     set_values: Annotated[
         list[str] | None, typer.Option("--set", help="PATH=VALUE: change a scene value")
     ] = None,
+    turntable: Annotated[int | None, typer.Option(
+        "--turntable", help="A film instead: N frames of the camera going once around "
+        "(whitted animate --turntable; -o NAME.mp4 or .gif, default SCENE_turntable.mp4)",
+        min=1, max=1_000_000)] = None,
     cluster: ClusterOption = None,
     scheduler: SchedulerOption = None,
 ) -> None:
     """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG).
-    An animated scene renders frame 0, or the frame --frame names."""
+    An animated scene renders frame 0, or the frame --frame names. A model file is shown on a
+    lit ground by a camera that frames it."""
     from pydantic import ValidationError
+
+    if turntable is not None:
+        _turntable_film(scene_path, output, turntable, width, height, samples, max_depth,
+                        threads, seed, set_values, quiet, cluster, scheduler)
+        return
+    output = output or Path("render.png")
 
     from ..output.formats import check_bit_depth, image_format
     from ..render.api import RenderJob
@@ -88,7 +98,7 @@ def render(
     if transfer not in (None, "srgb", "linear"):
         raise fail(f"--transfer: unknown transfer {shorten(transfer)!r} (use srgb or linear)")
     try:
-        scene, name = load_scene_argument(scene_path)
+        scene, name = load_scene_argument(scene_path, width=width, height=height)
         scene = apply_set_options(scene, set_values)
     except WhittedError as exc:
         raise fail(str(exc)) from None
@@ -127,6 +137,23 @@ def render(
         guard.on_interrupt(job.cancel)
         _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet, guard,
                           process_start, frame)
+
+
+def _turntable_film(scene_path, output, frames, width, height, samples, max_depth, threads,
+                    seed, set_values, quiet, cluster, scheduler) -> None:
+    """``render --turntable N``: the film ``whitted animate --turntable N`` makes."""
+    from .animate import animate
+
+    if output is None:
+        stem = scene_path.stem if scene_path is not None else "render"
+        output = Path(f"{stem}_turntable.mp4")
+    elif output.suffix.lower() in (".png", ".exr", ".pfm", ".npy", ".jpg", ".jpeg"):
+        raise fail(f"{output}: --turntable makes a film: name an .mp4 or .gif file, or a "
+                   "folder for the frames alone")
+    animate(scene_path=scene_path, output=output, frames=None, fps=None, width=width,
+            height=height, samples=samples, max_depth=max_depth, threads=threads, seed=seed,
+            set_values=set_values, crf=18, force=False, quiet=quiet, turntable=frames,
+            cluster=cluster, scheduler=scheduler)
 
 
 def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
