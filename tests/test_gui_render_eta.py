@@ -40,6 +40,30 @@ def test_a_batch_shares_only_the_rays_traced_since_the_last_one():
     assert cost.density.tolist() == [[10.0, 0.0]]
 
 
+def test_each_tile_keeps_its_own_rays_whatever_the_batch():
+    """A batch of two tiles with their own counts (what the render reports): the sky tile
+    is not charged for the glass tile beside it, however the lanes batched them."""
+    cost = CostMap(4, 2)
+    cost.learn(np.array([[0, 0, 2, 2], [2, 0, 4, 2]]), 40, np.array([4, 36]))
+    assert cost.complete
+    assert cost.density[:, :2].tolist() == [[1.0, 1.0], [1.0, 1.0]]
+    assert cost.density[:, 2:].tolist() == [[9.0, 9.0], [9.0, 9.0]]
+
+
+def test_a_render_reports_each_tiles_rays():
+    """RenderJob's progress carries each finished tile's rays; they add up to the rays."""
+    from whitted import RenderJob
+    from whitted.gui.main_window import starter_scene
+
+    scene = starter_scene().with_settings(width=32, height=24, samples=1, threads=1)
+    reports = []
+    job = RenderJob(scene)
+    job.progress = reports.append
+    job.run()
+    assert sum(len(p.tile_rays) for p in reports) == sum(len(p.new_tiles) for p in reports)
+    assert sum(int(p.tile_rays.sum()) for p in reports) == reports[-1].rays > 0
+
+
 def test_the_editor_says_the_time_left_from_the_previews_costs(qtbot, tmp_path):
     """In the editor: the preview of a picture that is sky above and glass below learns that
     the glass costs more rays a pixel; Ctrl+R then measures its progress in that cost."""

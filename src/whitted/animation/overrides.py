@@ -19,6 +19,7 @@ import tomllib
 from typing import TYPE_CHECKING, Any
 
 from ..errors import SceneError, shorten
+from ..scene.io import check_value_numbers
 from ..scene.paths import PathError, parse_path, resolve_path, set_value
 
 if TYPE_CHECKING:
@@ -184,8 +185,11 @@ def apply_overrides(scene: Scene, assignments: list[tuple[str, Any]] | dict[str,
         try:
             written = parse_path(path)
             steps = resolve_path(scene, written)
-            new = set_value(scene, written, value)  # errors name the path as written
-        except PathError as exc:
+            check_value_numbers(value, [step.key for step in steps])
+            new = set_value(scene, written, value, strict=True)  # as a file's value
+        except SceneError as exc:  # a number too large, as in a file
+            if not isinstance(exc, PathError):
+                raise SceneError(str(exc), where="--set") from None
             hint = ("; a range START:STOP:STEP is for whitted sweep, here give one value"
                     if text is not None and is_range(text) else "")
             raise SceneError(f"{exc}{hint}", where="--set") from None

@@ -43,6 +43,17 @@ def parse_size(text: str | None) -> tuple[int, int] | None:
             f"--size: expected WIDTHxHEIGHT such as 320x240 (got {text!r})") from None
     if w < 1 or h < 1:
         raise BenchUsageError(f"--size: width and height must be positive (got {text!r})")
+    from pydantic import ValidationError
+
+    from ..scene.messages import describe_validation_error
+    from ..scene.scene import RenderSettings
+
+    try:  # the limits of any render (100,000 a side, 100 megapixels), in the option's name
+        RenderSettings(width=w, height=h)
+    except ValidationError as exc:
+        where, message = describe_validation_error(exc)
+        where = where.rsplit(".", 1)[-1]  # the field, not the settings' class
+        raise BenchUsageError(f"--size: {where + ': ' if where else ''}{message}") from None
     return w, h
 
 

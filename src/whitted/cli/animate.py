@@ -19,6 +19,7 @@ from .app import (
     load_scene_argument,
     out,
     override_error,
+    with_options,
 )
 from .farm import ClusterOption, SchedulerOption, animate_on_farm
 from .interrupt import InterruptGuard
@@ -70,8 +71,8 @@ def animate(
         scene, name = load_scene_argument(scene_path, width=width, height=height,
                                           turntable=turntable)
         scene = apply_set_options(scene, set_values)
-        scene = scene.with_settings(width=width, height=height, samples=samples,
-                                    max_depth=max_depth, threads=threads, seed=seed)
+        scene = with_options(scene, width=width, height=height, samples=samples,
+                             max_depth=max_depth, threads=threads, seed=seed)
         chosen = parse_frame_range(frames, scene.frame_count)
         plan = prepare_film(scene, output, frames=chosen, fps=fps, crf=crf,
                             scene_path=scene_path,

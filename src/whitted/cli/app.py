@@ -162,16 +162,34 @@ def save_npy(path: Path, array: np.ndarray) -> None:
     atomic_write(path, lambda tmp: np.save(tmp, array))
 
 
-def override_error(exc: ValidationError) -> str:
-    """One line for a command-line value the render settings reject."""
+def override_error(exc: ValidationError, given: dict[str, object] | None = None) -> str:
+    """One line for command-line values the render settings reject. ``given``: the settings
+    the options gave (``{"samples": 4}``); a problem of the settings as a whole (the image
+    size, samples beside ``[render.antialias]``) is laid on the options that took part."""
     from ..scene.messages import clean_message as _clean_message
 
     e = exc.errors()[0]
+    named = [k for k, v in (given or {}).items() if v is not None]
     if e["loc"]:
         option = "--" + str(e["loc"][0]).replace("_", "-")
-    else:  # the only whole-settings check is the image size
-        option = "--width/--height"
+    else:  # a check of the settings as a whole: lay it on the options that were given
+        message = _clean_message(e)
+        involved = [k for k in named if k in message or
+                    (k in ("width", "height") and "megapixels" in message)]
+        option = "/".join("--" + k.replace("_", "-") for k in (involved or named)) or "render"
     return f"{option}: {_clean_message(e)}"
+
+
+def with_options(scene: Scene, **given: object) -> Scene:
+    """``scene.with_settings(**given)`` (the render options a command was given; None: not
+    given), a value the settings reject ending the command with one line that names the
+    option (:func:`override_error`), never the settings' class."""
+    from pydantic import ValidationError
+
+    try:
+        return scene.with_settings(**given)
+    except ValidationError as exc:
+        raise fail(override_error(exc, given)) from None
 
 
 #: whether main() paused the cyclic garbage collector for a render's set-up (a list: set once)

@@ -24,6 +24,7 @@ from .app import (
     override_error,
     resume_collector,
     save_npy,
+    with_options,
     with_scene_key,
 )
 from .console import err, out
@@ -102,13 +103,12 @@ def render(
         scene = apply_set_options(scene, set_values)
     except WhittedError as exc:
         raise fail(str(exc)) from None
+    scene = with_options(scene, width=width, height=height, samples=samples,
+                         max_depth=max_depth, threads=threads, seed=seed, transfer=transfer)
     try:
-        scene = scene.with_settings(width=width, height=height, samples=samples,
-                                    max_depth=max_depth, threads=threads, seed=seed,
-                                    transfer=transfer)
         if frame is not None or scene.is_animated:
             scene = scene.at_frame(frame or 0)
-    except ValidationError as exc:  # a command-line override out of range
+    except ValidationError as exc:
         raise fail(override_error(exc)) from None
     except WhittedError as exc:
         raise fail(str(exc)) from None

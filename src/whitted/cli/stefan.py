@@ -247,7 +247,7 @@ def _check_film_options(case_path: Path, output: Path, gif: Path | None, width: 
     except ValidationError as exc:
         from .app import override_error
 
-        raise _fail(override_error(exc)) from None
+        raise _fail(override_error(exc, {"width": width, "height": height})) from None
     films = [output, *([gif] if gif is not None else [])]
     formats = []
     for option, path in zip(("-o", "--gif"), films, strict=False):

@@ -17,6 +17,7 @@ from .app import (
     load_scene_argument,
     out,
     override_error,
+    with_options,
 )
 from .interrupt import InterruptGuard
 
@@ -80,8 +81,8 @@ def sweep(
             else:
                 fixed.append((path, value_text))
         scene = apply_overrides(scene, fixed)
-        scene = scene.with_settings(width=width, height=height, samples=samples,
-                                    max_depth=max_depth)
+        scene = with_options(scene, width=width, height=height, samples=samples,
+                             max_depth=max_depth)
         cells = sweep_cells(scene, axes)  # counted and checked value by value, made lazily
         scene.at_frame(frame)
         ncols = _sheet_columns(cells, columns)

@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import math
 import os
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -532,8 +533,7 @@ class _PovWriter:
         body += [t for t in (self.light(light) for light in self.scene.lights) if t]
         shapes = [self.shape(i, obj) for i, obj in enumerate(self.scene.objects)]
         header = [
-            "// POV-Ray 3.7 scene written by whitted"
-            + (f" from {source}" if source else ""),
+            WHITTED_HEADER + (f" from {source}" if source else ""),
             f"// render: povray +I<this file> +W{self.width} +H{self.height} "
             f"{povray_antialias_options(self.scene)} +FN"
             + (" File_Gamma=1.0" if r.transfer == "linear" else "")
@@ -595,19 +595,51 @@ def scene_to_pov(
     return writer.write(source)
 
 
+#: The first line of every file whitted exports (then `` from SOURCE``): how whitted tells
+#: its own exports, which it may replace, from anyone else's files, which it never does.
+WHITTED_HEADER = "// POV-Ray 3.7 scene written by whitted"
+
+
+def written_by_whitted(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` is a file whose first line says whitted wrote it (an export)."""
+    try:
+        with open(path, "rb") as file:
+            start = file.read(len(WHITTED_HEADER) + 1)
+    except OSError:
+        return False
+    return start.decode("utf-8", "replace").startswith(WHITTED_HEADER)
+
+
+def foreign_file(path: str | os.PathLike[str]) -> bool:
+    """Whether something that whitted did not export is at ``path`` (a file of someone
+    else's, which an export must not replace unless asked to). A folder, a device or a pipe
+    is left to the output checks, which refuse them whatever is asked."""
+    try:
+        status = os.stat(path)
+    except (OSError, ValueError):
+        return False
+    return stat.S_ISREG(status.st_mode) and not written_by_whitted(path)
+
+
 def export_pov(
     scene: Scene, path: str | os.PathLike[str], *, width: int | None = None,
-    height: int | None = None, source: str | None = None,
+    height: int | None = None, source: str | None = None, force: bool = False,
 ) -> Path:
     """Write the scene as a POV-Ray 3.7 file at ``path`` (atomically). Returns the path.
     :class:`~whitted.errors.OutputError` when ``path`` is the scene file (``source``) or a
-    file the scene reads, or cannot be written."""
+    file the scene reads, or cannot be written, or when a file whitted did not write is
+    there (whitted's exports start with :data:`WHITTED_HEADER`): ``force=True`` replaces
+    that one."""
+    from ..errors import OutputError
     from ..files import atomic_write
     from ..output.safety import check_outputs
 
     path = Path(path)
     source_file = source if source and Path(source).suffix.lower() in (".toml", ".json") else None
     check_outputs([path], scene, source_file)
+    if not force and foreign_file(path):
+        raise OutputError(f"{path}: is not a file whitted exported; it is kept (force=True "
+                          "replaces it)")
     text = scene_to_pov(scene, width=width, height=height, source=source)
     atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
     return path

@@ -100,7 +100,7 @@ class _Active:
 
     def on_preview_progress(self, p: Progress) -> None:
         """Called on a preview's thread: the rays each part of the picture cost."""
-        self.cost.learn(p.new_tiles, p.rays)
+        self.cost.learn(p.new_tiles, p.rays, p.tile_rays)
 
     def display_image(self) -> QImage:
         """The display picture: the dimmed preview (or black) where no tile has arrived yet,

@@ -3,7 +3,7 @@
 Tiles cost very different amounts (sky is one ray a pixel, glass dozens), so "35 % of the
 tiles in 3 s" says little about the rest. The preview of the same scene has already traced
 every part of the picture: :class:`CostMap` keeps, per preview pixel, the rays that its tiles
-cost (each batch of finished tiles shares the rays traced since the batch before). The full
+cost (each tile its own count, whichever batch of finished tiles it came in). The full
 render's finished tiles then say which share of the whole *cost* is done, and
 
     time left = elapsed × (cost of the tiles not yet done) / (cost of the tiles done)
@@ -24,10 +24,18 @@ class CostMap:
         self.covered = np.zeros((height, width), bool)
         self._rays = 0
 
-    def learn(self, tiles: np.ndarray, rays: int) -> None:
+    def learn(self, tiles: np.ndarray, rays: int, tile_rays: np.ndarray | None = None) -> None:
         """A batch of finished ``tiles`` (rows of x0, y0, x1, y1) and the rays traced in all
-        so far: the rays since the last batch are spread over these tiles' pixels."""
+        so far. With ``tile_rays`` (each tile's own rays) every tile gets its own cost; without,
+        the rays since the last batch are spread over these tiles' pixels."""
         new, self._rays = max(rays - self._rays, 0), max(rays, self._rays)
+        if tile_rays is not None and len(tile_rays) == len(tiles) and len(tiles):
+            for (x0, y0, x1, y1), count in zip(tiles, tile_rays, strict=True):
+                area = int((x1 - x0) * (y1 - y0))
+                if area > 0:
+                    self.density[y0:y1, x0:x1] = float(count) / area
+                    self.covered[y0:y1, x0:x1] = True
+            return
         area = sum(int((x1 - x0) * (y1 - y0)) for x0, y0, x1, y1 in tiles)
         if area <= 0:
             return

@@ -92,6 +92,9 @@ class Progress:
     eta: float | None
     #: the tiles finished in this batch, rows of (x0, y0, x1, y1): repaint just these
     new_tiles: np.ndarray = field(repr=False, default_factory=lambda: np.zeros((0, 4), np.int32))
+    #: the rays each of ``new_tiles`` cost (every kind together): what a part of the picture
+    #: costs, whatever the batches were
+    tile_rays: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0, np.int64))
 
     @property
     def fraction(self) -> float:
@@ -273,12 +276,13 @@ class RenderJob:
     def running(self) -> bool:
         return self._thread is not None and self._thread.is_alive()
 
-    def _report(self, done, total, counters, start, chunk) -> None:
+    def _report(self, done, total, counters, start, chunk, chunk_rays=None) -> None:
         if self.progress is None:
             return
         elapsed = time.perf_counter() - start
         eta = elapsed / done * (total - done) if done else None
-        self.progress(Progress(done, total, int(counters.sum()), elapsed, eta, chunk))
+        rays = np.zeros(len(chunk), np.int64) if chunk_rays is None else chunk_rays
+        self.progress(Progress(done, total, int(counters.sum()), elapsed, eta, chunk, rays))
 
     def _caustics_stage(self, compiled, params, stats) -> tuple[object, float]:
         """The photon map, and the render kernel's kind with caustics compiled (the first
@@ -403,7 +407,8 @@ class RenderJob:
                     tile_seconds[0] = (time.perf_counter() - run_start) / len(idx)
                     counters[idx] = part_counters
                     done += len(idx)
-                    self._report(done, len(tiles), counters, render_start, part)
+                    self._report(done, len(tiles), counters, render_start, part,
+                                 part_counters.sum(axis=1))
 
         pool = (ThreadPoolExecutor(lanes - 1, thread_name_prefix="whitted-lane") if lanes > 1
                 else None)

@@ -195,6 +195,13 @@ def _check_values(data: Any, keys: list[str | int], name: str | None, text: str,
                             f"{MAX_MAGNITUDE:.0e} in magnitude)")
 
 
+def check_value_numbers(value: Any, keys: list[str | int]) -> None:
+    """What a scene file's reader checks of every number, for one value that lands at
+    ``keys`` (a ``--set`` or sweep value): SceneError naming the key (``camera.position[1]:
+    number 1e+20 is too large ...``), so that the message is the file's."""
+    _check_values(value, list(keys), None, "", ".toml")
+
+
 def _json_key_line(text: str, key: str) -> int | None:
     pattern = re.compile(rf'"{re.escape(json.dumps(key)[1:-1])}"\s*:')
     hits = [i for i, raw in enumerate(text.splitlines()) if pattern.search(raw)]

@@ -72,7 +72,7 @@ def describe_validation_error(exc: ValidationError,
 
 def scene_error(
     exc: ValidationError, file: str | None, text: str | None, data: Any = None,
-    root: type[BaseModel] | None = None,
+    root: Any = None,
 ) -> SceneError:
     errors = exc.errors()
     # Unions report one error per member; the deepest location is the informative one.
@@ -159,7 +159,7 @@ def _short(value: Any) -> bool:
     return isinstance(value, int | float | str | bool) and len(repr(value)) <= 40
 
 
-def known_keys_hint(keys: list[str | int], data: Any, root: type[BaseModel]) -> str:
+def known_keys_hint(keys: list[str | int], data: Any, root: Any) -> str:
     """`` (did you mean 'radius'?)`` for a misspelt key, else the keys that are allowed there."""
     if not keys or not isinstance(keys[-1], str):
         return ""
@@ -175,11 +175,13 @@ def known_keys_hint(keys: list[str | int], data: Any, root: type[BaseModel]) -> 
     return ""
 
 
-def _allowed_keys(parent: list[str | int], data: Any, root: type[BaseModel]) -> list[str]:
-    """The keys the scene model accepts at ``parent`` (a cleaned location), or [] if unknown."""
-    models: list[type[BaseModel]] = [root]
+def _allowed_keys(parent: list[str | int], data: Any, root: Any) -> list[str]:
+    """The keys the scene model accepts at ``parent`` (a cleaned location), or [] if unknown.
+    ``root``: a model class, or an annotation naming models (the shapes' union)."""
+    models: list[type[BaseModel]] = _models_in(root)
     node = data
-    container = False  # the next key indexes a list or names a dict entry
+    # the next key indexes a list or names a dict entry
+    container = typing.get_origin(root) in (list, dict)
     for key in parent:
         node = _child(node, key)
         if container:

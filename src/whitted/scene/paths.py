@@ -247,39 +247,56 @@ def _adapter(annotation: Any) -> TypeAdapter:
     return adapter
 
 
-def _message(exc: ValidationError) -> str:
-    from .messages import validation_message
+def _rejected(exc: ValidationError, parent: tuple[Step, ...], root: Any, data: Any) -> PathError:
+    """The one line of a value the model rejects, worded as a scene file's error (the whole
+    key path, ``expected an integer (got True)``, ``unknown key (known: ...)``): ``parent``
+    is where the validated ``data`` hangs, ``root`` the model (or annotation) it met."""
+    from .messages import scene_error
 
-    return validation_message(exc)
+    e = scene_error(exc, None, None, data, root=root)
+    where = format_path(parent)
+    inner = e.where or ""
+    if inner:
+        where = f"{where}{inner}" if inner.startswith("[") or not where else f"{where}.{inner}"
+    return PathError(f"{where}: {e.message}" if where else e.message)
 
 
-def set_value(scene: Any, steps: tuple[Step, ...] | str, value: Any) -> Any:
+def set_value(scene: Any, steps: tuple[Step, ...] | str, value: Any, *,
+              strict: bool = False) -> Any:
     """A copy of ``scene`` with the value at ``steps`` replaced by ``value`` (validated where
     it lands). The original is unchanged. PathError (one line) when the path names nothing
-    or the value is rejected."""
+    or the value is rejected. ``strict``: the value follows a scene file's rules (numbers
+    are numbers, booleans booleans, no text for either), as ``--set`` and sweeps need;
+    otherwise pydantic's lax conversions apply (values made by whitted itself: tracks)."""
     steps = _steps(steps)
     if not steps:
         raise PathError("empty path")
-    return _set(scene, scene, steps, 0, value, None)
+    if not strict:
+        return _set(scene, scene, steps, 0, value, False)
+    from .types import file_strictness
+
+    with file_strictness():
+        return _set(scene, scene, steps, 0, value, True)
 
 
 def _set(scene: Any, node: Any, steps: tuple[Step, ...], n: int, value: Any,
-         item_type: Any) -> Any:
+         strict: bool) -> Any:
+    """``node`` with the value at ``steps[n:]`` replaced. A model validates the field it
+    holds (a list item or dict entry is validated with its list or dict, by the model that
+    holds them: the error's location is then the whole path)."""
     step = steps[n]
-    where = format_path(steps[: n + 1])
     last = n + 1 == len(steps)
+    where = format_path(steps[: n + 1])
     child, concrete = _child(scene, node, step, where, steps[:n], more=not last)
+    new_child = value if last else _set(scene, child, steps, n + 1, value, strict)
     if isinstance(node, BaseModel):
-        annotation = type(node).model_fields[step.key].annotation
-        inner = None
-        if typing.get_origin(annotation) in (list, dict):
-            inner = typing.get_args(annotation)[-1]
-        new_child = value if last else _set(scene, child, steps, n + 1, value, inner)
         if node is scene:  # the top level: validate the field only, then the cross-checks
+            annotation = type(node).model_fields[step.key].annotation
             try:
-                new_child = _adapter(annotation).validate_python(new_child)
+                new_child = _adapter(annotation).validate_python(new_child,
+                                                                 strict=strict or None)
             except ValidationError as exc:
-                raise PathError(f"{where}: {_message(exc)}") from None
+                raise _rejected(exc, steps[: n + 1], annotation, new_child) from None
             copy = node.model_copy(update={step.key: new_child})
             check = getattr(type(node), "_material_names_resolve", None)
             if check is not None:
@@ -289,18 +306,12 @@ def _set(scene: Any, node: Any, steps: tuple[Step, ...], n: int, value: Any,
                     raise PathError(str(exc)) from None
             return copy
         copy = node.model_copy()
-        try:
-            setattr(copy, step.key, new_child)
+        try:  # what assigning the attribute does, at the strictness asked for
+            type(copy).__pydantic_validator__.validate_assignment(
+                copy, step.key, new_child, strict=strict or None)
         except ValidationError as exc:
-            raise PathError(f"{where}: {_message(exc)}") from None
+            raise _rejected(exc, steps[:n], type(node), {step.key: new_child}) from None
         return copy
-    if last:  # a whole list item or dict entry
-        try:
-            new_child = _adapter(item_type).validate_python(value)
-        except ValidationError as exc:
-            raise PathError(f"{where}: {_message(exc)}") from None
-    else:
-        new_child = _set(scene, child, steps, n + 1, value, None)
     if isinstance(node, list):
         out = list(node)
         out[concrete.key] = new_child

@@ -83,8 +83,9 @@ class RenderSettings(Strict):
     @model_validator(mode="after")
     def _size(self) -> RenderSettings:
         if self.antialias is not None and self.samples > 1:
-            raise ValueError("antialias chooses the samples of each pixel: leave samples "
-                             "at 1 with [render.antialias]")
+            raise ValueError(f"samples = {self.samples} beside [render.antialias], which "
+                             "chooses the samples of each pixel itself: leave samples at 1 "
+                             "(antialias.max_samples sets the most)")
         if self.width * self.height > MAX_PIXELS:
             raise ValueError(
                 f"{self.width}x{self.height} is over {MAX_PIXELS // 1_000_000} megapixels"

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
 import types
@@ -26,6 +27,20 @@ from .messages import describe_validation_error
 _strict: ContextVar[bool] = ContextVar("whitted_strict_validation", default=False)
 _depth: ContextVar[int] = ContextVar("whitted_validation_depth", default=0)
 
+
+
+@contextlib.contextmanager
+def file_strictness():
+    """Validation inside the block is as strict as a scene file's, nested models too
+    (``--set`` and sweep values: ``photons = true`` or ``width = "32"`` is refused as the
+    file refuses it), and its errors are pydantic's own, their locations whole."""
+    strictness = _strict.set(True)
+    depth = _depth.set(_depth.get() + 1)
+    try:
+        yield
+    finally:
+        _depth.reset(depth)
+        _strict.reset(strictness)
 
 
 def _wrap(exc: ValidationError, model: type) -> Exception:
