@@ -80,6 +80,12 @@ def render(
     from pydantic import ValidationError
 
     if turntable is not None:
+        stills_only = [name for name, given in (("--aov", aov), ("--frame", frame is not None),
+                                                ("--bit-depth", bit_depth != 8),
+                                                ("--transfer", transfer)) if given]
+        if stills_only:
+            raise fail(f"--turntable makes a film: {', '.join(stills_only)} only apply to a "
+                       "still")
         _turntable_film(scene_path, output, turntable, width, height, samples, max_depth,
                         threads, seed, set_values, quiet, cluster, scheduler)
         return

@@ -28,12 +28,12 @@ def shipped_dir(name: str) -> Path | None:
 
 
 def example_names() -> dict[str, Path]:
-    """Short name -> scene file of every example (``glass_cube``, ``stefan/hollow_ice``)."""
+    """Short name -> scene file of every example scene (``glass_cube``); the Stefan cases in
+    ``stefan/`` are not scenes and go by their path."""
     folder = shipped_dir("examples")
     if folder is None:
         return {}
-    return {p.relative_to(folder).with_suffix("").as_posix(): p
-            for p in sorted(folder.rglob("*.toml"))}
+    return {p.stem: p for p in sorted(folder.glob("*.toml"))}
 
 
 def example_path(name: str) -> Path | None:
