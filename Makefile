@@ -64,12 +64,12 @@ check-wheel: $(VENV)/.test-deps
 	$(PYTHON) -m venv $(WHEEL_VENV)
 	$(WHEEL_VENV)/bin/python -m pip install --quiet dist/whitted-*.whl
 	set -e; here=$$(mktemp -d); cd $$here; \
-	  $(CURDIR)/$(WHEEL_VENV)/bin/whitted render glass_cube -W 96 -H 72 -o cube.png; \
-	  $(CURDIR)/$(WHEEL_VENV)/bin/whitted examples ex; \
-	  $(CURDIR)/$(WHEEL_VENV)/bin/whitted render ex/textured.toml -W 96 -H 72 -o textured.png; \
-	  $(CURDIR)/$(WHEEL_VENV)/bin/whitted render ex/models/teapot.obj -W 96 -H 72 -o teapot.png; \
-	  $(CURDIR)/$(WHEEL_VENV)/bin/whitted bench --quick --scene seed000; \
-	  ! $(CURDIR)/$(WHEEL_VENV)/bin/whitted stefan validate 2> stefan.err; \
+	  $(abspath $(WHEEL_VENV))/bin/whitted render glass_cube -W 96 -H 72 -o cube.png; \
+	  $(abspath $(WHEEL_VENV))/bin/whitted examples ex; \
+	  $(abspath $(WHEEL_VENV))/bin/whitted render ex/textured.toml -W 96 -H 72 -o textured.png; \
+	  $(abspath $(WHEEL_VENV))/bin/whitted render ex/models/teapot.obj -W 96 -H 72 -o teapot.png; \
+	  $(abspath $(WHEEL_VENV))/bin/whitted bench --quick --scene seed000; \
+	  ! $(abspath $(WHEEL_VENV))/bin/whitted stefan validate 2> stefan.err; \
 	  grep -q 'install whitted\[stefan\]' stefan.err; \
 	  cd $(CURDIR); rm -rf $$here
 	@echo "check-wheel: the installed wheel renders, copies its examples and runs the bench"
