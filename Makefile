@@ -2,8 +2,8 @@
 PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
-# Compiled kernels are kept here between runs (see src/whitted/_cache.py).
-export WHITTED_CACHE_DIR ?= $(CURDIR)/.cache
+# Compiled kernels are kept in the per-user cache (~/.cache/whitted, src/whitted/jit/cache.py),
+# the one every later `whitted` command uses, however whitted was installed.
 
 .PHONY: demo test test-oldest-numba test-timing check-wheel coverage lint install install-test bench clean
 
@@ -35,7 +35,7 @@ test: install-test
 	$(BIN)/python -m pytest -q
 
 ## The render smoke tests again with the oldest Numba pyproject.toml allows (stock Numba:
-## kernels/dispatcher.py verifies its tuning on newer ones), in a second virtual environment
+## jit/dispatcher.py verifies its tuning on newer ones), in a second virtual environment
 ## that holds only that Numba, its llvmlite and a NumPy it supports, and takes everything else
 ## from $(VENV)
 OLDEST_NUMBA := $(shell sed -n 's/.*"numba>=\([0-9.]*\),.*/\1/p' pyproject.toml)

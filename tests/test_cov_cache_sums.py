@@ -1,4 +1,4 @@
-"""The kernel cache's list of checksums (whitted/_cache.py ``KernelCache``) on a folder of
+"""The kernel cache's list of checksums (jit/cache.py ``KernelCache``) on a folder of
 stand-in cache files: a list of the wrong shape, a list that cannot be written, a missing
 folder, a read-only folder's one warning; and the renderer's fingerprint built from the
 kernel sources' hash (whitted/fingerprint.py)."""
@@ -9,8 +9,8 @@ import hashlib
 import json
 import re
 
-from whitted import _cache
-from whitted._cache import SUMS, KernelCache
+from whitted.jit import cache as _cache
+from whitted.jit.cache import SUMS, KernelCache
 
 
 def _folder(tmp_path):
@@ -78,11 +78,18 @@ def test_a_read_only_folder_says_once_that_it_compiles_in_memory(tmp_path, monke
     assert state.missed
 
 
-def test_the_fingerprint_names_the_version_and_the_kernel_sources():
+def test_the_fingerprint_names_the_version_the_source_the_libraries_and_the_cpu():
+    import llvmlite
+    import numba
+    import numpy
+
     import whitted
-    from whitted.fingerprint import renderer_fingerprint
+    from whitted.fingerprint import renderer_fingerprint, source_hash
 
     fingerprint = renderer_fingerprint()
-    assert fingerprint == f"whitted {whitted.__version__} kernels {_cache.kernel_source_hash()}"
-    assert re.fullmatch(r"whitted \S+ kernels [0-9a-f]{16}", fingerprint)
+    assert fingerprint.startswith(f"whitted {whitted.__version__} source {source_hash()} "
+                                  f"numba {numba.__version__} llvmlite {llvmlite.__version__} "
+                                  f"numpy {numpy.__version__} cpu ")
+    assert re.fullmatch(r"whitted \S+ source [0-9a-f]{16} numba \S+ llvmlite \S+ numpy \S+ "
+                        r"cpu \S+/[0-9a-f]{8}", fingerprint)
     assert renderer_fingerprint() is fingerprint  # computed once

@@ -132,12 +132,12 @@ def local_frames(film_scene, tmp_path) -> dict[int, bytes]:
     return frames
 
 
-def other_whitted(tmp_path: Path) -> Path:
-    """A copy of whitted's sources with one line of ``kernels/integrator.py`` changed."""
+def other_whitted(tmp_path: Path, module: str = "kernels/integrator.py") -> Path:
+    """A copy of whitted's sources with one line of ``module`` changed."""
     copy = tmp_path / "other-src"
     shutil.copytree(SRC, copy, ignore=shutil.ignore_patterns("__pycache__"))
-    integrator = copy / "whitted/kernels/integrator.py"
-    integrator.write_text(integrator.read_text() + "\nCHANGED_ON_THIS_WORKER = 1\n")
+    changed = copy / "whitted" / module
+    changed.write_text(changed.read_text() + "\nCHANGED_ON_THIS_WORKER = 1\n")
     return copy
 
 
@@ -209,11 +209,16 @@ def test_a_frame_records_its_renderer_and_another_renderers_frame_is_not_current
     assert not frame_is_current(tmp_path / "other.png", digest)
 
 
-def test_a_worker_with_another_whitted_gets_no_tasks_and_is_named(scheduler, film_scene,
-                                                                  local_frames, tmp_path):
+def test_a_worker_with_a_changed_non_kernel_module_gets_no_tasks_and_is_named(
+        scheduler, film_scene, local_frames, tmp_path):
+    """Not only the kernels decide a frame's pixels: a worker whose scene interpolation
+    differs from the client's is another renderer."""
+    from whitted.fingerprint import fingerprint_fields, source_hash
+
     address, worker, _ = scheduler
     worker("--name", "good", pythonpath=str(SRC))
-    worker("--name", "other", pythonpath=str(other_whitted(tmp_path)))
+    other = other_whitted(tmp_path, "scene/interpolate.py")
+    worker("--name", "other", pythonpath=str(other))
     notes: list[str] = []
     with distributed.Client(address) as client:
         client.wait_for_workers(2)
@@ -221,9 +226,14 @@ def test_a_worker_with_another_whitted_gets_no_tasks_and_is_named(scheduler, fil
         by_name = {d["name"]: w for w, d in workers_of(client).items()}
         assert ready == [by_name["good"]]
         [line] = [n for n in notes if by_name["other"] in n]
-        assert "runs whitted" in line and "not the client's" in line
-        assert line.endswith("it gets no tasks")
-        result = render_film(client, film_scene, tmp_path / "frames", chunk=1)
+        theirs = source_hash(other / "whitted")
+        ours = fingerprint_fields(renderer_fingerprint())["source"]
+        assert theirs != ours
+        assert line == (f"farm: worker {by_name['other']} runs another renderer (source "
+                        f"{theirs}, the client's {ours}): it gets no tasks")
+        result = render_film(client, film_scene, tmp_path / "frames", chunk=1,
+                             note=notes.append)
+    assert notes == [line]  # named once: by the readying, not again by the film
     assert set(result.workers.values()) == {by_name["good"]}
     for k in range(8):
         data = (tmp_path / "frames" / f"{k:04d}.png").read_bytes()
@@ -241,7 +251,7 @@ def test_no_worker_with_this_whitted_is_one_line_naming_them(scheduler, tmp_path
             ready_cluster(client, WhittedWorker(threads=1), None)
     message = str(lost.value)
     assert "\n" not in message and message.startswith("no worker can render: ")
-    assert f"worker {by_name['other']} runs whitted" in message
+    assert f"worker {by_name['other']} runs another renderer (source " in message
     assert (f"worker {by_name['none']} (none) cannot load whitted (ModuleNotFoundError: No "
             "module named 'whitted'; is whitted[farm] installed there?)") in message
 
@@ -287,6 +297,74 @@ def test_a_worker_without_whitted_joining_mid_film_is_named_and_does_not_hang_it
                      "installed there?): it gets no tasks"]
     for k in range(8):
         assert (tmp_path / "frames" / f"{k:04d}.png").read_bytes() == local_frames[k]
+
+
+def _animate(scene: Path, output: Path, address: str, *extra: str,
+             timeout: float = 300) -> subprocess.CompletedProcess:
+    """``whitted animate`` on the scheduler at ``address`` (a hang guard of ``timeout``)."""
+    return subprocess.run([sys.executable, "-m", "whitted", "animate", str(scene), "-o",
+                           str(output), "--scheduler", address, *extra], capture_output=True,
+                          text=True, timeout=timeout, env=env_with())
+
+
+def _wait_for_bare(address: str, name: str) -> str:
+    """The address of the worker ``name`` once it has said it cannot load whitted and the
+    scheduler lists it as closing (a worker that failed to start, which answers nothing)."""
+    with distributed.Client(address) as client:
+        def listed() -> str | None:
+            said = {m["worker"] for _, m in client.get_events("whitted-worker")
+                    if m.get("name") == name and m.get("status") == "missing"}
+            for w, d in workers_of(client).items():
+                if w in said and d.get("status") in ("closing", "closed", "failed"):
+                    return w
+            return None
+
+        wait_for(lambda: listed() is not None, f"the worker {name} to fail to start")
+        return listed()
+
+
+def test_a_worker_without_whitted_joining_between_films_never_hangs_the_next(scheduler,
+                                                                             tmp_path):
+    """A worker that cannot load whitted joins a scheduler that ran a film (the plugins are
+    registered there): it fails to start and stays listed, answering nothing. The next film
+    names it once and renders on the healthy worker; with only such a worker left, the film
+    ends at once with one line and exit status 3."""
+    address, worker, _ = scheduler
+    good = worker("--name", "good", pythonpath=str(SRC))
+    scene = tmp_path / "film.toml"
+    scene.write_text(FILM)
+    with distributed.Client(address) as client:
+        client.wait_for_workers(1)
+    first = _animate(scene, tmp_path / "first", address, "--frames", "0:1", "-q")
+    assert first.returncode == 0, first.stderr
+    bare_path = f"{no_whitted(tmp_path)}{os.pathsep}{SRC}"
+    worker("--name", "bare", pythonpath=bare_path)
+    bare = _wait_for_bare(address, "bare")
+
+    second = _animate(scene, tmp_path / "second", address, "--frames", "0:1")
+    assert second.returncode == 0, second.stderr
+    named = [line for line in second.stderr.splitlines() if line.startswith("farm: worker")]
+    assert named == [f"farm: worker {bare} (bare) cannot load whitted (ModuleNotFoundError: "
+                     "No module named 'whitted'; is whitted[farm] installed there?): it gets "
+                     "no tasks (it answers nothing: removed from the scheduler)"], second.stderr
+    assert sorted(p.name for p in (tmp_path / "second").glob("*.png")) == ["0000.png",
+                                                                          "0001.png"]
+    for name in ("0000.png", "0001.png"):  # the same frames as the first film's
+        assert ((tmp_path / "second" / name).read_bytes()
+                == (tmp_path / "first" / name).read_bytes())
+
+    os.killpg(good.pid, signal.SIGKILL)  # the healthy worker gone; a bare one joins
+    with distributed.Client(address) as client:
+        wait_for(lambda: not workers_of(client), "the healthy worker to be gone")
+    worker("--name", "bare2", pythonpath=bare_path)
+    bare2 = _wait_for_bare(address, "bare2")
+    third = _animate(scene, tmp_path / "third", address, "--frames", "0:1", "-q",
+                     timeout=120)
+    assert third.returncode == 3, third.stderr
+    assert third.stderr.strip().splitlines() == [
+        f"error: no worker can render: worker {bare2} (bare2) cannot load whitted "
+        "(ModuleNotFoundError: No module named 'whitted'; is whitted[farm] installed "
+        "there?)"]
 
 
 def test_a_stopped_worker_stalls_nothing_its_tasks_go_elsewhere(scheduler, film_scene,
@@ -451,7 +529,10 @@ def test_losing_the_scheduler_ends_in_one_line_keeping_the_frames(scheduler, tmp
     assert run.returncode == 3, stderr
     lines = stderr.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in stderr, stderr
-    assert lines[0].startswith(f"error: lost the connection to the scheduler at {address}")
+    # where the scheduler was and what is kept; not Dask's text of the broken connection
+    assert re.fullmatch(rf"error: lost the connection to the scheduler at {address} \(\d+ of "
+                        rf"400 frames are in {re.escape(str(tmp_path / 'frames'))}\)",
+                        lines[0]), lines[0]
     assert len(list((tmp_path / "frames").glob("*.png"))) >= 1
 
 

@@ -116,21 +116,56 @@ def listening(port: int) -> bool:
         return False
 
 
-def test_the_ssh_recipe_on_one_machine_renders_a_film(tmp_path):
-    """The doc's three commands, hosts 127.0.0.1 and free ports for the pinned ones."""
+def certificates(folder: Path) -> dict[str, Path]:
+    """The doc's openssl commands, run in ``folder``: the farm's certificate authority and one
+    certificate for its machines (``ca.pem``, ``farm.pem``, ``farm.key``); and an intruder's
+    certificate that no one signed (``intruder.pem``, ``intruder.key``)."""
+    import shutil
+
+    if shutil.which("openssl") is None:
+        pytest.skip("needs the openssl command")
+    [script] = [text for language, text in blocks() if language == "sh"
+                and "openssl req" in text]
+    lines = [line for line in script.replace("\\\n", " ").splitlines()
+             if line.strip() and not line.startswith("#")]
+    lines.append("openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes "
+                 "-days 2 -subj /CN=intruder -keyout intruder.key -out intruder.pem")
+    for line in lines:
+        subprocess.run(shlex.split(line), cwd=folder, check=True, capture_output=True,
+                       timeout=60)
+    return {name: folder / name for name in ("ca.pem", "farm.pem", "farm.key",
+                                            "intruder.pem", "intruder.key")}
+
+
+def tls_client(certs: dict[str, Path], cert: str = "farm") -> dict[str, str]:
+    """The doc's client settings (Dask's environment variables)."""
+    return {"DASK_DISTRIBUTED__COMM__TLS__CA_FILE": str(certs["ca.pem"]),
+            "DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT": str(certs[f"{cert}.pem"]),
+            "DASK_DISTRIBUTED__COMM__TLS__CLIENT__KEY": str(certs[f"{cert}.key"])}
+
+
+def test_the_ssh_recipe_on_one_machine_renders_a_film_over_tls(tmp_path):
+    """The doc's commands (scheduler, worker, client, all over TLS with the doc's
+    certificates), hosts 127.0.0.1 and free ports for the pinned ones: the film renders; a
+    client with a certificate the farm did not sign is refused in one line, and so is one
+    with no certificate at all."""
+    certs = certificates(tmp_path)
+    tls = ["--tls-ca-file", str(certs["ca.pem"]), "--tls-cert", str(certs["farm.pem"]),
+           "--tls-key", str(certs["farm.key"])]
     port, worker_port, nanny_port = free_port(), free_port(), free_port()
     env = dict(os.environ, WHITTED_FARM_CACHE=str(tmp_path / "assets"), NUMBA_NUM_THREADS="1")
+    address = f"tls://127.0.0.1:{port}"
     started = []
     try:
         started.append(subprocess.Popen(
-            [DASK, "scheduler", "--host", "127.0.0.1", "--port", str(port),
-             "--dashboard-address", ":0"], env=env, stdout=subprocess.DEVNULL,
+            [DASK, "scheduler", "--protocol", "tls", "--host", "127.0.0.1", "--port",
+             str(port), "--no-dashboard", *tls], env=env, stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL))
         started.append(subprocess.Popen(
-            [DASK, "worker", f"tcp://127.0.0.1:{port}", "--host", "127.0.0.1", "--nworkers",
+            [DASK, "worker", address, "--host", "127.0.0.1", "--nworkers",
              "1", "--nthreads", "2", "--worker-port", str(worker_port), "--nanny-port",
-             str(nanny_port), "--dashboard-address", ":0", "--local-directory",
-             str(tmp_path / "dask")], env=env, stdout=subprocess.DEVNULL,
+             str(nanny_port), "--no-dashboard", "--local-directory",
+             str(tmp_path / "dask"), *tls], env=env, stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL))
         end = time.monotonic() + 120
         while not (listening(worker_port) and listening(nanny_port)):
@@ -138,10 +173,16 @@ def test_the_ssh_recipe_on_one_machine_renders_a_film(tmp_path):
             time.sleep(0.05)
         scene = tmp_path / "film.toml"
         scene.write_text(FILM)
-        result = subprocess.run(
-            [sys.executable, "-m", "whitted", "animate", str(scene), "-o",
-             str(tmp_path / "film_frames"), "--scheduler", f"tcp://127.0.0.1:{port}"],
-            capture_output=True, text=True, timeout=300, env=env)
+
+        def animate(client_env: dict[str, str], output: str) -> subprocess.CompletedProcess:
+            return subprocess.run(
+                [sys.executable, "-m", "whitted", "animate", str(scene), "-o",
+                 str(tmp_path / output), "--scheduler", address], capture_output=True,
+                text=True, timeout=300, env=dict(env, **client_env))
+
+        result = animate(tls_client(certs), "film_frames")
+        intruder = animate(tls_client(certs, "intruder"), "intruder_frames")
+        bare = animate({}, "bare_frames")
     finally:
         for proc in reversed(started):
             proc.send_signal(signal.SIGTERM)
@@ -152,9 +193,21 @@ def test_the_ssh_recipe_on_one_machine_renders_a_film(tmp_path):
                 proc.wait()
     assert result.returncode == 0, result.stderr
     # one worker process with 2 Dask threads, on the pinned port
-    assert f"farm: 1 worker (2 Dask threads) at tcp://127.0.0.1:{port}" in result.stderr
+    assert f"farm: 1 worker (2 Dask threads) at {address}" in result.stderr
     assert "4 frames (4 rendered" in result.stdout
     assert len(list((tmp_path / "film_frames").glob("*.png"))) == 4
+    assert intruder.returncode == 3
+    assert intruder.stderr.strip().splitlines() == [
+        f"error: --scheduler {address}: the scheduler refused this client's TLS connection "
+        "(its certificate must be signed by the farm's certificate authority; docs/farm.md)"]
+    assert bare.returncode == 2
+    assert bare.stderr.strip().splitlines() == [
+        f"error: --scheduler {address}: a TLS scheduler needs this client's certificate: set "
+        "DASK_DISTRIBUTED__COMM__TLS__CA_FILE, DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT and "
+        "DASK_DISTRIBUTED__COMM__TLS__CLIENT__KEY (Dask's distributed.comm.tls settings; "
+        "docs/farm.md)"]
+    for refused in ("intruder_frames", "bare_frames"):
+        assert not any((tmp_path / refused).glob("*.png"))
 
 
 FILM = """
@@ -242,7 +295,7 @@ def test_the_container_recipe_renders_from_its_read_only_cache_as_another_user(o
     in memory with one warning line, and the render still succeeds."""
     import shutil
 
-    from whitted import _cache
+    from whitted.jit import cache as _cache
     from whitted.render.warm_up import warm_up_kernels
 
     if os.geteuid() != 0 or shutil.which("setpriv") is None:

@@ -252,6 +252,61 @@ def test_frames_that_carry_the_record_are_resumed_or_replaced(tmp_path):
     assert again.rendered == [1] and again.kept == [0, 2]
 
 
+def _refingerprint(path: Path, fingerprint: str) -> None:
+    """``path`` as another renderer would have written it: the same pixels and frame hash,
+    its fingerprint recorded instead of this process's."""
+    from PIL.PngImagePlugin import PngInfo
+
+    from whitted.fingerprint import FINGERPRINT_KEY
+
+    with PILImage.open(path) as im:
+        info = PngInfo()
+        for key, value in im.text.items():
+            info.add_text(key, fingerprint if key == FINGERPRINT_KEY else value)
+        im.save(path, pnginfo=info)
+
+
+def test_a_resume_never_keeps_frames_of_another_renderer(tmp_path):
+    """Frames carry the fingerprint they were made with: a frame whose hash matches but whose
+    renderer differs (another source, Numba, CPU target) is rendered again, the rest kept."""
+    from whitted.fingerprint import FINGERPRINT_KEY, fingerprint_fields, renderer_fingerprint
+
+    scene = load_scene(_scene(tmp_path, frames=4))
+    render_film(scene, tmp_path / "f", threads=1)
+    ours = renderer_fingerprint()
+    fields = fingerprint_fields(ours)
+    others = {1: ours.replace(fields["source"], "0123456789abcdef"),
+              2: ours.replace(f"cpu {fields['cpu']}", "cpu generic/e3b0c442"),
+              3: ours.replace(f"numba {fields['numba']}", "numba 0.61.0")}
+    for frame, fingerprint in others.items():
+        assert fingerprint != ours
+        _refingerprint(tmp_path / "f" / frame_name(frame, 4), fingerprint)
+    again = render_film(scene, tmp_path / "f", threads=1)
+    assert again.kept == [0] and again.rendered == [1, 2, 3]
+    for k in range(4):
+        with PILImage.open(tmp_path / "f" / frame_name(k, 4)) as im:
+            assert im.text[FINGERPRINT_KEY] == ours
+
+
+def test_a_frame_made_for_another_cpu_target_is_not_kept(tmp_path):
+    """A process compiling for another CPU target (``NUMBA_CPU_NAME=generic``) has another
+    fingerprint: its frames are rendered again by this one."""
+    from whitted.fingerprint import FINGERPRINT_KEY, renderer_fingerprint
+
+    scene_path = _scene(tmp_path, frames=2)
+    code = ("from whitted.fingerprint import renderer_fingerprint as f; print(f())")
+    env = dict(os.environ, NUMBA_CPU_NAME="generic", PYTHONPATH=str(SRC.parent))
+    theirs = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                            text=True, check=True, timeout=120).stdout.strip()
+    assert theirs != renderer_fingerprint() and "cpu generic/" in theirs
+    render_film(load_scene(scene_path), tmp_path / "f", threads=1)
+    _refingerprint(tmp_path / "f" / "0001.png", theirs)
+    again = render_film(load_scene(scene_path), tmp_path / "f", threads=1)
+    assert again.kept == [0] and again.rendered == [1]
+    with PILImage.open(tmp_path / "f" / "0001.png") as im:
+        assert im.text[FINGERPRINT_KEY] == renderer_fingerprint()
+
+
 # ----------------------------------------------------------------- issue 25 item 2
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import tomli_w
+import tomlkit
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -108,7 +108,7 @@ def mutated_scenes(draw):
 
 def _toml_text(data) -> str | None:
     try:
-        return tomli_w.dumps(data)
+        return tomlkit.dumps(data)
     except (TypeError, ValueError):  # nan in a key place, a None, ...: not writable as TOML
         return None
 
@@ -141,7 +141,7 @@ def test_truncated_and_corrupted_scene_text_ends_cleanly(tmp_path_factory, cut: 
                                                          insert: bytes, at: int, name: str,
                                                          as_json: bool):
     folder = tmp_path_factory.mktemp("text")
-    raw = (json.dumps(SCENES[name]) if as_json else tomli_w.dumps(SCENES[name])).encode()
+    raw = (json.dumps(SCENES[name]) if as_json else tomlkit.dumps(SCENES[name])).encode()
     raw = raw[: cut % (len(raw) + 1)]
     at = at % (len(raw) + 1)
     raw = raw[:at] + insert + raw[at:]

@@ -1,5 +1,5 @@
 """The kernel decorator: one compiled variant per real argument type, not per integer constant
-(the tuned dispatcher of kernels/dispatcher.py), and stock Numba where that is not verified."""
+(the tuned dispatcher of jit/dispatcher.py), and stock Numba where that is not verified."""
 
 from __future__ import annotations
 
@@ -12,13 +12,12 @@ import numpy as np
 import pytest
 from numba import types
 
-from whitted.kernels import dispatcher
-from whitted.kernels.dispatcher import widen_integer
-from whitted.kernels.jit import kernel, load_numba
+from whitted.jit import dispatcher, kernel, load_numba
+from whitted.jit.dispatcher import widen_integer
 
 load_numba()
 tuned_only = pytest.mark.skipif(not dispatcher.tuned(),
-                                reason="stock Numba here (kernels/dispatcher.py VERIFIED)")
+                                reason="stock Numba here (jit/dispatcher.py VERIFIED)")
 
 
 @kernel(cache=False)
@@ -140,8 +139,8 @@ def test_a_callee_of_an_inlined_kernel_is_not_inlined_by_inheritance():
 STOCK = """
 import numpy as np
 from numba.core.registry import CPUDispatcher
-from whitted.kernels import dispatcher
-from whitted.kernels.jit import kernel, load_numba
+from whitted.jit import dispatcher
+from whitted.jit import kernel, load_numba
 
 load_numba()
 assert dispatcher.tuned() is False
@@ -198,15 +197,17 @@ def test_private_names_are_listed_and_checked():
     with open(dispatcher.__file__) as f:
         source = f.read()
     for name in ("get_call_template", "_load_overload", "rtsys.initialize", "_nrt",
-                 "no_cpython_wrapper", "forceinline", "UserProvidedCacheLocator"):
+                 "no_cpython_wrapper", "forceinline", "FunctionCache"):
         assert name in source.split("PRIVATE_NAMES = (", 1)[1].split(")\n", 1)[0], name
 
 
-#: Numba's documented modules whitted may import outside kernels/dispatcher.py: the package,
+#: Numba's documented modules whitted may import outside jit/dispatcher.py: the package,
 #: its high-level and low-level extension API (numba.extending, numba.core.cgutils and the
-#: typing templates its examples use), and the event API (numba.core.event)
+#: typing templates its examples use), the event API (numba.core.event), and the cache
+#: locators that Numba's NUMBA_CACHE_LOCATOR_CLASSES setting chooses from (numba.core.caching:
+#: jit/locator.py subclasses the public UserProvidedCacheLocator)
 DOCUMENTED_NUMBA = {"numba", "numba.extending", "numba.types", "numba.core.cgutils",
-                    "numba.core.event", "numba.core.typing.templates"}
+                    "numba.core.event", "numba.core.typing.templates", "numba.core.caching"}
 
 
 def test_only_the_dispatcher_imports_undocumented_numba_modules():

@@ -1,4 +1,4 @@
-"""The kernel cache heals itself (whitted/_cache.py): damaged files are dropped and compiled
+"""The kernel cache heals itself (jit/cache.py): damaged files are dropped and compiled
 again with one warning line, an unusable folder falls back with one warning line, two cold
 renders share one folder; never a crash, a wrong image or an internal error."""
 
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import whitted
-from whitted import _cache
+from whitted.jit import cache as _cache
 from whitted.render.warm_up import warm_up_kernels
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
@@ -107,7 +107,7 @@ def _hold_compiling_marker(folder: str, started: Path, release: Path) -> subproc
     code = textwrap.dedent(f"""
         import pathlib, sys, time
         sys.path.insert(0, {str(REPO_ROOT / 'src')!r})
-        from whitted import _cache
+        from whitted.jit import cache as _cache
         state = _cache.KernelCache({folder!r}, own=True, helper=False)
         state.compiling()
         pathlib.Path({str(started)!r}).touch()
@@ -394,7 +394,7 @@ def test_no_usable_folder_at_all_compiles_in_memory(tmp_path):
     (cache=False), with one warning line, and still run."""
     script = textwrap.dedent("""
         import numpy as np
-        from whitted.kernels.jit import kernel
+        from whitted.jit import kernel
 
         @kernel(entry=True)
         def twice(a):

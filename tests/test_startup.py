@@ -113,7 +113,7 @@ def test_plain_line_is_what_rich_prints_and_needs_no_rich(tmp_path):
 
 
 def test_numba_imported_through_whitted_skips_its_scipy_and_yaml_probes(tmp_path):
-    """Numba imports SciPy and PyYAML only to probe for them (whitted/_lean_numba.py): after
+    """Numba imports SciPy and PyYAML only to probe for them (jit/lean_numba.py): after
     ``import whitted`` they are skipped, and both still import afterwards."""
     loaded = _modules_after("""
         import whitted, sys
@@ -121,7 +121,7 @@ def test_numba_imported_through_whitted_skips_its_scipy_and_yaml_probes(tmp_path
         assert "scipy" not in sys.modules and "yaml" not in sys.modules, "probed"
         import scipy, yaml  # still importable, for scikit-image and Dask
         assert scipy.__version__ and yaml.safe_load("a: 1") == {"a": 1}
-        from whitted import _lean_numba
+        from whitted.jit import lean_numba as _lean_numba
         assert _lean_numba._finder not in sys.meta_path  # one-shot: gone once numba is in
     """, tmp_path)
     assert {"numba", "scipy", "yaml"} <= loaded
@@ -140,7 +140,7 @@ def test_numba_config_file_still_read_through_whitted(tmp_path):
 
 
 def test_slp_vectoriser_stays_on_when_numba_was_imported_before_whitted(tmp_path):
-    """Loading Numba through whitted (kernels/jit.py) turns LLVM's SLP vectoriser on. Numba
+    """Loading Numba through whitted (jit/decorators.py) turns LLVM's SLP vectoriser on. Numba
     reads its settings from the environment again before a compile once the environment has
     changed (whitted sets
     NUMBA_CACHE_DIR when Numba is already imported): the setting must survive that, or the
@@ -149,7 +149,7 @@ def test_slp_vectoriser_stays_on_when_numba_was_imported_before_whitted(tmp_path
         import os
         import numba
         from numba.core import config
-        from whitted.kernels.jit import load_numba
+        from whitted.jit import load_numba
         load_numba()
         assert config.SLP_VECTORIZE == 1
         os.environ["WHITTED_TEST_CHANGE"] = "1"  # any change: Numba re-reads everything
@@ -158,7 +158,7 @@ def test_slp_vectoriser_stays_on_when_numba_was_imported_before_whitted(tmp_path
         assert numba.config.CACHE_DIR  # whitted's cache folder survives it too
     """, tmp_path)
     env = dict(os.environ, NUMBA_SLP_VECTORIZE="0")  # a user's own choice wins
-    result = subprocess.run([sys.executable, "-c", "import numba, whitted.kernels.jit as j; "
+    result = subprocess.run([sys.executable, "-c", "import numba, whitted.jit as j; "
                              "j.load_numba(); assert numba.config.SLP_VECTORIZE == 0"], env=env,
                             capture_output=True, text=True, timeout=600, cwd=tmp_path)
     assert result.returncode == 0, result.stderr
@@ -180,14 +180,14 @@ def test_public_api_resolves_every_name():
 
 def test_kernels_loaded_from_cache_then_a_new_kernel_compiles(tmp_path):
     """A render loads its kernels without Numba's compiler registries (with the tuned
-    dispatcher: kernels/dispatcher.py ``KernelCache``); a kernel compiled afterwards in the
+    dispatcher: jit/dispatcher.py ``KernelCache``); a kernel compiled afterwards in the
     same process, using NumPy and math functions and calling a loaded kernel, must still
     compile and give the right value."""
     loaded = _modules_after("""
         import math
         import numpy as np
         import whitted
-        from whitted.kernels.jit import kernel
+        from whitted.jit import kernel
         from whitted.kernels.vec import dot
 
         whitted.render(whitted.Scene(), width=8, height=8, threads=1)

@@ -373,7 +373,7 @@ def test_any_finite_uv_gives_a_colour_of_the_texture(random_textures, u: float, 
 
 def test_texture_color_inside_a_kernel_without_allocation(quad_png: Path):
     """The integrator calls texture_color from compiled code built without the Numba runtime."""
-    from whitted.kernels.jit import kernel
+    from whitted.jit import kernel
 
     @kernel(cache=False)
     def shade_all(tex_info, tex_pixels, k, uv, out):

@@ -16,9 +16,9 @@ from whitted.scene.toml_document import (
     compact_toml,
     edit_toml,
     edited_toml,
-    save_scene_toml,
     scene_toml,
 )
+from whitted.scene.writing import save_scene
 
 
 def load(text: str) -> whitted.Scene:
@@ -129,11 +129,11 @@ def test_named_materials_changed_removed_and_added():
     mats = {"red": whitted.Material(color=(1, 0.5, 0)),
             "green": whitted.Material(color=(0, 1, 0))}
     out = edited(scene.model_copy(update={"materials": mats}))
-    # red edited in place (its comment kept), blue gone (with the blank line after it),
-    # green new; the rest as it was
+    # red edited in place (only the number that changed; its comment kept), blue gone (with
+    # the blank line after it), green new; the rest as it was
     assert out == FILM.replace(
         "color = [1, 0, 0]   # red\n[materials.blue]\ncolor = [0, 0, 1]\n\n",
-        "color = [1.0, 0.5, 0.0]   # red\n\n[materials.green]\ncolor = [0.0, 1.0, 0.0]\n")
+        "color = [1, 0.5, 0]   # red\n\n[materials.green]\ncolor = [0.0, 1.0, 0.0]\n")
     # the last material gone: the table goes (and the object's reference with it)
     out = edited(scene.model_copy(update={"materials": {}, "objects": [S.Sphere(radius=1)]}))
     assert out == "# film\n" + LIGHTS_AND_OBJECTS.replace('material = "red"\n', "") + ANIMATION
@@ -280,16 +280,17 @@ def test_saving_into_another_folder_rebases_file_names(tmp_path):
     (home / "scene.toml").write_text(text)
     scene = whitted.load_scene(home / "scene.toml")
     # the same folder: the file as it was (nothing edited)
-    assert save_scene_toml(scene, home / "scene.toml", text=text, loaded=scene) == text
-    written = save_scene_toml(scene, other / "scene.toml", text=text, loaded=scene)
+    save_scene(scene, home / "scene.toml", text=text, loaded=scene)
+    assert (home / "scene.toml").read_text() == text
+    save_scene(scene, other / "scene.toml", text=text, loaded=scene)
+    written = (other / "scene.toml").read_text()
     assert written == '[[objects]]\ntype = "mesh"\nfile = "../home/models/tri.obj"\n'
-    assert (other / "scene.toml").read_text() == written
     moved = whitted.load_scene(other / "scene.toml")
     assert moved.resolve_path(moved.objects[0].file).resolve() == home / "models" / "tri.obj"
-    assert save_scene_toml(scene, other / "given.toml", payload="# as given\n") == \
-        "# as given\n"
-    assert (other / "given.toml").read_text() == "# as given\n"
-    assert sorted(p.name for p in other.iterdir()) == ["given.toml", "scene.toml"]
+    # Scene.save writes the same file as save_scene (one writer: compact TOML)
+    scene.save(other / "again.toml")
+    assert (other / "again.toml").read_text() == written
+    assert sorted(p.name for p in other.iterdir()) == ["again.toml", "scene.toml"]
 
 
 @pytest.mark.parametrize("preset", ["glass", "mirror"])
@@ -319,7 +320,7 @@ def test_items_edited_in_place_removed_and_added_and_a_track_retimed():
     assert out == (
         '[[lights]]\n# key\ntype = "point"\nposition = [0, 5, 0]\n\n[[objects]]\n'
         'type = "sphere"\nradius = 2.0   # unit\n'
-        'material = { preset = "plastic", color = [1.0, 0.0, 0.0] }\n\n'
+        'material = { preset = "plastic", color = [1.0, 0, 0.0] }\n\n'
         '\n[[objects]]\ntype = "sphere"\nname = "b"\nradius = 0.5\n'
         '[animation]\nframes = 4\n[[animation.tracks]]\npath = "camera.fov"\n'
         'keys = [[0, 30], [3, 60]]\ninterpolation = "smooth"\n')

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from whitted.compile.params import render_params
+from whitted.jit import kernel
 from whitted.kernels import integrator, tiles
 from whitted.kernels.callees import render_callees
-from whitted.kernels.jit import kernel
 from whitted.kernels.layout import N_RAY_KINDS
 from whitted.render import warm_up
 from whitted.scene.scene import RenderSettings, Scene

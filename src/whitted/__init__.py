@@ -17,7 +17,11 @@ import sys
 import types
 from typing import TYPE_CHECKING
 
-from . import _lean_numba
+from . import marks as _marks
+
+_marks.mark("interpreter")  # the interpreter has started and reached whitted
+
+from .jit import lean_numba as _lean_numba  # noqa: E402
 
 _lean_numba.install()  # Numba's import without its SciPy and PyYAML probes
 
@@ -26,8 +30,13 @@ _LAZY = {
     "Animation": ".animation", "Track": ".animation",
     "SceneError": ".errors", "WhittedError": ".errors",
     "Image": ".output",
-    "CancelToken": ".render", "Progress": ".render", "RenderJob": ".render",
-    "RenderStats": ".render", "render": ".render", "render_aovs": ".render",
+    "CancelToken": ".render", "JobState": ".render", "Progress": ".render",
+    "RenderJob": ".render", "RenderStats": ".render", "render_aovs": ".render",
+    # shown live in a notebook, unchanged elsewhere (whitted.notebook)
+    "render": ".notebook", "render_async": ".notebook", "render_film": ".notebook",
+    "film_from_frames": ".notebook", "sweep": ".notebook", "viewer": ".notebook",
+    "run_stefan": ".notebook",
+    "Film": ".output.inline_film", "ContactSheet": ".animation.sheet",
     "default_scene": ".scene.default",
     "framed": ".studio", "model_scene": ".studio", "turntable": ".studio",
     **dict.fromkeys((
@@ -41,12 +50,13 @@ _LAZY = {
 __all__ = [
     "Animation", "Track",
     "CSG", "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera", "CancelToken",
-    "CheckerTexture", "Cone", "Cylinder", "DirectionalLight", "Disk", "DiskLight", "Gradient",
-    "GradientTexture", "Image", "ImageTexture", "Material", "Mesh", "Plane",
-    "PointLight", "Progress", "Rectangle", "RenderJob", "RenderSettings", "RenderStats", "Scene",
-    "SceneError", "Sphere", "Torus", "Transform", "Triangle", "WhittedError", "__version__",
-    "default_scene", "framed", "load_scene", "model_scene", "render", "render_aovs",
-    "save_scene", "turntable",
+    "CheckerTexture", "Cone", "ContactSheet", "Cylinder", "DirectionalLight", "Disk",
+    "DiskLight", "Film", "Gradient", "GradientTexture", "Image", "ImageTexture", "JobState",
+    "Material", "Mesh", "Plane", "PointLight", "Progress", "Rectangle", "RenderJob",
+    "RenderSettings", "RenderStats", "Scene", "SceneError", "Sphere", "Torus", "Transform",
+    "Triangle", "WhittedError", "__version__", "default_scene", "film_from_frames", "framed",
+    "load_scene", "model_scene", "render", "render_aovs", "render_async", "render_film",
+    "run_stefan", "save_scene", "sweep", "turntable", "viewer",
 ]
 
 
@@ -91,9 +101,20 @@ sys.modules[__name__].__class__ = _Package
 
 if TYPE_CHECKING:  # for type checkers and IDEs: the same names, imported eagerly
     from .animation import Animation, Track
+    from .animation.sheet import ContactSheet
     from .errors import SceneError, WhittedError
+    from .notebook import (
+        film_from_frames,
+        render,
+        render_async,
+        render_film,
+        run_stefan,
+        sweep,
+        viewer,
+    )
     from .output import Image
-    from .render import CancelToken, Progress, RenderJob, RenderStats, render, render_aovs
+    from .output.inline_film import Film
+    from .render import CancelToken, JobState, Progress, RenderJob, RenderStats, render_aovs
     from .scene import (
         CSG,
         PRESETS,

@@ -110,7 +110,7 @@ def model_files(path: Path) -> list[Path]:
 
 @functools.cache
 def _kernel_sources() -> str:
-    from .._cache import kernel_source_hash
+    from ..jit.cache import kernel_source_hash
 
     return kernel_source_hash()
 

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels.jit import builder
+from ..jit import builder
 
 # Result codes (``info[INFO_CODE]``); the Python side turns them into messages.
 OK = 0

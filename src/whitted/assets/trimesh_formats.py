@@ -23,8 +23,8 @@ from struct import error as struct_error
 
 import numpy as np
 
-from .._cache import cache_dir
 from ..errors import SceneError
+from ..jit.cache import cache_root
 from ..scene.materials import Material
 from ..scene.textures import ImageTexture
 from .mesh_data import MeshData
@@ -62,7 +62,7 @@ def _embedded_image_file(image: object) -> Path | None:
         buffer = io.BytesIO()
         image.save(buffer, format="PNG")  # type: ignore[attr-defined]
         data = buffer.getvalue()
-        folder = cache_dir().parent / "textures"
+        folder = cache_root() / "textures"
         path = folder / f"{hashlib.sha256(data).hexdigest()[:32]}.png"
         if not path.is_file():
             folder.mkdir(parents=True, exist_ok=True)

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import math
 
+from ..jit import kernel
 from ..kernels.accel import closest_hit
 from ..kernels.geometry_ref import geometry_ref_if_instances
-from ..kernels.jit import kernel
 from ..kernels.lighting import any_occluder
 from ..kernels.tiles import camera_ray
 

@@ -77,6 +77,9 @@ def render(
     """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG).
     An animated scene renders frame 0, or the frame --frame names. A model file is shown on a
     lit ground by a camera that frames it."""
+    from .. import marks
+
+    marks.mark("command")  # the imports and the command line's parsing are done
     from pydantic import ValidationError
 
     if turntable is not None:
@@ -164,11 +167,12 @@ def _turntable_film(scene_path, output, frames, width, height, samples, max_dept
 
 def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
                       guard: InterruptGuard, process_start, frame: int | None) -> None:
+    from .. import marks
     from ..output.formats import image_format
     from ..render.api import render_aovs
 
     interrupted = guard.event
-
+    marks.mark("job")
     try:
         _run_with_progress(job, quiet, interrupted)
     except WhittedError as exc:  # a model or texture file the scene names is unusable
@@ -183,6 +187,7 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
                          "unchanged)")
     image = job.image
     assert image is not None
+    marks.mark("rendered")
     for warning in stats.warnings:
         err.line(f"warning: {warning}")
     written = [str(output)]
@@ -207,6 +212,14 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
     stats.wall_seconds = time.perf_counter() - process_start
     if not quiet or interrupted.is_set():
         out.line(f"{stats.summary()} -> {', '.join(written)}")
+    if marks.enabled():  # whitted bench --startup: the moments, and the job's own figures
+        marks.note("build", stats.build_seconds)
+        marks.note("kernels", stats.compile_seconds)
+        marks.note("render", stats.render_seconds)
+        if stats.photons is not None:
+            marks.note("photons", stats.photons.seconds)
+        marks.mark("written")
+        marks.write()
     if interrupted.is_set():  # (a signal may have come during the write)
         raise guard.exit(f"kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")
 

@@ -26,7 +26,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..kernels.jit import builder
+from ..jit import builder
 
 LEAF_HARD_CAP = 16  # a node with more primitives than this is always split
 MAX_DEPTH = 60  # root has depth 0; no leaf is deeper than this

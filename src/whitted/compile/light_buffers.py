@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels.jit import kernel
+from ..jit import kernel
 from ..kernels.layout import (
     CELL_COUNT,
     CELL_FIRST,

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels.jit import builder
+from ..jit import builder
 
 
 @builder

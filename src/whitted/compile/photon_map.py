@@ -20,8 +20,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import SceneError
+from ..jit import builder
 from ..kernels.caustics import cell_hash, cell_of
-from ..kernels.jit import builder
 from ..kernels.layout import (
     GRID_BITS,
     GRID_INV_CELL,

@@ -20,7 +20,15 @@ from ..render.api import available_threads
 from ._dask import Client, LocalCluster
 from .errors import ClusterLost, FarmError
 from .probe import WhittedProbe
-from .watch import Watch, missing_reason, ready_workers
+from .security import client_security, connect
+from .watch import (
+    FIRST_TASK_LIMIT,
+    POLL_SECONDS,
+    STALL_FLOOR,
+    Watch,
+    mismatch_reason,
+    missing_reason,
+)
 from .worker import WhittedWorker
 
 #: seconds to wait for a scheduler that does not answer (a refused connection fails at once)
@@ -115,49 +123,93 @@ def local_cluster(workers: int, threads: int, dask_threads: int = 1) -> LocalClu
 
 def ready_cluster(client: Client, plugin: WhittedWorker,
                   note: Callable[[str], None] | None = None,
-                  probe: WhittedProbe | None = None) -> list[str]:
+                  probe: WhittedProbe | None = None, *,
+                  stall_floor: float = STALL_FLOOR) -> list[str]:
     """Register ``probe`` (default :class:`WhittedProbe`: a worker that cannot import
     whitted, now or when it joins later, says so before it goes) and ``plugin`` (every worker
     readied: kernels loaded, or compiled with progress told through ``note``); name each
-    worker that cannot render in one line. Returns the ready workers; raises
-    :class:`ClusterLost` when there is none."""
-    watch = Watch(client, note)  # its events: the cold workers' progress, mismatches
-    failure = None
+    worker that cannot render in one line, once. Returns the ready workers; raises
+    :class:`ClusterLost` when there is none.
+
+    Never waits forever: a registration waits for every worker the scheduler lists, so a
+    listed worker that answers nothing (one that failed to start and stays ``closing``, one
+    stopped) is removed from the scheduler (:meth:`Watch.drop_dead`); a worker still
+    readying after ``stall_floor`` seconds while none compiles is left to join the job later
+    (its tasks come once it offers the ``whitted`` resource), or, when no worker is ready, the
+    readying ends with one line."""
+    watch = Watch(client, note, stall_floor=stall_floor)  # cold workers' progress, mismatches
     try:
+        failures = _register(client, [probe or WhittedProbe(), plugin], watch)
         try:
-            client.register_plugin(probe or WhittedProbe())
-            client.register_plugin(plugin)
+            info = client.scheduler_info(n_workers=-1)
         except (OSError, TimeoutError) as exc:
             raise watch.lost(exc) from None
-        except Exception as exc:  # noqa: BLE001 - a worker that cannot load the plugin
-            failure = exc
-        info = client.scheduler_info(n_workers=-1)
-        ready = ready_workers(info)
-        states = _states(client, [w for w in info.get("workers", {}) if w not in ready])
+        workers = {w: d for w, d in info.get("workers", {}).items() if w not in watch.dropped}
+        ready = watch.ready_workers(info)
+        states = _states(client, [w for w in workers if w not in ready])
     finally:
         watch.close()
+    failure = failures[0] if failures else None
     why = (str(failure) if type(failure) is Exception else f"{type(failure).__name__}: "
            f"{failure}") if failure is not None else ""
-    reasons, told = [], []
-    for worker in info.get("workers", {}):
+    reasons = dict(watch.dropped)
+    for worker in workers:
         if worker in ready:
             continue
         state = states.get(worker) or {}
         if state.get("status") == "missing":
-            reasons.append(missing_reason(state))
-            if worker in watch.told:  # the watch named it as the probe's event came
-                told.append(reasons[-1])
+            reasons[worker] = missing_reason(state)
         elif state.get("status") == "mismatch":
-            reasons.append(f"worker {worker} runs {state['fingerprint']}, not the client's "
-                           f"{state['wanted']}")
+            reasons[worker] = mismatch_reason(worker, state)
+        elif state.get("status") == "compiling" or (not state and not why):
+            reasons[worker] = (f"worker {worker} has not finished loading whitted in "
+                               f"{stall_floor:.0f} s")
         else:
-            reasons.append(f"worker {worker} cannot load whitted ({why or 'no answer'})")
+            reasons[worker] = f"worker {worker} cannot load whitted ({why or 'no answer'})"
     if not ready:
-        raise ClusterLost("no worker can render: " + ("; ".join(reasons) or "no workers"))
-    for reason in reasons:
-        if note is not None and reason not in told:
-            note(f"farm: {reason}: it gets no tasks")
+        raise ClusterLost("no worker can render: "
+                          + ("; ".join(reasons.values()) or "no workers"))
+    for worker, reason in reasons.items():
+        watch.tell(worker, f"farm: {reason}: it gets no tasks")
     return ready
+
+
+def _register(client: Client, plugins: list, watch: Watch) -> list[BaseException]:
+    """Register ``plugins`` in turn (on a thread); meanwhile drop the listed workers that
+    answer nothing, and stop waiting once the stall floor has passed with a ready worker
+    and none compiling (or :data:`~whitted.farm.watch.FIRST_TASK_LIMIT` in any case). The
+    registrations' errors (a worker that cannot load a plugin)."""
+    failures: list[BaseException] = []
+    done = threading.Event()
+
+    def register() -> None:
+        try:
+            for plugin in plugins:
+                try:
+                    client.register_plugin(plugin)
+                except Exception as exc:  # noqa: BLE001 - a worker that cannot load it
+                    failures.append(exc)
+        finally:
+            done.set()
+
+    threading.Thread(target=register, name="whitted-register", daemon=True).start()
+    start = time.monotonic()
+    while not done.wait(POLL_SECONDS):
+        now = time.monotonic()
+        try:
+            info = client.scheduler_info(n_workers=-1)
+        except (OSError, TimeoutError) as exc:
+            raise watch.lost(exc) from None
+        workers = info.get("workers", {})
+        watch.drop_dead(workers, now, silent=True)
+        waited = now - start
+        if waited > FIRST_TASK_LIMIT or (waited > watch.stall_floor and watch.ready_workers(
+                info) and not watch.compiling(workers, now)):
+            break
+    if watch.disconnected():
+        raise watch.lost()
+    # a broken connection to a worker removed meanwhile is no reason to name the others by
+    return [f for f in failures if not isinstance(f, OSError | TimeoutError)]
 
 
 def _states(client: Client, workers: list[str], wait: float = 2.0) -> dict[str, dict]:
@@ -190,12 +242,9 @@ def farm_client(cluster: str | None = None, scheduler: str | None = None, *,
         client = Client(owned)
     else:
         threads = threads or 1
+        client_security(scheduler)  # TLS settings checked before any connection
         reach_scheduler(scheduler)
-        try:
-            client = Client(scheduler, timeout=f"{CONNECT_SECONDS}s")
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise ClusterLost(f"--scheduler {scheduler}: cannot reach the scheduler ({exc})"
-                              ) from None
+        client = connect(scheduler, CONNECT_SECONDS)
     try:
         link = dashboard_link(client)
         if note is not None:

@@ -5,9 +5,18 @@ at the cluster (:class:`Watch`):
 
 - **Workers that cannot render.** A worker whose renderer fingerprint differs from the
   client's, or that cannot load whitted at all, never offers the ``whitted`` resource, so it
-  is never given a task (:mod:`.worker`); the watch names it in one line, once. When no worker
-  can render (none is ready or compiling kernels) for :data:`STALL_FLOOR` seconds, the job
-  ends with one line saying why (every worker lost, or which ones run what).
+  is never given a task (:mod:`.worker`); the watch names it in one line, once for each
+  client (:func:`told_workers`). When no worker can render (none is ready or compiling
+  kernels) for :data:`STALL_FLOOR` seconds, the job ends with one line saying why (every
+  worker lost, or which ones run what).
+- **Workers that no longer answer.** A Dask worker that fails to start (one without whitted
+  cannot load the whitted plugin) closes itself, but may stay listed by the scheduler as
+  ``closing`` without answering anything: every plugin registration (a broadcast to all
+  listed workers) would then wait for it forever, and Dask drops it only after its
+  ``worker-ttl`` (5 minutes by default). Such a worker (one that said it cannot load
+  whitted and is closing, or one whose heartbeat stopped for the stall floor) is removed from
+  the scheduler (``Client.retire_workers(..., close_workers=False, remove=True)``: nothing is
+  asked of it) and named once (:meth:`Watch.drop_dead`).
 - **Stalls.** A worker that holds whitted tasks is *stalled* when it has sent no heartbeat to
   the scheduler, or finished no frame or band, for the stall limit::
 
@@ -36,6 +45,7 @@ import contextlib
 import math
 import threading
 import time
+import weakref
 from collections.abc import Callable, Iterable
 from concurrent.futures import CancelledError
 from typing import Any
@@ -49,6 +59,22 @@ STALL_FLOOR = 30.0  # seconds: never less than this before a worker is called st
 STALL_FACTOR = 10.0  # times the expected time of a task
 FIRST_TASK_LIMIT = 600.0  # seconds without a finished frame, before a worker's first one
 KICK_SECONDS = 5.0  # a task on no worker this long, beside an idle ready worker: again
+#: a worker the scheduler lists with one of these statuses is going (one that failed to start
+#: can stay "closing" for good, answering nothing)
+GONE_STATUSES = frozenset({"closing", "closed", "failed"})
+
+_told: weakref.WeakKeyDictionary[Any, set[str]] = weakref.WeakKeyDictionary()
+_told_lock = threading.Lock()
+
+
+def told_workers(client: Client) -> set[str]:
+    """The workers already named to the user by jobs of ``client`` (each is named once,
+    whichever job, or the readying of the cluster, found it first)."""
+    with _told_lock:
+        try:
+            return _told.setdefault(client, set())
+        except TypeError:  # not weakly referable: this job's own set
+            return set()
 
 
 def ready_workers(info: dict[str, Any]) -> list[str]:
@@ -73,7 +99,9 @@ class Watch:
         self.started = time.monotonic()
         self._lock = threading.Lock()
         self.states: dict[str, dict[str, Any]] = {}  # worker -> its last plugin event
-        self.told: set[str] = set()  # workers named already (once each)
+        self.told = told_workers(client)  # workers named already (once each)
+        self.dropped: dict[str, str] = {}  # workers removed from the scheduler, and why
+        self.compiling_since: dict[str, tuple[float, float]] = {}  # worker -> (first, last)
         self.last_progress: dict[str, float] = {}  # worker -> when it last finished one
         self.seconds: list[float] = []  # each finished frame's (band's) time
         self.first_seen: dict[str, float] = {}
@@ -85,10 +113,10 @@ class Watch:
         self.unplaced: dict[str, float] = {}  # our task key -> since when it is on no worker
         self.frames_per_task = 1
         self.result_seconds = stall_floor  # the longest wait for a finished task's result
-        for _, message in client.get_events(EVENT_TOPIC):  # what happened before this job
+        # what happened before this job: the workers still listed that cannot render are named
+        # as the job first looks at the cluster (once for this client)
+        for _, message in client.get_events(EVENT_TOPIC):
             self.states[message.get("worker", "?")] = message
-            if message.get("status") == "missing":  # named when it happened
-                self.told.add(message.get("worker", "?"))
         client.subscribe_topic(EVENT_TOPIC, self._on_worker_event)
         client.subscribe_topic(PROGRESS_TOPIC, self._on_progress)
 
@@ -106,16 +134,87 @@ class Watch:
             before = self.states.get(worker) or {}
             self.states[worker] = message
         if message.get("status") == "missing":  # it cannot load whitted, and is going
-            with self._lock:
-                told = worker in self.told
-                self.told.add(worker)
-            if not told:
-                self.note(f"farm: {missing_reason(message)}: it gets no tasks")
+            self.tell(worker, f"farm: {missing_reason(message)}: it gets no tasks")
         elif message.get("status") == "compiling":  # a cold worker: say so, in tenths
+            now = time.monotonic()
+            with self._lock:
+                first, _ = self.compiling_since.get(worker, (now, now))
+                self.compiling_since[worker] = (first, now)
             tenth = int(10 * message.get("fraction", 0.0))
             if before.get("status") != "compiling" or int(10 * before["fraction"]) != tenth:
                 self.note(f"farm: worker {worker} is compiling the kernels (a cold cache: "
                           f"first run of this whitted there): {10 * tenth}%")
+
+    def tell(self, worker: str, line: str) -> bool:
+        """Say ``line`` about ``worker`` unless it was named already; whether it was said."""
+        with self._lock:
+            if worker in self.told:
+                return False
+            self.told.add(worker)
+        self.note(line)
+        return True
+
+    def compiling(self, workers: Iterable[str], now: float) -> list[str]:
+        """The workers compiling kernels now: they said so in the last stall floor, and began
+        less than :data:`FIRST_TASK_LIMIT` ago (a compile that never ends is not waited
+        for)."""
+        with self._lock:
+            states, since = dict(self.states), dict(self.compiling_since)
+        busy = []
+        for worker in workers:
+            if (states.get(worker) or {}).get("status") != "compiling" or worker in self.excluded:
+                continue
+            first, last = since.get(worker, (-math.inf, -math.inf))
+            if now - last <= self.stall_floor and now - first <= FIRST_TASK_LIMIT:
+                busy.append(worker)
+        return busy
+
+    def _heartbeat_quiet(self, worker: str, identity: dict[str, Any], now: float) -> float:
+        """Seconds since ``worker``'s heartbeat (its ``last_seen`` at the scheduler) last
+        changed, as seen from here."""
+        seen = identity.get("last_seen")
+        last_seen, unchanged_since = self.heartbeats.get(worker, (None, now))
+        if seen != last_seen:
+            self.heartbeats[worker] = (seen, now)
+            return 0.0
+        return now - unchanged_since
+
+    def dead_workers(self, workers: dict[str, Any], now: float, *,
+                     silent: bool = False) -> dict[str, str]:
+        """The listed workers that will answer nothing, and why: one that said it cannot
+        load whitted and is closing (a worker that failed to start), one closing with no
+        heartbeat for the stall floor, and with ``silent`` (while a registration waits for
+        every worker) any whose heartbeat stopped for the stall floor."""
+        with self._lock:
+            states = dict(self.states)
+        dead = {}
+        for worker, identity in workers.items():
+            quiet = self._heartbeat_quiet(worker, identity, now)
+            state = states.get(worker) or {}
+            going = identity.get("status") in GONE_STATUSES
+            if going and state.get("status") == "missing":
+                dead[worker] = missing_reason(state)
+            elif (going or silent) and quiet > self.stall_floor:
+                dead[worker] = (f"worker {worker} is {identity.get('status')} and has sent no "
+                                f"heartbeat for {quiet:.0f} s")
+        return dead
+
+    def drop_dead(self, workers: dict[str, Any], now: float, *,
+                  silent: bool = False) -> list[str]:
+        """Remove :meth:`dead_workers` from the scheduler (nothing is asked of them: a
+        registration or a job then waits for them no more) and name each once."""
+        dead = {w: r for w, r in self.dead_workers(workers, now, silent=silent).items()
+                if w not in self.dropped}
+        if not dead:
+            return []
+        with contextlib.suppress(Exception):  # gone already, or the scheduler going: the same
+            self.client.retire_workers(workers=list(dead), close_workers=False, remove=True)
+        for worker, reason in dead.items():
+            self.dropped[worker] = reason
+            self.excluded.add(worker)
+            self.tell(worker, f"farm: {reason}: it gets no tasks (it answers nothing: removed "
+                      "from the scheduler)")
+        return list(dead)
 
     def _on_progress(self, event: tuple[float, dict[str, Any]]) -> None:
         _, message = event
@@ -189,9 +288,10 @@ class Watch:
         return self.client.status not in ("running", "newly-created")
 
     def lost(self, exc: BaseException | None = None) -> ClusterLost:
+        """The one line for a scheduler gone: where it was, not Dask's text of the broken
+        connection (its local and remote sockets, its stream's state)."""
         where = getattr(self.client.scheduler, "address", None) or "the scheduler"
-        why = f" ({_first_line(exc)})" if exc is not None and str(exc).strip() else ""
-        return ClusterLost(f"lost the connection to the scheduler at {where}{why}")
+        return ClusterLost(f"lost the connection to the scheduler at {where}")
 
     def ready_workers(self, info: dict[str, Any]) -> list[str]:
         return [w for w in ready_workers(info) if w not in self.excluded]
@@ -218,6 +318,8 @@ class Watch:
             raise self.lost(exc) from None
         now = time.monotonic()
         workers = info.get("workers", {})
+        self.drop_dead(workers, now)
+        workers = {w: d for w, d in workers.items() if w not in self.dropped}
         self._tell_unready(workers, now)
         ready = self.ready_workers(info)
         moved: set[str] = set()
@@ -270,12 +372,9 @@ class Watch:
     def _stalled(self, worker: str, identity: dict[str, Any], now: float) -> str:
         """Why ``worker`` (holding our tasks) is stalled, or ''."""
         since = self.busy_since.get(worker, now)
-        seen = identity.get("last_seen")
-        last_seen, unchanged_since = self.heartbeats.get(worker, (None, now))
-        if seen != last_seen:
-            self.heartbeats[worker] = (seen, now)
-        elif now - unchanged_since > self.stall_floor:
-            return f"sent no heartbeat for {now - unchanged_since:.0f} s"
+        quiet = self._heartbeat_quiet(worker, identity, now)
+        if quiet > self.stall_floor:
+            return f"sent no heartbeat for {quiet:.0f} s"
         with self._lock:
             progress = self.last_progress.get(worker)
         quiet = now - max(since, progress or since)
@@ -295,15 +394,13 @@ class Watch:
                 continue
             line = self.unready_reason(worker, states.get(worker), now)
             if line:
-                self.told.add(worker)
-                self.note(f"farm: {line}: it gets no tasks")
+                self.tell(worker, f"farm: {line}: it gets no tasks")
 
     def unready_reason(self, worker: str, state: dict[str, Any] | None, now: float) -> str:
         if state is not None and state.get("status") == "missing":
             return missing_reason(state)
         if state is not None and state.get("status") == "mismatch":
-            return (f"worker {worker} runs {state['fingerprint']}, not the client's "
-                    f"{state['wanted']}")
+            return mismatch_reason(worker, state)
         if state is None and now - self.first_seen.get(worker, now) > self.stall_floor:
             return (f"worker {worker} has not loaded whitted in {self.stall_floor:.0f} s "
                     "(is whitted[farm] installed there?)")
@@ -312,9 +409,7 @@ class Watch:
     def _no_worker(self, workers: dict[str, Any], now: float) -> None:
         with self._lock:
             states = dict(self.states)
-        compiling = [w for w in workers if (states.get(w) or {}).get("status") == "compiling"
-                     and w not in self.excluded]
-        if compiling:
+        if self.compiling(workers, now):
             self.no_worker_since = None
             return
         if self.no_worker_since is None:
@@ -322,16 +417,25 @@ class Watch:
             return
         if now - self.no_worker_since <= self.stall_floor:
             return
-        if not workers:
+        if not workers and not self.dropped:
             raise ClusterLost(f"every worker was lost ({now - self.no_worker_since:.0f} s "
                               "without one)")
-        reasons = []
+        reasons = list(self.dropped.values())
         for worker in workers:
             reason = (f"worker {worker} stalled" if worker in self.excluded
                       else self.unready_reason(worker, states.get(worker), now + 1e9)
                       or f"worker {worker} is not ready")
             reasons.append(reason)
         raise ClusterLost("no worker can render: " + "; ".join(reasons))
+
+
+def mismatch_reason(worker: str, state: dict[str, Any]) -> str:
+    """What a ``mismatch`` event of the whitted plugin says: the worker renders with another
+    renderer than the client (:mod:`whitted.fingerprint`), and what differs."""
+    from ..fingerprint import fingerprint_difference
+
+    return (f"worker {worker} runs another renderer ("
+            f"{fingerprint_difference(state.get('fingerprint', '?'), state.get('wanted', '?'))})")
 
 
 def missing_reason(state: dict[str, Any]) -> str:
@@ -342,11 +446,6 @@ def missing_reason(state: dict[str, Any]) -> str:
     named = f" ({name})" if name and name != worker else ""
     return (f"worker {worker}{named} cannot load whitted ({state.get('error', '?')}; is "
             "whitted[farm] installed there?)")
-
-
-def _first_line(exc: BaseException | None) -> str:
-    text = str(exc).strip().splitlines()[0] if exc is not None and str(exc).strip() else ""
-    return text or type(exc).__name__
 
 
 def run_tasks(watch: Watch, tasks: dict[Future, Any],

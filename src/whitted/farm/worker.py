@@ -7,8 +7,9 @@ the render kernels from the worker's Numba cache, compiling them there on a cold
 (:func:`whitted.render.warm_up.warm_up_kernels`). That happens before the worker runs its first
 task, so no frame pays for it and no two frames on one worker compile twice.
 
-Before any of that it compares the worker's renderer fingerprint (whitted's version and a hash
-of its kernel sources, :mod:`whitted.fingerprint`) with the client's, which the plugin carries:
+Before any of that it compares the worker's renderer fingerprint (whitted's version, a hash of
+all its source, the versions of Numba, llvmlite and NumPy, the CPU target the kernels are
+compiled for: :mod:`whitted.fingerprint`) with the client's, which the plugin carries:
 a worker running another whitted is never given a task. A worker offers the Dask resource
 :data:`RESOURCE` (one unit per Dask thread) only once it is readied, and every whitted task
 asks for one unit: a worker that is still compiling, runs another whitted, or cannot load

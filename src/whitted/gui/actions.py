@@ -60,8 +60,13 @@ ROWS: tuple[Row, ...] = (
     # Edit (undo and redo come from the undo stack: their rows name the keys)
     Row("undo", "&Undo", None, ("Ctrl+Z",), "Edit", 0, "undo the last edit"),
     Row("redo", "&Redo", None, ("Ctrl+Shift+Z", "Ctrl+Y"), "Edit", 0, "redo the edit undone"),
-    Row("duplicate", "D&uplicate", "editing.duplicate_selected", ("Ctrl+D",), "Edit", 1,
-        "duplicate the selected lights and objects"),
+    Row("duplicate", "D&uplicate", "editing.duplicate_and_grab", ("Shift+D", "Ctrl+D"),
+        "Edit", 1, "duplicate the selected lights and objects (named X.001) and move the "
+        "copies with the mouse, as G does; Esc keeps them where the originals are"),
+    Row("select_all", "Select &all", "editing.select_all", ("A",), "Edit", 1,
+        "select every light and object"),
+    Row("add_menu", "&Add…", "show_add_menu", ("Shift+A",), "Edit", 1,
+        "the Add menu (objects and lights) at the pointer"),
     Row("rename", "Re&name", "editing.rename_selected", ("F2",), "Edit", 1,
         "rename the selection in the scene tree (also a double-click there)"),
     Row("delete", "&Delete", "editing.delete_selected", ("Del", "X"), "Edit", 1,

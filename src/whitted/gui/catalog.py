@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import typing
 from collections.abc import Callable
 from pathlib import Path
 
@@ -10,13 +11,23 @@ from pydantic import BaseModel
 
 from .. import scene as S
 from ..scene import Scene
+from ..scene.shapes import Shape
 from .camera_ops import project, target_of
 
-#: the Add Object menu, in order: kind -> menu text
-OBJECT_KINDS = {
-    "sphere": "Sphere", "box": "Box", "plane": "Plane", "rectangle": "Rectangle",
-    "disk": "Disk", "triangle": "Triangle", "cylinder": "Cylinder", "cone": "Cone",
-}
+
+def shape_kinds() -> list[str]:
+    """The ``type`` of every kind of object a scene accepts, in the scene format's order."""
+    union = typing.get_args(Shape)[0]
+    return [cls.model_fields["type"].default for cls in typing.get_args(union)]
+
+
+#: menu texts where the kind's name is not the text
+MENU_TEXT = {"csg": "CSG (box minus sphere)"}
+#: kinds added otherwise than from the Add Object menu's list (a model: from its file)
+ADDED_OTHERWISE = ("mesh",)
+#: the Add Object menu, in order: kind -> menu text (every shape of the scene format)
+OBJECT_KINDS = {kind: MENU_TEXT.get(kind, kind.capitalize()) for kind in shape_kinds()
+                if kind not in ADDED_OTHERWISE}
 LIGHT_KINDS = {
     "ambient": "Ambient light", "point": "Point light", "directional": "Directional light",
     "disk": "Disk light (soft shadows)",
@@ -153,6 +164,13 @@ def _objects(t: np.ndarray) -> dict[str, Callable[[], BaseModel]]:
                                                  _v(t + [0.0, 0.5, 0]))),
         "cylinder": lambda: S.Cylinder(base=_v(t - 0.5 * up), top=_v(t + 0.5 * up), radius=0.4),
         "cone": lambda: S.Cone(base=_v(t - 0.5 * up), top=_v(t + 0.5 * up), radius=0.45),
+        # a ring lying on the floor: centred by its transform (a torus is about its origin)
+        "torus": lambda: S.Torus(major_radius=0.5, minor_radius=0.15,
+                                 transform=S.Transform(translate=_v(t))),
+        "csg": lambda: S.CSG(operation="difference", material="plastic", objects=[
+            S.Box(min=(-0.5, -0.5, -0.5), max=(0.5, 0.5, 0.5)),
+            S.Sphere(center=(0.5, 0.5, 0.5), radius=0.55)],
+            transform=S.Transform(translate=_v(t))),
     }
 
 

@@ -4,6 +4,7 @@ the undo stack. Every edit builds a new validated scene; nothing invalid is ever
 from __future__ import annotations
 
 import copy
+import re
 from pathlib import Path
 from typing import Any
 
@@ -279,11 +280,7 @@ class SceneDocument(QObject):
             return None
         kind, index = key
         names = {getattr(i, "name", None) for i in getattr(self.scene, kind)}
-        base = (item.name or item.type) + " copy"
-        name, n = base, 2
-        while name in names:
-            name, n = f"{base} {n}", n + 1
-        copy_ = item.model_copy(update={"name": name}, deep=True)
+        copy_ = item.model_copy(update={"name": copy_name(item, names)}, deep=True)
         items = list(getattr(self.scene, kind))
         items.insert(index + 1, copy_)
         self.apply(rebuild_scene(self.scene, **{kind: items}), f"Duplicate {label_of(item)}",
@@ -318,6 +315,16 @@ class SceneDocument(QObject):
         self.changed.emit(self.selection)
         if (self.selection, self.extra) != before:
             self.selection_changed.emit(self.selection)
+
+
+def copy_name(item: Any, names: set) -> str:
+    """A copy's name as Blender gives it: "ball.001", then "ball.002" (the copy of
+    "ball.001" is "ball.002" too), the first not in ``names``."""
+    base = re.sub(r"\.\d{3,}$", "", getattr(item, "name", None) or item.type)
+    n = 1
+    while f"{base}.{n:03d}" in names:
+        n += 1
+    return f"{base}.{n:03d}"
 
 
 def label_of(item: Any) -> str:

@@ -8,11 +8,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 from PySide6.QtCore import QObject, Qt
 
 from ..errors import WhittedError
 from . import catalog
-from .document import EditRefused, item_of, label_of, rebuild_scene, with_item
+from .document import EditRefused, copy_name, item_of, label_of, rebuild_scene, with_item
 from .picking import id_at
 from .transform_tool import TransformTool, light_position
 
@@ -40,6 +41,13 @@ class GroupTool:
                 finish=lambda *a: None,
                 apply=lambda value, merge, k=key: self.results.__setitem__(k, value),
                 status=status if n == 0 else (lambda text: None)))
+        if mode in ("rotate", "scale") and len(self.tools) > 1:
+            # several objects turn and grow about their median point (Blender's default
+            # pivot), not each about its own centre
+            median = np.mean([t.centre for t in self.tools], axis=0)
+            for t in self.tools:
+                t.centre = median
+                t.own_centre = np.linalg.solve(t.parent[:3, :3], median - t.parent[:3, 3])
         self.merge_key = self.tools[0].merge_key
         self.start_uv = self.uv = None
 
@@ -224,16 +232,34 @@ class Editing(QObject):
             names = {getattr(i, "name", None) for i in update[kind]}
             for index in sorted(i for k, i in keys if k == kind):
                 item = getattr(scene, kind)[index]
-                base, n = (item.name or item.type) + " copy", 2
-                name = base
-                while name in names:
-                    name, n = f"{base} {n}", n + 1
+                name = copy_name(item, names)
                 names.add(name)
                 update[kind].append(item.model_copy(update={"name": name}, deep=True))
                 new_keys.append((kind, len(update[kind]) - 1))
         self.doc.apply(rebuild_scene(scene, **update), f"Duplicate {len(keys)} items",
                        select=new_keys)
         return new_keys
+
+    def duplicate_and_grab(self):
+        """Shift+D (and Ctrl+D): duplicate the selection, then move the copies with the
+        mouse as G does (Esc or a right-click leaves them on the originals)."""
+        if self.window_.viewport.tool is not None:
+            return None
+        keys = self.duplicate_selected()
+        if keys:
+            self.start_tool("move")
+        return keys
+
+    def select_all(self) -> None:
+        """A: every light and object (the active one stays active when it is one of them)."""
+        scene = self.doc.scene
+        keys = [(kind, i) for kind in ("lights", "objects")
+                for i in range(len(getattr(scene, kind)))]
+        active = self.doc.selection
+        if active in keys:
+            keys.remove(active)
+            keys.append(active)
+        self.doc.select(keys)
 
     def rename_selected(self) -> None:
         key = self.doc.selection

@@ -4,8 +4,10 @@ given by corner + edges shows those)."""
 
 from __future__ import annotations
 
+import types
+import typing
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 from ..scene import PRESETS
 
@@ -15,9 +17,9 @@ TEXT, NUMBER, INT, OPT_INT, VEC3, ANGLES, SCALE, COLOUR, COEF, CHOICE, BOOL, FIL
     "bool", "file", "attenuation",
 )
 # the headings the panel groups fields under
-GEOMETRY, TRANSFORM, MATERIAL, TEXTURE, LIGHT, VIEW, IMAGE, QUALITY, OUTPUT = (
+GEOMETRY, TRANSFORM, MATERIAL, TEXTURE, LIGHT, VIEW, IMAGE, QUALITY, OUTPUT, BLUR = (
     "Shape", "Placement (transform)", "Material", "Texture", "Light", "View", "Image", "Quality",
-    "Output",
+    "Output", "Focal blur",
 )
 
 
@@ -108,12 +110,68 @@ def material_specs(material: Any) -> list[Spec]:
 
 MODEL_FILTER = ("3D models (*.obj *.ply *.stl *.off *.glb *.gltf);;All files (*)")
 
+#: every shape's fields the panel does not show in its Shape section (shown elsewhere, or
+#: a CSG object's children, which are items of their own in the tree)
+NOT_SHAPE_FIELDS = ("type", "name", "material", "transform", "objects")
+#: labels and tips of shape fields whose name does not say it well enough
+FIELD_LABELS = {"center": "Centre", "major_radius": "Major radius",
+                "minor_radius": "Minor (tube) radius"}
+FIELD_TIPS = {"major_radius": "from the centre to the middle of the tube, in the xz plane",
+              "minor_radius": "the tube's radius",
+              "operation": "difference: the first child minus the others; merge: a union "
+                           "without inner surfaces"}
+
+
+def _editor_kind(annotation: Any) -> tuple[str, tuple]:
+    """The editor for a field of this type, and its choices (None: no editor fits)."""
+    args = [a for a in typing.get_args(annotation) if a is not type(None)]
+    origin = typing.get_origin(annotation)
+    if origin in (typing.Union, types.UnionType) and len(args) == 1:
+        return _editor_kind(args[0])
+    if origin is typing.Annotated:
+        return _editor_kind(args[0])
+    if origin is Literal:
+        return CHOICE, tuple(args)
+    if annotation is bool:
+        return BOOL, ()
+    if annotation is float:
+        return NUMBER, ()
+    if annotation is int:
+        return INT, ()
+    if origin is tuple and len(args) == 3 and all(_editor_kind(a)[0] == NUMBER for a in args):
+        return VEC3, ()
+    return "", ()
+
+
+def shape_field_specs(obj: Any) -> list[Spec]:
+    """The Shape section of a kind of object, made from its model's fields (numbers, vectors,
+    choices, switches): what a shape without a hand-made section shows."""
+    specs = []
+    for name, info in type(obj).model_fields.items():
+        if name in NOT_SHAPE_FIELDS:
+            continue
+        kind, choices = _editor_kind(info.annotation)
+        if not kind:
+            continue
+        label = FIELD_LABELS.get(name, name.replace("_", " ").capitalize())
+        specs.append(Spec((name,), label, kind, GEOMETRY, choices=choices,
+                          tip=FIELD_TIPS.get(name, "")))
+    return specs
+
+
+#: shapes whose Shape section is made by hand (labels, tips, the form a box is given in);
+#: every other shape's is made from its fields
+HAND_MADE = ("sphere", "plane", "rectangle", "disk", "triangle", "box", "cylinder", "cone",
+             "mesh")
+
 
 def object_specs(obj: Any) -> list[Spec]:
     g = GEOMETRY
     kind = obj.type
     specs = _name()
-    if kind == "sphere":
+    if kind not in HAND_MADE:
+        specs += shape_field_specs(obj)
+    elif kind == "sphere":
         specs += [Spec(("center",), "Centre", VEC3, g), Spec(("radius",), "Radius", NUMBER, g)]
     elif kind == "plane":
         specs += [Spec(("point",), "Point", VEC3, g), Spec(("normal",), "Normal", VEC3, g)]
@@ -185,7 +243,31 @@ def camera_specs(camera: Any) -> list[Spec]:
     ]
     if camera.projection == "orthographic":
         specs.append(Spec(("ortho_height",), "Visible height", NUMBER, g))
+    specs += [
+        Spec(("aperture",), "Aperture", COEF, BLUR, 0.0, 1.0,
+             tip="the lens's diameter in scene units: 0 is a pinhole (everything sharp); "
+                 "larger blurs more what is not in focus (the box takes up to 1e6)"),
+        Spec(("focus_mode",), "Focus on", CHOICE, BLUR, choices=FOCUS_MODES,
+             tip="the plane in focus: through the point the camera looks at, at a distance "
+                 "along the view, or through a point"),
+    ]
+    if camera.focal_distance is not None:
+        specs.append(Spec(("focal_distance",), "Focal distance", NUMBER, BLUR,
+                          tip="along the viewing direction, scene units"))
+    elif camera.focal_point is not None:
+        specs.append(Spec(("focal_point",), "Focal point", VEC3, BLUR,
+                          tip="the plane through this point, facing the camera, is sharp"))
     return specs
+
+
+#: the camera's "Focus on" choices: its look_at point, a distance, a point
+FOCUS_MODES = ("look-at point", "distance", "point")
+
+
+def focus_mode(camera: Any) -> str:
+    if camera.focal_distance is not None:
+        return "distance"
+    return "point" if camera.focal_point is not None else "look-at point"
 
 
 def render_specs(settings: Any) -> list[Spec]:

@@ -12,10 +12,11 @@ from PySide6.QtWidgets import QApplication
 
 from .. import scene as S
 from ..errors import WhittedError
-from ..scene import Scene, load_scene, save_scene
-from ..scene.toml_document import edited_toml, save_scene_toml, scene_toml
-from ..scene.writing import rebase_files
+from ..scene import Scene, load_scene
+from ..scene.toml_document import edited_toml
+from ..scene.writing import for_folder, scene_text, write_scene_text
 from .autosave import recovery_for
+from .keyframes import unposed
 
 
 def starter_scene() -> Scene:
@@ -70,6 +71,7 @@ class FileControl(QObject):
             return False
         self.window_.controller.stop()
         self.doc.set_scene(starter_scene(), None)
+        self.source_path = None
         self.remember_source(None, None)
         return True
 
@@ -93,6 +95,7 @@ class FileControl(QObject):
             return False
         self.window_.controller.stop()
         self.doc.set_scene(scene, path)
+        self.source_path = None  # read afresh: what earlier saves wrote is forgotten
         self.remember_source(scene, path)
         self.window_.recent.add(path)
         self.offer_recovery()
@@ -101,7 +104,15 @@ class FileControl(QObject):
     def remember_source(self, scene: Scene | None, path: Path | None,
                         text: str | None = None) -> None:
         """Keep the TOML file's text as read (or written) and the scene it holds: saving
-        writes only the edits into it (comments and layout stay)."""
+        writes only the edits into it (comments and layout stay). The versions written
+        before, while the same file stays open, lend their spellings: a value or an object
+        set back is written as the file first had it, comments included."""
+        same_file = path is not None and getattr(self, "source_path", None) == path
+        history = list(getattr(self, "history", [])) if same_file else []
+        if same_file and self.source_text is not None and self.source_scene is not None:
+            history.append((self.source_text, self.source_scene))
+        self.history: list[tuple[str, Scene]] = history[-20:]
+        self.source_path = path
         self.source_text: str | None = text
         self.source_scene: Scene | None = scene
         if text is None and path is not None and Path(path).suffix.lower() == ".toml":
@@ -155,36 +166,43 @@ class FileControl(QObject):
         same_folder = old_path is not None and \
             Path(old_path).parent.resolve() == path.parent.resolve()  # the same file names
         if self.source_text is not None and self.source_scene is not None and same_folder:
-            edited = edited_toml(scene, self.source_text, self.source_scene)
+            edited = edited_toml(scene, self.source_text, self.source_scene,
+                                 history=self.history)
             if edited is not None:
                 return edited
             if self.window_.ask_rewrite(path) != "rewrite":
                 return None
-        return scene_toml(scene)
+        return scene_text(scene, path)
 
     def save_to(self, path: Path) -> bool:
         old_path = self.doc.path
         scene = self.doc.scene
         text = None
         try:
-            if path.parent.resolve() != scene.base_dir.resolve():
-                scene = rebase_files(scene, path.parent)
+            # the values the tracks drive are shown posed at the current frame; the file
+            # keeps its still values there
+            written = for_folder(unposed(scene, self.source_scene), path)
             if path.suffix.lower() == ".toml":
-                text = self._toml_text(scene, path)
+                text = self._toml_text(written, path)
                 if text is None:
                     self.status.showMessage("Not saved: the file was left as it was", 5000)
                     return False
-                save_scene_toml(scene, path, payload=text)
             else:
-                save_scene(scene, path)
+                text = scene_text(written, path)
+            write_scene_text(path, text)
         except (WhittedError, OSError, ValueError) as exc:
             self.window_.show_error("Cannot save the scene", str(exc))
             return False
-        self.remember_source(scene, path, text)
+        if path.suffix.lower() == ".toml":
+            from ..scene.toml_document import read_toml
+
+            self.remember_source(read_toml(text, written), path, text)
+        else:
+            self.remember_source(None, path)
         autosave = self.window_.autosave
         if old_path is not None and old_path != path:
             autosave.discard(old_path)
-        self.doc.mark_saved(path, scene.with_base_dir(path.parent))
+        self.doc.mark_saved(path, for_folder(scene, path).with_base_dir(path.parent))
         autosave.discard()
         self.window_.recent.add(path)
         self.status.showMessage(f"Saved {path}", 4000)

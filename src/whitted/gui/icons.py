@@ -7,7 +7,17 @@ import math
 from functools import cache
 
 from PySide6.QtCore import QPointF, QRectF, Qt
-from PySide6.QtGui import QBrush, QColor, QIcon, QPainter, QPen, QPixmap, QPolygonF, QRadialGradient
+from PySide6.QtGui import (
+    QBrush,
+    QColor,
+    QIcon,
+    QPainter,
+    QPainterPath,
+    QPen,
+    QPixmap,
+    QPolygonF,
+    QRadialGradient,
+)
 
 SIZE = 32
 OBJECT = QColor(90, 150, 220)
@@ -77,6 +87,20 @@ def icon_for(kind: str) -> QIcon:
         else:
             p.drawPolygon(_poly((16, 3), (26, 25), (6, 25)))
             p.drawEllipse(QPointF(16, 25), 10, 3.5)
+    elif kind == "torus":  # a ring seen from above and a little aside: a hole in the middle
+        path = QPainterPath()
+        path.setFillRule(Qt.FillRule.OddEvenFill)
+        path.addEllipse(c, 13, 8)
+        path.addEllipse(c, 6, 3)
+        p.setBrush(OBJECT)
+        p.drawPath(path)
+    elif kind == "csg":  # a box with a ball cut out of its corner
+        path = QPainterPath()
+        path.addRect(QRectF(5, 9, 18, 18))
+        hole = QPainterPath()
+        hole.addEllipse(QPointF(23, 9), 9, 9)
+        p.setBrush(OBJECT)
+        p.drawPath(path.subtracted(hole))
     elif kind == "mesh":
         p.setBrush(OBJECT)
         p.drawPolygon(_poly((4, 24), (12, 6), (20, 20)))

@@ -226,6 +226,32 @@ def posed(scene: Scene, frame: int) -> Scene:
     return out
 
 
+def unposed(scene: Scene, source: Scene | None) -> Scene:
+    """``scene`` (posed at some frame) with the still values its tracks drive put back as
+    ``source`` (the file as read) has them: what a save writes. The tracks give those
+    values at every frame, so the file's own still values stay as written (a key inserted
+    at a frame does not rewrite the still ``[camera] position``)."""
+    if scene.animation is None or source is None:
+        return scene
+    out = scene
+    for track in scene.animation.tracks:
+        steps = _posable(scene, track)
+        if steps is None:
+            continue
+        try:
+            src_steps = resolve_path(source, track.path)
+            if format_path(src_steps) != format_path(steps):
+                continue  # items moved since the file was read: not the same value
+            before = get_value(source, src_steps)
+            if _plain(get_value(out, steps)) != _plain(before):
+                out = set_value(out, steps, before)
+        except (PathError, ValueError, TypeError, AttributeError):
+            continue
+    if out is not scene:
+        out = out.with_base_dir(getattr(scene, "_base_dir", None))
+    return out
+
+
 def unkeyed_edits(scene: Scene, frame: int) -> list[str]:
     """The tracks (their paths) whose value in ``scene``, posed at ``frame``, was edited
     since and not keyed: the frame's pose would replace those edits."""
@@ -283,4 +309,5 @@ def key_frames(scene: Scene) -> list[float]:
 
 
 __all__ = ["NEW_FPS", "NEW_FRAMES", "delete_keys", "frame_still", "insert_keys", "key_frames",
-           "key_targets", "posed", "track_paths", "tracks_following_items", "unkeyed_edits"]
+           "key_targets", "posed", "track_paths", "tracks_following_items", "unkeyed_edits",
+           "unposed"]

@@ -13,8 +13,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from PySide6.QtCore import QSettings, Qt
-from PySide6.QtGui import QAction, QCloseEvent
+from PySide6.QtCore import QSettings, Qt, QTimer
+from PySide6.QtGui import QAction, QCloseEvent, QCursor
 from PySide6.QtWidgets import (
     QApplication,
     QDialog,
@@ -94,6 +94,7 @@ class MainWindow(QMainWindow):
         self.editing = Editing(self)
         self.overlays = Overlays(self)
         self.ids = IdBuffer(self)
+        self.child_ids = IdBuffer(self)  # a CSG child's own outline
         self.acts = make_actions(self)
         self.render_control = RenderControl(self)
         self._make_menus()
@@ -109,6 +110,7 @@ class MainWindow(QMainWindow):
         self.doc.undo_stack.cleanChanged.connect(self._update_title)
         self.autosave.saved.connect(self._status)
         self.ids.ready.connect(self.overlays.update_outline)
+        self.child_ids.ready.connect(self.overlays.update_outline)
         self.doc.selection_changed.connect(self._selection_changed)
         self.navigation.changed.connect(self._view_changed)
         self.viewport.clicked.connect(self.editing.pick)
@@ -141,7 +143,32 @@ class MainWindow(QMainWindow):
                          | QDockWidget.DockWidgetFeature.DockWidgetFloatable)
         self.addDockWidget(area, dock)
         self.resizeDocks([dock], [width], Qt.Orientation.Horizontal)
+        if not hasattr(self, "_dock_widths"):
+            self._dock_widths: list[tuple[QDockWidget, int]] = []
+        self._dock_widths.append((dock, width))
         return dock
+
+    def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        super().resizeEvent(event)
+        if event.oldSize().isValid() and event.size().width() > event.oldSize().width():
+            QTimer.singleShot(0, self.restore_docks)
+
+    def restore_docks(self) -> None:
+        """After the window was made narrow (the panels squeezed), growing it gives the
+        panels their widths back before the picture grows (the picture keeps 480 px)."""
+        central = self.centralWidget()
+        spare = (central.width() if central is not None else 0) - 480
+        docks, widths = [], []
+        for dock, want in getattr(self, "_dock_widths", []):
+            if spare <= 0 or not dock.isVisible() or dock.isFloating() or \
+                    dock.width() >= want - 2:
+                continue
+            grow = min(want - dock.width(), spare)
+            spare -= grow
+            docks.append(dock)
+            widths.append(dock.width() + grow)
+        if docks:
+            self.resizeDocks(docks, widths, Qt.Orientation.Horizontal)
 
     def _fit_window(self) -> None:
         w, h = WINDOW_SIZE
@@ -161,6 +188,7 @@ class MainWindow(QMainWindow):
         file.insertMenu(self.acts["save"], self.recent_menu)
         self.recent_menu.aboutToShow.connect(self.files.fill_recent)
         add = bar.addMenu("&Add")
+        self.add_menu = add
         bar.insertMenu(menus["Object"].menuAction(), add)
         self.add_object_menu = add.addMenu("&Object")
         self.object_actions: dict[str, QAction] = {}
@@ -309,6 +337,14 @@ class MainWindow(QMainWindow):
 
     def _start_dir(self) -> str:
         return str(self.doc.path.parent if self.doc.path else Path.cwd())
+
+    def show_add_menu(self) -> None:
+        """Shift+A: the Add menu (objects, lights) under the pointer, as Blender's; at the
+        picture's centre when the pointer is not over the window."""
+        pos = QCursor.pos()
+        if not self.rect().contains(self.mapFromGlobal(pos)):
+            pos = self.viewport.mapToGlobal(self.viewport.rect().center())
+        self.add_menu.popup(pos)
 
     def show_controls(self) -> None:
         """Help > Controls: made from the actions table, so it lists every shortcut."""

@@ -7,13 +7,14 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from PySide6.QtCore import QObject, QPointF, QRectF, Qt
 from PySide6.QtGui import QColor, QPainter, QPen
 
 from . import camera_ops
 from .document import label_of
-from .picking import outline_image
-from .transform_tool import light_position, object_bounds
+from .picking import outline_image, outline_mask, solo_child
+from .transform_tool import item_bounds, light_position, object_bounds
 
 LIGHT_PICK_PX = 12
 
@@ -23,6 +24,7 @@ class Overlays(QObject):
         super().__init__(window)
         self.window_ = window
         self.doc = window.doc
+        self._solo_cache: tuple | None = None
 
     def _camera(self):
         return self.window_.navigation.camera()
@@ -76,7 +78,11 @@ class Overlays(QObject):
         for key in selected:
             if key[0] != "objects":
                 continue
-            bounds = object_bounds(scene, key[1])
+            try:  # a CSG child: its own box, in its parents' places
+                bounds = object_bounds(scene, key[1]) if len(key) == 2 else item_bounds(
+                    solo_child(scene, key).objects[key[1]], scene)
+            except (IndexError, AttributeError, ValueError):
+                bounds = None
             if bounds is None:
                 continue
             lo, hi = bounds
@@ -115,22 +121,49 @@ class Overlays(QObject):
             p.drawText(c + QPointF(12, 4), label_of(light))
 
     def update_outline(self) -> None:
-        """The selected objects' outline over the picture (from the current id image)."""
+        """The selected objects' outline over the picture (from the current id image); a
+        child of a CSG object is outlined itself (from the id image of a scene where it
+        stands alone in its parent's place)."""
         window = self.window_
         keys = [k for k in self.doc.selected_keys() if k[0] == "objects"]
         shown = window.shown_scene()
-        ids = window.ids.ids if window.ids.scene is shown else None
-        if not keys:
-            outline = None
-        elif ids is None:
-            window.ids.request(shown)
-            return
-        else:
-            outline = outline_image(ids, [k[1] for k in keys])
+        tops = [k[1] for k in keys if len(k) == 2]
+        children = [k for k in keys if len(k) > 2]
+        masks = []
+        if tops:
+            ids = window.ids.ids if window.ids.scene is shown else None
+            if ids is None:
+                window.ids.request(shown)
+                return
+            masks.append(outline_mask(ids, tops))
+        if children:
+            solo = self._solo(shown, children[0])
+            ids = window.child_ids.ids if window.child_ids.scene is solo else None
+            if ids is None:
+                window.child_ids.request(solo)
+                return
+            masks.append(ids == children[0][1])
+        outline = None
+        if masks:
+            mask = masks[0] if len(masks) == 1 or masks[0].shape != masks[1].shape else \
+                masks[0] | masks[1]
+            outline = outline_image(mask.astype(np.int32), 1, mask=mask)
         viewport = window.viewport
         if outline is not viewport.outline:
             viewport.outline = outline
             viewport.update()
+
+    def _solo(self, shown, key):
+        """The scene whose id image outlines CSG child ``key`` (kept while ``shown`` is)."""
+        cached = self._solo_cache
+        if cached is not None and cached[0] is shown and cached[1] == key:
+            return cached[2]
+        try:
+            solo = solo_child(shown, key)
+        except (IndexError, AttributeError, ValueError):
+            solo = shown
+        self._solo_cache = (shown, key, solo)
+        return solo
 
 
 __all__ = ["LIGHT_PICK_PX", "Overlays"]

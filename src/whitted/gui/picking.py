@@ -37,11 +37,35 @@ def id_at(ids: np.ndarray, u: float, v: float) -> int:
     return int(ids[y, x])
 
 
-def outline_image(ids: np.ndarray, index, thickness: int = 1) -> QImage | None:
+def solo_child(scene: Scene, key: tuple) -> Scene:
+    """``scene`` with the CSG object of ``key`` = ("objects", i, k, ...) replaced by its
+    descendant at ``key`` alone, in the same place (inside a one-child union carrying each
+    ancestor's transform): the id image of this scene outlines that child itself."""
+    from ..scene.shapes import CSG
+
+    chain = [scene.objects[key[1]]]
+    for k in key[2:]:
+        chain.append(chain[-1].objects[k])
+    node = chain[-1]
+    for ancestor in reversed(chain[:-1]):
+        node = CSG(operation="union", objects=[node], transform=ancestor.transform)
+    objects = list(scene.objects)
+    objects[key[1]] = node
+    return scene.model_copy(update={"objects": objects})
+
+
+def outline_mask(ids: np.ndarray, index) -> np.ndarray:
+    """Where object ``index`` (or any of a list of indices) is seen."""
+    if isinstance(index, int):
+        return ids == index
+    return np.isin(ids, np.atleast_1d(np.asarray(index, np.int64)))
+
+
+def outline_image(ids: np.ndarray, index, thickness: int = 1, *,
+                  mask: np.ndarray | None = None) -> QImage | None:
     """A transparent image with the outline of object ``index`` (or of each object of a
-    list of indices; None if none is seen)."""
-    mask = np.isin(ids, np.atleast_1d(np.asarray(index, np.int64))) if not isinstance(
-        index, int) else ids == index
+    list of indices, or of ``mask``; None if none is seen)."""
+    mask = outline_mask(ids, index) if mask is None else mask
     if not mask.any():
         return None
     inner = mask.copy()

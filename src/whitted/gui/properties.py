@@ -44,6 +44,7 @@ from .widgets import (
     ChoiceEditor,
     CoefficientEditor,
     ColourEditor,
+    ElidedLabel,
     FieldEditor,
     FieldRow,
     FileEditor,
@@ -99,7 +100,7 @@ class PropertyPanel(QWidget):
         self._signature: object = None
         #: the item this panel shows, and the only one its edits go to
         self.key: tuple | None = None
-        self.title = QLabel(self)
+        self.title = ElidedLabel("", self)
         self.title.setStyleSheet("font-weight: bold; font-size: 11pt;")
         self.scroll = QScrollArea(self)
         self.scroll.setWidgetResizable(True)
@@ -144,12 +145,32 @@ class PropertyPanel(QWidget):
         except Exception:  # noqa: BLE001 - an unreadable file shows the default instead
             return None
 
+    def inherited(self, key: tuple, *, even_if_own: bool = False
+                  ) -> tuple[BaseModel, Any] | None:
+        """For a CSG child without a material of its own (``even_if_own``: with or without):
+        the nearest CSG object above it that has one, and that material (what the child is
+        made of); else None."""
+        if key is None or key[0] != "objects" or len(key) < 3:
+            return None
+        chain = [self.doc.item(key[:n]) for n in range(2, len(key) + 1)]
+        if any(item is None for item in chain) or (
+                chain[-1].material is not None and not even_if_own):
+            return None
+        for ancestor in reversed(chain[:-1]):
+            if ancestor.material is not None:
+                return ancestor, ancestor.material
+        return None
+
     def shown_material(self, key: tuple) -> Material:
-        """The material the panel shows for an object: its own, or its model file's first."""
+        """The material the panel shows for an object: its own, its model file's first, or
+        (a CSG child without one) the one it inherits from its CSG object."""
         from_file = self.file_materials(key)
         if from_file:
             return from_file[0]
-        return self.doc.scene.material_of(key[1])
+        item = self.doc.item(key)
+        inherited = self.inherited(key)
+        ref = inherited[1] if inherited is not None else getattr(item, "material", None)
+        return self.doc.scene.resolve_material(ref)
 
     def refresh(self, *_: object) -> None:
         key = self.doc.selection
@@ -177,7 +198,15 @@ class PropertyPanel(QWidget):
         if key == BACKGROUND:
             return "Background"
         kind = "Light" if key[0] == "lights" else "Object"
-        return f"{kind}: {label_of(item)} ({item.type})"
+        one = f"{kind}: {label_of(item)} ({item.type})"
+        keys = self.doc.selected_keys()
+        if len(keys) < 2:
+            return one
+        counts = [(sum(k[0] == kind for k in keys), word) for kind, word in
+                  (("objects", "object"), ("lights", "light"))]
+        parts = [f"{n} {word}{'s' if n > 1 else ''}" for n, word in counts if n]
+        # the panel edits the active one: say which
+        return f"{' and '.join(parts)} selected · {label_of(item)} ({item.type})"
 
     def _rebuild(self, key: tuple, specs: list[F.Spec]) -> None:
         # the focus must not stay in the old form (a window of its own once taken out of
@@ -291,6 +320,8 @@ class PropertyPanel(QWidget):
             return get_path(Transform(), path[1:])
         if key == BACKGROUND and path == ("mode",):
             return "colour" if item.gradient is None else "gradient"
+        if key == CAMERA and path == ("focus_mode",):
+            return F.focus_mode(item)
         if path == ("smooth",):
             return SMOOTH[item.smooth]
         value = get_path(item, path)
@@ -315,6 +346,11 @@ class PropertyPanel(QWidget):
             name = Path(obj_file).name
             entries.append((f"From the model file ({name})" if not count or count == 1 else
                             f"From the model file ({name}, {count} materials)", "file:"))
+        inherited = self.inherited(key, even_if_own=True)
+        if inherited is not None:
+            parent, ref = inherited
+            what = ref if isinstance(ref, str) else (ref.preset or "its own")
+            entries.append((f"Inherited from {label_of(parent)} ({what})", "inherit:"))
         entries.append(("Default (grey)", "default:"))
         entries += [(f"{name} (scene material)", f"named:{name}")
                     for name in self.doc.scene.materials]
@@ -336,13 +372,16 @@ class PropertyPanel(QWidget):
                                      "glTF...); editing a value overrides them all with this "
                                      "one", Qt.ItemDataRole.ToolTipRole)
         ref = item.material
-        if ref is None and obj_file:
+        if ref is None and inherited is not None:
+            current = "inherit:"
+        elif ref is None and obj_file:
             current = "file:"
         elif ref is None:
             current = "default:"
         elif isinstance(ref, str):
             current = f"named:{ref}" if ref in self.doc.scene.materials else f"preset:{ref}"
-        elif not isinstance(ref, str) and ref == Material() and obj_file:
+        elif not isinstance(ref, str) and ref == Material() and (
+                obj_file or self.inherited(key, even_if_own=True)):
             current = "default:"
         elif ref.preset is not None and ref == Material(preset=ref.preset):
             current = f"preset:{ref.preset}"
@@ -404,9 +443,26 @@ class PropertyPanel(QWidget):
                 c = data["color"]
                 data["gradient"] = Gradient(top=c, bottom=c).model_dump()
             return data
+        if key == CAMERA and path == ("focus_mode",):
+            return self._focus_data(item, data, value)
         if path == ("smooth",):
             value = {v: k for k, v in SMOOTH.items()}[value]
         return set_path(data, path, value)
+
+    @staticmethod
+    def _focus_data(camera: Any, data: dict, mode: str) -> dict:
+        """The camera focusing as ``mode`` says, on the plane it focuses on now (a distance
+        along the view, or the point on the view's axis at that distance)."""
+        distance = round(camera.focus(), 4)
+        data["focal_distance"] = data["focal_point"] = None
+        if mode == "distance":
+            data["focal_distance"] = distance if distance > 0 else 1.0
+        elif mode == "point":
+            forward = camera.basis()[2]
+            point = [float(p + max(distance, 1e-3) * f)
+                     for p, f in zip(camera.position, forward, strict=True)]
+            data["focal_point"] = tuple(round(c, 4) for c in point)
+        return data
 
     def _new_texture(self, kind: str, old: dict | None) -> dict | None:
         if kind == "none":
@@ -428,10 +484,12 @@ class PropertyPanel(QWidget):
         if item is None or key[0] != "objects":
             return
         data = item.model_dump()
-        if kind == "file":  # a model without a material of its own: its file's materials
+        if kind in ("file", "inherit"):  # a model's file's materials; a CSG parent's
             data["material"] = None
-        elif kind == "default":  # (a model's "none" is its file's: grey is an override)
-            data["material"] = {} if getattr(item, "file", None) else None
+        elif kind == "default":  # (a model's "none" is its file's, a CSG child's its
+            # parent's: grey is an override there)
+            data["material"] = {} if getattr(item, "file", None) or self.inherited(key) \
+                else None
         elif kind == "named":
             data["material"] = name
         elif kind == "preset":

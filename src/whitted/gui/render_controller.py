@@ -207,15 +207,38 @@ class RenderController(QObject):
 
     def _backdrop(self, scene: Scene) -> np.ndarray | None:
         """The last preview scaled to the render's size and dimmed, to show under the tiles
-        a render has not reached yet (None before any preview)."""
+        a render has not reached yet (None before any preview). A preview seen through
+        another camera (the user's own view) is not shown under the camera's tiles: a quick
+        small preview through the render's camera is made instead."""
         preview = self.last_preview
         if preview is None:
             return None
+        shown = self._shown.scene if self._shown is not None else None
+        if shown is None or shown.camera != scene.camera:
+            preview = self._quick_preview(scene)
+            if preview is None:
+                return None
         s = scene.render
         small = encode_ldr(preview.pixels, transfer=s.transfer, tonemap=s.tonemap)
         ys = np.arange(s.height) * small.shape[0] // s.height
         xs = np.arange(s.width) * small.shape[1] // s.width
         return (small[ys][:, xs] * BACKDROP_DIM).astype(np.uint8)
+
+    def _quick_preview(self, scene: Scene) -> Image | None:
+        """A small preview of ``scene`` made now (a few milliseconds: the compiled geometry
+        of the previews is reused when only the camera differs)."""
+        try:
+            small = preview_scene(scene, min(self.interactive_pixels, 160 * 120))
+            key = _geometry_key(small)
+            cached = self._compiled
+            compiled = cached[1] if cached is not None and cached[0] == key else \
+                compile_scene(small, light_buffers=False)
+            job = RenderJob(small)
+            job.compiled = compiled
+            job.run()
+            return job.image
+        except Exception:  # noqa: BLE001 - a backdrop only: the render shows the error
+            return None
 
     def stop(self) -> None:
         """Stop the full render after the tiles in flight; the picture so far is kept."""

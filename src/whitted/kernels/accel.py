@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..jit import kernel, overload
 from .extras import (
     csg_hit_if_extras,
     extra_normal_if_extras,
@@ -20,7 +21,6 @@ from .extras import (
 )
 from .features import has_extras, has_instances, instances_possible
 from .intersect import INF, intersect_local, normal_local, triangle_barycentric
-from .jit import kernel, overload
 from .layout import (
     FIRST_EXTRA_SHAPE,
     MAT_KT,

@@ -19,12 +19,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..jit import kernel, numba_object
 from .integrator import trace_path
-from .jit import kernel, numba_object
 from .layout import N_RAY_KINDS, RAY_PRIMARY
 from .tiles import camera_ray, lens_ray, own_lines
 
-geometry_ref_if_instances = numba_object(".geometry_ref", "geometry_ref_if_instances")
+geometry_ref_if_instances = numba_object(f"{__package__}.geometry_ref",
+                                         "geometry_ref_if_instances")
 def adaptive_workspace(tile_width: int, tile_height: int, levels: int):
     """Scratch memory of one lane: the corners of a tile's pixels, one pixel's sample grid
     and its marks, and the stack of squares to visit (three per level and the first)."""

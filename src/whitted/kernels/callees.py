@@ -6,7 +6,7 @@ compiles it. On a cold cache the render API starts a second process that compile
 (and then the builders) into the on-disk cache while the first compiles ``render_tiles``;
 when the first reaches one of them it waits for the helper and loads it instead of compiling
 it too (``render/warm_up.py``, ``dispatcher.KernelCache.wait_for_helper``; only with the tuned
-dispatcher of kernels/dispatcher.py). The types must be
+dispatcher of jit/dispatcher.py). The types must be
 exactly the ones the callers ask for, or the helper's work is wasted: ``tests/test_warm_up.py``
 checks them. Integers are int64 everywhere (``dispatcher.KernelDispatcher`` widens them); what is
 compiled is each kernel's twin for calls from kernels (``callee``).

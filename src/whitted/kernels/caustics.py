@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-from .jit import kernel, overload
+from ..jit import kernel, overload
 from .layout import (
     GRID_BITS,
     GRID_INV_CELL,

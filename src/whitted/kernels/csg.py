@@ -43,6 +43,7 @@ import math
 
 import numpy as np
 
+from ..jit import kernel, numba_object
 from .hit_list import keep_nearest
 from .intersect import (
     INF,
@@ -52,7 +53,6 @@ from .intersect import (
     normal_local,
     sphere_span,
 )
-from .jit import kernel, numba_object
 from .layout import (
     CSG_DIFFERENCE,
     CSG_INTERSECTION,
@@ -74,10 +74,10 @@ from .traverse import inverse_direction, slab_entry
 from .vec import dot, madd
 from .xform import normal_to_world, to_object
 
-# kernels/frame_array.py is a Numba extension: imported with Numba (kernels/jit.py)
-float_slots = numba_object(".frame_array", "float_slots")
-int_slots = numba_object(".frame_array", "int_slots")
-slots = numba_object(".frame_array", "slots")
+# kernels/frame_array.py is a Numba extension: imported with Numba (jit/decorators.py)
+float_slots = numba_object(f"{__package__}.frame_array", "float_slots")
+int_slots = numba_object(f"{__package__}.frame_array", "int_slots")
+slots = numba_object(f"{__package__}.frame_array", "slots")
 FRAME_SLOTS = CSG_MAX_LEAVES + 1  # kernels/frame_array.py's
 
 GRAZING = 1e-9  # |cos| between ray and normal below which a crossing is only a touch

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..jit import kernel, overload
 from .csg import csg_hit
 from .features import extras_possible
 from .intersect import INF
-from .jit import kernel, overload
 from .layout import PRIM_FLIP, PRIM_MEDIUM, PRIM_TYPE, SHAPE_CSG, SHAPE_TORUS
 from .torus import intersect_torus, torus_normal, torus_uv
 from .traverse import inverse_direction

@@ -20,7 +20,7 @@ the CSG walk (kernels/extras.py) stay out of the default scene's kernels and col
 
 from __future__ import annotations
 
-from .jit import overload
+from ..jit import overload
 
 NO_INSTANCES_DTYPE = "float32"  # dtype of GeometryArrays.inst_box in scenes without
 # dtype of GeometryArrays.unbounded in scenes with the shapes from layout.FIRST_EXTRA_SHAPE

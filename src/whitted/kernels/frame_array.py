@@ -11,7 +11,7 @@ uninitialised (``cgutils.alloca_once``: LLVM places the allocation in the functi
 block, so a loop does not grow the stack), and give their address; ``slots`` views the
 address as an array: Numba's public ``numba.carray`` with stock Numba, and the tuned
 dispatcher's ``frame_view`` for kernels compiled without Numba's runtime (whose returned
-arrays ``numba.carray`` cannot make; kernels/dispatcher.py lists the names it relies on).
+arrays ``numba.carray`` cannot make; jit/dispatcher.py lists the names it relies on).
 Both must be called in the kernel that uses the array: the slots live as long as its frame.
 Kernels run as plain Python (NUMBA_DISABLE_JIT) get new NumPy arrays instead.
 """
@@ -24,8 +24,8 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from .dispatcher import frame_view, tuned
-from .jit import _jit_disabled
+from ..jit.decorators import _jit_disabled
+from ..jit.dispatcher import frame_view, tuned
 from .layout import CSG_MAX_LEAVES
 
 FRAME_SLOTS = CSG_MAX_LEAVES + 1

@@ -12,7 +12,7 @@ field (``geo.prim_info``) loads just that field through the pointer. The kernels
 once for either (attribute access is the same); ``render_tiles`` makes the reference at its
 start in scenes with mesh instances (:func:`geometry_ref_if_instances`), so every call below
 it passes one word. The pointer lives as long as that kernel's
-frame, which outlives every call it makes. Only the tuned kernels (kernels/dispatcher.py),
+frame, which outlives every call it makes. Only the tuned kernels (jit/dispatcher.py),
 which run without Numba's runtime, make references; with stock Numba the tuple is passed.
 """
 
@@ -99,7 +99,7 @@ def _geometry_ref_if_instances(geo):
     # Measured, CPU time, 1 thread, interleaved (AMD EPYC Zen 4): sphere1m at 640x360 0.242 ->
     # 0.094 s with the reference; but seed000, a scene without instances, 0.69 -> 0.79 s: there
     # LLVM inlines the walks into render_tiles and nothing was copied
-    from .dispatcher import tuned
+    from ..jit.dispatcher import tuned
     from .features import extras_possible, instances_possible
 
     # scenes with tori or CSG too: their walks are calls, not inlined (csg.py). Tuned kernels

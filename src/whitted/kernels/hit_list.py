@@ -3,7 +3,7 @@ kept sorted by t and at most :data:`MAX_SHADOW_HITS` long (the nearest ones)."""
 
 from __future__ import annotations
 
-from .jit import kernel
+from ..jit import kernel
 
 MAX_SHADOW_HITS = 32  # transparent surfaces one shadow ray gathers in one walk (hits buffer)
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import math
 
+from ..jit import kernel
 from .accel import closest_hit, hit_material, surface_normals
 from .caustics import add_caustic, caustics_on
-from .jit import kernel
 from .layout import (
     MAT_AMBIENT,
     MAT_ATTEN,

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 from .layout import (
     SHAPE_BOX,
     SHAPE_DISK,

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 
-from .jit import kernel
+from ..jit import kernel
 
 # Measured on the seed000 benchmark (CPU-time medians; 0.577 s without light buffers): 32
 # cells a side 0.538 s, 64: 0.531 s, 128: 0.527 s (lists of at most 16 primitives); at 128, a

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 
+from ..jit import kernel, overload
 from .accel import (
     closest_hit,
     hit_analytic,
@@ -19,7 +20,6 @@ from .extras import body_medium
 from .features import extras_possible, has_extras, has_instances, instances_possible
 from .hit_list import keep_nearest
 from .intersect import INF
-from .jit import kernel, overload
 from .layout import (
     CELL_COUNT,
     CELL_FIRST,

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import math
 
+from ..jit import kernel
 from .extras import body_medium
-from .jit import kernel
 from .layout import MAT_IOR, MAT_OUTSIDE, MAX_MEDIA, PRIM_SOLID
 
 

@@ -25,8 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..jit import kernel, numba_object
 from .intersect import INF
-from .jit import kernel, numba_object
 from .layout import (
     EMBREE_ALL,
     EMBREE_CLEAR,
@@ -47,9 +47,9 @@ from .layout import (
 from .traverse import slab_entry
 from .vec import cross, normalize
 
-# kernels/embree.py's intrinsics are Numba extensions: imported with Numba (kernels/jit.py)
-embree_intersect = numba_object(".embree", "embree_intersect")
-embree_occluded = numba_object(".embree", "embree_occluded")
+# kernels/embree.py's intrinsics are Numba extensions: imported with Numba (jit/decorators.py)
+embree_intersect = numba_object(f"{__package__}.embree", "embree_intersect")
+embree_occluded = numba_object(f"{__package__}.embree", "embree_occluded")
 
 OPAQUE_KT = 0.01  # the lecture's rule: an occluder with kt below this blocks the light
 

@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import math
 
+from ..jit import kernel, numba_object
 from .accel import closest_hit, hit_material, surface_normals
 from .integrator import split_at_surface
-from .jit import kernel, numba_object
 from .layout import (
     LIGHT_DIRECTION,
     LIGHT_DIRECTIONAL,
@@ -44,7 +44,8 @@ from .media import absorbed
 from .sampling import concentric_disk, random01, random_pair
 from .vec import dot, madd, normalize, vload
 
-geometry_ref_if_instances = numba_object(".geometry_ref", "geometry_ref_if_instances")
+geometry_ref_if_instances = numba_object(f"{__package__}.geometry_ref",
+                                         "geometry_ref_if_instances")
 
 # emitter rows (compile/photon_map.py): one per (light, target) pair
 EMIT_LIGHT = 0  # row of the light table

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from .jit import kernel
+from ..jit import kernel
 
 MASK32 = 0xFFFFFFFF
 INV_2_32 = 1.0 / 4294967296.0

@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 from .texture_layout import (
     AXIS_U,
     FILTER_NEAREST,

@@ -13,10 +13,10 @@ import math
 
 import numpy as np
 
+from ..jit import kernel, numba_object
 from .accel import closest_hit, surface_normals
 from .hit_list import MAX_SHADOW_HITS
 from .integrator import N_STACK_F, N_STACK_I, trace_path
-from .jit import kernel, numba_object
 from .layout import (
     MAX_MEDIA,
     N_RAY_KINDS,
@@ -29,8 +29,9 @@ from .vec import dot, madd, normalize, sub
 
 BVH_STACK = 128
 
-# kernels/geometry_ref.py is a Numba extension: imported with Numba (kernels/jit.py)
-geometry_ref_if_instances = numba_object(".geometry_ref", "geometry_ref_if_instances")
+# kernels/geometry_ref.py is a Numba extension: imported with Numba (jit/decorators.py)
+geometry_ref_if_instances = numba_object(f"{__package__}.geometry_ref",
+                                         "geometry_ref_if_instances")
 
 
 CACHE_LINE = 128  # bytes: the longest cache line of the cores whitted runs on (Apple's

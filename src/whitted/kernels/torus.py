@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 
-from .jit import kernel
+from ..jit import kernel
 from .vec import dot, normalize, sub, vload
 
 INF = math.inf

@@ -9,8 +9,8 @@ import math
 
 import numpy as np
 
+from ..jit import kernel
 from .intersect import INF
-from .jit import kernel
 
 TINY_DIRECTION = 1e-30  # stands in for a zero direction component in the slab test
 

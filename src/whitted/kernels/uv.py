@@ -16,11 +16,11 @@ from __future__ import annotations
 
 import math
 
+from ..jit import kernel, overload
 from .accel import to_object
 from .extras import extra_uv_if_extras
 from .features import has_extras, instances_possible
 from .intersect import _box_local, triangle_barycentric
-from .jit import kernel, overload
 from .layout import (
     DISK_TANGENT,
     FIRST_EXTRA_SHAPE,

@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from .jit import kernel
+from ..jit import kernel
 from .vec import normalize
 
 

@@ -7,12 +7,14 @@ cancellable, with progress callbacks.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
+from enum import StrEnum
 
 import numpy as np
 
@@ -65,6 +67,20 @@ def _as_scene(scene: object, what: str = "scene") -> Scene:
         return load_scene(scene)
     raise ArgumentError(f"{what} must be a whitted.Scene or the path of a scene file, "
                         f"got {type(scene).__name__}")
+
+
+class JobState(StrEnum):
+    """Where a :class:`RenderJob` is: not started, running, or how it ended. A str, so
+    ``job.state == "finished"`` reads as well as ``job.state is JobState.FINISHED``."""
+
+    READY = "ready"  # made, not started
+    RUNNING = "running"  # compiling or rendering
+    FINISHED = "finished"  # every tile rendered
+    CANCELLED = "cancelled"  # stopped by its CancelToken: the tiles finished are in the image
+    FAILED = "failed"  # raised: ``job.error`` is what
+
+    def __str__(self) -> str:
+        return self.value
 
 
 class CancelToken:
@@ -227,23 +243,74 @@ class RenderJob:
             max_depth=self.settings.max_depth,
         )
         self.image: Image | None = None
+        #: what the job raised (its state is then FAILED), None otherwise
         self.error: BaseException | None = None
+        self._state = JobState.READY
+        #: tiles rendered so far, of ``tiles_total`` (0 until the tiles are laid out)
+        self.tiles_done = 0
+        self.tiles_total = 0
         self._thread: threading.Thread | None = None
+        self._ended = threading.Event()  # set when the background thread has ended
 
     def cancel(self) -> None:
         self.cancel_token.cancel()
 
+    @property
+    def state(self) -> JobState:
+        """:class:`JobState`: READY, RUNNING, then FINISHED, CANCELLED or FAILED."""
+        return self._state
+
+    @property
+    def finished(self) -> bool:
+        """Every tile was rendered."""
+        return self._state is JobState.FINISHED
+
+    @property
+    def cancelled(self) -> bool:
+        """The job ended because it was cancelled (its image holds the tiles finished)."""
+        return self._state is JobState.CANCELLED
+
+    @property
+    def failed(self) -> bool:
+        """The job raised; :attr:`error` is the exception."""
+        return self._state is JobState.FAILED
+
+    @property
+    def fraction(self) -> float:
+        """The part of the image rendered so far, 0..1 (0 while compiling)."""
+        return self.tiles_done / self.tiles_total if self.tiles_total else 0.0
+
+    def partial_image(self) -> Image:
+        """The picture as it is now, at any time (running or ended): a copy of the
+        framebuffer as an :class:`Image` with the scene's transfer and tone map (tiles not
+        rendered yet are black)."""
+        return Image(self.framebuffer.copy(), transfer=self.settings.transfer,
+                     tonemap=self.settings.tonemap, meta={"stats": self.stats})
+
+    def srgb(self) -> np.ndarray:
+        """The picture as it is now as display values: uint8 (H, W, 3), the scene's tone map
+        and transfer (sRGB by default), tiles not rendered yet black."""
+        return self.partial_image().to_srgb8()
+
+    def __repr__(self) -> str:
+        s = self.settings
+        state = f"failed: {self.error!r}" if self.failed else str(self._state)
+        done = f", {self.tiles_done}/{self.tiles_total} tiles" if self.tiles_total else ""
+        return f"<RenderJob {s.width}x{s.height} {state}{done}>"
+
     def start(self) -> threading.Thread:
         """Run the job on a background thread (once: :class:`JobStateError` when started
         again)."""
-        if self._thread is not None:
+        if self._thread is not None or self._state is not JobState.READY:
             raise JobStateError("this render job was already started (make a new RenderJob)")
 
         def target() -> None:
+            # what it raises is kept in self.error (state FAILED), handed to whoever waits
             try:
-                self.run()
-            except BaseException as exc:  # noqa: BLE001 - handed to whoever joins
-                self.error = exc
+                with contextlib.suppress(BaseException):
+                    self.run()
+            finally:
+                self._ended.set()
 
         self._thread = threading.Thread(target=target, name="whitted-render", daemon=True)
         self._thread.start()
@@ -251,10 +318,10 @@ class RenderJob:
 
     def join(self, timeout: float | None = None) -> bool:
         """Wait for the background thread (if any) without raising its error; True when it
-        has finished."""
+        has finished. (It waits on an event, not ``Thread.join``: a KeyboardInterrupt in the
+        wait leaves the job's state true.)"""
         if self._thread is not None:
-            self._thread.join(timeout)
-            return not self._thread.is_alive()
+            return self._ended.wait(timeout)
         return True
 
     def wait(self, timeout: float | None = None) -> Image | None:
@@ -265,8 +332,7 @@ class RenderJob:
             if self.image is not None:  # finished by run()
                 return self.image
             raise JobStateError("wait() before start(): start the job first (or call run())")
-        self._thread.join(timeout)
-        if self._thread.is_alive():
+        if not self._ended.wait(timeout):
             return None
         if self.error is not None:
             raise self.error
@@ -274,7 +340,7 @@ class RenderJob:
 
     @property
     def running(self) -> bool:
-        return self._thread is not None and self._thread.is_alive()
+        return self._thread is not None and not self._ended.is_set()
 
     def _report(self, done, total, counters, start, chunk, chunk_rays=None) -> None:
         if self.progress is None:
@@ -303,6 +369,22 @@ class RenderJob:
         return lights, stats.photons.seconds
 
     def run(self) -> Image:
+        """Render (blocking) and return the :class:`Image`; a cancelled job returns the
+        tiles it finished (``state`` CANCELLED). What it raises is kept in :attr:`error`
+        (``state`` FAILED) and raised. :class:`JobStateError` when run a second time."""
+        if self._state is not JobState.READY:
+            raise JobStateError("this render job has already run (make a new RenderJob)")
+        self._state = JobState.RUNNING
+        try:
+            image = self._run()
+        except BaseException as exc:
+            self.error = exc
+            self._state = JobState.FAILED
+            raise
+        self._state = JobState.CANCELLED if self.stats.cancelled else JobState.FINISHED
+        return image
+
+    def _run(self) -> Image:
         from ..kernels.tiles import lane_workspace, render_tiles
 
         wall_start = time.perf_counter()
@@ -322,7 +404,7 @@ class RenderJob:
                 lights, photon_seconds = self._caustics_stage(compiled, params, stats)
         tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size, self.rows)
         counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
-        stats.tiles_total = len(tiles)
+        stats.tiles_total = self.tiles_total = len(tiles)
         lanes = self.threads
         antialias = self.settings.antialias
         levels = 0
@@ -407,6 +489,7 @@ class RenderJob:
                     tile_seconds[0] = (time.perf_counter() - run_start) / len(idx)
                     counters[idx] = part_counters
                     done += len(idx)
+                    self.tiles_done = done
                     self._report(done, len(tiles), counters, render_start, part,
                                  part_counters.sum(axis=1))
 

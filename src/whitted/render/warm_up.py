@@ -6,7 +6,7 @@ shared with a second process (``python -m whitted.render.warm_up``) when there a
 or more. While this process compiles ``render_tiles`` (and its callees on the way, depth
 first), the helper compiles a share of the render kernel's callees (``kernels/callees.py``),
 then the scene builders and the OBJ loader, into the cache. When this process reaches one of
-the helper's callees it waits for it (``KernelCache.wait_for_helper``, kernels/dispatcher.py)
+the helper's callees it waits for it (``KernelCache.wait_for_helper``, jit/dispatcher.py)
 and loads it instead of compiling it a second time (with stock Numba, which has neither the
 twins nor the wait, the helper compiles only the builders and the loader). Then it waits for the
 helper (which by then is on the builders and loader, work this process would do next) and
@@ -41,10 +41,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .._cache import HELPER_ENV, prepare
 from ..assets.mesh import load_obj_bytes
 from ..compile.params import render_params
 from ..compile.scene import CompiledScene, compile_scene
+from ..jit.cache import HELPER_ENV, prepare
 from ..kernels.features import EXTRAS_DTYPE
 from ..kernels.layout import N_RAY_KINDS
 from ..scene.lights import PointLight
@@ -265,7 +265,7 @@ def caustics_compile():
     global _progress, _label
     from numba.core import event
 
-    from ..kernels.jit import load_numba
+    from ..jit import load_numba
 
     load_numba()
     count = _CompileCount(EXPECTED_CAUSTICS_COMPILES)
@@ -389,9 +389,9 @@ def _interrupt_at_safe_points(count: _CompileCount):
 
 def _delegated(instances: bool) -> list:
     """The helper's share of the render kernel's callees: (twin dispatcher, types) pairs;
-    none with stock Numba (no twins to compile, nothing to wait for: kernels/dispatcher.py)."""
-    from ..kernels.dispatcher import tuned
-    from ..kernels.jit import load_numba
+    none with stock Numba (no twins to compile, nothing to wait for: jit/dispatcher.py)."""
+    from ..jit import load_numba
+    from ..jit.dispatcher import tuned
 
     load_numba()
     if not tuned():
@@ -409,8 +409,8 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
     builders, counting both for :func:`compile_progress`; on any exception (Ctrl-C) the
     helper is stopped at once rather than waited for."""
     global _progress
-    from ..kernels.dispatcher import kernel_cache_class
-    from ..kernels.jit import load_numba
+    from ..jit import load_numba
+    from ..jit.dispatcher import kernel_cache_class
 
     load_numba()  # Numba, with whitted's settings
     KernelCache = kernel_cache_class()  # noqa: N806 - None with stock Numba

@@ -77,31 +77,3 @@ class Animation(Strict):
         new = Track(path, keys, interpolation=interpolation)
         return Animation(frames=self.frames, fps=self.fps, cyclic=self.cyclic,
                          tracks=[*self.tracks, new])
-
-
-def animation_toml(data: dict[str, Any]) -> str:
-    """The ``[animation]`` table (as ``model_dump(mode="json")`` gives it) as TOML text with
-    one key per line: ``[12, [9.0, 2.6, 0.0]],``."""
-    import tomlkit
-
-    doc = tomlkit.document()
-    table = tomlkit.table()
-    for name, value in data.items():
-        if name != "tracks":
-            table.add(name, value)
-    doc.add("animation", table)
-    tracks = tomlkit.aot()
-    for track in data.get("tracks", []):
-        t = tomlkit.table()
-        t.add("path", track["path"])
-        if "interpolation" in track:
-            t.add("interpolation", track["interpolation"])
-        keys = tomlkit.array()
-        for pair in track["keys"]:
-            keys.append(list(pair))
-        keys.multiline(True)
-        t.add("keys", keys)
-        tracks.append(t)
-    if data.get("tracks"):
-        table.add("tracks", tracks)
-    return tomlkit.dumps(doc)

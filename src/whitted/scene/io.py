@@ -16,10 +16,10 @@ from pydantic import ValidationError
 
 from ..errors import ArgumentError, SceneError, shorten
 from ..files import path_problem, read_limited
+from .file_names import named_files
 from .messages import format_path, json_line, scene_error, toml_line
 from .scene import Scene
 from .types import MAX_MAGNITUDE
-from .writing import named_files
 
 SCENE_SUFFIXES = (".toml", ".json")
 

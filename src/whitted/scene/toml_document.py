@@ -7,7 +7,15 @@ differ from their defaults.
 - :func:`compact_toml`: a whole scene as compact TOML (a file that did not exist before)
 - :func:`edit_toml`: the text of a TOML scene file with the changes from ``old`` to ``new``
 - :func:`edited_toml`: that edit, read back and checked, or None when it cannot be made
-- :func:`save_scene_toml`: write a scene, style-preserving when the file's text is known
+- :func:`scene_toml`: the TOML to save a scene as, style-preserving when the file's text is
+  known (``whitted.save_scene`` and the editor both write through it)
+
+An edit touches the file's text only where a value changed: one number of a vector, one key
+of a CSG child inside a multi-line array; new numbers are rounded to the decimals the file
+uses. Earlier versions of the same file (``history``) lend their spelling: a value set back
+to what a version said is written as that version wrote it, and an object deleted and then
+restored comes back as it was written, with its comments (a comment block right above an
+``[[objects]]`` header belongs to that object).
 
 Every result is read back and compared with the scene before it is written. When a file's own
 style cannot carry an edit, :func:`scene_toml` writes the scene compactly (nothing is lost);
@@ -15,20 +23,23 @@ the editor asks first (:func:`edited_toml` says None) rather than rewrite a user
 
 from __future__ import annotations
 
+import contextvars
+import copy
 import difflib
-from pathlib import Path
-from typing import Any
+import math
+import re
+import tomllib
+from collections.abc import Iterable
+from typing import TYPE_CHECKING, Any
 
 import tomlkit
-from pydantic import BaseModel
-from tomlkit.items import AoT, Array, InlineTable, Table
+from pydantic import BaseModel, ValidationError
+from tomlkit.items import AoT, Array, Comment, InlineTable, Table
 
-from ..errors import SceneError
-from ..files import atomic_write
-from .io import parse_scene_text, scene_from_dict
 from .materials import Material
-from .scene import Scene
-from .writing import rebase_files, scene_to_dict
+
+if TYPE_CHECKING:
+    from .scene import Scene
 
 # ---------------------------------------------------------------------- compact data
 
@@ -80,18 +91,57 @@ def compact_data(model: BaseModel) -> dict[str, Any]:
     return out
 
 
+class _Style:
+    """How an edit writes into one file: new numbers rounded to ``decimals`` (None: exact,
+    for a file written afresh), and the spellings of the file's earlier versions."""
+
+    def __init__(self, decimals: int | None = None, memory: _Memory | None = None) -> None:
+        self.decimals = decimals
+        self.memory = memory
+
+
+_STYLE: contextvars.ContextVar[_Style | None] = contextvars.ContextVar("toml_style", default=None)
+
+
+def _style() -> _Style:
+    return _STYLE.get() or _Style()
+
+#: a float literal in TOML text (its fraction's digits counted for the file's rounding)
+_FLOAT = re.compile(r"(?<![\w.\"'#-])[-+]?\d+\.(\d+)(?:[eE][-+]?\d+)?(?![\w.])")
+
+
+def file_decimals(text: str) -> int:
+    """The decimals new numbers get in ``text``: as many as its most precise number shows
+    (3 to 6; 4 in a file of whole numbers only)."""
+    found = [len(m.group(1)) for m in _FLOAT.finditer(text)]
+    return min(max(max(found), 3), 6) if found else 4
+
+
+def _rounded(value: float, decimals: int | None) -> float:
+    """``value`` rounded to ``decimals``; a small one (under a tenth of a unit of the file's
+    precision's hundreds) keeps ``decimals`` significant digits instead."""
+    if decimals is None or not math.isfinite(value):
+        return value
+    if abs(value) >= 10.0 ** (2 - decimals):
+        return round(value, decimals) + 0.0  # (no -0.0)
+    return float(f"{value:.{decimals}g}") + 0.0
+
+
 def _item(value: Any, *, inline: bool = True) -> Any:
-    """A tomlkit item for plain data: tables inline (compact) unless ``inline`` is False."""
+    """A tomlkit item for plain data: tables inline (compact) unless ``inline`` is False;
+    floats rounded as the file being edited rounds them."""
     if isinstance(value, dict):
         table = tomlkit.inline_table() if inline else tomlkit.table()
         for k, v in value.items():
             table[k] = _item(v)
         return table
-    if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+    if isinstance(value, list | tuple):
         array = tomlkit.array()
         for v in value:
             array.append(_item(v))
         return array
+    if isinstance(value, float):
+        return tomlkit.item(_rounded(value, _style().decimals))
     return tomlkit.item(value)
 
 
@@ -131,8 +181,37 @@ def _is_table(node: Any) -> bool:
     return isinstance(node, Table | InlineTable)
 
 
-def _set_field(table: Any, name: str, old: BaseModel, new: BaseModel) -> None:
-    """Make ``table[name]`` say the new value of field ``name`` (or drop it: a default)."""
+def _key(item: BaseModel) -> str:
+    return item.model_dump_json()
+
+
+def _ident(kind: str, item: BaseModel) -> tuple:
+    """Which item of a file's earlier versions may lend ``item`` its spellings."""
+    return (kind, getattr(item, "type", None), getattr(item, "name", None))
+
+
+def _is_models(value: Any) -> bool:
+    return isinstance(value, list | tuple) and bool(value) and all(
+        isinstance(v, BaseModel) for v in value)
+
+
+def _set_elements(array: Array, old: Any, new: Any) -> None:
+    """Write into ``array`` only the elements of a vector (or a list of them) that changed."""
+    for k, (o, n) in enumerate(zip(old, new, strict=True)):
+        if o == n:
+            continue
+        node = array[k]
+        if isinstance(node, Array) and isinstance(n, list | tuple) and \
+                isinstance(o, list | tuple) and len(o) == len(n) == len(node):
+            _set_elements(node, o, n)
+        else:
+            array[k] = _item(_plain(n))
+
+
+def _set_field(table: Any, name: str, old: BaseModel, new: BaseModel,
+               ident: tuple | None = None) -> None:
+    """Make ``table[name]`` say the new value of field ``name`` (or drop it: a default),
+    changing as little of its text as it can."""
     old_value, new_value = getattr(old, name), getattr(new, name)
     if old_value == new_value:
         return
@@ -141,12 +220,25 @@ def _set_field(table: Any, name: str, old: BaseModel, new: BaseModel) -> None:
             and type(new_value) is type(old_value) and _is_table(node)
             and getattr(old_value, "type", None) == getattr(new_value, "type", None)
             and getattr(old_value, "preset", None) == getattr(new_value, "preset", None)):
-        _update_table(node, old_value, new_value)
+        _update_table(node, old_value, new_value, None if ident is None else (*ident, name))
         return
     default = _defaults_for(new).get(name, object())
     if new_value is None or (new_value == default and name not in ("type", "preset")):
         if name in table:
             del table[name]
+        return
+    memory = _style().memory
+    spelt = memory.spelling(ident, name, new_value, node) if memory and ident else None
+    if spelt is not None:  # as an earlier version of the file wrote it
+        table[name] = spelt
+        return
+    if _is_models(new_value) and _is_models(old_value) and isinstance(node, AoT | Array):
+        _update_items(node, list(old_value), list(new_value), "objects")  # CSG children
+        return
+    if isinstance(node, Array) and isinstance(new_value, list | tuple) and \
+            isinstance(old_value, list | tuple) and len(old_value) == len(new_value) == \
+            len(node) and not _is_models(new_value):
+        _set_elements(node, old_value, new_value)  # one number of a vector
         return
     plain = _plain(new_value)
     # a sub-table only where the file has one: ``material = "glass"`` becoming an object's
@@ -155,13 +247,40 @@ def _set_field(table: Any, name: str, old: BaseModel, new: BaseModel) -> None:
         new_value, BaseModel) and isinstance(node, Table)))
 
 
-def _update_table(table: Any, old: BaseModel, new: BaseModel) -> None:
+def _update_table(table: Any, old: BaseModel, new: BaseModel, ident: tuple | None = None) -> None:
     for name in type(new).model_fields:
-        _set_field(table, name, old, new)
+        _set_field(table, name, old, new, ident)
 
 
-def _key(item: BaseModel) -> str:
-    return item.model_dump_json()
+def _update_items(node: AoT | Array, old: list, new: list, kind: str) -> None:
+    """The items of a ``[[lights]]``/``[[objects]]`` list or a CSG object's ``objects``
+    array: items matched one to one, each edited in place; removed ones go with their
+    comments, added ones come back as an earlier version wrote them or compactly."""
+    inline = isinstance(node, Array)
+    memory = _style().memory
+
+    def fresh(item: BaseModel) -> Any:
+        kept = memory.item(kind, item, InlineTable if inline else Table) if memory else None
+        if kept is not None:
+            return kept
+        return _item(compact_data(item)) if inline else _block(compact_data(item))
+
+    ops = difflib.SequenceMatcher(None, [_key(i) for i in old], [_key(i) for i in new],
+                                  autojunk=False).get_opcodes()
+    for tag, i1, i2, j1, j2 in reversed(ops):  # from the end: earlier indices stay valid
+        if tag == "equal":
+            continue
+        paired = min(i2 - i1, j2 - j1) if tag == "replace" else 0
+        for k in range(paired):
+            o, n = old[i1 + k], new[j1 + k]
+            if type(o) is type(n) and getattr(o, "type", None) == getattr(n, "type", None):
+                _update_table(node[i1 + k], o, n, _ident(kind, n))
+            else:
+                node[i1 + k] = fresh(n)
+        for index in range(i2 - 1, i1 + paired - 1, -1):  # removed
+            del node[index]
+        for k in range(j2 - 1, j1 + paired - 1, -1):  # added, in order
+            node.insert(i1 + paired, fresh(new[k]))
 
 
 def _update_list(doc: Any, name: str, old: list, new: list) -> None:
@@ -173,25 +292,7 @@ def _update_list(doc: Any, name: str, old: list, new: list) -> None:
     if not isinstance(node, AoT | Array):  # none yet (a file that loads has no other form)
         doc[name] = _aot(new)
         return
-    inline = isinstance(node, Array)
-    fresh = (lambda it: _item(compact_data(it))) if inline else (
-        lambda it: _block(compact_data(it)))
-    ops = difflib.SequenceMatcher(None, [_key(i) for i in old], [_key(i) for i in new],
-                                  autojunk=False).get_opcodes()
-    for tag, i1, i2, j1, j2 in reversed(ops):  # from the end: earlier indices stay valid
-        if tag == "equal":
-            continue
-        paired = min(i2 - i1, j2 - j1) if tag == "replace" else 0
-        for k in range(paired):
-            o, n = old[i1 + k], new[j1 + k]
-            if type(o) is type(n) and getattr(o, "type", None) == getattr(n, "type", None):
-                _update_table(node[i1 + k], o, n)
-            else:
-                node[i1 + k] = fresh(n)
-        for index in range(i2 - 1, i1 + paired - 1, -1):  # removed
-            del node[index]
-        for k in range(j2 - 1, j1 + paired - 1, -1):  # added, in order
-            node.insert(i1 + paired, fresh(new[k]))
+    _update_items(node, old, new, name)
 
 
 def _block(data: dict[str, Any]) -> Table:
@@ -208,19 +309,141 @@ def _aot(items: list) -> AoT:
     return aot
 
 
-def edit_toml(text: str, old: Scene, new: Scene) -> str:
+# ---------------------------------------------------------------------- a file's comments
+
+
+def _trailing(body: list) -> int:
+    """Where the comment block that ends ``body`` (a table's items) and belongs to what
+    follows starts: the comments after its last blank line, right above the next header."""
+    end = len(body)
+    start = end
+    while start > 0 and body[start - 1][0] is None and isinstance(body[start - 1][1], Comment):
+        start -= 1
+    return start
+
+
+def _last_body(node: Any) -> list | None:
+    """The items at the end of a table as the file shows them (the last sub-table's)."""
+    while True:
+        if isinstance(node, AoT):
+            if not len(node):
+                return None
+            node = node[-1]
+            continue
+        if not isinstance(node, Table):
+            return None
+        body = node.value.body
+        if body and isinstance(body[-1][1], Table | AoT) and body[-1][0] is not None:
+            node = body[-1][1]
+            continue
+        return body
+
+
+def _own_comments(doc: Any) -> None:
+    """Give each ``[[lights]]``/``[[objects]]`` table the comment lines right above its
+    header (tomlkit keeps them at the end of the table before): deleting an object takes its
+    comments with it, and restoring it brings them back. The text stays the same."""
+    keys = [k.key if k is not None else None for k, _ in doc.body]
+    for name in ("lights", "objects"):
+        aot = doc.get(name)
+        if not isinstance(aot, AoT) or not len(aot) or name not in keys:
+            continue
+        at = keys.index(name)
+        before = [item for k, item in doc.body[:at] if k is not None]
+        tables = [before[-1] if before else None, *aot]
+        for prev, table in zip(tables, list(aot), strict=False):
+            body = _last_body(prev) if prev is not None else None
+            if not body:
+                continue
+            start = _trailing(body)
+            if start == len(body):
+                continue
+            lead = "".join(item.as_string() for _, item in body[start:])
+            del body[start:]
+            table.trivia.indent = lead + table.trivia.indent
+
+
+class _Memory:
+    """The items and values of a file's earlier versions (its text and the scene it held),
+    to write something set back as that version wrote it."""
+
+    def __init__(self, versions: Iterable[tuple[str, Scene]]) -> None:
+        self.whole: dict[tuple, Any] = {}
+        self.tables: dict[tuple, list[tuple[BaseModel, Any]]] = {}
+        for text, scene in versions:
+            try:
+                doc = tomlkit.parse(text)
+                _own_comments(doc)
+            except (tomlkit.exceptions.TOMLKitError, ValueError, TypeError):
+                continue
+            for name in ("render", "camera", "background"):
+                if _is_table(doc.get(name)):
+                    self._table((name,), getattr(scene, name), doc[name])
+            for kind in ("lights", "objects"):
+                node = doc.get(kind)
+                if isinstance(node, AoT | Array) and len(node) == len(getattr(scene, kind)):
+                    self._items(kind, list(getattr(scene, kind)), node)
+
+    def _table(self, ident: tuple, model: BaseModel, node: Any) -> None:
+        self.tables.setdefault(ident, []).append((model, node))
+        for name in type(model).model_fields:
+            value, sub = getattr(model, name), node.get(name)
+            if isinstance(value, BaseModel) and _is_table(sub):
+                self._table((*ident, name), value, sub)
+            elif _is_models(value) and isinstance(sub, AoT | Array) and len(sub) == len(value):
+                self._items("objects", list(value), sub)
+
+    def _items(self, kind: str, items: list, node: Any) -> None:
+        for item, table in zip(items, node, strict=True):
+            if _is_table(table):
+                self.whole.setdefault((kind, _key(item)), table)
+                self._table(_ident(kind, item), item, table)
+
+    def item(self, kind: str, item: BaseModel, form: type) -> Any:
+        """A copy of ``item`` as an earlier version wrote it (a table of ``form``), or None."""
+        node = self.whole.get((kind, _key(item)))
+        return copy.deepcopy(node) if isinstance(node, form) else None
+
+    def spelling(self, ident: tuple, name: str, value: Any, node: Any) -> Any:
+        """A copy of field ``name`` = ``value`` as an earlier version of the item wrote it,
+        or None (also when the file now writes it in another form)."""
+        for model, table in reversed(self.tables.get(ident, [])):
+            if getattr(model, name, object()) == value and name in table:
+                kept = table[name]
+                if node is None or type(kept) is type(node) or not isinstance(
+                        kept, Table | AoT):
+                    if isinstance(kept, Table | AoT):
+                        return None  # a sub-table is written field by field
+                    return copy.deepcopy(kept)
+        return None
+
+
+def edit_toml(text: str, old: Scene, new: Scene, *,
+              history: Iterable[tuple[str, Scene]] = ()) -> str:
     """``text`` (a TOML file that loads as ``old``) changed so that it loads as ``new``:
-    comments, layout and untouched values stay byte for byte."""
+    comments, layout and untouched values stay byte for byte; new numbers are rounded as
+    the file's are; ``history`` (earlier versions: text and scene) lends its spellings."""
     if old == new:
         return text
     doc = tomlkit.parse(text)
+    _own_comments(doc)
+    memory = _Memory([*history, (text, old)])
+    token = _STYLE.set(_Style(file_decimals(text), memory))
+    try:
+        _edit_doc(doc, old, new)
+    finally:
+        _STYLE.reset(token)
+    return tomlkit.dumps(doc)
+
+
+def _edit_doc(doc: Any, old: Scene, new: Scene) -> None:
     for name in ("render", "camera", "background"):
         o, n = getattr(old, name), getattr(new, name)
         if o == n:
             continue
         node = doc.get(name)
         if _is_table(node):
-            _update_table(node, o, n)
+            _update_table(node, o, n, (name,))
         else:  # not in the file: it was the default, so the new value is not
             doc[name] = _table(compact_data(n))
     if old.materials != new.materials:
@@ -232,7 +455,7 @@ def edit_toml(text: str, old: Scene, new: Scene) -> str:
             del node[key]
         for key, mat in new.materials.items():
             if key in old.materials and _is_table(node.get(key)):
-                _update_table(node[key], old.materials[key], mat)
+                _update_table(node[key], old.materials[key], mat, ("materials", key))
             elif old.materials.get(key) != mat:
                 node[key] = _table(compact_data(mat))
         if not new.materials:
@@ -243,7 +466,6 @@ def edit_toml(text: str, old: Scene, new: Scene) -> str:
             _update_list(doc, name, list(o), list(n))
     if old.animation != new.animation:
         _update_animation(doc, old.animation, new.animation)
-    return tomlkit.dumps(doc)
 
 
 # ---------------------------------------------------------------------- the [animation] table
@@ -253,7 +475,7 @@ def _keys_array(keys: list) -> Array:
     """A track's keys, one ``[frame, value]`` a line (as people write them)."""
     array = tomlkit.array()
     for frame, value in sorted(keys, key=lambda k: k[0]):
-        array.append(tomlkit.item([frame, _plain(value)]))
+        array.append(_item([frame, _plain(value)]))
     array.multiline(len(keys) > 1)
     return array
 
@@ -299,12 +521,12 @@ def _update_track(table: Any, old: Any, new: Any) -> None:
         paired = min(i2 - i1, j2 - j1) if tag == "replace" else 0
         for k in range(paired):
             frame, value = new.keys[j1 + k]
-            array[i1 + k] = tomlkit.item([frame, _plain(value)])
+            array[i1 + k] = _item([frame, _plain(value)])
         for index in range(i2 - 1, i1 + paired - 1, -1):
             del array[index]
         for k in range(j2 - 1, j1 + paired - 1, -1):
             frame, value = new.keys[k]
-            array.insert(i1 + paired, tomlkit.item([frame, _plain(value)]))
+            array.insert(i1 + paired, _item([frame, _plain(value)]))
 
 
 def _update_animation(doc: Any, old: Any, new: Any) -> None:
@@ -343,50 +565,66 @@ def _update_animation(doc: Any, old: Any, new: Any) -> None:
         del node["tracks"]
 
 
-def _loads(text: str, scene: Scene) -> Scene | None:
+def _close(a: Any, b: Any, tolerance: float) -> bool:
+    """Plain data ``a`` equal to ``b`` but for numbers rounded to ``tolerance``."""
+    if isinstance(a, float | int) and isinstance(b, float | int) and not isinstance(
+            a, bool) and not isinstance(b, bool):
+        return a == b or abs(a - b) <= tolerance or math.isclose(a, b, rel_tol=1e-5)
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_close(a[k], b[k], tolerance) for k in a)
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_close(x, y, tolerance) for x, y in zip(a, b, strict=True))
+    return a == b
+
+
+def _loads(text: str, like: Scene) -> Scene | None:
+    """The scene the TOML ``text`` holds (read as ``whitted.load_scene`` reads it), or None."""
     try:
-        loaded = scene_from_dict(parse_scene_text(text, ".toml"))
-    except (SceneError, ValueError):
+        return type(like).model_validate(tomllib.loads(text), strict=True)
+    except (tomllib.TOMLDecodeError, ValidationError, ValueError, RecursionError):
         return None
-    return loaded
 
 
-def edited_toml(scene: Scene, text: str, loaded: Scene) -> str | None:
+def read_toml(text: str, scene: Scene) -> Scene:
+    """The scene the TOML ``text`` (just written for ``scene``) holds: ``scene`` with the
+    numbers as the file rounded them."""
+    loaded = _loads(text, scene)
+    return scene if loaded is None or loaded == scene else loaded.with_base_dir(
+        getattr(scene, "_base_dir", None))
+
+
+def same_scene(loaded: Scene | None, scene: Scene, decimals: int | None = None) -> bool:
+    """Whether a file that loads as ``loaded`` says ``scene`` (its new numbers rounded to
+    ``decimals``)."""
+    if loaded is None:
+        return False
+    if loaded == scene or decimals is None:
+        return loaded == scene
+    return _close(loaded.model_dump(mode="json"), scene.model_dump(mode="json"),
+                  0.5001 * 10.0 ** -decimals)
+
+
+def edited_toml(scene: Scene, text: str, loaded: Scene, *,
+                history: Iterable[tuple[str, Scene]] = ()) -> str | None:
     """``text`` (the file as read, which loaded as ``loaded``) with only the edits that make
     it ``scene`` written into it, checked by reading it back; None when the file's own style
     cannot carry them (the caller then asks before writing the whole file afresh)."""
     try:
-        edited = edit_toml(text, loaded, scene)
+        edited = edit_toml(text, loaded, scene, history=history)
     except (KeyError, TypeError, ValueError, tomlkit.exceptions.TOMLKitError):
         return None
-    return edited if _loads(edited, scene) == scene else None
+    return edited if same_scene(_loads(edited, scene), scene, file_decimals(text)) else None
 
 
-def scene_toml(scene: Scene, *, text: str | None = None, loaded: Scene | None = None) -> str:
+def scene_toml(scene: Scene, *, text: str | None = None, loaded: Scene | None = None,
+               history: Iterable[tuple[str, Scene]] = ()) -> str:
     """The TOML to save ``scene`` as: ``text`` (the file as read, which loaded as ``loaded``)
     with only the edits written into it, else the compact form. Checked by reading it back."""
     if text is not None and loaded is not None:
-        edited = edited_toml(scene, text, loaded)
+        edited = edited_toml(scene, text, loaded, history=history)
         if edited is not None:
             return edited
     compact = compact_toml(scene)
     if _loads(compact, scene) == scene:
         return compact
-    import tomli_w
-
-    return tomli_w.dumps(scene_to_dict(scene))  # every value spelt out: always loads back
-
-
-def save_scene_toml(scene: Scene, path: str | Path, *, text: str | None = None,
-                    loaded: Scene | None = None, payload: str | None = None) -> str:
-    """Write ``scene`` to the TOML file ``path`` atomically (see :func:`scene_toml`, or
-    ``payload`` when the caller has made the text already); relative model and texture names
-    are rewritten when the folder changes. Returns the text written."""
-    path = Path(path)
-    if payload is None:
-        if path.parent.resolve() != scene.base_dir.resolve():
-            scene = rebase_files(scene, path.parent)
-            text = loaded = None  # another folder: file names change, write it afresh
-        payload = scene_toml(scene, text=text, loaded=loaded)
-    atomic_write(path, lambda tmp: Path(tmp).write_text(payload, encoding="utf-8"))
-    return payload
+    return tomlkit.dumps(scene.model_dump(mode="json", exclude_none=True))  # every value

@@ -1,122 +1,83 @@
-"""Writing scene files (TOML or JSON, one schema), and the model and texture files a scene
-names, re-pointed when the scene is saved in another folder."""
+"""Writing scene files (TOML or JSON, one schema): the one writer of scene files, used by
+``whitted.save_scene``, ``Scene.save`` and the editor. A TOML file whose text is known is
+edited in place (:mod:`.toml_document`: only the changed values, comments kept); without it
+a compact, readable file is written. Relative model and texture file names are re-pointed
+once when the file goes to another folder (:mod:`.file_names`)."""
 
 from __future__ import annotations
 
+import errno
 import json
-import os
+from collections.abc import Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import tomli_w
-
-from ..errors import SceneError
+from ..errors import OutputError, SceneError
 from ..files import atomic_write
-from .animation import animation_toml
-from .materials import Material
-from .timeline import is_sequence, sequence_file
+from .file_names import named_files, rebase_files
 
 if TYPE_CHECKING:
     from .scene import Scene
-
-
-def named_files(scene: Scene) -> list[tuple[list[str | int], str]]:
-    """(key path, file name) of every model and texture file the scene names."""
-    named: list[tuple[list[str | int], str]] = []
-    for i, obj in enumerate(scene.objects):
-        if getattr(obj, "file", None):
-            named.append((["objects", i, "file"], obj.file))
-        mat = obj.material
-        if isinstance(mat, Material) and getattr(mat.texture, "file", None):
-            named.append((["objects", i, "material", "texture", "file"], mat.texture.file))
-    for key, mat in scene.materials.items():
-        if mat.texture is not None and getattr(mat.texture, "file", None):
-            named.append((["materials", key, "texture", "file"], mat.texture.file))
-
-    expanded: list[tuple[list[str | int], str]] = []
-    for keys, pattern in named:
-        if len(keys) == 3 and is_sequence(pattern):  # a mesh sequence: every frame's file
-            expanded.extend((keys, sequence_file(pattern, k)) for k in range(scene.frame_count))
-        else:
-            expanded.append((keys, pattern))
-    return expanded
 
 
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
     return scene.model_dump(mode="json", exclude_none=True)
 
 
-def _moved_name(name: str, old: Path, new: Path) -> str:
-    """File name ``name`` (relative to folder ``old``) as seen from folder ``new``: relative
-    while that stays close (at most two levels up), else absolute."""
-    p = Path(name).expanduser()
-    if p.is_absolute():
-        return name
-    target = (old / p).resolve()
-    try:
-        rel = Path(os.path.relpath(target, new))
-    except ValueError:  # another drive
-        return str(target)
-    if rel.parts[:3] == ("..", "..", ".."):
-        return str(target)
-    return rel.as_posix()
-
-
-def rebase_files(scene: Scene, folder: str | Path) -> Scene:
-    """A copy of ``scene`` whose relative model and texture file names point at the same
-    files from ``folder`` (and whose base folder is ``folder``): what saving elsewhere needs."""
-    old = scene.base_dir
-    folder = Path(folder).resolve()
-    if old.resolve() == folder:
-        return scene.with_base_dir(folder)
-
-    def moved(name: str) -> str:
-        return _moved_name(name, old, folder)
-
-    objects = []
-    for obj in scene.objects:
-        update: dict[str, Any] = {}
-        if getattr(obj, "file", None):
-            update["file"] = moved(obj.file)
-        mat = obj.material
-        if isinstance(mat, Material) and getattr(mat.texture, "file", None):
-            tex = mat.texture.model_copy(update={"file": moved(mat.texture.file)})
-            update["material"] = mat.model_copy(update={"texture": tex})
-        objects.append(obj.model_copy(update=update) if update else obj)
-    materials = {}
-    for key, mat in scene.materials.items():
-        if getattr(mat.texture, "file", None):
-            tex = mat.texture.model_copy(update={"file": moved(mat.texture.file)})
-            mat = mat.model_copy(update={"texture": tex})
-        materials[key] = mat
-    return scene.model_copy(update={"objects": objects, "materials": materials}).with_base_dir(
-        folder)
-
-
-def save_scene(scene: Scene, path: str | Path) -> Path:
-    """Write ``scene`` as TOML or JSON (by extension), atomically. Relative model and texture
-    file names are rewritten to stay valid from the new file's folder."""
-    path = Path(path)
-    if path.parent.resolve() != scene.base_dir.resolve():
-        scene = rebase_files(scene, path.parent)
+def _suffix(path: Path) -> str:
     suffix = path.suffix.lower()
-    data = scene_to_dict(scene)
-    if suffix == ".toml":
-        animation = data.pop("animation", None)
-        text = tomli_w.dumps(data)
-        if animation is not None:  # one key per line, not one number per line
+    if suffix not in (".toml", ".json"):
+        raise SceneError(f"unknown scene format {path.suffix!r} (use .toml or .json)",
+                         file=str(path))
+    return suffix
 
-            text += "\n" + animation_toml(animation)
-        payload = text.encode()
-    elif suffix == ".json":
-        payload = (json.dumps(data, indent=2) + "\n").encode()
-    else:
-        raise SceneError(
-            f"unknown scene format {path.suffix!r} (use .toml or .json)", file=str(path)
-        )
 
-    def write(tmp: str) -> None:
-        Path(tmp).write_bytes(payload)
+def for_folder(scene: Scene, path: str | Path) -> Scene:
+    """``scene`` as saved at ``path``: relative file names re-pointed from its folder."""
+    folder = Path(path).parent
+    if folder.resolve() != scene.base_dir.resolve():
+        return rebase_files(scene, folder)
+    return scene
 
-    atomic_write(path, write)
+
+def scene_text(scene: Scene, path: str | Path, *, text: str | None = None,
+               loaded: Scene | None = None,
+               history: Iterable[tuple[str, Scene]] = ()) -> str:
+    """What the file ``path`` holds once ``scene`` (already :func:`for_folder`) is saved
+    there: TOML (``text``, which loaded as ``loaded``, with only the edits written into it;
+    else compact) or JSON, by the file's extension."""
+    if _suffix(Path(path)) == ".json":
+        return json.dumps(scene_to_dict(scene), indent=2) + "\n"
+    from .toml_document import scene_toml
+
+    return scene_toml(scene, text=text, loaded=loaded, history=history)
+
+
+def write_scene_text(path: str | Path, payload: str) -> Path:
+    """Write ``payload`` to ``path`` atomically; OutputError with one line when the folder
+    cannot take it ("cannot write PATH: permission denied")."""
+    path = Path(path)
+    try:
+        atomic_write(path, lambda tmp: Path(tmp).write_text(payload, encoding="utf-8"))
+    except OSError as exc:
+        reason = (exc.strerror or errno.errorcode.get(exc.errno or 0, str(exc))).lower()
+        raise OutputError(f"cannot write {path}: {reason}") from None
     return path
+
+
+def save_scene(scene: Scene, path: str | Path, *, text: str | None = None,
+               loaded: Scene | None = None) -> Path:
+    """Write ``scene`` as TOML or JSON (by extension), atomically. Relative model and texture
+    file names are rewritten to stay valid from the new file's folder. ``text`` (a TOML
+    file's text in the same folder, which loaded as ``loaded``) is edited in place."""
+    path = Path(path)
+    _suffix(path)
+    if path.parent.resolve() != scene.base_dir.resolve():
+        text = loaded = None  # another folder: its file names change, written afresh
+    moved = for_folder(scene, path)
+    write_scene_text(path, scene_text(moved, path, text=text, loaded=loaded))
+    return path
+
+
+__all__ = ["for_folder", "named_files", "rebase_files", "save_scene", "scene_text",
+           "scene_to_dict", "write_scene_text"]

@@ -29,9 +29,6 @@ from __future__ import annotations
 
 import os
 
-from .._cache import configure_kernel_cache
-
-configure_kernel_cache()  # before numba reads its settings
 # Threads that wait at the end of a parallel loop sleep instead of spinning (OpenMP layer). A
 # step is three short parallel loops; on a machine shared with other work a spinning thread
 # keeps a core from the thread everyone waits for. Measured on the 2-core VM under load:
@@ -39,7 +36,11 @@ configure_kernel_cache()  # before numba reads its settings
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import numpy as np  # noqa: E402
-from numba import njit, prange  # noqa: E402
+
+from ..jit import builder, numba_object  # noqa: E402
+
+#: Numba's parallel range, in the kernels' globals once Numba is loaded (jit/decorators.py)
+prange = numba_object("numba", "prange")
 
 AIR = 0
 BODY = 1
@@ -50,7 +51,7 @@ P_CI, P_KI, P_CW, P_KW, P_HL = 0, 1, 2, 3, 4
 TINY = 1e-300  # keeps 0/0 out of the harmonic mean of two zero conductivities
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@builder(entry=False, error_model="numpy", numba_inline=True)
 def _temperature(h, p):
     if h < 0.0:
         return h / p[P_CI]
@@ -59,7 +60,7 @@ def _temperature(h, p):
     return 0.0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@builder(entry=False, error_model="numpy", numba_inline=True)
 def _conductivity(h, p):
     if h <= 0.0:
         return p[P_KI]
@@ -68,12 +69,12 @@ def _conductivity(h, p):
     return p[P_KI] + h / p[P_HL] * (p[P_KW] - p[P_KI])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@builder(entry=False, error_model="numpy", numba_inline=True)
 def _face(kc, kn, tn, tc):
     return 2.0 * kc * kn / (kc + kn + TINY) * (tn - tc)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@builder(entry=False, error_model="numpy", numba_inline=True)
 def _state(h, p):
     """Temperature and conductivity of a body cell of enthalpy ``h``: ``_temperature`` and
     ``_conductivity`` with every branch computed and selected (the same operations, so the
@@ -87,7 +88,7 @@ def _state(h, p):
     return t, k
 
 
-@njit(cache=True, error_model="numpy")
+@builder(entry=False, error_model="numpy")
 def _state_plane(H, kind, p, i, T, K):
     """Temperature and conductivity of the cells of plane i, ghosts included (air and ghost
     cells 0): computed from H as a step needs them, never stored for the grid."""
@@ -103,7 +104,7 @@ def _state_plane(H, kind, p, i, T, K):
             kk[k] = kv if body else 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@builder(entry=False, error_model="numpy")
 def _faces_x(Ka, Ta, Kb, Tb, fx):
     """``fx[j, k]``: the flux term of the face between cell (j, k) of plane a and of the next
     plane b, as the cell in plane a computes it (``_face``); the cell in plane b adds its
@@ -119,7 +120,7 @@ def _faces_x(Ka, Ta, Kb, Tb, fx):
             f[k] = _face(ka[k], kb[k], tb[k], ta[k])
 
 
-@njit(cache=True, error_model="numpy")
+@builder(entry=False, error_model="numpy")
 def _conduct_slab(H, kind, Hn, p, g, i0, i1, TA, KA, TB, KB, fxa, fxb, fya, fyb, fz):
     """Hn = H + dt/dx² * sum over the six faces of k_face (T_nb - T) (harmonic-mean face
     conductivity; air and ghost neighbours, k = 0, add exactly zero) for the planes
@@ -168,7 +169,7 @@ def _conduct_slab(H, kind, Hn, p, g, i0, i1, TA, KA, TB, KB, fxa, fxb, fya, fyb,
         fxa, fxb = fxb, fxa
 
 
-@njit(cache=True)
+@builder(entry=False)
 def _slab_buffers(H, slabs):
     """Scratch of each slab, allocated once per call (not per step): two planes of T and k and
     two planes of x faces (``planes[c, 0:6]``), three rows (``rows[c, 0:3]``), and 27
@@ -178,7 +179,7 @@ def _slab_buffers(H, slabs):
     return np.empty((slabs, 6, ny, nz)), np.empty((slabs, 3, nz)), np.empty((slabs, 27))
 
 
-@njit(cache=True, inline="always")
+@builder(entry=False, numba_inline=True)
 def _occupancy(H, kind, i, j, k, hl):
     """1 for a body cell (its ice fraction while it melts), 0 for air; a ghost cell mirrors
     the cell inside (an adiabatic wall or the table adds no slope)."""
@@ -194,7 +195,7 @@ def _occupancy(H, kind, i, j, k, hl):
     return 1.0 - h / hl
 
 
-@njit(cache=True, inline="always")
+@builder(entry=False, numba_inline=True)
 def _surface_scale(H, kind, i, j, k, hl, occ):
     """|n|_2 / |n|_1 of the occupancy gradient (3x3x3, Sobel weights) at a surface cell; 1
     where it vanishes. ``occ`` (27 values) is scratch: each neighbour's occupancy is
@@ -220,13 +221,13 @@ def _surface_scale(H, kind, i, j, k, hl, occ):
     return np.sqrt(gx * gx + gy * gy + gz * gz) / l1
 
 
-@njit(cache=True)
+@builder
 def surface_scale(H, kind, i, j, k, hl):
     """``_surface_scale`` with its own scratch."""
     return _surface_scale(H, kind, i, j, k, hl, np.empty(27))
 
 
-@njit(cache=True, inline="always")
+@builder(entry=False, numba_inline=True)
 def _boundary_flux(h_coef, inv_h, t_far, drain, tc, kc, hc, dx):
     """Heat flux density (W/m²) into a cell through a face to the outside at ``t_far``:
     series resistance of the film (1/h) and the half cell (dx / 2k). A draining (air) face
@@ -242,7 +243,7 @@ def _boundary_flux(h_coef, inv_h, t_far, drain, tc, kc, hc, dx):
     return (t_far - tc) / r
 
 
-@njit(cache=True, inline="always")
+@builder(entry=False, numba_inline=True)
 def _neighbour(i, j, k, face):
     if face == 0:
         return i - 1, j, k
@@ -257,7 +258,7 @@ def _neighbour(i, j, k, face):
     return i, j, k + 1
 
 
-@njit(cache=True, inline="always")
+@builder(entry=False, numba_inline=True)
 def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain, air_h,
                   air_inv_h, air_t, i, j, k, scale, out, m, rescale, occ, is_surface):
     """The boundary heat of one surface cell, added to Hn; drain if it is all liquid and a
@@ -310,7 +311,7 @@ def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain
                 out[m, 2] += 1.0
 
 
-@njit(cache=True)
+@builder(entry=False)
 def _inverse(h):
     """1 / h, 0 where h is 0 or infinite (those faces never use it)."""
     if h > 0.0 and h != np.inf:
@@ -318,7 +319,7 @@ def _inverse(h):
     return 0.0
 
 
-@njit(cache=True)
+@builder(entry=False)
 def _apply_drains(Hn, kind, surface, scale, out, n_surface, is_surface):
     """Drained cells become air; their body neighbours join the surface list. Serial, in list
     order (deterministic). Returns the new list length."""
@@ -343,7 +344,7 @@ def _apply_drains(Hn, kind, surface, scale, out, n_surface, is_surface):
     return n
 
 
-@njit(cache=True)
+@builder
 def find_surface(kind, face_h, air_h, surface, is_surface):
     """Fill the surface list: body cells with a face to air (its direction's air_h > 0) or to a grid
     face with h > 0. Returns its length."""
@@ -370,7 +371,7 @@ def find_surface(kind, face_h, air_h, surface, is_surface):
     return n
 
 
-@njit(cache=True)
+@builder(entry=False)
 def _index_surface(surface, ns, plane_start, plane_cells):
     """The surface list by grid plane (a counting sort, list order within a plane): plane i
     holds ``plane_cells[plane_start[i - 1]:plane_start[i]]``."""
@@ -386,7 +387,7 @@ def _index_surface(surface, ns, plane_start, plane_cells):
         fill[q] += 1
 
 
-@njit(cache=True, parallel=True)
+@builder(parallel=True)
 def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
                        air_t, surface, scale, n_surface, is_surface, n_steps, totals,
                        stop_on_breach, rescale_every, first_step, slabs):
@@ -450,7 +451,7 @@ def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h
     return done
 
 
-@njit(cache=True)
+@builder
 def run_steps_serial(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
                      air_t, surface, scale, n_surface, is_surface, n_steps, totals,
                      stop_on_breach, rescale_every, first_step):
@@ -503,7 +504,7 @@ def run_steps_serial(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
     return done
 
 
-@njit(cache=True, parallel=True)
+@builder(parallel=True)
 def total_enthalpy(H, kind):
     """Sum of H over body cells (J/m³ times cells), in a fixed order."""
     nx, ny, nz = H.shape

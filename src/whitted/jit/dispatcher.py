@@ -2,7 +2,7 @@
 it was verified with. The one module of whitted that uses names Numba does not document.
 
 :func:`make_dispatcher` gives ``numba.njit`` with the kernel's documented options (see
-kernels/jit.py) unless :func:`tuned` holds: Numba and llvmlite within :data:`VERIFIED`, every
+jit/decorators.py) unless :func:`tuned` holds: Numba and llvmlite within :data:`VERIFIED`, every
 name in :data:`PRIVATE_NAMES` importable, and ``WHITTED_NUMBA_TUNING`` not ``0``. The tuned
 dispatcher cuts the cold compile and the render time; kernels compute the same either way
 (the tests run both). docs/performance.md has the measurements.
@@ -25,11 +25,9 @@ What the tuned dispatcher does:
 - **LLVM inlining** (``forceinline``) for ``inline="always"``, set to False on every other
   kernel (Numba passes it on to callees that do not set it, so inlining would depend on
   compile order).
-- **One writability check per folder** (:class:`KernelCacheLocator`): Numba checks the cache
-  folder (a temporary file) and hashes the source file for each of some 230 dispatchers.
-- **A read-only warm folder** (whitted/_cache.py, ``KernelCache.read_only``): the locator
-  takes it without the writability check (Numba's would refuse it, and every other place),
-  and a failed save there is no error: the kernel is compiled in memory, said once.
+- **A read-only warm folder** (jit/cache.py, ``KernelCache.read_only``): a failed save there
+  is no error: the kernel is compiled in memory, said once (jit/locator.py, public API, takes
+  the folder without Numba's writability check, and checks a writable one once a process).
 - **Loading without refreshing the compiler's registries**: before it looks in the cache,
   Numba's ``FunctionCache.load_overload`` installs every implementation registry, and the
   NumPy one probes for a BLAS by importing ``scipy.linalg`` (0.25-0.35 s of a warm render's
@@ -47,6 +45,8 @@ import os
 import threading
 import types as pytypes
 
+from .cache import read_only
+
 #: (package, oldest version, first version not verified): the tuned dispatcher runs only here
 VERIFIED = {"numba": ((0, 68), (0, 69)), "llvmlite": ((0, 50), (0, 51))}
 
@@ -60,9 +60,6 @@ PRIVATE_NAMES = (
     "numba.core.caching.FunctionCache (subclassed): load_overload, _load_overload, "
     "_guard_against_spurious_io_errors (overridden), _cache_path, _py_func, _impl_class",
     "numba.core.runtime.rtsys.initialize",
-    "numba.core.caching.CompileResultCacheImpl (subclassed): _locator_classes",
-    "numba.core.caching.UserProvidedCacheLocator (subclassed): ensure_cache_path, "
-    "get_cache_path, get_source_stamp, _py_file",
     "target options _nrt, no_cpython_wrapper, no_cfunc_wrapper, forceinline",
     "numba.np.arrayobj.make_array, populate_array (frame_view: an array over stack slots "
     "without the runtime, which numba.carray needs)",
@@ -120,11 +117,7 @@ def widen_integer(ty):
 
 
 def _make_classes():
-    from numba.core.caching import (
-        CompileResultCacheImpl,
-        FunctionCache,
-        UserProvidedCacheLocator,
-    )
+    from numba.core.caching import FunctionCache
     from numba.core.registry import CPUDispatcher
     from numba.core.runtime import rtsys
 
@@ -132,39 +125,9 @@ def _make_classes():
                                           "enable_caching")),
                          (FunctionCache, ("load_overload", "_load_overload",
                                           "_guard_against_spurious_io_errors")),
-                         (CompileResultCacheImpl, ("_locator_classes",)),
-                         (rtsys, ("initialize",)),
-                         (UserProvidedCacheLocator, ("ensure_cache_path", "get_cache_path",
-                                                     "get_source_stamp"))):
+                         (rtsys, ("initialize",))):
         for name in names:
             getattr(owner, name)  # AttributeError: not the Numba this was verified with
-
-    class KernelCacheLocator(UserProvidedCacheLocator):
-        """Numba's locator of the cache folder (``NUMBA_CACHE_DIR``), checking that the
-        folder can be written once per process, not per dispatcher, and hashing a source
-        file once per state of it (the key holds its modification time and size, as
-        Numba's does)."""
-
-        _writable: set[str] = set()
-        _stamps: dict[tuple, bytes] = {}
-
-        def ensure_cache_path(self):
-            path = self.get_cache_path()
-            if path not in self._writable:
-                if not _read_only(path):  # a read-only warm folder: loaded from only
-                    super().ensure_cache_path()  # OSError when the folder is not usable
-                self._writable.add(path)
-
-        def get_source_stamp(self):
-            st = os.stat(self._py_file)
-            key = (self._py_file, st.st_mtime_ns, st.st_size)
-            stamp = self._stamps.get(key)
-            if stamp is None:
-                stamp = self._stamps[key] = super().get_source_stamp()
-            return stamp
-
-    class KernelCacheImpl(CompileResultCacheImpl):
-        _locator_classes = [KernelCacheLocator, *CompileResultCacheImpl._locator_classes]
 
     class KernelCache(FunctionCache):
         """Numba's on-disk cache of one kernel, waiting for the compile helper when it is
@@ -174,20 +137,19 @@ def _make_classes():
         #: kernel's qualified name when it is not in the cache, it waits while the helper
         #: compiles that kernel and says whether it did (then it loads instead)
         wait_for_helper = None
-        _impl_class = KernelCacheImpl
 
         @contextlib.contextmanager
         def _guard_against_spurious_io_errors(self):
             """Numba's guard; in a read-only folder, a file that cannot be written or read
             is a kernel compiled in memory (said once), not an error."""
-            if not _read_only(self._cache_path):
+            if not read_only(self._cache_path):
                 with super()._guard_against_spurious_io_errors():
                     yield
                 return
             try:
                 yield
             except OSError:
-                from .._cache import read_only_miss
+                from .cache import read_only_miss
 
                 read_only_miss()
 
@@ -244,14 +206,6 @@ def _make_classes():
 _twin_lock = threading.Lock()
 
 
-def _read_only(path: str) -> bool:
-    """Whether ``path`` is in the kernel cache folder this process uses read-only."""
-    from .._cache import _state
-
-    return (_state is not None and _state.read_only and _state.folder is not None
-            and os.path.abspath(path).startswith(os.path.abspath(_state.folder)))
-
-
 def kernel_cache_class():
     """The tuned dispatcher's cache class (for the compile helper's wait), or None."""
     return _classes[1] if tuned() else None
@@ -270,7 +224,7 @@ def _twin_function(f):
 
 
 def make_dispatcher(f, options: dict, specialise_constants: bool, cache: bool):
-    """The dispatcher of kernel ``f`` compiled with ``options`` (as kernels/jit.py resolved
+    """The dispatcher of kernel ``f`` compiled with ``options`` (as jit/decorators.py resolved
     them): tuned (with the maker of its twin), or ``numba.njit`` with the documented ones."""
     if not tuned():
         import numba

@@ -11,7 +11,7 @@ which a Kernel passes on to its dispatcher). So ``import whitted`` and the comma
 never render never import Numba.
 
 The dispatcher is Numba's own (``numba.njit`` with the options below), or, on the Numba
-versions kernels/dispatcher.py was verified with, that module's tuned one (integer widening,
+versions jit/dispatcher.py was verified with, that module's tuned one (integer widening,
 twins without Python wrappers, no runtime in render kernels): the one module that uses
 names Numba does not document. Options:
 
@@ -26,8 +26,8 @@ names Numba does not document. Options:
 - ``specialise_constants=True``: a variant per integer constant (what stock Numba always
   does; the tuned dispatcher otherwise compiles one int64 variant);
 - ``entry=True``: a kernel Python calls (its calls seal the cache files a compile wrote,
-  whitted/_cache.py);
-- ``cache`` (default True): kept in the kernel cache (whitted/_cache.py; in memory when no
+  jit/cache.py);
+- ``cache`` (default True): kept in the kernel cache (jit/cache.py; in memory when no
   folder can be used).
 
 When Numba comes in (:func:`load_numba`) the kernel cache is prepared and checked, the
@@ -71,7 +71,7 @@ def _jit_disabled() -> bool:
 
 
 def load_numba() -> None:
-    """Prepare and check the kernel cache (whitted/_cache.py), import Numba with whitted's
+    """Prepare and check the kernel cache (jit/cache.py), import Numba with whitted's
     settings, register the deferred extensions, and put dispatchers where kernels will look
     for them (module docstring). Does nothing the second time."""
     global _numba_loaded, _numba_imported
@@ -80,7 +80,7 @@ def load_numba() -> None:
     with _lock:  # another thread waits here until the swap is done
         if _numba_loaded or _numba_imported:  # done, or this thread is swapping (re-entry)
             return
-        from .._cache import prepare
+        from .cache import prepare
 
         prepare()  # NUMBA_CACHE_DIR set, the files checked, before Numba reads any
         if "NUMBA_SLP_VECTORIZE" not in os.environ:
@@ -110,7 +110,7 @@ def _compile_listener():
     returns (Kernel.__call__)."""
     from numba.core import event
 
-    from .._cache import prepare
+    from .cache import prepare
 
     class CompileSeen(event.Listener):
         def on_start(self, ev) -> None:
@@ -123,8 +123,8 @@ def _compile_listener():
 
 
 def seal_cache() -> None:
-    """Enter the cache files compiles wrote in the list of checksums (whitted/_cache.py)."""
-    from .._cache import prepare
+    """Enter the cache files compiles wrote in the list of checksums (jit/cache.py)."""
+    from .cache import prepare
 
     state = prepare()
     if state.unsealed:
@@ -147,7 +147,7 @@ def _swap_in_globals() -> None:
 
 class Kernel:
     """A kernel: its Python function (``py_func``), the Numba options it is compiled with,
-    and, made when first needed, its Numba dispatcher (kernels/dispatcher.py)."""
+    and, made when first needed, its Numba dispatcher (jit/dispatcher.py)."""
 
     _dispatcher = None
     entry = False
@@ -169,13 +169,13 @@ class Kernel:
             load_numba()
             with _lock:
                 if self._dispatcher is None:
-                    from .._cache import prepare
+                    from .cache import prepare
                     from .dispatcher import make_dispatcher
 
                     state = prepare()
                     cache = self.cache and state.folder is not None
                     if cache and state.read_only:
-                        from .._cache import read_only_miss
+                        from .cache import read_only_miss
                         from .dispatcher import tuned
 
                         if not tuned():  # stock Numba cannot load from a folder it
@@ -189,7 +189,7 @@ class Kernel:
     def __call__(self, *args, **kwargs):
         result = self.dispatcher(*args, **kwargs)
         if self.entry:
-            from .._cache import _state
+            from .cache import _state
 
             if _state is not None and _state.unsealed:
                 _state.seal()
@@ -235,10 +235,8 @@ class NumbaObject:
 
 
 def numba_object(module: str, name: str):
-    """``name`` of ``module`` (relative to whitted.kernels when it starts with a dot), for a
-    kernel to use: imported when Numba is (at once when it is already)."""
-    if module.startswith("."):
-        module = __package__ + module
+    """``name`` of ``module`` (a full module name), for a kernel to use: imported when Numba
+    is (at once when it is already)."""
     made = NumbaObject(module, name)
     return made.resolve() if _numba_loaded else made
 

@@ -16,7 +16,7 @@ and owned by another user; a shared read-only mount) is used as it is, for loadi
 (:attr:`KernelCache.read_only`), without a word, when it holds whitted's list of sums and
 every file in it matches the list (nothing could be deleted or sealed there). Nothing is
 written to it: no lock, no seal, no marker, no compile helper. A kernel it lacks is compiled
-in memory, with one ``warning:`` line (:func:`read_only_miss`, from kernels/dispatcher.py);
+in memory, with one ``warning:`` line (:func:`read_only_miss`, from jit/dispatcher.py);
 with stock Numba (no tuned dispatcher, which can load from a folder it cannot write) every
 kernel is, with that same one line. A read-only folder that fails its check is one that
 cannot be used (above).
@@ -61,10 +61,12 @@ import os
 import sys
 import tempfile
 import threading
-import time
 from pathlib import Path
 
+#: the sources that decide the kernels' machine code: every file of these packages, and the
+#: two modules of this one that choose how kernels are compiled
 KERNEL_DIRS = ("kernels", "compile", "assets")
+KERNEL_FILES = ("jit/decorators.py", "jit/dispatcher.py")
 #: the list of sums in the cache folder
 SUMS = "whitted-sums.json"
 LOCK = "whitted.lock"
@@ -79,12 +81,12 @@ LOCK_WAIT_SECONDS = 900.0  # a process holding the lock longer than this is not 
 
 
 def kernel_source_hash() -> str:
-    root = Path(__file__).parent
+    root = Path(__file__).parents[1]
     h = hashlib.sha256()
-    for folder in KERNEL_DIRS:
-        for path in sorted((root / folder).glob("*.py")):
-            h.update(path.name.encode())
-            h.update(path.read_bytes())
+    paths = [path for folder in KERNEL_DIRS for path in sorted((root / folder).glob("*.py"))]
+    for path in paths + [root / name for name in KERNEL_FILES]:
+        h.update(path.relative_to(root).as_posix().encode())
+        h.update(path.read_bytes())
     return h.hexdigest()[:16]
 
 
@@ -93,16 +95,33 @@ def _user_base() -> str:
                         "whitted")
 
 
+def toolchain() -> str:
+    """The Numba and llvmlite versions that compile the kernels (imports Numba, through
+    lean_numba.py's hook)."""
+    import llvmlite
+    import numba
+
+    return f"numba{numba.__version__}-llvmlite{llvmlite.__version__}"
+
+
 def _folder_name() -> str:
-    # stock Numba's code (WHITTED_NUMBA_TUNING=0, kernels/dispatcher.py) is kept apart from
+    # stock Numba's code (WHITTED_NUMBA_TUNING=0, jit/dispatcher.py) is kept apart from
     # the tuned dispatcher's: the same kernel and types, compiled with other options
     stock = "-stock" if os.environ.get("WHITTED_NUMBA_TUNING", "1") == "0" else ""
-    return f"numba-{kernel_source_hash()}{stock}"
+    return f"numba-{kernel_source_hash()}-{toolchain()}{stock}"
+
+
+def cache_root() -> Path:
+    """The per-user folder of whitted's caches (``$WHITTED_CACHE_DIR``, default
+    ``~/.cache/whitted``): the same for a checkout, an editable and a wheel install."""
+    return Path(os.environ.get("WHITTED_CACHE_DIR") or _user_base())
 
 
 def cache_dir() -> Path:
-    base = os.environ.get("WHITTED_CACHE_DIR") or _user_base()
-    return Path(base) / _folder_name()
+    """The kernel cache folder: named after what decides the machine code (every kernel
+    source, the Numba and llvmlite versions; the CPU is in Numba's index), never after
+    where whitted is installed."""
+    return cache_root() / _folder_name()
 
 
 def _warn(message: str) -> None:
@@ -121,6 +140,26 @@ def _usable(folder: str) -> str | None:
     return None
 
 
+def _file_lock(path: str, timeout: float = -1):
+    """A lock on the file ``path`` (filelock: ``flock`` on Unix, ``msvcrt`` on Windows), held
+    by one process at a time and released when its process ends however it ends. Without a
+    lock-file fallback: a file system without locks means no lock (a leftover lock file of a
+    killed process would stop every later one)."""
+    from filelock import FileLock
+
+    try:
+        return FileLock(path, timeout=timeout, mode=0o666, thread_local=False,
+                        fallback_to_soft=False)
+    except TypeError:  # a filelock without soft locks, so without the fallback
+        return FileLock(path, timeout=timeout, mode=0o666, thread_local=False)
+
+
+def _marker_lock(path: str):
+    """The lock on a ``whitted-compiling-<pid>`` marker: held by its process while it
+    compiles; another process that can take it knows the owner has ended."""
+    return _file_lock(path)
+
+
 class KernelCache:
     """The kernel cache folder this process uses (``folder``; None: compiling in memory)."""
 
@@ -134,10 +173,10 @@ class KernelCache:
         self.missed = False  # a kernel it lacked was compiled in memory (and said so)
         self._seen: dict[str, tuple[int, int, int]] = {}  # file -> (inode, size, mtime)
         self._lock = threading.RLock()
-        self._lock_fd: int | None = None
+        self._file_lock = None  # the folder's lock file, held (filelock.FileLock)
         self._lock_depth = 0
         self.unsealed = False  # Numba compiled something since the last seal
-        self._compiling_fd: int | None = None  # held while this process has unsealed files
+        self._compiling_lock = None  # held while this process has unsealed files
 
     # ---------------------------------------------------------------- lock
     @contextlib.contextmanager
@@ -159,85 +198,66 @@ class KernelCache:
                     self._release()
 
     def _acquire(self) -> None:
-        import fcntl
+        from filelock import Timeout
 
+        lock = _file_lock(os.path.join(self.folder, LOCK), LOCK_WAIT_SECONDS)
         try:
-            fd = os.open(os.path.join(self.folder, LOCK), os.O_RDWR | os.O_CREAT, 0o666)
-        except OSError:
-            return
-        deadline = time.monotonic() + LOCK_WAIT_SECONDS
-        while True:
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-                break
-            except BlockingIOError:
-                if time.monotonic() > deadline:
-                    break  # a process holding it this long is not waited for
-                time.sleep(0.05)
-            except OSError:  # a file system without locks
-                break
-        self._lock_fd = fd
+            lock.acquire(poll_interval=0.05)
+        except Timeout:
+            return  # a process holding it this long is not waited for
+        except (OSError, NotImplementedError):
+            return  # it cannot be made, or a file system without locks
+        self._file_lock = lock
 
     def _release(self) -> None:
-        fd, self._lock_fd = self._lock_fd, None
-        if fd is not None:
-            os.close(fd)  # releases the lock
+        lock, self._file_lock = self._file_lock, None
+        if lock is not None:
+            lock.release()
 
     # ---------------------------------------------------------------- compiling marker
     def compiling(self) -> None:
         """Numba is compiling here: until the next :meth:`seal`, this process may leave
         cache files the list does not name yet, and says so to other processes with a marker
-        file it holds a shared lock on (``whitted-compiling-<pid>``; a process that ended
-        holds nothing, whatever its marker says)."""
+        file it holds a lock on (``whitted-compiling-<pid>``; a process that ended holds
+        nothing, whatever its marker says)."""
         if self.folder is None or self.helper or self.read_only \
-                or self._compiling_fd is not None:
+                or self._compiling_lock is not None:
             return
-        import fcntl
-
+        lock = _marker_lock(os.path.join(self.folder, f"{COMPILING}{os.getpid()}"))
         try:
-            fd = os.open(os.path.join(self.folder, f"{COMPILING}{os.getpid()}"),
-                         os.O_RDWR | os.O_CREAT, 0o666)
-        except OSError:
+            lock.acquire(timeout=0)
+        except Exception:  # noqa: BLE001 - cannot be made or locked: no marker, as before
             return
-        try:
-            fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
-            return
-        self._compiling_fd = fd
+        self._compiling_lock = lock
 
     def _done_compiling(self) -> None:
-        if self._compiling_fd is None:
+        if self._compiling_lock is None:
             return
         with contextlib.suppress(OSError):
             os.unlink(os.path.join(self.folder, f"{COMPILING}{os.getpid()}"))
-        os.close(self._compiling_fd)  # releases its lock
-        self._compiling_fd = None
+        self._compiling_lock.release()
+        self._compiling_lock = None
 
     def others_compiling(self) -> bool:
         """Whether another live process is compiling into this folder now (its new files
         are not sealed yet). Markers of processes that ended are deleted."""
-        import fcntl
+        from filelock import Timeout
 
         busy = False
         for marker in Path(self.folder).glob(f"{COMPILING}*"):
             if marker.name == f"{COMPILING}{os.getpid()}":
                 continue
+            lock = _marker_lock(str(marker))
             try:
-                fd = os.open(marker, os.O_RDWR)
-            except OSError:
-                continue
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
+                lock.acquire(timeout=0)
+            except Timeout:
                 busy = True
-            except OSError:
+            except (OSError, NotImplementedError):
                 pass
             else:
                 with contextlib.suppress(OSError):
                     marker.unlink()
-            finally:
-                os.close(fd)
+                lock.release()
         return busy
 
     # ---------------------------------------------------------------- sums
@@ -398,12 +418,37 @@ _state: KernelCache | None = None
 _state_lock = threading.Lock()
 
 
+#: jit/locator.py's locator, as Numba's NUMBA_CACHE_LOCATOR_CLASSES names it
+LOCATOR = "whitted.jit.locator.KernelLocator"
+#: Numba's own locators, in Numba's order (after whitted's)
+NUMBA_LOCATORS = ("UserProvidedCacheLocator", "InTreeCacheLocator", "UserWideCacheLocator",
+                  "IPythonCacheLocator", "ZipCacheLocator")
+
+
+def locator_setting(current: str) -> str:
+    """The value of ``NUMBA_CACHE_LOCATOR_CLASSES`` with whitted's locator first: before the
+    user's own list when there is one, else before Numba's default order."""
+    names = [n.strip() for n in current.split(",") if n.strip()] or list(NUMBA_LOCATORS)
+    return ",".join([LOCATOR] + [n for n in names if n != LOCATOR])
+
+
+def read_only(path: str) -> bool:
+    """Whether ``path`` is in the kernel cache folder this process uses read-only."""
+    state = _state
+    return (state is not None and state.read_only and state.folder is not None
+            and os.path.abspath(path).startswith(os.path.abspath(state.folder)))
+
+
 def _set_numba_cache_dir(folder: str) -> None:
     os.environ["NUMBA_CACHE_DIR"] = folder
+    # whitted's functions filed by their folder inside whitted, not by the install path
+    locators = locator_setting(os.environ.get("NUMBA_CACHE_LOCATOR_CLASSES", ""))
+    os.environ["NUMBA_CACHE_LOCATOR_CLASSES"] = locators
     if "numba" in sys.modules:  # numba already read its settings: tell it directly
         import numba
 
         numba.config.CACHE_DIR = folder
+        numba.config.CACHE_LOCATOR_CLASSES = locators
 
 
 def prepare() -> KernelCache:
