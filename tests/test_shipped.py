@@ -135,3 +135,10 @@ def test_the_core_needs_no_extra(tmp_path):
         done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True,
                               text=True, timeout=300)
         assert done.returncode == 0, (args, done.stderr)
+
+
+def test_whitted_examples_takes_o_as_well(tmp_path):
+    done = run("examples", "-o", "ex", cwd=tmp_path)
+    assert done.returncode == 0 and (tmp_path / "ex/glass_cube.toml").is_file()
+    done = run("examples", "a", "-o", "b", cwd=tmp_path)
+    assert done.returncode == 2 and done.stderr.count("\n") == 1

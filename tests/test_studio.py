@@ -225,3 +225,28 @@ def test_turntable_film_from_the_command_line(tmp_path):
     assert len(frames) == 4
     a, b = (np.asarray(Image.open(f), float) for f in frames[:2])
     assert np.abs(a - b).mean() > 1  # the view turned
+
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+coordinate = st.floats(-1e6, 1e6, allow_nan=False)
+
+
+@settings(max_examples=60, deadline=None)
+@given(points=st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=1, max_size=12),
+       azimuth=st.floats(-720, 720), elevation=st.floats(-89, 89),
+       margin=st.floats(0, 0.85), aspect=st.sampled_from([(64, 48), (48, 64), (100, 10)]))
+def test_framing_fuzz_every_point_inside(points, azimuth, elevation, margin, aspect):
+    """Any cloud of points (one point, a line, a plane, 1e6 apart), any view: every point in
+    front of the camera and inside the picture with the margin."""
+    from whitted.studio.framing import camera_for
+
+    pts = np.array(points, float)
+    width, height = aspect
+    camera = camera_for(pts, whitted.Camera(), width, height, azimuth, elevation, margin)
+    scene = whitted.Scene(render=whitted.RenderSettings(width=width, height=height),
+                          camera=camera)
+    xy = project(scene, pts)
+    assert np.all(np.isfinite(xy))
+    assert np.max(np.abs(xy)) <= 1 - margin + 1e-6

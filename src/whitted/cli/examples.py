@@ -18,11 +18,16 @@ from .console import out
 def examples(
     folder: Annotated[Path | None, typer.Argument(
         metavar="[DIR]", help="Folder to copy the examples into (made if missing)")] = None,
+    output: Annotated[Path | None, typer.Option(
+        "-o", "--output", help="The same as DIR")] = None,
 ) -> None:
     """List the example scenes (render one by name: whitted render glass_cube), or copy them
     with their models and textures into DIR; files already in DIR are kept as they are."""
     from ..files.shipped import copy_examples, example_names, shipped_dir
 
+    if folder is not None and output is not None and folder != output:
+        raise fail(f"give the folder once: DIR ({folder}) or -o ({output})")
+    folder = folder or output
     if folder is None:
         names = example_names()
         if not names:

@@ -109,24 +109,27 @@ def camera_for(points: np.ndarray, camera: Camera, width: int, height: int,
         data.update(look_at=tuple(aim), position=tuple(aim + back * 4 * radius))
         return Camera.model_validate(data)
     tx, ty = Camera.model_validate(data).half_extents(width, height)
+    # no nearer than a millionth of the coordinates' size (a lone point: the camera stays
+    # far enough from it for the ray offsets)
+    floor = 1e-6 * max(1.0, float(np.max(np.abs(pts))))
     aim = centre
     for _ in range(6):  # aim at the middle of the picture the points make, then come near
-        distance, u, v = _fit(pts - aim, right, upward, back, tx, ty, margin)
+        distance, u, v = _fit(pts - aim, right, upward, back, tx, ty, margin, floor)
         aim = aim + (right * (u.max() + u.min()) * tx + upward * (v.max() + v.min()) * ty) \
             * distance / 2
-    distance, _, _ = _fit(pts - aim, right, upward, back, tx, ty, margin)
+    distance, _, _ = _fit(pts - aim, right, upward, back, tx, ty, margin, floor)
     data.update(look_at=tuple(aim), position=tuple(aim + back * distance))
     return Camera.model_validate(data)
 
 
-def _fit(rel, right, upward, back, tx, ty, margin):
+def _fit(rel, right, upward, back, tx, ty, margin, floor):
     """The nearest distance from the aim point at which every point is inside the picture
     with the margin, and the points' places in it (fractions of the half width, height)."""
     x, y, z = rel @ right, rel @ upward, rel @ back  # z: towards the camera
     # a point at depth d - z from the camera is inside when |x| <= tx (1 - margin) (d - z)
     need = np.maximum(np.abs(x) / (tx * (1 - margin)), np.abs(y) / (ty * (1 - margin))) + z
     radius = float(np.max(np.linalg.norm(rel, axis=1)))
-    distance = max(float(np.max(need)), 1.05 * radius, 1e-9)
+    distance = max(float(np.max(need)), 1.05 * radius, floor)
     depth = distance - z
     return distance, x / depth / tx, y / depth / ty
 
