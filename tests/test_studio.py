@@ -250,3 +250,31 @@ def test_framing_fuzz_every_point_inside(points, azimuth, elevation, margin, asp
     xy = project(scene, pts)
     assert np.all(np.isfinite(xy))
     assert np.max(np.abs(xy)) <= 1 - margin + 1e-6
+
+
+@pytest.mark.parametrize("suffix", [".ply", ".stl", ".off", ".glb", ".gltf"])
+def test_every_model_format_gets_its_quick_look(tmp_path, suffix):
+    """An icosphere written by trimesh in each format, framed in the picture; glTF's red
+    material kept, the others (no material in the file) in clay."""
+    import trimesh
+
+    from whitted.studio.model import CLAY
+
+    mesh = trimesh.creation.icosphere(subdivisions=2, radius=2.0)
+    mesh.apply_translation([5.0, 3.0, -1.0])
+    if suffix in (".glb", ".gltf"):
+        mesh.visual = trimesh.visual.TextureVisuals(
+            material=trimesh.visual.material.PBRMaterial(baseColorFactor=[230, 30, 30, 255]))
+    path = tmp_path / f"ball{suffix}"
+    mesh.export(path)
+    scene = whitted.model_scene(path, width=W, height=H)
+    ids = whitted.render_aovs(scene)["id"]
+    ys, xs = np.nonzero(ids == 0)
+    assert len(xs) > 0.1 * W * H
+    assert xs.min() >= 2 and xs.max() <= W - 3 and ys.min() >= 2 and ys.max() <= H - 3
+    assert scene.objects[1].point[1] == pytest.approx(1.0, abs=1e-3)  # ground under the ball
+    if suffix in (".glb", ".gltf"):
+        rgb = whitted.render(scene).pixels[ids == 0].mean(axis=0)
+        assert rgb[0] > 2 * rgb[1], rgb
+    else:
+        assert scene.objects[0].material == CLAY
