@@ -278,3 +278,18 @@ def test_every_model_format_gets_its_quick_look(tmp_path, suffix):
         assert rgb[0] > 2 * rgb[1], rgb
     else:
         assert scene.objects[0].material == CLAY
+
+
+def test_a_turntable_keeps_a_long_model_in_frame_from_every_side(tmp_path):
+    """A bar eight times longer than wide: framed for the turntable, every frame holds it."""
+    bar = "\n".join(f"v {x} {y} {z}" for x in (-4, 4) for y in (0, 1) for z in (-0.5, 0.5))
+    faces = "f 1 2 4 3\nf 5 7 8 6\nf 1 5 6 2\nf 3 4 8 7\nf 1 3 7 5\nf 2 6 8 4\n"
+    scene = whitted.model_scene(write(tmp_path, "bar.obj", bar + "\n" + faces), width=W,
+                                height=H, all_around=True)
+    film = whitted.turntable(scene, 12)
+    pts = world_points(scene.objects[0], scene)
+    for k in range(12):
+        xy = project(film.at_frame(k), pts)
+        assert np.max(np.abs(xy)) <= 1 - MARGIN + 1e-9, k
+    look = np.asarray(scene.camera.look_at)
+    assert look[0] == pytest.approx(0) and look[2] == pytest.approx(0)  # on the bar's axis

@@ -101,7 +101,8 @@ def load_scene_argument(scene_path: Path | None, *, width: int | None = None,
         if len(size) == 1:  # keep the default picture's shape
             size.setdefault("width", max(1, round(size["height"] * 4 / 3)))
             size.setdefault("height", max(1, round(size["width"] * 3 / 4)))
-        scene, name = model_scene(scene_path, **size), str(scene_path)
+        scene = model_scene(scene_path, **size, all_around=turntable is not None)
+        name = str(scene_path)
     else:
         example = None if _exists(scene_path) else example_path(str(scene_path))
         scene = load_scene(example or scene_path)

@@ -78,9 +78,11 @@ def _up_frame(up) -> np.ndarray:
 
 def camera_for(points: np.ndarray, camera: Camera, width: int, height: int,
                azimuth: float = AZIMUTH, elevation: float = ELEVATION,
-               margin: float = MARGIN, up=(0.0, 1.0, 0.0)) -> Camera:
+               margin: float = MARGIN, up=(0.0, 1.0, 0.0), all_around: bool = False) -> Camera:
     """``camera`` (its lens kept) moved to look at ``points`` from (azimuth, elevation), as
-    close as it can while every point lies inside the picture with ``margin`` free."""
+    close as it can while every point lies inside the picture with ``margin`` free. With
+    ``all_around`` (a turntable), it aims at the points' vertical axis and stays far enough
+    for them to be inside from every azimuth at that elevation."""
     if not 0.0 <= margin < 0.9:
         raise ArgumentError(f"framed: margin must be 0..0.9 of the picture, got {margin!r}")
     if not (math.isfinite(azimuth) and math.isfinite(elevation)) or abs(elevation) >= 90:
@@ -112,6 +114,11 @@ def camera_for(points: np.ndarray, camera: Camera, width: int, height: int,
     # no nearer than a millionth of the coordinates' size (a lone point: the camera stays
     # far enough from it for the ray offsets)
     floor = 1e-6 * max(1.0, float(np.max(np.abs(pts))))
+    if all_around:
+        aim, distance = _around(pts, centre, world_up, azimuth, elevation, tx, ty, margin,
+                                floor)
+        data.update(look_at=tuple(aim), position=tuple(aim + back * distance))
+        return Camera.model_validate(data)
     aim = centre
     for _ in range(6):  # aim at the middle of the picture the points make, then come near
         distance, u, v = _fit(pts - aim, right, upward, back, tx, ty, margin, floor)
@@ -120,6 +127,26 @@ def camera_for(points: np.ndarray, camera: Camera, width: int, height: int,
     distance, _, _ = _fit(pts - aim, right, upward, back, tx, ty, margin, floor)
     data.update(look_at=tuple(aim), position=tuple(aim + back * distance))
     return Camera.model_validate(data)
+
+
+def _around(pts, centre, world_up, azimuth, elevation, tx, ty, margin, floor, steps=24):
+    """The aim on the vertical axis through ``centre`` (moved up or down to the middle of
+    the pictures) and the distance that keeps every point in frame from each of ``steps``
+    azimuths."""
+    views = []
+    for k in range(steps):
+        back = view_direction(azimuth + 360.0 * k / steps, elevation, world_up)
+        right = np.cross(world_up, back)
+        right /= np.linalg.norm(right)
+        views.append((right, np.cross(back, right), back))
+    aim = centre
+    for _ in range(4):
+        fits = [_fit(pts - aim, *view, tx, ty, margin, floor) for view in views]
+        distance = max(f[0] for f in fits)
+        middle = (max(float(f[2].max()) for f in fits) + min(float(f[2].min()) for f in fits)) / 2
+        aim = aim + world_up * middle * ty * distance / math.cos(math.radians(elevation))
+    distance = max(_fit(pts - aim, *view, tx, ty, margin, floor)[0] for view in views)
+    return aim, distance
 
 
 def _fit(rel, right, upward, back, tx, ty, margin, floor):

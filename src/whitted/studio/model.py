@@ -67,10 +67,12 @@ def studio_lights(centre: np.ndarray, radius: float, up=(0.0, 1.0, 0.0),
 
 
 def model_scene(model: str | Path, *, up: str = "y", width: int = 800, height: int = 600,
-                azimuth: float = AZIMUTH, elevation: float = ELEVATION) -> Scene:
+                azimuth: float = AZIMUTH, elevation: float = ELEVATION,
+                all_around: bool = False) -> Scene:
     """A scene showing the model file ``model``: the model (its own materials, or clay) on a
     ground plane under its lowest point, the studio lights, a sky gradient and a framed
-    three-quarter view. ``up``: the model's up axis (``y``, as glTF and most OBJ files;
+    three-quarter view (with ``all_around``, far enough to stay in frame from every side, for
+    :func:`~whitted.turntable`). ``up``: the model's up axis (``y``, as glTF and most OBJ files;
     ``z``, as many CAD and scan files; ``x``). One-line SceneError for a model that cannot
     be read or has nothing to show."""
     from ..assets import load_mesh
@@ -108,6 +110,7 @@ def model_scene(model: str | Path, *, up: str = "y", width: int = 800, height: i
     scene = Scene(render=RenderSettings(width=width, height=height, samples=1),
                   background=SKY, objects=[mesh, ground],
                   lights=studio_lights(centre, radius, azimuth=azimuth))
-    camera = camera_for(finite, scene.camera, width, height, azimuth, elevation)
+    camera = camera_for(finite, scene.camera, width, height, azimuth, elevation,
+                        all_around=all_around)
     scene.camera = camera
     return scene
