@@ -142,3 +142,16 @@ def test_whitted_examples_takes_o_as_well(tmp_path):
     assert done.returncode == 0 and (tmp_path / "ex/glass_cube.toml").is_file()
     done = run("examples", "a", "-o", "b", cwd=tmp_path)
     assert done.returncode == 2 and done.stderr.count("\n") == 1
+
+
+def test_every_missing_package_of_the_stefan_extra_is_named(tmp_path):
+    done = run("stefan", "validate", cwd=tmp_path, pre=(
+        "for m in ('scipy', 'skimage', 'matplotlib'):\n    sys.modules[m] = None"))
+    assert done.returncode == 2 and done.stderr.count("\n") == 1
+    assert "SciPy, scikit-image and Matplotlib" in done.stderr
+    code = ("import sys\nsys.modules['PySide6'] = None\nfrom whitted.program import main\n"
+            "sys.argv = ['whitted', 'gui']\nmain()\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=tmp_path, timeout=300)
+    assert done.returncode == 2 and done.stderr.count("\n") == 1
+    assert "install whitted[gui]" in done.stderr

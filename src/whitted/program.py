@@ -53,11 +53,13 @@ def gui(
         raise fail(f"{scene_path}: unknown scene format {scene_path.suffix!r} (use .toml or .json)")
     # Qt is imported by the editor only, after its check of the system libraries Qt needs
     if importlib.util.find_spec("PySide6") is None:
-        raise fail("the editor needs PySide6, which is not installed: pip install 'whitted[gui]'")
+        raise fail("the editor needs PySide6, which is not installed: install whitted[gui] "
+                   "(pip install 'whitted[gui]')")
     try:
         from .gui.app import run_editor
     except ImportError as exc:
-        raise fail(f"the editor needs PySide6 ({exc}): pip install 'whitted[gui]'") from None
+        raise fail(f"the editor needs PySide6 ({exc}): install whitted[gui] "
+                   "(pip install 'whitted[gui]')") from None
     raise typer.Exit(run_editor(scene, scene_path))
 
 

@@ -39,7 +39,8 @@ def _needs_the_solver() -> None:
                                          ("matplotlib", "Matplotlib"))
                if importlib.util.find_spec(module) is None]
     if missing:
-        raise _fail(f"whitted stefan needs {' and '.join(missing)}, which are not installed: "
+        names = ", ".join(missing[:-1]) + " and " * (len(missing) > 1) + missing[-1]
+        raise _fail(f"whitted stefan needs {names}, which are not installed: "
                     "install whitted[stefan] (pip install 'whitted[stefan]')")
 
 

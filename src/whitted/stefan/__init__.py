@@ -29,7 +29,9 @@ def missing_packages() -> list[str]:
 
 
 if missing_packages():
-    raise ImportError(f"whitted's Stefan solver needs {' and '.join(missing_packages())}, "
+    _names = missing_packages()
+    raise ImportError(f"whitted's Stefan solver needs "
+                      f"{', '.join(_names[:-1]) + ' and ' * (len(_names) > 1) + _names[-1]}, "
                       "which are not installed: install whitted[stefan] "
                       "(pip install 'whitted[stefan]')")
 
