@@ -1,6 +1,6 @@
 """Caustics by photon mapping (docs/caustics.md): the physics checked against exact optics,
-with the expected values computed here from whitted's own Fresnel model (Schlick, cosine on
-the air side), determinism, and the settings."""
+with the expected values computed here from the exact Fresnel equations (whitted's),
+determinism, and the settings."""
 
 from __future__ import annotations
 
@@ -40,10 +40,13 @@ def scene_of(objects, photons=100_000, passes=1, radius=0.0, lights=None, size=(
     return Scene.model_validate(data)
 
 
-def schlick_air(cos_air, n):
-    """whitted's Fresnel reflectance at a glass/air surface, either way through it."""
-    r0 = ((n - 1) / (n + 1)) ** 2
-    return r0 + (1 - r0) * (1 - cos_air) ** 5
+def fresnel_air(cos_air, n):
+    """The exact Fresnel reflectance for unpolarised light at a glass/air surface, either way
+    through it (whitted's, kernels/integrator.py)."""
+    cos_glass = np.sqrt(1 - (1 - cos_air * cos_air) / (n * n))
+    rs = (cos_air - n * cos_glass) / (cos_air + n * cos_glass)
+    rp = (cos_glass - n * cos_air) / (cos_glass + n * cos_air)
+    return 0.5 * (rs * rs + rp * rp)
 
 
 def caustic_power(lights):
@@ -60,7 +63,7 @@ def floor_points(half, count):
 def test_slab_passes_its_transmittance_under_a_directional_light():
     # normal incidence: F = r0 = 0.04 at each face; with the internal reflections the slab
     # passes T = (1 - F)^2 (1 + F^2 + F^4 + ...) = (1 - F) / (1 + F) = 0.923077
-    f = schlick_air(1.0, 1.5)
+    f = fresnel_air(1.0, 1.5)
     expected = (1 - f) / (1 + f)
     assert expected == pytest.approx(0.923077, abs=1e-6)
     scene = scene_of([{"type": "box", "min": [-2, 1, -2], "max": [2, 1.5, 2],
@@ -87,14 +90,14 @@ def test_a_body_of_ior_1_leaves_the_floor_as_lit_as_without_it():
 
 def ball_power_on_floor(n, steps=400_000):
     """Fraction of the power through a glass ball's cross-section that reaches the floor
-    below, by whitted's Fresnel: the part reflected by the outer surface downward
+    below, by the exact Fresnel equations: the part reflected by the outer surface downward
     (incidence past 45 degrees) plus the part leaving after k internal reflections whose
     deviation 2(i - t) + k(pi - 2t) still points down."""
     b = (np.arange(steps) + 0.5) / steps
     cos_i = np.sqrt(1 - b * b)
     i = np.arcsin(b)
     t = np.arcsin(b / n)
-    f = schlick_air(cos_i, n)
+    f = fresnel_air(cos_i, n)
     total = np.sum(f * 2 * b * (np.cos(math.pi - 2 * i) > 0)) / steps
     for k in range(12):
         deviation = 2 * (i - t) + k * (math.pi - 2 * t)
@@ -104,7 +107,7 @@ def ball_power_on_floor(n, steps=400_000):
 
 def test_glass_ball_total_caustic_power():
     expected = ball_power_on_floor(1.5)
-    assert expected == pytest.approx(0.91979, abs=2e-4)
+    assert expected == pytest.approx(0.91272, abs=2e-4)
     scene = scene_of([{"type": "sphere", "center": [0, 3, 0], "radius": 1.0,
                        "material": GLASS}], photons=200_000)
     _, lights, _ = scene_photon_map(scene, threads=2)
@@ -223,9 +226,10 @@ def test_disk_light_casts_a_soft_caustic_of_the_same_power():
     _, sharp, _ = scene_photon_map(scene_of(ball, lights=point, radius=0.02), threads=2)
     _, soft, _ = scene_photon_map(scene_of(ball, lights=disk, radius=0.02), threads=2)
     power = [caustic_power(a) for a in (sharp, soft)]
-    # a disk of this size, 6 away, sends the ball nearly the point light's power (within
-    # the change of solid angle over the disk: 1 - ~1.5 %)
-    assert power[1] == pytest.approx(power[0], rel=0.03)
+    # each point of the disk (radius 1, 4 above the ball's centre) shines on the ball as a
+    # point light of its share of the intensity would: the power goes with the solid angle,
+    # ~ 1 / (16 + rho^2), whose mean over the disk is ln(17 / 16): 0.970 of the centre's
+    assert power[1] == pytest.approx(power[0] * 16 * math.log(17 / 16), rel=0.01)
     peak = [irradiance(a, [[0, 0, 0]], [0, 1, 0])[0, 0] for a in (sharp, soft)]
     assert peak[1] < 0.5 * peak[0]  # the disk's focus is spread: a soft caustic
 
@@ -294,6 +298,26 @@ def test_export_writes_photons_blocks():
     assert "photons { target reflection on refraction on collect off }" in text
     plain = scene_to_pov(scene.with_settings(caustics=CausticsSettings()))
     assert "photons" not in plain
+
+
+def test_export_keeps_the_photon_count_within_what_povray_reads():
+    # photons x passes past 2^31 - 1 wrapped round in POV-Ray's C int (it shot 1 photon):
+    # the count is clipped to the largest it holds, and a comment line says so
+    from whitted.export.pov import POV_MAX_COUNT, scene_to_pov
+
+    assert POV_MAX_COUNT == 2_147_483_647
+    ball = [{"type": "sphere", "center": [0, 2, 0], "radius": 1.0, "material": GLASS}]
+    # 3.2e9, exactly 2^31, and 2048 short of 2^31 - 1
+    for photons, passes in ((50_000_000, 64), (1_048_576, 2048), (1_048_575, 2048)):
+        text = scene_to_pov(scene_of(ball, photons=photons, passes=passes))
+        count = min(photons * passes, POV_MAX_COUNT)
+        assert f"photons {{ count {count} autostop 0" in text
+        notes = [line for line in text.splitlines() if "POV-Ray's count holds" in line]
+        if photons * passes > POV_MAX_COUNT:
+            assert notes == [f"  // whitted shoots {photons * passes} photons ({photons} x "
+                             f"{passes} passes); POV-Ray's count holds at most 2147483647"]
+        else:
+            assert count == 2_147_481_600 and notes == []
 
 
 PRESET_GLASS = {"preset": "glass"}  # kr 0.05, kt 0.95, ior 1.5, fresnel
@@ -378,7 +402,7 @@ def test_no_rim_at_the_edge_of_a_transparent_bodys_shadow():
     # floor, must step from T to 1 with no overshoot or undershoot beyond the noise. Before
     # the shadow photons, the gather radius straddling the edge gave a dark rim inside
     # (photons missing beyond the edge, ~T/2) and a bright one outside (1 + ~T/2).
-    f = schlick_air(1.0, 1.5)
+    f = fresnel_air(1.0, 1.5)
     t = (1 - f) / (1 + f)
     r = 0.03
     camera = {"position": [0, 0.5, 0], "look_at": [0, 0, 0], "up": [0, 0, -1],
@@ -519,15 +543,20 @@ def test_render_through_a_clear_body_of_ior_1_equals_the_render_without_it():
     camera = {"position": [0, 8, 0.0], "look_at": [0, 0, 0], "up": [0, 0, -1],
               "projection": "orthographic", "ortho_height": 4.0}
     ball = [{"type": "sphere", "center": [0, 2, 0], "radius": 1.0, "material": clear}]
-    with_ball = scene_of(ball, photons=200_000, size=(24, 24), camera=camera)
-    a = render(with_ball).pixels[..., 0]
+    # 20,000 photons: few enough that some floor points see only a handful (an estimate
+    # faded out where photons are few left those up to 1.2e-3 off; the caustic and shadow
+    # photons, one estimator, cancel exactly)
+    with_ball = scene_of(ball, photons=20_000, size=(24, 24), camera=camera)
+    image = render(with_ball)
+    a = image.pixels[..., 0]
     b = render(scene_of([], photons=0, size=(24, 24), camera=camera)).pixels[..., 0]
     assert np.all(b == 1.0)
     centres = (np.arange(24) + 0.5) / 6 - 2
     rho = np.hypot(*np.meshgrid(centres, centres))
-    r = with_ball.render.caustics.radius or 0.062  # the default radius here (docs)
+    r = image.meta["stats"].photons.radius  # the default radius, fitted to the photons
+    assert 0.1 < r < 0.3
     inside = rho < 1 - 2 * r
-    assert inside.sum() > 60
+    assert inside.sum() > 20
     assert a[inside].mean() == pytest.approx(1.0, rel=0.01)
     assert np.all(np.abs(a[inside] - 1.0) < 0.05)
     assert np.all(a[rho > 1 + 2 * r] == 1.0)  # directly lit: exactly as without
@@ -537,3 +566,144 @@ def test_render_through_a_clear_body_of_ior_1_equals_the_render_without_it():
     rim = np.abs(rho - 1) <= 2 * r
     assert rim.sum() > 20
     np.testing.assert_allclose(a, b, atol=1e-4)
+
+
+def _ring_flux(lights, light_height, edges, angles=48):
+    """Power on the floor in the rings ``edges`` (sampled every 0.005 in radius, at
+    ``angles`` points round each circle: the gather discs cover the rings several times
+    over, so sparse photons are all counted) as a render sees it: the point light's direct
+    term, the clear bodies passed, plus the photon map's caustic and shadow estimate."""
+    from meridian import direct
+
+    step = 0.005
+    rho = np.arange(edges[0] + step / 2, edges[-1], step)
+    phi = (np.arange(angles)[None, :] + 0.5 + 0.37 * np.arange(len(rho))[:, None]) \
+        * (2 * math.pi / angles)
+    pts = np.stack([rho[:, None] * np.cos(phi), np.zeros_like(phi),
+                    rho[:, None] * np.sin(phi)], axis=-1).reshape(-1, 3)
+    e = irradiance(lights, pts, [0, 1, 0], shadows=True)[:, 0].reshape(len(rho), angles)
+    ring = (e.mean(axis=1) + direct(rho, light_height)) * 2 * math.pi * rho * step
+    return np.array([ring[(rho > a) & (rho < b)].sum() for a, b in zip(edges[:-1], edges[1:],
+                                                                           strict=True)])
+
+
+def test_hollow_ice_holding_water_matches_a_meridian_plane_trace():
+    # the coursework's object: a ball of ice (R 1, n 1.31; a CSG difference) with a hollow
+    # of radius 0.8 holding water (n 1.33, reaching a hair into the ice), 2 above the floor,
+    # a point light 6 above it; default caustics settings. The reference traces rays in the
+    # meridian plane with exact Fresnel (tests/meridian.py): under the ball a sharp caustic
+    # (2.1 at the middle) in a wide, weak halo (0.046 at 0.22 from the axis, 2e-4 at 1.4):
+    # light through the ball's outer zones, where photons are few
+    from meridian import direct, floor_rings
+
+    ice = dict(GLASS, ior=1.31)
+    water = dict(GLASS, ior=1.33)
+    lights = [{"type": "point", "position": [0, 6, 0], "intensity": 1.0,
+               "falloff": "inverse_square"}]
+    objects = [{"type": "csg", "operation": "difference", "material": ice,
+                "objects": [{"type": "sphere", "center": [0, 2, 0], "radius": 1.0},
+                            {"type": "sphere", "center": [0, 2, 0], "radius": 0.8}]},
+               {"type": "sphere", "center": [0, 2, 0], "radius": 0.8001, "material": water}]
+    scene = scene_of(objects, lights=lights, photons=100_000).with_settings(max_depth=10)
+    _, arrays, stats = scene_photon_map(scene, threads=2)
+    edges, traced, straight = floor_rings(6.0, 2.0, [1.0, 0.8], [1.31, 1.33], rays=100_000,
+                                          edges=np.array([0.0, 0.3, 1.5]))
+    area = math.pi * (edges[1:] ** 2 - edges[:-1] ** 2)
+    rho = np.linspace(0, 1.5, 15001)
+    lit = np.array([np.trapezoid((direct(rho, 6.0) * 2 * math.pi * rho)[(rho >= a) & (rho <= b)],
+                                 rho[(rho >= a) & (rho <= b)])
+                    for a, b in zip(edges[:-1], edges[1:], strict=True)])
+    reference = (traced - straight) * area + lit
+    got = _ring_flux(arrays, 6.0, edges)
+    flux = got.sum() / reference.sum()
+    halo = got[1] / reference[1]
+    print(f"flux {flux:.4f} halo {halo:.4f} radius {stats.radius:.4f}")
+    assert flux == pytest.approx(1.0, abs=0.04)
+    assert halo == pytest.approx(1.0, abs=0.15)
+
+
+def test_a_glass_csg_of_mesh_files_taking_its_material_casts_a_caustic(tmp_path):
+    # a CSG difference of two cubes loaded from an OBJ file that names no material: the
+    # cubes take the CSG's glass (POV-Ray's rule), so it is a photon target like any glass.
+    # The file's meshes used to keep whitted's default white for a file without materials:
+    # no photon passed, and caustics on rendered what caustics off did, bit for bit
+    from whitted.compile.scene import compile_scene
+    from whitted.kernels.layout import MAT_KT, PRIM_MATERIAL, PRIM_TYPE, SHAPE_TRIANGLE
+
+    corners = [[x, y, z] for z in (-1, 1) for y in (-1, 1) for x in (-1, 1)]
+    quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2],
+             [1, 3, 7, 5]]
+    obj = tmp_path / "cube.obj"
+    obj.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in corners)
+                   + "".join("f " + " ".join(str(i + 1) for i in q) + "\n" for q in quads))
+    csg = {"type": "csg", "operation": "difference", "material": GLASS, "objects": [
+        {"type": "mesh", "file": str(obj), "transform": {"scale": 0.5,
+                                                          "translate": [0, 2, 0]}},
+        {"type": "mesh", "file": str(obj), "transform": {"scale": 0.2,
+                                                          "translate": [0, 2.5, 0]}}]}
+    camera = {"position": [0, 0.5, 0], "look_at": [0, 0, 0], "up": [0, 0, -1],
+              "projection": "orthographic", "ortho_height": 2.0}
+    scene = scene_of([csg], photons=20_000, size=(12, 12), camera=camera)
+    compiled = compile_scene(scene)
+    info = compiled.geometry.prim_info
+    glass_row = info[info[:, PRIM_TYPE] == SHAPE_TRIANGLE, PRIM_MATERIAL]
+    assert len(glass_row) == 24 and np.all(compiled.materials[glass_row, MAT_KT] == 1.0)
+    _, lights, stats = scene_photon_map(scene, threads=2)
+    assert stats.targets == 1
+    # the sun's power through the cube's 1 x 1 top, less what its faces reflect and the
+    # hole's faces send sideways: most of it
+    assert 0.8 < caustic_power(lights) < 1.0
+    # the floor under it, seen from below the cube: lit by photons through four faces
+    # (F = 0.04 each: 0.85), where without caustics shadow rays pass the glass whole (1)
+    lit = render(scene, threads=2).pixels[..., 0]
+    plain = render(scene.with_settings(caustics=CausticsSettings())).pixels[..., 0]
+    assert np.all(plain[4:8, 4:8] == 1.0)
+    assert lit[4:8, 4:8].mean() == pytest.approx(0.87, abs=0.06)
+
+
+DIGEST = """
+import hashlib, sys
+from whitted.compile.photon_map import scene_photon_map
+from whitted.scene.scene import Scene
+scene = Scene.model_validate_json(sys.stdin.read())
+_, lights, stats = scene_photon_map(scene, threads=2)
+print(hashlib.sha256(lights.photons.tobytes()).hexdigest(), repr(stats.radius))
+"""
+
+
+def _hollow_ice_scene(photons):
+    ice = dict(GLASS, ior=1.31)
+    water = dict(GLASS, ior=1.33, attenuation=[0.1, 0.05, 0.02])
+    lights = [{"type": "point", "position": [0.5, 6, 0.3], "intensity": 1.0}]
+    objects = [{"type": "csg", "operation": "difference", "material": ice,
+                "objects": [{"type": "sphere", "center": [0, 2, 0], "radius": 1.0},
+                            {"type": "torus", "major_radius": 0.3, "minor_radius": 0.5,
+                             "transform": {"translate": [0, 2, 0]}}]},
+               {"type": "sphere", "center": [0, 2, 0], "radius": 0.45, "material": water}]
+    return scene_of(objects, lights=lights, photons=photons)
+
+
+def test_photons_are_the_same_compiled_cold_or_loaded_from_the_cache(tmp_path):
+    # the photon tracer is compiled without fast-math (kernels/strict.py): a process that
+    # compiles it into an empty cache, one that loads it from the cache the tests use and
+    # this one give the same photons, bit for bit, and so the same fitted radius
+    import hashlib
+    import os
+    import subprocess
+    import sys
+
+    scene = _hollow_ice_scene(4000)
+    _, lights, stats = scene_photon_map(scene, threads=2)
+    here = (hashlib.sha256(lights.photons.tobytes()).hexdigest(), repr(stats.radius))
+    assert len(lights.photons) > 1000
+    runs = []
+    for cache in (str(tmp_path / "empty"), os.environ.get("WHITTED_CACHE_DIR")):
+        env = dict(os.environ)
+        env.pop("WHITTED_CACHE_DIR", None)
+        if cache:
+            env["WHITTED_CACHE_DIR"] = cache
+        run = subprocess.run([sys.executable, "-c", DIGEST], input=scene.model_dump_json(),
+                             capture_output=True, text=True, env=env, timeout=1200,
+                             check=True)
+        runs.append(tuple(run.stdout.split()))
+    assert runs[0] == runs[1] == here

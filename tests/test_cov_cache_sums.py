@@ -9,6 +9,9 @@ import hashlib
 import json
 import re
 
+from hypothesis import given
+from hypothesis import strategies as st
+
 from whitted.jit import cache as _cache
 from whitted.jit.cache import SUMS, KernelCache
 
@@ -93,3 +96,51 @@ def test_the_fingerprint_names_the_version_the_source_the_libraries_and_the_cpu(
     assert re.fullmatch(r"whitted \S+ source [0-9a-f]{16} numba \S+ llvmlite \S+ numpy \S+ "
                         r"cpu \S+/[0-9a-f]{8}", fingerprint)
     assert renderer_fingerprint() is fingerprint  # computed once
+
+
+_WORD = st.text(alphabet="abcdefghijklmnopqrstuvwxyz0123456789./-+", min_size=1, max_size=12)
+
+
+@given(st.dictionaries(_WORD, _WORD, min_size=1, max_size=6), st.data())
+def test_a_fingerprint_difference_names_exactly_what_differs(ours, data):
+    from whitted.fingerprint import fingerprint_difference, fingerprint_fields
+
+    changed = data.draw(st.sets(st.sampled_from(sorted(ours))))
+    theirs = {k: (v + "x" if k in changed else v) for k, v in ours.items()}
+    a = " ".join(f"{k} {v}" for k, v in theirs.items())
+    b = " ".join(f"{k} {v}" for k, v in ours.items())
+    assert fingerprint_fields(a) == theirs and fingerprint_fields(b) == ours
+    text = fingerprint_difference(a, b)
+    if not changed:
+        assert text == a  # nothing differs: the fingerprint itself
+        return
+    parts = text.split("; ")
+    assert [p.split(" ")[0] for p in parts] == [k for k in ours if k in changed]
+    for part in parts:
+        name = part.split(" ")[0]
+        assert part == f"{name} {theirs[name]}, the client's {ours[name]}"
+
+
+def test_the_source_hash_covers_every_file_of_the_package(tmp_path):
+    """Any file of the package, kernel or not, source or data, changes the hash; compiled
+    bytecode does not."""
+    import shutil
+    from pathlib import Path
+
+    import whitted
+    from whitted.fingerprint import source_hash
+
+    copy = tmp_path / "whitted"
+    shutil.copytree(Path(whitted.__file__).parent, copy,
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    before = source_hash(copy)
+    (copy / "__pycache__").mkdir(exist_ok=True)
+    (copy / "__pycache__" / "x.cpython-311.pyc").write_bytes(b"\0")
+    assert source_hash.__wrapped__(copy) == before
+    seen = {before}
+    for name in ("scene/interpolate.py", "cli/render.py", "scene/data/default.toml"):
+        path = copy / name
+        path.write_bytes(path.read_bytes() + b"\n")
+        now = source_hash.__wrapped__(copy)
+        assert now not in seen
+        seen.add(now)

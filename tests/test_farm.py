@@ -14,6 +14,7 @@ import pytest
 
 distributed = pytest.importorskip("distributed")
 
+from farm_film import farm_film  # noqa: E402
 from whitted import load_scene  # noqa: E402
 from whitted.farm import (  # noqa: E402
     FrameFailed,
@@ -21,7 +22,6 @@ from whitted.farm import (  # noqa: E402
     band_ranges,
     chunk_size,
     collect_assets,
-    render_film,
     render_still,
     ship_assets,
 )
@@ -285,12 +285,12 @@ def test_film_on_two_workers_is_the_local_film_frame_by_frame(client, film_scene
                                                               local_frames, tmp_path):
     folder = tmp_path / "frames"
     arrived = []
-    result = render_film(client, film_scene, folder, assets="ship", chunk=3,
+    result = farm_film(client, film_scene, folder, assets="ship", chunk=3,
                          progress=lambda done, total, frame: arrived.append((done, frame)))
-    assert result.tasks == 3 and result.chunk == 3  # 8 frames: 3 + 3 + 2
+    assert result.report.tasks == 3 and result.report.chunk == 3  # 8 frames: 3 + 3 + 2
     assert sorted(result.rendered) == list(range(8)) and result.kept == []
     assert [done for done, _ in arrived] == list(range(1, 9))
-    assert result.asset_bytes > 0
+    assert result.report.asset_bytes > 0
     assert_frames_match(folder, local_frames, range(8))
 
 
@@ -302,10 +302,10 @@ def test_resume_renders_only_the_missing_frames(client, film_scene, local_frames
             raise KeyboardInterrupt  # the user stops the client
 
     with pytest.raises(KeyboardInterrupt):
-        render_film(client, film_scene, folder, chunk=1, progress=stop_after_three)
+        farm_film(client, film_scene, folder, chunk=1, progress=stop_after_three)
     first = sorted(int(p.stem) for p in folder.glob("*.png"))
     assert len(first) >= 3  # and every other frame that had arrived when it was stopped
-    again = render_film(client, film_scene, folder, chunk=1)
+    again = farm_film(client, film_scene, folder, chunk=1)
     assert sorted(again.kept) == first
     assert sorted(again.rendered) == sorted(set(range(8)) - set(first))
     assert_frames_match(folder, local_frames, range(8))
@@ -318,7 +318,7 @@ def test_a_failing_frame_is_named_after_the_others_are_saved(client, examples_di
     scene = film_of(path, 5).with_settings(width=24, height=16, samples=1)
     folder = tmp_path / "frames"
     with pytest.raises(FrameFailed) as failure:
-        render_film(client, scene, folder, assets="ship", chunk=2)
+        farm_film(client, scene, folder, assets="ship", chunk=2)
     message = str(failure.value)
     assert message.startswith(f"frame 3: {bad}:4:")  # the client's file name, its line
     assert "\n" not in message
@@ -347,7 +347,7 @@ def test_a_worker_killed_mid_film_costs_only_a_retry(client, film_scene, tmp_pat
             os.kill(victim, signal.SIGKILL)  # the worker process, without warning
             killed.append(frame)
 
-    result = render_film(client, film_scene, folder, chunk=1, retries=0,
+    result = farm_film(client, film_scene, folder, chunk=1, retries=0,
                          progress=kill_one_worker, **settings)
     assert killed
     assert sorted(result.rendered) == list(range(8))  # each frame written exactly once

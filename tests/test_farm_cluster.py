@@ -20,8 +20,9 @@ import pytest
 
 distributed = pytest.importorskip("distributed")
 
+from farm_film import farm_film  # noqa: E402
 from whitted.animation.frames import render_frame  # noqa: E402
-from whitted.farm import ClusterLost, WhittedWorker, render_film  # noqa: E402
+from whitted.farm import ClusterLost, WhittedWorker  # noqa: E402
 from whitted.farm.cluster import ready_cluster  # noqa: E402
 from whitted.fingerprint import FINGERPRINT_KEY, renderer_fingerprint  # noqa: E402
 
@@ -231,10 +232,10 @@ def test_a_worker_with_a_changed_non_kernel_module_gets_no_tasks_and_is_named(
         assert theirs != ours
         assert line == (f"farm: worker {by_name['other']} runs another renderer (source "
                         f"{theirs}, the client's {ours}): it gets no tasks")
-        result = render_film(client, film_scene, tmp_path / "frames", chunk=1,
+        result = farm_film(client, film_scene, tmp_path / "frames", chunk=1,
                              note=notes.append)
     assert notes == [line]  # named once: by the readying, not again by the film
-    assert set(result.workers.values()) == {by_name["good"]}
+    assert set(result.report.workers.values()) == {by_name["good"]}
     for k in range(8):
         data = (tmp_path / "frames" / f"{k:04d}.png").read_bytes()
         assert data == local_frames[k]
@@ -284,12 +285,12 @@ def test_a_worker_without_whitted_joining_mid_film_is_named_and_does_not_hang_it
             wait_for(lambda: notes or joined[0].poll() is not None,
                      "the worker without whitted to be named")
 
-        result = render_film(client, film_scene, tmp_path / "frames", chunk=1,
+        result = farm_film(client, film_scene, tmp_path / "frames", chunk=1,
                              progress=join_one, note=notes.append)
         good = {w for w, d in workers_of(client).items() if d["name"] == "good"}
         [event] = missing()
     assert joined and sorted(result.rendered) == list(range(8))
-    assert set(result.workers.values()) == good
+    assert set(result.report.workers.values()) == good
     assert event["name"] == "bare"
     # one line naming it (address and name) and what it lacks, once
     assert notes == [f"farm: worker {event['worker']} (bare) cannot load whitted "
@@ -387,7 +388,7 @@ def test_a_stopped_worker_stalls_nothing_its_tasks_go_elsewhere(scheduler, film_
             stopped.append(victim)
 
             try:
-                result = render_film(client, film_scene, tmp_path / "frames", chunk=1,
+                result = farm_film(client, film_scene, tmp_path / "frames", chunk=1,
                                      note=notes.append, stall_floor=2.0)
             except ClusterLost:
                 print(notes)
@@ -415,7 +416,7 @@ def test_a_killed_lone_worker_costs_retries_not_the_film(film_scene, local_frame
                 os.kill(next(iter(pid.values())), signal.SIGKILL)
                 killed.append(frame)
 
-        result = render_film(client, film_scene, tmp_path / "frames", chunk=1,
+        result = farm_film(client, film_scene, tmp_path / "frames", chunk=1,
                              progress=kill_it)
         assert next(iter(client.run(os.getpid).values())) != next(iter(pid.values()))
     assert killed and sorted(result.rendered) == list(range(8))
@@ -446,8 +447,9 @@ def test_a_finished_frame_lost_with_its_worker_before_it_came_is_rendered_again(
     monkeypatch.setattr(Watch, "wait", wait_then_kill)
     with farm_client("local:1", threads=1) as client:
         pid = client.run(os.getpid)
-        result = render_film(client, film_scene, tmp_path / "frames", chunk=1)
-    assert "lost" in killed and not result.failed and sorted(result.rendered) == list(range(8))
+        result = farm_film(client, film_scene, tmp_path / "frames", chunk=1)
+    assert "lost" in killed and not result.report.failed
+    assert sorted(result.rendered) == list(range(8))
     for k in range(8):
         assert (tmp_path / "frames" / f"{k:04d}.png").read_bytes() == local_frames[k]
 
@@ -498,7 +500,7 @@ def test_losing_every_worker_ends_in_one_line_keeping_the_frames(scheduler, film
                 lone.wait()
 
         with pytest.raises(ClusterLost) as lost:
-            render_film(client, film_scene, tmp_path / "frames", chunk=1, progress=kill_it,
+            farm_film(client, film_scene, tmp_path / "frames", chunk=1, progress=kill_it,
                         stall_floor=3.0)
     # a task the killed worker had finished but not handed over goes back to any worker
     # (none is left): the watch, not the resubmission, ends it

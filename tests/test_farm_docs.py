@@ -40,7 +40,7 @@ def commands() -> list[list[str]]:
             for args in re.findall(r"args: \[(.*?)\]", text, flags=re.S):
                 found.append([w.strip().strip('"') for w in args.replace("\n", " ").split(",")])
             continue
-        if language == "python":
+        if language in ("python", "text"):  # code; what a program prints
             continue
         for line in text.splitlines():
             line = line.split(" #")[0].strip()
@@ -233,6 +233,38 @@ fps = 12
 path = "camera.position"
 keys = [[0, [0, 1.5, 5]], [3, [3, 1.5, 4]]]
 """
+
+
+def test_the_python_local_cluster_recipe_renders_the_local_film(tmp_path):
+    """The doc's Python block, as written but for a small film and no poster: a LocalCluster
+    on loopback, readied, the film pipeline with the farm's executor; its frames are the
+    frames a local render writes, byte for byte."""
+    from whitted import load_scene
+    from whitted.animation.film import render_film
+
+    [code] = [text for language, text in blocks() if language == "python"
+              and "LocalCluster(" in text]
+    assert "with_settings(width=1920, height=1080)" in code
+    code = code.replace("with_settings(width=1920, height=1080)", "with_settings()")
+    code = "\n".join(line for line in code.splitlines() if "poster" not in line)
+    (tmp_path / "film.toml").write_text(FILM)
+    run = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                         text=True, timeout=600, env=dict(os.environ, NUMBA_NUM_THREADS="1"))
+    assert run.returncode == 0, run.stderr
+    import ast
+
+    # print(result.rendered, result.kept, result.report.tasks, result.report.workers)
+    match = re.fullmatch(r"(\[[^\]]*\]) \[\] (\d+) (\{.*\})", run.stdout.splitlines()[-1])
+    assert match, run.stdout
+    rendered, workers = ast.literal_eval(match[1]), ast.literal_eval(match[3])
+    assert sorted(rendered) == [0, 1, 2, 3] and int(match[2]) >= 1
+    assert sorted(workers) == [0, 1, 2, 3]
+    assert all(w.startswith("tcp://127.0.0.1:") for w in workers.values())
+    assert (tmp_path / "film.mp4").stat().st_size > 0
+    local = render_film(load_scene(tmp_path / "film.toml"), tmp_path / "local", threads=1)
+    assert local.rendered == [0, 1, 2, 3]
+    for path in local.files:
+        assert (tmp_path / "film_frames" / path.name).read_bytes() == path.read_bytes()
 
 
 # ------------------------------------------------------------------ the container recipe

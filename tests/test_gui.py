@@ -226,7 +226,7 @@ def test_undo_and_redo_every_edit(window):
     s3 = window.doc.scene
     window.delete_selected()
     s4 = window.doc.scene
-    assert [o.name for o in s3.objects[-2:]] == ["crate", "crate copy"]
+    assert [o.name for o in s3.objects[-2:]] == ["crate", "crate.001"]
     assert len(s4.objects) == len(s2.objects)
     assert window.act_undo.shortcut().toString() == "Ctrl+Z"
     assert window.act_redo.shortcut().toString() == "Ctrl+Shift+Z"

@@ -232,8 +232,8 @@ def test_ctrl_d_duplicates_every_selected_item_in_one_step_and_selects_the_copie
     qtbot.keyClick(window.tree, Qt.Key.Key_D, Qt.KeyboardModifier.ControlModifier)
     scene = window.doc.scene
     assert len(scene.objects) == count + 2 and len(scene.lights) == lights + 1
-    assert [o.name for o in scene.objects[-2:]] == ["ball 1 copy", "ball 2 copy"]
-    assert scene.lights[-1].name == "lamp copy"
+    assert [o.name for o in scene.objects[-2:]] == ["ball 1.001", "ball 2.001"]
+    assert scene.lights[-1].name == "lamp.001"
     assert window.doc.undo_stack.count() == steps + 1
     assert set(window.doc.selected_keys()) == {("lights", lights), ("objects", count),
                                                ("objects", count + 1)}

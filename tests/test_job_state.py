@@ -30,6 +30,12 @@ def test_finished_job_says_so_and_its_srgb_is_the_image(scene):
     np.testing.assert_array_equal(srgb, image.to_srgb8())
     assert srgb.any()
     assert "finished, 24/24 tiles" in repr(job)
+    import io
+
+    from PIL import Image as PILImage
+
+    shown = np.asarray(PILImage.open(io.BytesIO(job._repr_png_())).convert("RGB"))
+    np.testing.assert_array_equal(shown, srgb)  # a job in a notebook shows its picture
 
 
 def test_cancelled_job_keeps_the_tiles_it_finished(scene):

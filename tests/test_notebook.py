@@ -60,6 +60,9 @@ def test_detection_outside_a_kernel(monkeypatch):
     monkeypatch.setenv("WHITTED_NOTEBOOK", "1")
     monkeypatch.setattr(detect, "widgets_installed", lambda: False)
     assert not detect.in_notebook()  # forced on, but no extra: the plain path
+    assert not detect.live_view(None)
+    with pytest.raises(whitted.WhittedError, match=r"whitted\[notebook\]"):
+        detect.live_view(True)  # asked for by name: one line naming the extra
 
 
 def test_plain_render_outside_a_notebook_shows_nothing(scene, shown):
@@ -82,8 +85,8 @@ def test_live_render_fills_in_and_ends_at_100_percent(scene, shown):
     np.testing.assert_array_equal(image.pixels,
                                   whitted.render(scene, live=False, width=96,
                                                  height=64).pixels)
-    # the view's own work stays within its budget (one update may take it over)
-    wall = image.meta["stats"].wall_seconds
+    # the view's own work stays within its budget (the last update may take it over)
+    wall = time.perf_counter() - view.started
     assert view.view_seconds <= live.BUDGET * wall + view.longest_update + 1e-3
     assert "whitted render" in repr(box)
 
@@ -309,6 +312,32 @@ def test_stefan_results_plot_and_balance(tmp_path, shown, examples_dir):
 
     again = load_results(tmp_path / "melt")
     np.testing.assert_array_equal(again.heat_in_J, results.heat_in_J)
+    # a run written before series.csv had the budget's columns: from the saved states
+    import csv
+
+    series = tmp_path / "melt" / "series.csv"
+    rows = list(csv.DictReader(io.StringIO(series.read_text())))
+    older = [c for c in rows[0] if c not in ("heat_in_J", "heat_drained_J", "condensed_cm3")]
+    out = io.StringIO()
+    writer = csv.DictWriter(out, fieldnames=older, extrasaction="ignore", lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    series.write_text(out.getvalue())
+    from_states = load_results(tmp_path / "melt")
+    np.testing.assert_allclose(from_states.heat_in_J, results.heat_in_J, rtol=1e-12)
+    np.testing.assert_allclose(from_states.drained_J, results.drained_J, rtol=0, atol=1e-9)
+    # a damaged saved state: that time's budget is unknown (NaN), the rest stands
+    (tmp_path / "melt" / "fields" / "state_0001.npz").write_bytes(b"not a state")
+    damaged = load_results(tmp_path / "melt")
+    assert np.isnan(damaged.heat_in_J[1]) and damaged.heat_in_J[2] == results.heat_in_J[2]
+    assert _png(damaged._repr_png_()).size
+    # a damaged series: one line naming the folder
+    from whitted.stefan.case import CaseError
+
+    (tmp_path / "melt" / "series.csv").write_text("time_s,ice_volume_cm3\nzero,1\n")
+    with pytest.raises(CaseError) as info:
+        load_results(tmp_path / "melt")
+    assert "\n" not in str(info.value) and "series.csv" in str(info.value)
 
 
 def test_stefan_results_of_a_folder_without_a_run(tmp_path):
@@ -470,3 +499,50 @@ def test_render_film_into_a_folder_makes_the_film_in_memory(tmp_path, examples_d
                                frames=[0, 1], width=16, height=10, fps=2, live=False)
     assert film.path is None and film.frames == 2 and film.kind in ("mp4", "gif")
     assert sorted(p.name for p in (tmp_path / "frames").iterdir()) == ["0000.png", "0001.png"]
+
+
+def test_a_script_never_imports_the_widgets():
+    import subprocess
+    import sys
+
+    code = ("import sys, whitted\n"
+            "image = whitted.render(whitted.Scene(), width=4, height=4, threads=1)\n"
+            "print(image.width, 'ipywidgets' in sys.modules, 'IPython' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=600, env={**os.environ, "WHITTED_NOTEBOOK": ""})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["4", "False", "False"]
+    assert out.stderr == ""
+
+
+def test_a_big_film_is_linked_not_embedded(tmp_path, monkeypatch):
+    from whitted.output import inline_film
+
+    film = whitted.film_from_frames(_frames(tmp_path / "frames", n=2), kind="gif")
+    path = film.save(tmp_path / "film.gif")
+    on_disk = whitted.Film(path, frames=2, fps=24, size=(9, 6))
+    monkeypatch.setattr(inline_film, "EMBED_LIMIT", 10)
+    html = on_disk._repr_html_()
+    assert f'src="{path.as_posix()}"' in html and "base64" not in html
+    assert repr(on_disk) == "<Film film.gif: 2 frames at 24 fps, 9x6, 0.1 s>"
+
+
+def test_the_first_compile_shows_in_the_bar(scene, monkeypatch):
+    from whitted.render import RenderJob, warm_up
+
+    job = RenderJob(scene)
+    view = live.LiveRender(job, stop=False)
+    monkeypatch.setattr(warm_up, "compile_progress", lambda: 0.4)
+    view.update()
+    assert view.bar.description == "compiling" and view.bar.value == 40.0
+    assert "compiling the kernels" in view.status.value
+    monkeypatch.setattr(warm_up, "compile_progress", lambda: None)
+    view._next = 0.0
+    view.update()
+    assert "preparing the scene" in view.status.value
+
+
+def test_render_async_outside_a_notebook_is_the_plain_render(scene, shown):
+    image = asyncio.run(whitted.render_async(scene, live=False))
+    assert shown == []
+    np.testing.assert_array_equal(image.pixels, whitted.render(scene, live=False).pixels)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import whitted
-from whitted.kernels.integrator import refract, schlick
+from whitted.kernels.integrator import fresnel, refract
 
 
 def test_snell_30_degrees_air_to_glass():
@@ -35,11 +35,65 @@ def test_total_internal_reflection_beyond_critical_angle():
         assert ok is expect_ok
 
 
-def test_schlick_values():
-    assert schlick(1.0, 1.0, 1.5, 1.0) == pytest.approx(0.04)  # ((1-1.5)/2.5)^2
-    assert schlick(0.0, 1.0, 1.5, 0.5) == pytest.approx(1.0)  # grazing: all reflected
-    # leaving the denser medium uses the transmitted cosine
-    assert schlick(0.2, 1.5, 1.0, 1.0) == pytest.approx(0.04)
+def fresnel_by_angles(theta_i, n1, n2):
+    """The unpolarised Fresnel reflectance written with the angles (Born & Wolf): s and p
+    as -sin(i - t) / sin(i + t) and tan(i - t) / tan(i + t); 1 past the critical angle."""
+    s = n1 / n2 * math.sin(theta_i)
+    if s >= 1.0:
+        return 1.0
+    if theta_i == 0.0:
+        return ((n1 - n2) / (n1 + n2)) ** 2
+    theta_t = math.asin(s)
+    rs = math.sin(theta_i - theta_t) / math.sin(theta_i + theta_t)
+    rp = math.tan(theta_i - theta_t) / math.tan(theta_i + theta_t)
+    return 0.5 * (rs * rs + rp * rp)
+
+
+def reflectance_as_traced(theta_i, n1, n2):
+    """What a ray arriving at angle theta_i is reflected, as the integrator and the photons
+    decide it (integrator.split_at_surface): refracted by Snell's law, then the Fresnel
+    kernel; total internal reflection reflects everything."""
+    d = (math.sin(theta_i), -math.cos(theta_i), 0.0)
+    n = (0.0, 1.0, 0.0)
+    ok, t = refract(d, n, n1 / n2)
+    if not ok:
+        return 1.0
+    return fresnel(-(d[1] * n[1]), n1, n2, -(t[1] * n[1]))
+
+
+@pytest.mark.parametrize("n1, n2", [(1.0, 1.5), (1.5, 1.0), (1.31, 1.33), (1.33, 1.31),
+                                    (1.0, 1.0)])
+def test_fresnel_is_exact_at_every_angle(n1, n2):
+    # 0 to 90 degrees in steps of 0.05 (past the critical angle from 1.5 into 1.0: total
+    # internal reflection), against the formula written with the angles
+    angles = np.radians(np.linspace(0.0, 90.0, 1801))
+    got = np.array([reflectance_as_traced(a, n1, n2) for a in angles])
+    want = np.array([fresnel_by_angles(a, n1, n2) for a in angles[:-1]] + [1.0])
+    if n1 == n2:
+        want[:-1] = 0.0  # nothing to reflect: the ray goes straight on, even at grazing
+        got = got[:-1]
+        want = want[:-1]
+    np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)
+    assert np.all((got >= 0.0) & (got <= 1.0))
+
+
+def test_fresnel_worked_values():
+    # normal incidence: ((n1 - n2) / (n1 + n2))^2, the same either way through
+    assert fresnel(1.0, 1.0, 1.5, 1.0) == pytest.approx(0.04, abs=1e-15)
+    assert fresnel(1.0, 1.5, 1.0, 1.0) == pytest.approx(0.04, abs=1e-15)
+    assert fresnel(0.0, 1.0, 1.5, math.sqrt(1 - 1 / 2.25)) == 1.0  # grazing
+    # Brewster's angle, tan i = n2 / n1: the p-polarised half is not reflected at all
+    i = math.atan(1.5)
+    t = math.asin(math.sin(i) / 1.5)
+    rs = math.sin(i - t) / math.sin(i + t)
+    assert fresnel(math.cos(i), 1.0, 1.5, math.cos(t)) == pytest.approx(0.5 * rs * rs, rel=1e-12)
+    # ice against water reflects almost nothing until near grazing: 5.7e-5 at normal
+    # incidence, 5.2e-4 at 60 degrees, 2.8 % at 80 (Schlick's (1 - cos)^5 gave 3.1 % and 39 %)
+    assert fresnel(1.0, 1.31, 1.33, 1.0) == pytest.approx((0.02 / 2.64) ** 2)
+    assert reflectance_as_traced(math.radians(60.0), 1.31, 1.33) == pytest.approx(5.168e-4,
+                                                                                  rel=1e-3)
+    assert reflectance_as_traced(math.radians(80.0), 1.31, 1.33) == pytest.approx(0.02783,
+                                                                                  rel=1e-3)
 
 
 # --- end to end: an orthographic camera looks through slabs at a small bright target --------

@@ -520,12 +520,12 @@ def test_bad_extension(tmp_path):
     with pytest.raises(ValueError) as exc:
         img.save(tmp_path / "a.xyz")
     assert str(exc.value) == (
-        "unsupported image format '.xyz' (use .png, .jpg, .exr, .pfm or .npy)"
+        "unsupported image format '.xyz' (use .png, .jpg, .tif, .webp, .exr, .pfm or .npy)"
     )
     with pytest.raises(ValueError, match="unsupported image format"):
         img.save(tmp_path / "noext")
     with pytest.raises(ValueError, match="unsupported image format"):
-        read_image(tmp_path / "a.tiff")
+        read_image(tmp_path / "a.xyz")
     assert os.listdir(tmp_path) == []
 
 

@@ -348,7 +348,9 @@ def test_a5_memory_need_is_checked_before_the_render(tmp_path: Path, monkeypatch
     from whitted.output import safety
 
     write(tmp_path / "scene.toml", SCENE)
-    monkeypatch.setattr(safety, "available_memory", lambda: 1000)
+    from whitted.files.memory import MemoryRoom
+
+    monkeypatch.setattr(safety, "memory_room", lambda: MemoryRoom(1000, "is free"))
     line = one_line_error(run_main("render", "scene.toml", "-o", "out.png", cwd=tmp_path),
                           "needs about", "memory")
     assert "16x12" in line

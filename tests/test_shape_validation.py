@@ -70,11 +70,11 @@ CASES = [
      "part in CSG"),
     (S.CSG, {"operation": "union", "objects": [S.Sphere(radius=1)] * 64},
      "CSG: a CSG object holds at most 63 solids and operations together; this one has 64 "
-     "solids in 1 operations"),
+     "solids in 1 operation, nested 1 deep"),
     (S.CSG, {"operation": "union", "objects": [S.CSG(operation="union", objects=[
         S.Sphere(radius=1)] * 31)] * 2},
      "CSG: a CSG object holds at most 63 solids and operations together; this one has 62 "
-     "solids in 3 operations"),
+     "solids in 3 operations, nested 2 deep"),
 ]
 
 

@@ -26,7 +26,7 @@ def test_one_phase_lambda_root(stefan, quoted):
 
 def test_two_phase_lambda_and_front_after_an_hour():
     lam = exact.two_phase_lambda(PROPS, 10.0, -10.0)
-    # the issue quotes 0.2089 and 9.14 mm; these property values give 0.20908 (0.09 % off)
+    # the specification quotes 0.2089 and 9.14 mm; these property values give 0.20908 (0.09 % off)
     assert lam == pytest.approx(0.2089, rel=1e-3)
     assert float(exact.front(lam, PROPS, 3600.0)) == pytest.approx(9.14e-3, abs=0.005e-3)
 

@@ -17,7 +17,7 @@ from whitted.cli.main import app
 from whitted.scene import load_scene
 from whitted.stefan.case import Case, CaseError, case_from_dict, load_case
 from whitted.stefan.geometry import initial_state
-from whitted.stefan.run import run_case
+from whitted.stefan.run import condensed_volume, run_case
 from whitted.stefan.surfaces import extract_surfaces
 
 REPO = Path(__file__).resolve().parents[1]
@@ -107,6 +107,12 @@ def test_run_writes_everything_and_resumes(tmp_path):
     rows = list(csv.DictReader((out / "series.csv").open()))
     assert [float(r["time_s"]) for r in rows] == [0.0, 300.0, 600.0]
     assert float(rows[-1]["ice_volume_cm3"]) < float(rows[0]["ice_volume_cm3"])
+    # heat in and heat drained are columns; their difference is the enthalpy gained
+    heat_in = [float(r["heat_in_J"]) for r in rows]
+    assert heat_in[0] == 0.0 and heat_in[1] > 0.0 and heat_in[2] > heat_in[1]
+    assert all(float(r["heat_drained_J"]) >= 0.0 for r in rows)
+    assert float(rows[-1]["condensed_cm3"]) == pytest.approx(
+        1e6 * condensed_volume(case, heat_in[-1]), rel=1e-9)
     for i in range(3):
         mesh = trimesh.load(out / "surfaces" / f"outer_{i:04d}.ply")
         assert mesh.is_watertight

@@ -1,4 +1,4 @@
-"""Issue 30: the room's radiation and condensation (against the issue's and the handbooks'
+"""The room's radiation and condensation (against the quoted estimates and the handbooks'
 numbers), the three further 1-D cases, thin grids on the serial kernel whatever their
 orientation, and the film's measured absorption and anti-aliasing."""
 
@@ -25,7 +25,7 @@ def test_saturation_pressure_matches_the_handbook():
 
 
 def test_radiation_and_condensation_at_the_default_room():
-    # issue 30: a 0 °C surface in 25 °C surroundings receives about 128 W/m² by radiation
+    # a 0 °C surface in 25 °C surroundings receives about 128 W/m² by radiation
     # (eps sigma (298.15^4 - 273.15^4) with eps = 0.97) against 500 W/m² by convection (h 20)
     film = room.outer_film(25.0, 20.0, relative_humidity=0.0)
     assert film.radiation == pytest.approx(0.97 * 5.670374419e-8 * (298.15**4 - 273.15**4))
@@ -93,7 +93,7 @@ def test_the_film_scene_has_measured_absorption_and_four_samples(tmp_path):
     assert f"{WATER_ABSORPTION_CM[0]:.4g}" in text
     boosted = still_life_scene(None, None, 60.0, absorption_boost=3.0)
     assert "exaggerated x3" in boosted
-    # caustics on by default (issue 30: the light the ice focuses on the table), 5/3 photons
+    # caustics on by default (the light the ice focuses on the table), 5/3 photons
     # a pixel (480 x 360: 288,000; 400 x 300: 200,000), off with 0
     assert scene.render.caustics.photons == 288_000
     small = tmp_path / "small.toml"
@@ -101,3 +101,28 @@ def test_the_film_scene_has_measured_absorption_and_four_samples(tmp_path):
     assert load_scene(small).render.caustics.photons == 200_000
     path.write_text(still_life_scene(None, None, 60.0, caustic_photons=0))
     assert load_scene(path).render.caustics.photons == 0
+
+
+def test_condensed_water_joins_the_puddle():
+    # a 0 °C surface in the default room (h 20, 25 °C): condensation brings its share s of the
+    # heat; Q J of heat melt Q / (rho_w L) of water and condense s Q / (rho_w L_v)
+    from whitted.stefan.room import L_VAPORISATION
+    from whitted.stefan.run import condensed_volume, meltwater
+
+    for rh, low, high in ((0.3, 0.012, 0.02), (0.7, 0.045, 0.07)):
+        case = case_from_dict({"air": {"relative_humidity": rh}})
+        film = room.outer_film(25.0, 20.0, emissivity=0.97, relative_humidity=rh)
+        share = film.condensation / (film.convection + film.radiation + film.condensation)
+        assert case.condensation_share() == pytest.approx(share, rel=1e-12)
+        q = 1.0e4  # J
+        melt = q / (1000.0 * 333.6e3)
+        cond = condensed_volume(case, q)
+        assert cond == pytest.approx(share * q / (1000.0 * L_VAPORISATION), rel=1e-12)
+        # about 5 % more water at 70 % humidity (1.6 % at 30 %)
+        assert low < cond / melt < high
+        assert meltwater(case, (1e-5, 0.0), (1e-5 - melt * 1000 / 917, 0.0), cond) == \
+            pytest.approx(melt + cond, rel=1e-9)
+    dry = case_from_dict({"air": {"relative_humidity": 0.0}})
+    assert condensed_volume(dry, 1.0e4) == 0.0
+    auto = case_from_dict({"air": {"h": "auto", "relative_humidity": 0.7}})
+    assert 0.0 < auto.condensation_share() < 1.0

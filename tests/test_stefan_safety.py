@@ -1,6 +1,6 @@
-"""Issue 25's Stefan items: the run folder is whitted's only when whitted made it (3), estimates
-before work (11), strict types (12), resume after 10,000 saves (17), the drain-mode film to the
-end of the run (18), the shell and cavity measures (19); and fuzzing of case files."""
+"""The Stefan run's safety: the run folder is whitted's only when whitted made it, estimates
+before work, strict types, resume after 10,000 saves, the drain-mode film to the end of the
+run, the shell and cavity measures; and fuzzing of case files."""
 
 from __future__ import annotations
 

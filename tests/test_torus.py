@@ -191,3 +191,20 @@ def test_both_root_finders_agree_on_rays_tangent_to_the_tube(u, v, w, gap, minor
     t = math.cos(w) * t_u + math.sin(w) * t_v
     o = tuple(p + gap * n - 5.0 * t)
     _assert_root_finders_agree(o, tuple(t), minor)
+
+
+SPINDLE = Torus(major_radius=0.6, minor_radius=0.9)  # the tube overlaps itself: a lemon
+
+
+def test_a_spindle_torus_is_met_only_on_its_outer_surface():
+    # along the x axis through the centre: the outer surface at |x| = 0.6 + 0.9 = 1.5; the
+    # lemon's (|x| = 0.9 - 0.6 = 0.3) lies inside the solid and bounds nothing
+    np.testing.assert_allclose(Compiled(SPINDLE).all_hits((-10, 0, 0), (1, 0, 0)),
+                               [8.5, 11.5], rtol=REL)
+    # straight down the axis: the two cusps are points where the tube meets itself: the
+    # ray enters at the top cusp (y = sqrt(0.81 - 0.36)) and leaves at the bottom one;
+    # off the axis, down through the dimple above the lemon: in and out of the outer surface
+    c = Compiled(SPINDLE)
+    ts = c.all_hits((0.2, 10, 0), (0, -1, 0))
+    # (rho - R)^2 + y^2 = r^2 at rho = 0.2: y = +-sqrt(0.81 - 0.16)
+    np.testing.assert_allclose(ts, [10 - math.sqrt(0.65), 10 + math.sqrt(0.65)], rtol=1e-9)

@@ -120,3 +120,16 @@ def test_tour_stefan_run_plots(tour):
     plot = _png(_data(cell, "image/png")[0])
     assert plot.shape[1] > 2 * plot.shape[0]  # melt fraction, shell, heat budget
     assert "melted" in _data(cell, "text/plain")[-1]
+
+
+def test_tour_awaited_render_has_a_stop_button(tour):
+    state = tour.metadata["widgets"]["application/vnd.jupyter.widget-state+json"]["state"]
+    cell = _cell(tour, "await whitted.render_async(")
+    (view,) = _data(cell, "application/vnd.jupyter.widget-view+json")
+    box = state[view["model_id"]]["state"]
+    row = state[box["children"][0].removeprefix("IPY_MODEL_")]["state"]
+    kinds = [state[c.removeprefix("IPY_MODEL_")] for c in row["children"]]
+    assert [k["model_name"] for k in kinds] == ["FloatProgressModel", "ButtonModel"]
+    assert kinds[1]["state"]["description"] == "Stop"
+    assert kinds[0]["state"]["value"] == 100.0
+    assert "192x108" in _data(cell, "text/plain")[-1]

@@ -14,10 +14,20 @@ render farm.
   no file in the way that whitted did not write (a frame PNG carries whitted's frame record,
   :mod:`whitted.animation.frames`; anything else there is the user's, and is never written
   over).
-* :func:`render_film`: renders the frames that are missing or out of date (resume: a frame
-  whose record matches what it would show is kept), calls ``progress`` as it goes, stops at
-  ``cancel`` (the frames finished stay), then encodes the film (a temporary file renamed when
-  the encoder succeeded: a good film is never replaced by a failed one).
+* :func:`missing_frames`: each frame's still, the hash its PNG records and its file; the
+  frames whose PNG already records that hash, made by this renderer
+  (:mod:`whitted.fingerprint`), are kept (resume), the others are to render.
+* :func:`render_film`: the pipeline: plan (:func:`prepare_film`), the missing frames, render
+  them with an *executor*, assemble (encode the film once the whole numbered sequence is on
+  disk, in frame order: a temporary file renamed when the encoder succeeded, so a good film
+  is never replaced by a failed one). ``progress`` is called as it goes; ``cancel`` stops it
+  (the frames finished stay; run it again to resume).
+
+The executor renders the missing frames and writes each one's PNG (atomically, with its
+record) as it is finished: :class:`LocalFrames` renders them one after another in this
+process, each on the render's own threads; the render farm's
+:class:`whitted.farm.DaskFrames` renders them on a Dask cluster. Any object with the same
+``render_frames`` method will do (:class:`FrameExecutor`).
 """
 
 from __future__ import annotations
@@ -26,18 +36,19 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
-from ..errors import OutputError, RenderCancelled, SceneError
-from .frames import FrameRenderer, FrameResult, is_whitted_frame
+from ..errors import OutputError, RenderCancelled, SceneError, WhittedError
+from .frames import FrameRenderer, FrameResult, frame_digest, frame_is_current, is_whitted_frame
 
 if TYPE_CHECKING:
     from ..render.api import CancelToken, Progress
     from ..scene.scene import Scene
 
 __all__ = ["DEFAULT_FPS", "FRAME_DIGITS", "FilmPaths", "FilmPlan", "FilmProgress",
-           "FilmResult", "check_frame_files", "film_paths", "frame_name", "parse_frame_range",
-           "prepare_film", "render_film"]
+           "FilmResult", "FrameExecutor", "FrameFailed", "FrameJob", "LocalFrames",
+           "check_frame_files", "film_paths", "frame_name", "missing_frames",
+           "parse_frame_range", "prepare_film", "render_film"]
 
 #: Digits of a frame's name at least (more when the film has more frames).
 FRAME_DIGITS = 4
@@ -230,6 +241,89 @@ def prepare_film(
 
 
 @dataclass
+class FrameJob:
+    """One frame of a film: its number, its still (``scene.at_frame(frame)``), the hash its
+    PNG records (:func:`~whitted.animation.frames.frame_digest`) and its file."""
+
+    frame: int
+    still: Scene
+    digest: str
+    path: Path
+
+
+def missing_frames(scene: Scene, plan: FilmPlan,
+                   force: bool = False) -> tuple[list[FrameJob], list[FrameJob]]:
+    """(the frames to render, the frames kept) of ``plan``, in frame order: a frame whose
+    PNG already records its hash, made by this renderer, is kept unless ``force``."""
+    todo, kept = [], []
+    for frame, path in zip(plan.frames, plan.files, strict=True):
+        still = scene.at_frame(frame)
+        job = FrameJob(frame, still, frame_digest(still, frame), path)
+        (kept if not force and frame_is_current(path, job.digest) else todo).append(job)
+    return todo, kept
+
+
+class FrameFailed(WhittedError):
+    """A frame could not be rendered: ``frame`` and the reason, in one line."""
+
+    def __init__(self, frame: int, reason: str) -> None:
+        prefix = f"frame {frame}:"  # a reason that names its frame already is not told twice
+        super().__init__(reason if reason.startswith(prefix) else f"{prefix} {reason}")
+        self.frame = frame
+        self.reason = reason
+
+
+#: ``tell(event, frame, **extra)``: an executor's progress (events of :class:`FilmProgress`)
+Tell = Callable[..., None]
+#: ``finished(job, result, warnings)``: an executor wrote ``job``'s PNG
+Finished = Callable[[FrameJob, FrameResult, list[str]], None]
+
+
+class FrameExecutor(Protocol):
+    """Renders the missing frames of a film: writes each frame's PNG (atomically, its record
+    included) and calls ``finished`` for it, in any order; ``tell`` (may be None) gets the
+    ``frame`` and ``tiles`` events it can give. Returns False when ``cancel`` stopped it (the
+    frames finished stay). Raises :class:`FrameFailed` (after every other frame is written)
+    or another one-line :class:`~whitted.WhittedError`."""
+
+    def render_frames(self, scene: Scene, jobs: list[FrameJob], *, finished: Finished,
+                      tell: Tell | None, cancel: CancelToken | None) -> bool: ...
+
+
+class LocalFrames:
+    """The frames one after another in this process, each on ``threads`` render threads
+    (None: the scene's); ``renderer`` keeps compiled geometry between consecutive frames."""
+
+    def __init__(self, threads: int | None = None,
+                 renderer: FrameRenderer | None = None) -> None:
+        self.renderer = renderer or FrameRenderer(threads)
+        self.report = None
+
+    def render_frames(self, scene: Scene, jobs: list[FrameJob], *, finished: Finished,
+                      tell: Tell | None, cancel: CancelToken | None) -> bool:
+        for job in jobs:
+            if cancel is not None and cancel.cancelled:
+                return False
+            if tell is not None:
+                tell("frame", job.frame)
+            tiles = None if tell is None else (
+                lambda p, k=job.frame: tell("tiles", k, tiles=p))
+            try:
+                done = self.renderer.render(job.still, job.frame, job.path, force=True,
+                                            progress=tiles, cancel=cancel, digest=job.digest)
+            except OSError as exc:
+                raise OutputError(f"{job.path}: cannot write: {exc.strerror or exc}") from None
+            if done.cancelled:
+                return False
+            finished(job, done, list(done.stats.warnings) if done.stats else [])
+        return True
+
+    def compiles(self) -> str:
+        """What the compiles between frames reused."""
+        return self.renderer.cache.stats.summary() if self.renderer.frames_rendered else ""
+
+
+@dataclass
 class FilmProgress:
     """What :func:`render_film`'s ``progress`` receives. ``event``: ``frame`` (frame
     ``frame`` starts), ``tiles`` (``tiles`` of it are done), ``done`` (it is finished:
@@ -250,16 +344,18 @@ class FilmResult:
 
     plan: FilmPlan
     files: list[Path] = field(default_factory=list)  # the finished frames, in frame order
-    rendered: list[int] = field(default_factory=list)
+    rendered: list[int] = field(default_factory=list)  # in the order they were finished
     kept: list[int] = field(default_factory=list)  # already on disk and current (resume)
     cancelled: bool = False  # stopped by ``cancel``: the frames finished are kept
     film: Path | None = None  # the film encoded (None: frames only, or not finished)
     size: tuple[int, int] = (0, 0)  # of the film's pictures (MP4: odd sides + 1)
-    render_seconds: float = 0.0
+    render_seconds: float = 0.0  # each rendered frame's time where it was rendered, summed
     encode_seconds: float = 0.0
     wall_seconds: float = 0.0
     warnings: list[str] = field(default_factory=list)
     compiles: str = ""  # what the compiles between frames reused (reuse.CompileStats.summary)
+    #: what the executor says of its run (the farm's: tasks, workers, ...; None locally)
+    report: Any = None
 
     @property
     def complete(self) -> bool:
@@ -281,19 +377,22 @@ def render_film(
     progress: Callable[[FilmProgress], None] | None = None,
     cancel: CancelToken | None = None,
     renderer: FrameRenderer | None = None,
+    executor: FrameExecutor | None = None,
 ) -> FilmResult:
     """Render ``frames`` (default: all) of ``scene`` to numbered PNGs and encode the film.
 
     ``output``: ``film.mp4`` / ``film.gif`` (frames in ``film_frames/``), a folder (frames
     only), or a :class:`FilmPlan` from :func:`prepare_film` (checked already). A frame already
-    on disk from the same scene, settings and files is kept (``force``: rendered anyway).
-    ``progress(FilmProgress)`` is called as frames start, progress and finish. ``cancel``
-    (a :class:`~whitted.render.api.CancelToken`) stops the film after the tiles in flight:
-    the frame being rendered is not written, the finished ones stay, no film is encoded (an
-    encode in progress is stopped and its temporary file removed) and the result says
-    ``cancelled``. Run it again to continue. Raises a one-line
-    :class:`~whitted.WhittedError` for what cannot work (see :func:`prepare_film`), a
-    model that cannot be read, or an encoder that failed (``OutputError``; the frames stay)."""
+    on disk from the same scene, settings, files and renderer is kept (``force``: rendered
+    anyway). ``executor`` renders the missing frames (default :class:`LocalFrames` with
+    ``threads`` and ``renderer``; the farm's :class:`whitted.farm.DaskFrames` on a cluster).
+    ``progress(FilmProgress)`` is called as frames start, progress and finish (kept frames
+    first). ``cancel`` (a :class:`~whitted.render.api.CancelToken`) stops the film: the frames
+    finished stay, no film is encoded (an encode in progress is stopped and its temporary
+    file removed) and the result says ``cancelled``. Run it again to continue. Raises a
+    one-line :class:`~whitted.WhittedError` for what cannot work (see :func:`prepare_film`), a
+    frame that failed (:class:`FrameFailed`, after the executor wrote what it could), or an
+    encoder that failed (``OutputError``; the frames stay)."""
     from ..output.video import encode_film, even_size
 
     started = time.perf_counter()
@@ -306,44 +405,41 @@ def render_film(
     except OSError as exc:
         raise OutputError(f"{folder}: cannot make the frames folder: "
                           f"{exc.strerror or exc}") from None
-    renderer = renderer or FrameRenderer(threads)
+    executor = executor or LocalFrames(threads, renderer)
     total = len(plan.frames)
+    on_disk: dict[int, Path] = {}
 
     def tell(event: str, frame: int | None, **extra: Any) -> None:
         if progress is not None:
-            progress(FilmProgress(event, frame, len(result.files), total, **extra))
+            progress(FilmProgress(event, frame, len(on_disk), total, **extra))
 
-    for frame, path in zip(plan.frames, plan.files, strict=True):
-        if cancel is not None and cancel.cancelled:
-            result.cancelled = True
-            break
-        still = scene.at_frame(frame)
-        tell("frame", frame)
-        tiles = None if progress is None else (
-            lambda p, k=frame: tell("tiles", k, tiles=p))
-        try:
-            done = renderer.render(still, frame, path, force=force, progress=tiles,
-                                   cancel=cancel)
-        except OSError as exc:
-            raise OutputError(f"{path}: cannot write: {exc.strerror or exc}") from None
-        if done.cancelled:
-            result.cancelled = True
-            break
-        result.files.append(path)
-        new = []
-        if done.rendered:
-            result.rendered.append(frame)
-            result.render_seconds += done.seconds
-            for warning in done.stats.warnings if done.stats else []:
-                if warning not in result.warnings:
-                    result.warnings.append(warning)
-                    new.append(warning)
-        else:
-            result.kept.append(frame)
-        tell("done", frame, result=done, warnings=new)
+    todo, kept = missing_frames(scene, plan, force)
+    for job in kept:
+        on_disk[job.frame] = job.path
+        result.kept.append(job.frame)
+        tell("done", job.frame, result=FrameResult(job.frame, job.path, job.digest,
+                                                   rendered=False))
 
-    if result.rendered:
-        result.compiles = renderer.cache.stats.summary()
+    def finished(job: FrameJob, done: FrameResult, warnings: list[str]) -> None:
+        on_disk[job.frame] = job.path
+        result.rendered.append(job.frame)
+        result.render_seconds += done.seconds
+        new = [w for w in warnings if w not in result.warnings]
+        result.warnings.extend(new)
+        tell("done", job.frame, result=done, warnings=new)
+
+    try:
+        if todo and not (cancel is not None and cancel.cancelled):
+            result.cancelled = not executor.render_frames(
+                scene, todo, finished=finished, tell=tell if progress is not None else None,
+                cancel=cancel)
+        elif todo:
+            result.cancelled = True
+    finally:
+        result.files = [on_disk[k] for k in plan.frames if k in on_disk]
+        result.report = getattr(executor, "report", None)
+        compiles = getattr(executor, "compiles", None)
+        result.compiles = compiles() if callable(compiles) else ""
     film = plan.paths.film
     if film is not None and not result.cancelled and len(result.files) == total:
         tell("encoding", None)

@@ -268,13 +268,15 @@ class FrameRenderer:
         force: bool = False,
         progress: Callable[[Progress], None] | None = None,
         cancel: CancelToken | None = None,
+        digest: str | None = None,
     ) -> FrameResult:
         """Render ``still`` (a scene from ``scene.at_frame(frame)``) to the PNG ``path``,
-        unless ``path`` already holds this frame (its hash matches) and ``force`` is off."""
+        unless ``path`` already holds this frame (its hash matches) and ``force`` is off.
+        ``digest``: the frame's hash when the caller made it already."""
         from ..render.api import RenderJob
 
         path = Path(path)
-        digest = frame_digest(still, frame)
+        digest = digest or frame_digest(still, frame)
         if not force and frame_is_current(path, digest):
             return FrameResult(frame, path, digest, rendered=False)
         start = time.perf_counter()

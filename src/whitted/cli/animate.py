@@ -82,9 +82,7 @@ def animate(
     except ValidationError as exc:
         raise fail(override_error(exc)) from None
     if cluster is not None or scheduler is not None:  # frames on a Dask cluster (cli/farm.py)
-        plan.paths.frames.mkdir(exist_ok=True)
-        animate_on_farm(scene, chosen, plan.paths.frames, plan.paths.film, fps=plan.fps,
-                        crf=plan.crf, force=force, quiet=quiet, cluster=cluster,
+        animate_on_farm(scene, plan, force=force, quiet=quiet, cluster=cluster,
                         scheduler=scheduler, threads=threads)
 
     cancel = CancelToken()

@@ -140,6 +140,8 @@ def with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
     from ..scene.writing import named_files
 
     file = getattr(exc, "file", None)
+    if not file and getattr(exc, "where", None) and not name.startswith("<"):
+        return f"{name}: {exc}"  # a scene key's problem found while compiling
     if not file or file == name:
         return str(exc)
     for keys, named in named_files(scene):

@@ -22,6 +22,7 @@ from .interrupt import InterruptGuard
 if TYPE_CHECKING:
     from rich.progress import Progress
 
+    from ..animation.film import FilmPlan
     from ..scene.scene import Scene
 
 EXIT_CLUSTER = 3  # the cluster cannot do the job (docs/farm.md)
@@ -160,67 +161,73 @@ def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
     raise typer.Exit(0)
 
 
-def animate_on_farm(scene: Scene, frames: range, folder: Path, film: Path | None, *,
-                    fps: float, crf: int, force: bool, quiet: bool, cluster: str | None,
-                    scheduler: str | None, threads: int | None) -> None:
-    """``whitted animate`` on a cluster: frames as tasks, each written here as it arrives
-    (resumable, as the local command), then the film encoded from the whole sequence."""
+def animate_on_farm(scene: Scene, plan: FilmPlan, *, force: bool, quiet: bool,
+                    cluster: str | None, scheduler: str | None, threads: int | None) -> None:
+    """``whitted animate`` on a cluster: the film pipeline (:mod:`whitted.animation.film`)
+    with the farm's executor: frames as tasks, each written here as it arrives (resumable, as
+    the local command), then the film encoded from the whole sequence."""
+    from ..animation.film import missing_frames, render_film
+    from ..render.api import CancelToken
     from .app import err, fail, out
 
     farm = farm_module()
     start = time.perf_counter()
+    folder, film, total = plan.paths.frames, plan.paths.film, len(plan.frames)
     note = None if quiet else (lambda line: err.print(line, markup=False, highlight=False))
     finished: list[int | None] = []
+    cancel = CancelToken()
     # Ctrl-C, SIGTERM (cli/interrupt.py): while the cluster starts, at once; while frames
     # render, after writing every frame that arrived (a second signal: at once)
     starting, rendering = InterruptGuard(at_once=True), InterruptGuard()
+    rendering.on_interrupt(cancel.cancel)
 
     def stopped() -> typer.Exit:
         guard = rendering if rendering.interrupted else starting
-        return guard.exit(f"{len(finished)} of {len(frames)} frames finished in {folder}; "
+        return guard.exit(f"{len(finished)} of {total} frames finished in {folder}; "
                           "run the same command again to continue")
 
     try:
         farm.check_farm_options(cluster, scheduler)
-        plan = farm.plan_film(scene, folder, frames=frames, force=force)
+        todo, _ = missing_frames(scene, plan, force)
         # a cluster only when frames are missing: a finished film is only encoded
         connect = (farm.farm_client(cluster, scheduler, threads=threads, note=note)
-                   if plan.todo else nullcontext())
+                   if todo else nullcontext())
         with quiet_dask_logs(), starting, connect as client, rendering:
             progress = bar("frames", quiet)
 
-            def frame_done(done: int, total: int, frame: int | None) -> None:
-                finished.append(frame)
+            def frame_done(p) -> None:
+                if p.event != "done":
+                    return
+                finished.append(p.frame)
+                for warning in p.warnings:
+                    err.print(f"warning: {warning}", markup=False, highlight=False)
                 if progress is not None:
-                    progress.update(task, completed=done, total=total)
-                elif not quiet and frame is not None:
-                    err.print(f"frame {frame} ({done}/{total})", highlight=False)
+                    progress.update(task, completed=p.done, total=p.total)
+                elif not quiet and p.result.rendered:
+                    err.print(f"frame {p.frame} ({p.done}/{p.total})", highlight=False)
 
             with progress if progress is not None else nullcontext():
-                task = progress.add_task("frames", total=len(frames)) if progress else None
-                result = farm.render_film(client, scene, folder, film=film, fps=fps, crf=crf,
-                                          progress=frame_done, plan=plan,
-                                          cancel=rendering.event, note=note)
+                task = progress.add_task("frames", total=total) if progress else None
+                executor = (farm.DaskFrames(client, note=note) if client is not None
+                            else None)
+                result = render_film(scene, plan, force=force, progress=frame_done,
+                                     cancel=cancel, executor=executor)
     except KeyboardInterrupt:  # while the cluster started, or a second signal
         raise stopped() from None
     except farm.ClusterLost as exc:
-        kept = f" ({len(finished)} of {len(frames)} frames are in {folder})" if finished else ""
+        kept = f" ({len(finished)} of {total} frames are in {folder})" if finished else ""
         raise cluster_fail(f"{exc}{kept}") from None
-    except WhittedError as exc:  # a bad option, a failed frame
+    except WhittedError as exc:  # a bad option, a failed frame, the encoder
         raise fail(str(exc)) from None
-    except (ValueError, OSError) as exc:  # the encoder
-        raise fail(f"{film}: cannot encode: {exc}") from None
-    if result.interrupted:
+    if result.cancelled:
         raise stopped()
-    for warning in result.warnings:
-        err.print(f"warning: {warning}", markup=False, highlight=False)
     if not quiet:
         done = f"{len(result.rendered)} rendered" + (
             f", {len(result.kept)} already done" if result.kept else "")
         per_frame = (f", {result.render_seconds / len(result.rendered):.2f} s a frame on a "
                      "worker" if result.rendered else "")
+        tasks = f", {result.report.tasks} tasks" if result.report is not None else ""
         target = f"; {film}" if film is not None else ""
-        out.print(f"{len(result.paths)} frames ({done}{per_frame}, {result.tasks} tasks) -> "
-                  f"{folder}{target}; total {time.perf_counter() - start:.1f} s",
-                  highlight=False)
+        out.print(f"{total} frames ({done}{per_frame}{tasks}) -> {folder}{target}; total "
+                  f"{time.perf_counter() - start:.1f} s", highlight=False)
     raise typer.Exit(0)

@@ -86,6 +86,8 @@ def info(
                   markup=False, highlight=False)
     out.print(f"image: {r.width}x{r.height}, {r.samples} sample(s)/pixel, max depth "
               f"{r.max_depth}, min weight {r.min_weight}")
+    for line in effect_lines(scene):
+        out.print(line, markup=False, highlight=False)
     out.print(f"objects: {len(scene.objects)}")
     for i, obj in enumerate(scene.objects):
         mat = obj.material if isinstance(obj.material, str) else (
@@ -130,7 +132,44 @@ def info(
         for light in scene.lights if light.type != "ambient"
     )
     primary = r.width * r.height * r.samples
-    out.print(f"work: {primary:,} primary rays, up to {shadow} shadow ray(s) per hit, "
-              f"secondary rays up to depth {r.max_depth}")
+    if r.antialias is not None:  # from the pixels' corners to every pixel fully split
+        levels = r.antialias.levels
+        most = ((r.width << levels) + 1) * ((r.height << levels) + 1)
+        rays = f"{(r.width + 1) * (r.height + 1):,} to {most:,} primary rays"
+    else:
+        rays = f"{primary:,} primary rays"
+    photons = r.caustics.photons * r.caustics.passes
+    out.print(f"work: {rays}, up to {shadow} shadow ray(s) per hit, "
+              f"secondary rays up to depth {r.max_depth}"
+              + (f", {photons:,} photons" if photons else ""))
+
+
+def effect_lines(scene) -> list[str]:
+    """What ``whitted info`` says of anti-aliasing, focal blur and caustics: on or off,
+    and with what settings."""
+    r, cam = scene.render, scene.camera
+    aa = r.antialias
+    if aa is None:
+        lines = [f"anti-aliasing: off ({r.samples} sample(s)/pixel; "
+                 "[render.antialias] for adaptive)"]
+    else:
+        lines = [f"anti-aliasing: adaptive (POV-Ray's method 2), threshold {aa.threshold:g}, "
+                 f"up to {aa.max_samples} samples/pixel ({aa.levels} level(s) of splits)"]
+    if cam.aperture > 0.0:
+        source = ("focal_distance" if cam.focal_distance is not None
+                  else "focal_point" if cam.focal_point is not None
+                  else "the look_at point" if cam.look_at is not None else "the default")
+        lines.append(f"focal blur: aperture {cam.aperture:g}, in focus at {cam.focus():.4g} "
+                     f"({source}); each of a pixel's samples through its own point of the lens")
+    else:
+        lines.append("focal blur: off (camera.aperture = 0)")
+    c = r.caustics
+    if c.photons == 0:
+        lines.append("caustics: off ([render.caustics] photons = 0)")
+    else:
+        radius = f"radius {c.radius:g}" if c.radius > 0.0 else "radius fitted to the photons"
+        lines.append(f"caustics: {c.photons:,} photons x {c.passes:,} pass(es), {radius}, "
+                     f"alpha {c.alpha:g}")
+    return lines
 
 

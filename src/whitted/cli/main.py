@@ -86,7 +86,12 @@ def main() -> None:
         err.print(Text.assemble(("error:", "bold red"), " ", one_line(str(exc))), soft_wrap=True)
         sys.exit(EXIT_USER_ERROR)
     except MemoryError:
-        err.print(Text.assemble(("error:", "bold red"), " ", "out of memory"), soft_wrap=True)
+        from ..files.memory import memory_room
+
+        room = memory_room()
+        err.print(Text.assemble(("error:", "bold red"), " ", one_line(
+            "out of memory" + (f": {room.describe()}" if room is not None else ""))),
+            soft_wrap=True)
         sys.exit(EXIT_USER_ERROR)
     except Exception as exc:  # noqa: BLE001 - a bug: one line, the traceback on request
         if os.environ.get("WHITTED_DEBUG"):

@@ -3,9 +3,11 @@ the tiles finished (cli/interrupt.py), AOVs beside it, or bands on a farm (cli/f
 
 from __future__ import annotations
 
+import math
 import os
 import threading
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated
 
@@ -21,6 +23,7 @@ from .app import (
     fail,
     is_dir,
     load_scene_argument,
+    note,
     override_error,
     resume_collector,
     save_npy,
@@ -30,6 +33,7 @@ from .app import (
 from .console import err, out
 from .farm import ClusterOption, SchedulerOption, render_still_on_farm
 from .interrupt import InterruptGuard
+from .region import parse_region
 
 AOV_NAMES = ("depth", "normal", "id")
 
@@ -67,6 +71,19 @@ def render(
     set_values: Annotated[
         list[str] | None, typer.Option("--set", help="PATH=VALUE: change a scene value")
     ] = None,
+    region: Annotated[str | None, typer.Option(
+        "--region", help="Render only X0:X1,Y0:Y1 (pixels, or fractions such as "
+        "0.25:0.75) into the full-size image")] = None,
+    alpha: Annotated[bool, typer.Option(
+        "--alpha", help="Alpha channel, 0 where nothing is hit (.png .tif .webp .exr .npy)"
+    )] = False,
+    exposure: Annotated[float, typer.Option(
+        "--exposure", help="Exposure in stops: the image times 2^EV")] = 0.0,
+    quality: Annotated[int | None, typer.Option(
+        "--quality", help="JPEG or WebP quality, 1-100 (default: JPEG 95, WebP lossless)"
+    )] = None,
+    resume: Annotated[bool, typer.Option(
+        "--continue", help="Finish an interrupted render from the tiles it kept")] = False,
     turntable: Annotated[int | None, typer.Option(
         "--turntable", help="A film instead: N frames of the camera going once around "
         "(whitted animate --turntable; -o NAME.mp4 or .gif, default SCENE_turntable.mp4)",
@@ -74,18 +91,22 @@ def render(
     cluster: ClusterOption = None,
     scheduler: SchedulerOption = None,
 ) -> None:
-    """Render SCENE (or the built-in default scene) to an image (PNG, EXR, PFM, NPY, JPEG).
-    An animated scene renders frame 0, or the frame --frame names. A model file is shown on a
-    lit ground by a camera that frames it."""
+    """Render SCENE (or the built-in default scene) to an image: PNG, JPEG, TIFF, WebP,
+    EXR, PFM or NPY, chosen by the name given to -o. An animated scene renders frame 0, or
+    the frame --frame names; an interrupted render (Ctrl-C) keeps its finished tiles, and
+    --continue finishes it. A model file is shown on a lit ground by a camera that frames
+    it."""
     from .. import marks
 
     marks.mark("command")  # the imports and the command line's parsing are done
     from pydantic import ValidationError
 
     if turntable is not None:
-        stills_only = [name for name, given in (("--aov", aov), ("--frame", frame is not None),
-                                                ("--bit-depth", bit_depth != 8),
-                                                ("--transfer", transfer)) if given]
+        stills_only = [name for name, given in (
+            ("--aov", aov), ("--frame", frame is not None), ("--bit-depth", bit_depth != 8),
+            ("--transfer", transfer), ("--region", region), ("--alpha", alpha),
+            ("--exposure", exposure != 0.0), ("--quality", quality is not None),
+            ("--continue", resume)) if given]
         if stills_only:
             raise fail(f"--turntable makes a film: {', '.join(stills_only)} only apply to a "
                        "still")
@@ -94,8 +115,8 @@ def render(
         return
     output = output or Path("render.png")
 
-    from ..output.formats import check_bit_depth, image_format
-    from ..render.api import RenderJob
+    from ..output.formats import check_bit_depth, check_image_options, image_format
+    from ..render.api import DEFAULT_TILE, RenderJob
 
     process_start = time.perf_counter()
     aovs = _parse_aovs(aov)
@@ -103,8 +124,16 @@ def render(
         raise fail(f"{output}: is a directory (give a file name such as {output / 'render.png'})")
     try:
         check_bit_depth(bit_depth, image_format(output))
+        check_image_options(image_format(output), alpha=alpha)
     except ValueError as exc:
         raise fail(f"{output}: {exc}") from None
+    try:
+        check_image_options(image_format(output), quality=quality)
+    except ValueError as exc:
+        raise fail(f"--quality: {exc}") from None
+    if not math.isfinite(exposure) or abs(exposure) > MAX_EXPOSURE:
+        raise fail(f"--exposure: {exposure:g} stops is not a finite number from "
+                   f"-{MAX_EXPOSURE} to {MAX_EXPOSURE}")
     if transfer not in (None, "srgb", "linear"):
         raise fail(f"--transfer: unknown transfer {shorten(transfer)!r} (use srgb or linear)")
     try:
@@ -121,6 +150,12 @@ def render(
         raise fail(override_error(exc)) from None
     except WhittedError as exc:
         raise fail(str(exc)) from None
+    pixels_region = None
+    if region is not None:
+        try:
+            pixels_region = parse_region(region, scene.render.width, scene.render.height)
+        except ValueError as exc:
+            raise fail(f"--region: {exc}") from None
     outputs = [output] + [output.with_name(f"{output.stem}.{a}.npy") for a in aovs]
     try:
         from ..output.safety import check_memory, check_outputs
@@ -130,22 +165,69 @@ def render(
     except WhittedError as exc:
         raise fail(str(exc)) from None
     resume_collector()  # set-up done: the job (or the farm's client) runs with it
-    if cluster is not None or scheduler is not None:  # bands on a Dask cluster (cli/farm.py)
+    farm = cluster is not None or scheduler is not None
+    if farm and (region is not None or alpha or resume or exposure or quality is not None):
+        raise fail("--region, --alpha, --exposure, --quality and --continue render here, not "
+                   "on a cluster (leave out --cluster/--scheduler)")
+    if farm:  # bands on a Dask cluster (cli/farm.py)
         render_still_on_farm(scene, output, cluster=cluster, scheduler=scheduler,
                              threads=threads, quiet=quiet, bit_depth=bit_depth, aovs=aovs,
                              frame=frame)
 
+    from .tile_state import job_digest, state_path
+
+    kept = state_path(output)
+    digest = job_digest(scene, frame or 0, pixels_region, DEFAULT_TILE)
+    earlier = _kept_tiles(kept, digest, scene) if resume else None
     try:
-        job = RenderJob(scene)
+        job = RenderJob(scene, region=pixels_region, resume=earlier)
     except WhittedError as exc:
         raise fail(str(exc)) from None
     ends_at_once.append(True)
+    finish = StillFinish(pixels_region, alpha, exposure, quality, kept, digest)
     # Ctrl-C, SIGTERM: stop after the tiles in flight (cli/interrupt.py); the handlers stay
     # until the image is written: a signal during the write lets it finish
     with InterruptGuard() as guard:
         guard.on_interrupt(job.cancel)
         _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet, guard,
-                          process_start, frame)
+                          process_start, frame, finish)
+
+
+#: the widest --exposure, in stops (2^64 times brighter or darker is far beyond any use)
+MAX_EXPOSURE = 64
+
+
+@dataclass
+class StillFinish:
+    """What ``whitted render`` does to the picture after the tiles: the region, alpha,
+    exposure and quality options, and the tile state file of an interrupted render."""
+
+    region: tuple[int, int, int, int] | None
+    alpha: bool
+    exposure: float
+    quality: int | None
+    state: Path
+    digest: str
+
+
+def _kept_tiles(path: Path, digest: str, scene):
+    """The tiles an interrupted render of this very job kept, for --continue (None: none,
+    and the whole picture is rendered; a damaged or foreign state file is one line)."""
+    from .tile_state import StateError, load_state
+
+    r = scene.render
+    try:
+        state = load_state(path, max_bytes=64 + 2 * 12 * r.width * r.height + (1 << 24))
+    except StateError as exc:
+        raise fail(f"--continue: {path}: {exc} (render without --continue to start over)") \
+            from None
+    if state is None:
+        note(f"--continue: no kept tiles at {path}: rendering the whole picture")
+        return None
+    if state.digest != digest:
+        raise fail(f"--continue: {path} holds tiles of another scene, settings or region "
+                   "(render without --continue to start over)")
+    return state.finished, state.framebuffer
 
 
 def _turntable_film(scene_path, output, frames, width, height, samples, max_depth, threads,
@@ -156,7 +238,8 @@ def _turntable_film(scene_path, output, frames, width, height, samples, max_dept
     if output is None:
         stem = scene_path.stem if scene_path is not None else "render"
         output = Path(f"{stem}_turntable.mp4")
-    elif output.suffix.lower() in (".png", ".exr", ".pfm", ".npy", ".jpg", ".jpeg"):
+    elif output.suffix.lower() in (".png", ".exr", ".pfm", ".npy", ".jpg", ".jpeg", ".tif",
+                                   ".tiff", ".webp"):
         raise fail(f"{output}: --turntable makes a film: name an .mp4 or .gif file, or a "
                    "folder for the frames alone")
     animate(scene_path=scene_path, output=output, frames=None, fps=None, width=width,
@@ -166,7 +249,8 @@ def _turntable_film(scene_path, output, frames, width, height, samples, max_dept
 
 
 def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
-                      guard: InterruptGuard, process_start, frame: int | None) -> None:
+                      guard: InterruptGuard, process_start, frame: int | None,
+                      finish: StillFinish) -> None:
     from .. import marks
     from ..output.formats import image_format
     from ..render.api import render_aovs
@@ -191,14 +275,31 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
     for warning in stats.warnings:
         err.line(f"warning: {warning}")
     written = [str(output)]
+    plain = not (finish.alpha or finish.exposure or finish.quality is not None
+                 or finish.region is not None)
     try:
-        if frame is not None and not interrupted.is_set() and bit_depth == 8 \
+        whole = not interrupted.is_set() and stats.tiles_done == stats.tiles_total
+        if not whole:  # what finishing it needs, beside the picture (cli/tile_state.py)
+            from .tile_state import TileState, foreign, save_state
+
+            if foreign(finish.state):  # a file of someone else's by that name: kept
+                err.line(f"warning: {finish.state} is not whitted's: the tiles are kept in "
+                         f"{output} only (--continue cannot finish it)")
+            else:
+                save_state(finish.state, TileState(finish.digest, job.tiles_finished.copy(),
+                                                   job.framebuffer))
+        if frame is not None and whole and plain and bit_depth == 8 \
                 and image_format(output) == "png":  # the very file the film's frame K is
             from ..animation.frames import frame_digest, write_frame_png
 
             write_frame_png(output, image, frame_digest(scene, frame), frame)
         else:
-            image.save(output, bit_depth=bit_depth)
+            _save_still(image, output, bit_depth, scene, finish, whole and finish.alpha,
+                        job.threads)
+        if whole:
+            from .tile_state import remove_state
+
+            remove_state(finish.state)
         if aovs and not interrupted.is_set():
             planes = render_aovs(scene)
             for path, aov_name in zip(outputs[1:], aovs, strict=True):
@@ -221,7 +322,32 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
         marks.mark("written")
         marks.write()
     if interrupted.is_set():  # (a signal may have come during the write)
-        raise guard.exit(f"kept {stats.tiles_done}/{stats.tiles_total} tiles in {output}")
+        raise guard.exit(f"kept {stats.tiles_done}/{stats.tiles_total} tiles in {output} "
+                         f"and {finish.state.name}; the same command with --continue "
+                         "finishes it")
+
+
+def _save_still(image, output: Path, bit_depth: int, scene, finish: StillFinish,
+                with_alpha: bool, threads: int) -> None:
+    """The picture written with the options that change it: exposure (2^EV), quality, and
+    an alpha channel (render/coverage.py) once every tile is done (an interrupted one is
+    written without, until --continue finishes it)."""
+    import numpy as np
+
+    from ..output.image import Image
+
+    pixels = image.pixels
+    alpha = None
+    if with_alpha:
+        from ..render.coverage import render_coverage, straight_colour
+
+        alpha, background = render_coverage(scene, region=finish.region, threads=threads)
+        pixels = straight_colour(pixels, alpha, background)
+    if finish.exposure:
+        pixels = pixels * np.float32(2.0 ** finish.exposure)
+    if pixels is not image.pixels:
+        image = Image(pixels, transfer=image.transfer, tonemap=image.tonemap)
+    image.save(output, bit_depth=bit_depth, alpha=alpha, quality=finish.quality)
 
 
 def _wait(job, interrupted: threading.Event, tick=None, until: float | None = None) -> bool:

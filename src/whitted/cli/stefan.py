@@ -205,6 +205,19 @@ def validate(
                       f"{r['error_pct']:+.1f} %", "yes" if r["in_range"] else "below (Nu = 1)")
     out.print(table)
 
+    grids = (32, 64, 128) if full else (32,)
+    table = Table(title="The flow solver on de Vahl Davis's square cavity (Pr 0.71; reference, "
+                  "whitted, error)")
+    for col in ("Ra", "grid", "Nu ref", "Nu", "error", "u_max ref", "u_max", "error",
+                "v_max ref", "v_max", "error"):
+        table.add_column(col, justify="right")
+    for r in v.flow_cavity_rows(grids):
+        table.add_row(f"{r['ra']:.0e}", r["grid"], f"{r['nu_ref']:.3f}", f"{r['nu']:.4f}",
+                      f"{r['nu_error_pct']:+.2f} %", f"{r['u_ref']:.3f}", f"{r['u_max']:.3f}",
+                      f"{r['u_error_pct']:+.2f} %", f"{r['v_ref']:.3f}", f"{r['v_max']:.3f}",
+                      f"{r['v_error_pct']:+.2f} %")
+    out.print(table)
+
     slab = v.convective_slab()
     out.print(f"convective slab (h = 20 W/m²K, air 20 °C, 3000 s): receded "
               f"{slab['receded_mm']:.4f} mm, h dT t / (rho_i L) = {slab['expected_mm']:.4f} mm, "
@@ -223,26 +236,6 @@ def validate(
         v.plot_front(plot)
         out.print(f"plot -> {plot}")
     out.print(f"({time.perf_counter() - t0:.1f} s)")
-
-
-def _stamp(path: Path, text: str):
-    """The frame as an array with the simulated time written in its corner."""
-    import numpy as np
-    from PIL import Image, ImageDraw
-
-    image = Image.open(path).convert("RGB")
-    draw = ImageDraw.Draw(image)
-    size = max(12, image.height // 18)
-    try:
-        from PIL import ImageFont
-
-        font = ImageFont.load_default(size=size)
-    except (TypeError, OSError):  # an old Pillow: its bitmap font
-        font = None
-    x, y = size // 2, size // 2
-    draw.text((x + 1, y + 1), text, fill=(0, 0, 0), font=font)
-    draw.text((x, y), text, fill=(255, 255, 255), font=font)
-    return np.asarray(image)
 
 
 def _check_film_options(case_path: Path, output: Path, gif: Path | None, width: int,
@@ -298,12 +291,8 @@ def film(
     time (the piece on a table, backlit; ice 1.31, water 1.333, measured absorption, 4 samples
     per pixel) and encode the film with the simulated time in each frame. Ctrl-C or SIGTERM
     keeps the solved times and the finished frames; run again to continue."""
-    from ..animation.film import FilmPaths, frame_name, render_film
-    from ..output.video import encode_film
     from ..render.api import CancelToken
-    from ..scene import load_scene
-    from ..stefan.run import film_bubbles, film_frames, film_puddles
-    from ..stefan.scene import ABSORPTION_BOOST, still_life_scene, write_scene
+    from ..stefan.film import render_melt_film
 
     started = time.perf_counter()
     _check_film_options(case_path, output, gif, width, height, fps)
@@ -314,84 +303,23 @@ def film(
         if result.interrupted:
             raise guard.exit(f"while solving: kept every saved time in {work}; run the same "
                              "command again to continue")
-        shown = film_frames(work)  # to the end of the run (drain: the outer surface alone)
-        count = len(shown)
-        times = [f.time for f in shown]
-        if count == 0:
-            raise _fail(f"{work}: no saved time has a surface to film")
         cancel = CancelToken()
         guard.on_interrupt(cancel.cancel)
-        render_start = time.perf_counter()
-        if all(f.inner is not None for f in shown):  # one animated still life: render_film
-            scene_path = work / "film.toml"
-            write_scene(scene_path, still_life_scene(
-                "surfaces/outer_{frame:04d}.ply", "surfaces/inner_{frame:04d}.ply", None,
-                width=width, height=height, size_cm=100 * max(case.block.size), frames=count,
-                fps=fps, bubbles=film_bubbles(work, shown),
-                puddles=film_puddles(work, shown, case)))
-            try:
-                scene = load_scene(scene_path)
-                frames = render_film(scene, FilmPaths(None, work / "frames"), fps=fps,
-                                     scene_path=scene_path, cancel=cancel,
-                                     progress=None if quiet else _frame_line)
-            except WhittedError as exc:
-                raise _fail(str(exc)) from None
-            if frames.cancelled:
-                raise guard.exit(f"{len(frames.files)} of {count} frames finished in "
-                                 f"{work / 'frames'}; run the same command again to continue")
-            files = list(frames.files)
-        else:  # after the breach (drain) there is no cavity: each saved time's own still life
-            files = _render_saved_times(work, shown, width, height, cancel, quiet, guard,
-                                        frame_name)
-        render_seconds = time.perf_counter() - render_start
-        label = ("measured absorption" if ABSORPTION_BOOST == 1.0
-                 else f"absorption x{ABSORPTION_BOOST:g}")
-        stamped = [_stamp(path, f"t = {times[k] / 60:5.1f} min   ({label})")
-                   for k, path in enumerate(files)]
-        for path in [output, *([gif] if gif is not None else [])]:
-            try:
-                encode_film(stamped, path, fps, cancel=cancel)
-            except WhittedError:  # cancelled: ffmpeg stopped, the film as it was
-                raise guard.exit(f"every frame is in {work / 'frames'}; {path} was not "
-                                 "written") from None
-            except (ValueError, OSError) as exc:
-                raise _fail(f"{path}: cannot encode: "
-                            f"{getattr(exc, 'strerror', None) or exc}") from None
-    out.print(f"{count} frames ({render_seconds / count:.2f} s a frame, wall) -> {output}"
-              + (f", {gif}" if gif is not None else "")
-              + f"; total {time.perf_counter() - started:.1f} s")
-
-
-def _render_saved_times(work: Path, shown, width: int, height: int, cancel, quiet: bool,
-                        guard: InterruptGuard, frame_name) -> list[Path]:
-    """Each saved time's own scene (``scenes/frame_NNNN.toml``, written by the run) rendered
-    to ``frames/``: the film of a run whose later times have no cavity. A cancel keeps the
-    frames finished (each written atomically)."""
-    from ..render import render as render_scene
-
-    folder = work / "frames"
-    folder.mkdir(exist_ok=True)
-    files = []
-    for k, f in enumerate(shown):
-        if cancel.cancelled:
-            raise guard.exit(f"{k} of {len(shown)} frames finished in {folder}; run the same "
-                             "command again to continue")
-        path = folder / frame_name(k, len(shown))
         try:
-            image = render_scene(work / "scenes" / f"frame_{f.index:04d}.toml", width=width,
-                                 height=height, cancel=cancel)
-            if not cancel.cancelled:
-                image.save(path)
+            made = render_melt_film(work, case, [output, *([gif] if gif is not None else [])],
+                                    width=width, height=height, fps=fps, cancel=cancel,
+                                    progress=None if quiet else _frame_line)
         except WhittedError as exc:
             raise _fail(str(exc)) from None
-        if not cancel.cancelled:
-            files.append(path)
-            if not quiet:
-                out.line(f"frame {k} ({k + 1}/{len(shown)}): rendered")
-    if cancel.cancelled:
-        raise guard.exit(f"{len(files)} of {len(shown)} frames finished in {folder}; run the "
-                         "same command again to continue")
-    return files
+        if made.cancelled:
+            if len(made.frames) == made.count:
+                raise guard.exit(f"every frame is in {work / 'frames'}; the film was not "
+                                 "written")
+            raise guard.exit(f"{len(made.frames)} of {made.count} frames finished in "
+                             f"{work / 'frames'}; run the same command again to continue")
+    out.print(f"{made.count} frames ({made.render_seconds / made.count:.2f} s a frame, wall) "
+              f"-> {output}" + (f", {gif}" if gif is not None else "")
+              + f"; total {time.perf_counter() - started:.1f} s")
 
 
 def _frame_line(p) -> None:

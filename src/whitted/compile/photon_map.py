@@ -12,7 +12,6 @@ the gather averages the passes' estimates in one render.
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -70,6 +69,8 @@ from .scene import CompiledScene
 
 SLOTS = 6  # records one photon may store: SHADOW_SLOTS shadow photons, caustic photons
 #: (diffuse surfaces that also reflect or refract) in the rest
+#: the offset (in cells) of the grid the default radius counts photons in
+GRID_SHIFT = np.array([0.5, 0.5, 0.5])
 DEFAULT_NEIGHBOURS = 256  # photons the default radius gathers where light is not focused
 MAX_TARGETS = 64  # more bodies than this are aimed at as one bounding sphere
 PHOTON_BYTES = PHOTON_WIDTH * 4
@@ -259,19 +260,14 @@ def fitted_radius(positions: np.ndarray, guess: float,
     pos = positions.astype(np.float64)
     for _ in range(2):
         h = 2.0 * r
-        cells = np.floor(pos / h).astype(np.int64)
+        # the cells shifted off the origin: a floor at y = 0 would lie on their boundary,
+        # its photons split between two rows of cells by their last bits
+        cells = np.floor(pos / h + GRID_SHIFT).astype(np.int64)
         keys = (cells[:, 0] * 73856093) ^ (cells[:, 1] * 19349663) ^ (cells[:, 2] * 83492791)
         _, inverse, counts = np.unique(keys, return_inverse=True, return_counts=True)
         density = float(np.median(counts[inverse])) / (h * h)
         r = min(4.0 * guess, max(guess / 8.0, math.sqrt(neighbours / (math.pi * density))))
     return r
-
-
-def _available_memory() -> int | None:
-    try:
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        return None
 
 
 def check_photon_memory(settings: CausticsSettings, threads: int = 1) -> int:
@@ -281,13 +277,41 @@ def check_photon_memory(settings: CausticsSettings, threads: int = 1) -> int:
     :class:`SceneError` naming the key when that is more than half the memory available."""
     need = (settings.photons * (SLOTS * PHOTON_BYTES + 4)
             + settings.photons * settings.passes * (3 * PHOTON_BYTES + 8 + 8))
-    have = _available_memory()
-    if have is not None and need > MEMORY_SHARE * have:
+    from ..files.memory import memory_room
+
+    room = memory_room()
+    if room is not None and need > MEMORY_SHARE * room.bytes:
         raise SceneError(
             f"render.caustics: {settings.photons:,} photons x {settings.passes:,} passes need "
-            f"about {need / 2**30:.1f} GiB of memory, more than half the "
-            f"{have / 2**30:.1f} GiB available (shoot fewer photons or passes)")
+            f"about {need / 2**30:.1f} GiB of memory, more than half of what this process "
+            f"may take: {room.describe()} (shoot fewer photons or passes)")
     return need
+
+
+#: The smallest gather radius, in units in the last place of the photons' float32 positions
+#: at the scene's size: below it no two positions differ by less than the radius, and its
+#: square would underflow the gather's arithmetic (1e-300 squared is 0).
+RADIUS_ULPS = 16
+
+
+def smallest_radius(compiled: CompiledScene) -> float:
+    """The smallest gather radius the scene's size allows (:data:`RADIUS_ULPS`)."""
+    lo, hi = compiled.bounds_min, compiled.bounds_max
+    size = float(max(np.abs(lo).max(), np.abs(hi).max())) if np.all(np.isfinite(lo)) \
+        and np.all(np.isfinite(hi)) else 1.0
+    return RADIUS_ULPS * float(np.spacing(np.float32(max(size, 1.0))))
+
+
+def check_radius(compiled: CompiledScene, settings: CausticsSettings) -> None:
+    """:class:`SceneError` naming ``render.caustics.radius`` when it is set below what the
+    photons' positions can resolve in this scene (0, the default, chooses one)."""
+    if settings.radius == 0.0:
+        return
+    floor = smallest_radius(compiled)
+    if settings.radius < floor:
+        raise SceneError(f"{settings.radius:g} is smaller than the photons' positions can "
+                         f"resolve in this scene (at least {floor:.2g}; 0 chooses one)",
+                         where="render.caustics.radius")
 
 
 @builder
@@ -340,7 +364,11 @@ def shoot_pass(compiled: CompiledScene, rows: np.ndarray, clear: np.ndarray,
     """The records the photons of one pass store, in photon order (chunks of photons not
     started once ``cancelled()`` is true are left out: the render is being cancelled)."""
     from ..kernels.photons import trace_photons
+    from ..kernels.strict import strict
 
+    # compiled without fast-math (kernels/strict.py): the same photons on every CPU target,
+    # cold compiled or loaded from the cache
+    tracer = strict(trace_photons)
     settings = np.zeros(N_SET)
     settings[SET_SEED] = params.seed
     settings[SET_PASS] = pass_index
@@ -356,7 +384,7 @@ def shoot_pass(compiled: CompiledScene, rows: np.ndarray, clear: np.ndarray,
     def run(k: int) -> None:
         if cancelled():
             return
-        trace_photons(compiled.geometry, compiled.materials, clear,
+        tracer(compiled.geometry, compiled.materials, clear,
                       compiled.lights.table, rows, settings, int(bounds[k]),
                       int(bounds[k + 1]), out, counts,
                       np.empty(BVH_STACK, np.int32), np.empty(MAX_MEDIA, np.int32),
@@ -380,6 +408,7 @@ def photon_lights(compiled: CompiledScene, params: RenderParams, settings: Caust
 
     start = time.perf_counter()
     check_photon_memory(settings, threads)
+    check_radius(compiled, settings)
     stats = stats if stats is not None else PhotonStats()
     targets = caustic_targets(compiled)
     stats.warnings = [f"objects[{i}] reflects or refracts but is unbounded: it casts no "

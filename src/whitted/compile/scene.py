@@ -28,6 +28,7 @@ from ..kernels.layout import (
     GeometryArrays,
     LightArrays,
 )
+from ..scene.materials import Material
 from ..scene.scene import Scene
 from ..scene.shapes import CSG, Mesh
 from .csg import add_csg
@@ -150,7 +151,11 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
             continue
         if isinstance(shape, CSG):
             def emit_mesh(src, child, cm, mat, obj_index=obj_index):
-                own = child.material is None and child.file is not None and src.materials
+                # a mesh child without a material takes the CSG's, unless its file gives
+                # materials of its own (an OBJ's MTL): whitted's default for a file that
+                # names none is not one
+                own = (child.material is None and child.file is not None
+                       and any(x != Material() for x in src.materials))
                 rows = np.array([materials.add(x) for x in src.materials], np.int32)
                 first = b.rows
                 count = add_flat_mesh(b, meshes, src, rows, child, cm,

@@ -81,6 +81,10 @@ IMAGE_TYPES = {".png": "png", ".jpg": "jpeg", ".jpeg": "jpeg", ".tga": "tga", ".
                ".exr": "exr"}
 
 
+#: the largest photon ``count`` POV-Ray reads (a C int; a larger one wraps round)
+POV_MAX_COUNT = 2**31 - 1
+
+
 def pov_filter(mat: Material) -> float:
     """The pigment's ``filter`` that makes POV-Ray transmit what whitted does. Without
     ``fresnel`` it is ``kt``. With it, POV-Ray's ``conserve_energy`` passes
@@ -310,7 +314,13 @@ class _PovWriter:
         if c.photons == 0:
             return ""
         radius = f" radius {num(c.radius)}" if c.radius > 0 else ""
-        return (f"  photons {{ count {c.photons * c.passes} autostop 0 jitter 0.4 "
+        count = c.photons * c.passes
+        note = ""
+        if count > POV_MAX_COUNT:  # POV-Ray keeps the count in a C int: more wraps round
+            note = (f"  // whitted shoots {count} photons ({c.photons} x {c.passes} passes); "
+                    f"POV-Ray's count holds at most {POV_MAX_COUNT}\n")
+            count = POV_MAX_COUNT
+        return (f"{note}  photons {{ count {count} autostop 0 jitter 0.4 "
                 f"max_trace_level {self.scene.render.max_depth + 1} gather 20, 100"
                 f"{radius} }}\n")
 
@@ -420,6 +430,11 @@ class _PovWriter:
             if isinstance(child, CSG):
                 children.append(self.csg(index, child, mat, top=False))
                 continue
+            if isinstance(child, Mesh):  # POV-Ray takes a closed mesh2 in CSG
+                lines, _ = self.mesh2(child, mat)
+                children.append("\n".join([*lines, *self.body_lines(None, None,
+                                                                      child.transform)]) + "\n}")
+                continue
             body, _, uv, placement = self.primitive(index, child)
             lines = [body, f"  texture {{ {self.texture_name(mat, uv)}{placement} }}",
                      *self.body_lines(None, None, child.transform)]
@@ -489,6 +504,16 @@ class _PovWriter:
         return body, solid, uv, placement
 
     def mesh(self, index: int, obj: Mesh) -> str:
+        lines, material = self.mesh2(obj, None, index)
+        lines += self.body_lines(material if obj.solid else None, material, obj.transform)
+        return _labelled(index, obj) + "\n".join(lines) + "\n}"
+
+    def mesh2(self, obj: Mesh, material: Material | None,
+              index: int | None = None) -> tuple[list[str], Material]:
+        """The lines of a ``mesh2`` block up to its texture (the block left open), and the
+        material that fills it. ``material``: one material for every triangle (a mesh in
+        CSG, which whitted shades with its child's or the CSG object's material); None: the
+        object's own, or the file's per triangle."""
         parts = mesh_parts(self.scene, obj)
         normals = parts.normals
         if obj.smooth is False:
@@ -504,8 +529,8 @@ class _PovWriter:
         if parts.uvs is not None:
             block = _vector_block(parts.uvs, False)
             out.append(f"  uv_vectors {{ {len(parts.uvs)},\n{block}\n  }}")
-        per_face = (obj.material is None and parts.face_material is not None
-                    and len(parts.materials) > 1)
+        per_face = (material is None and obj.material is None
+                    and parts.face_material is not None and len(parts.materials) > 1)
         if per_face:
             names = [self.texture_name(m, True) for m in parts.materials]
             out.append(f"  texture_list {{ {len(names)}, "
@@ -521,11 +546,11 @@ class _PovWriter:
             candidates = [m for m in parts.materials if m.kt > 0.0] or parts.materials[:1]
             material = candidates[0]
         else:
-            material = (self.scene.material_of(index) if obj.material is not None or
-                        not parts.materials else parts.materials[0])
+            if material is None:
+                material = (self.scene.material_of(index) if obj.material is not None or
+                            not parts.materials else parts.materials[0])
             out.append(f"  texture {{ {self.texture_name(material, True)} }}")
-        out += self.body_lines(material if obj.solid else None, material, obj.transform)
-        return _labelled(index, obj) + "\n".join(out) + "\n}"
+        return out, material
 
     def write(self, source: str | None) -> str:
         r = self.scene.render

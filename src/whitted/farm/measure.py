@@ -70,9 +70,10 @@ def measure_local(scene, folder: Path, threads: int = 2) -> dict:
 
 def measure_cluster(scene, workers: int, folder: Path, overhead: bool,
                     dask_threads: int = 1) -> dict:
-    from . import render_film
+    from ..animation.film import render_film
     from ._dask import Client
     from .cluster import local_cluster
+    from .film import DaskFrames
     from .worker import WhittedWorker, warm_seconds
 
     row: dict = {"workers": workers, "threads_per_worker": dask_threads}
@@ -86,15 +87,16 @@ def measure_cluster(scene, workers: int, folder: Path, overhead: bool,
         row["plugin_warm_s"] = time.perf_counter() - start
         row["worker_warm_s"] = sorted(client.run(warm_seconds).values())
         start = time.perf_counter()
-        result = render_film(client, scene, folder, force=True)
+        result = render_film(scene, folder, force=True, executor=DaskFrames(client))
+        report = result.report
         row["wall_s"] = time.perf_counter() - start
         row["per_frame_worker_s"] = result.render_seconds / max(1, len(result.rendered))
-        row["per_frame_worker_cpu_s"] = result.render_cpu_seconds / max(1, len(result.rendered))
-        row["tasks"] = result.tasks
-        row["chunk"] = result.chunk
-        sizes = [p.stat().st_size for p in result.paths]
+        row["per_frame_worker_cpu_s"] = report.render_cpu_seconds / max(1, len(result.rendered))
+        row["tasks"] = report.tasks
+        row["chunk"] = report.chunk
+        sizes = [p.stat().st_size for p in result.files]
         row["png_bytes_mean"] = statistics.mean(sizes)
-        row["asset_bytes"] = result.asset_bytes
+        row["asset_bytes"] = report.asset_bytes
         if overhead:
             trips = []
             for i in range(30):

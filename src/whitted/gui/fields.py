@@ -86,7 +86,8 @@ def material_specs(material: Any) -> list[Spec]:
         Spec((*m, "ior"), "Refractive index", COEF, g, 1.0, 3.0, tip="ior, 0..10 (glass 1.5)"),
         Spec((*m, "attenuation"), "Attenuation", ATTEN, g, 0.0, 2.0,
              tip="absorption per unit length inside; a number or r, g, b"),
-        Spec((*m, "fresnel"), "Fresnel", BOOL, g, tip="split kt into reflection by Schlick"),
+        Spec((*m, "fresnel"), "Fresnel", BOOL, g,
+             tip="split kt into reflection by the Fresnel equations"),
     ]
     tex = getattr(material, "texture", None)
     if "texture" not in type(material).model_fields:

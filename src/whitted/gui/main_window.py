@@ -127,8 +127,8 @@ class MainWindow(QMainWindow):
         self.viewport.set_aspect(scene.render.width, scene.render.height)
         self.render_control.update_preview_target()
         if warm_up:
-            self.viewport.caption = "Loading the render kernels (the first run compiles them)…"
             self.controller.warm_up()
+            self.render_control.show_warm_up()
             self.ids.warm_up(self.doc.scene)
         self.navigation.reset()
         self.controller.request_preview(self.shown_scene())
@@ -150,25 +150,25 @@ class MainWindow(QMainWindow):
 
     def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
         super().resizeEvent(event)
-        if event.oldSize().isValid() and event.size().width() > event.oldSize().width():
-            QTimer.singleShot(0, self.restore_docks)
+        QTimer.singleShot(0, self.restore_docks)
 
     def restore_docks(self) -> None:
-        """After the window was made narrow (the panels squeezed), growing it gives the
-        panels their widths back before the picture grows (the picture keeps 480 px)."""
-        central = self.centralWidget()
-        spare = (central.width() if central is not None else 0) - 480
-        docks, widths = [], []
-        for dock, want in getattr(self, "_dock_widths", []):
-            if spare <= 0 or not dock.isVisible() or dock.isFloating() or \
-                    dock.width() >= want - 2:
-                continue
-            grow = min(want - dock.width(), spare)
-            spare -= grow
-            docks.append(dock)
-            widths.append(dock.width() + grow)
-        if docks:
-            self.resizeDocks(docks, widths, Qt.Orientation.Horizontal)
+        """The panels' widths at the window's largest size are remembered; when the window
+        comes back to that size (after it was made small and the panels squeezed), the
+        panels get those widths back (Qt would give all the new room to the picture)."""
+        docks = [d for d, _ in getattr(self, "_dock_widths", [])]
+        if not docks:
+            return
+        width = self.width()
+        memory = getattr(self, "_dock_memory", None)
+        widths = [d.width() for d in docks]
+        if memory is None or width > memory[0]:
+            self._dock_memory = (width, widths)
+        elif width >= memory[0] - 2:
+            if widths != memory[1] and all(d.isVisible() and not d.isFloating()
+                                           for d in docks):
+                self.resizeDocks(docks, memory[1], Qt.Orientation.Horizontal)
+            self._dock_memory = (width, [d.width() for d in docks])
 
     def _fit_window(self) -> None:
         w, h = WINDOW_SIZE

@@ -5,7 +5,7 @@ file renders), so the picture switches to camera view."""
 
 from __future__ import annotations
 
-from PySide6.QtCore import QEvent, QObject
+from PySide6.QtCore import QEvent, QObject, QTimer
 from PySide6.QtWidgets import QLabel, QProgressBar
 
 
@@ -113,8 +113,33 @@ class RenderControl(QObject):
             self.progress.hide()
         self.update_actions()
 
+    #: the captions of the kernels' loading (replaced as it goes, cleared when ready)
+    WARM_UP_CAPTIONS = ("Loading", "Compiling", "Waiting for another whitted")
+
+    def show_warm_up(self) -> None:
+        """While the kernels load, the picture says how it goes (twice a second)."""
+        if not hasattr(self, "_warm_timer"):
+            self._warm_timer = QTimer(self)
+            self._warm_timer.setInterval(500)
+            self._warm_timer.timeout.connect(self._warm_up_tick)
+        self._warm_timer.start()
+        self._warm_up_tick()
+
+    def _warm_up_tick(self) -> None:
+        if self.controller.kernels_loaded:
+            self._warm_timer.stop()
+            return
+        caption = self.viewport.caption
+        if not caption or caption.startswith(self.WARM_UP_CAPTIONS):
+            text = self.controller.warm_up_text()
+            if text != caption:
+                self.viewport.caption = text
+                self.viewport.update()
+
     def _kernels_ready(self, seconds: float) -> None:
-        if self.viewport.caption.startswith("Loading"):
+        if hasattr(self, "_warm_timer"):
+            self._warm_timer.stop()
+        if self.viewport.caption.startswith(self.WARM_UP_CAPTIONS):
             self.viewport.caption = ""
             self.viewport.update()
         if seconds > 1:

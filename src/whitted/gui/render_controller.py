@@ -169,7 +169,15 @@ class RenderController(QObject):
 
     def warm_up(self) -> None:
         """Compile or load the kernels on a background thread (the first render waits)."""
+        self._warm_started = time.perf_counter()
+
         def work() -> None:
+            from ..jit.cache import prepare
+
+            try:
+                self._kernel_cache = prepare()  # (what the warm-up uses: it says who waits)
+            except Exception:  # noqa: BLE001 - the warm-up reports a broken cache itself
+                self._kernel_cache = None
             self._warm_seconds = warm_up_kernels()
             self._warm.set()
 
@@ -179,6 +187,28 @@ class RenderController(QObject):
     @property
     def kernels_loaded(self) -> bool:
         return self._warm.is_set()
+
+    def warm_up_text(self) -> str:
+        """What the picture says while the kernels load: how far a first compile is, that
+        another whitted process is compiling them (this one waits, then loads its work), or
+        how long the loading has taken."""
+        from ..render.warm_up import compile_label, compile_progress
+
+        elapsed = time.perf_counter() - getattr(self, "_warm_started", time.perf_counter())
+        fraction = compile_progress()
+        if fraction is not None:
+            return (f"Compiling {compile_label()} (the first run only): {fraction:.0%}, "
+                    f"{elapsed:.0f} s")
+        cache = getattr(self, "_kernel_cache", None)
+        if cache is not None:
+            try:
+                busy = cache.others_compiling()
+            except Exception:  # noqa: BLE001 - only a caption
+                busy = False
+            if busy:
+                return ("Waiting for another whitted process, which is compiling the render "
+                        f"kernels ({elapsed:.0f} s); this one then loads them…")
+        return "Loading the render kernels…" + (f" {elapsed:.0f} s" if elapsed >= 1 else "")
 
     # ------------------------------------------------------------------ full renders
 

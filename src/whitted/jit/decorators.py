@@ -56,6 +56,10 @@ _numba_loaded = False  # Numba imported, extensions registered, kernels swapped
 _numba_imported = False  # the first two done (the swap may still be under way)
 _deferred: list = []  # registrations waiting for Numba: callables, run in order
 _defining_modules: set[str] = set()  # modules that defined kernels (swapped by load_numba)
+#: every kernel made, by its Python function, and every overload registered, by the function
+#: it implements: (implementation, options) (kernels/strict.py makes IEEE twins from them)
+kernels_by_function: dict = {}
+overloads_by_function: dict = {}
 
 
 def _jit_disabled() -> bool:
@@ -245,6 +249,8 @@ def overload(function, **options):
     """Numba's ``numba.extending.overload``, registered when Numba is loaded."""
 
     def decorate(implementation):
+        overloads_by_function[function] = (implementation, options)
+
         def register():
             from numba.extending import overload as numba_overload
 
@@ -282,6 +288,7 @@ def kernel(fn=None, *, entry: bool = False, **options):
         if _jit_disabled():
             return f
         made = Kernel(f, opts, specialise_constants, cache, entry)
+        kernels_by_function[f] = made
         if _numba_loaded and not entry:
             return made.dispatcher
         _defining_modules.add(f.__module__)

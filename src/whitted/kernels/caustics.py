@@ -19,7 +19,6 @@ from .layout import (
     GRID_BITS,
     GRID_INV_CELL,
     GRID_PASS,
-    GRID_PASSES,
     GRID_R2_MAX,
     MAT_KD,
     PHOTON_DIRECTION,
@@ -30,11 +29,6 @@ from .layout import (
 #: a photon counts at a point only when it lies within this fraction of the gather radius
 #: of the point's tangent plane (no light leaks round corners onto walls)
 PLANE_FRACTION = 0.5
-#: an estimate made of fewer photons than this fades out (to 0 at FEWEST_PHOTONS): where
-#: photons are sparse (light spread thin by a convex mirror), lone photons would show as
-#: blotches of the gather disc's size (POV-Ray's ``gather`` minimum does the same)
-MIN_PHOTONS = 8
-FEWEST_PHOTONS = 2
 
 
 def _photons_possible(lights_type) -> bool:
@@ -75,12 +69,14 @@ def caustic_irradiance(lights, p, n, shadows):
     """Irradiance (per channel) the photon map gives at point ``p`` of a surface whose unit
     normal ``n`` faces the side being shaded: the photons of each pass within that pass's
     radius of ``p``, arriving on that side and near the tangent plane, weighted by the
-    Epanechnikov kernel ``2 / (pi r^2) (1 - d^2 / r^2)``, averaged over the passes. The
-    caustic photons' estimate fades out where fewer than MIN_PHOTONS per pass are found;
-    with ``shadows`` the shadow photons' (negative: the light the direct term counts and the
-    clear bodies take away) is added, whole. The grid's cells are the largest radius: the
-    ball around ``p`` meets at most 3x3x3 of them, each its own row of the hash table
-    (:func:`cell_hash`)."""
+    Epanechnikov kernel ``2 / (pi r^2) (1 - d^2 / r^2)``, averaged over the passes; with
+    ``shadows`` the shadow photons' estimate (negative: the light the direct term counts and
+    the clear bodies take away) is added, made the same way. The two are one estimator, never
+    faded or cut where photons are few: each photon's kernel integrates to its power, so the
+    light a region gets is counted in full however thinly it is spread, and where a clear
+    body bends nothing its caustic and shadow photons cancel exactly. The grid's cells are the
+    largest radius: the ball around ``p`` meets at most 3x3x3 of them, each its own row of
+    the hash table (:func:`cell_hash`)."""
     grid = lights.photon_grid
     photons = lights.photons
     cells = lights.photon_cells
@@ -100,7 +96,6 @@ def caustic_irradiance(lights, p, n, shadows):
     s0 = 0.0
     s1 = 0.0
     s2 = 0.0
-    found = 0
     for ix in range(ix0, ix1 + 1):
         for iy in range(iy0, iy1 + 1):
             for iz in range(iz0, iz1 + 1):
@@ -132,17 +127,9 @@ def caustic_irradiance(lights, p, n, shadows):
                         s1 += w * c1
                         s2 += w * c2
                         continue
-                    found += 1
                     e0 += w * c0
                     e1 += w * c1
                     e2 += w * c2
-    passes = grid[GRID_PASSES]
-    if found < MIN_PHOTONS * passes:
-        fade = max(0.0, (found - FEWEST_PHOTONS * passes) / ((MIN_PHOTONS - FEWEST_PHOTONS)
-                                                              * passes))
-        e0 *= fade
-        e1 *= fade
-        e2 *= fade
     if shadows:
         return e0 + s0, e1 + s1, e2 + s2
     return e0, e1, e2

@@ -67,13 +67,21 @@ def refract(d, n, eta):
 
 
 @kernel
-def schlick(cos_i, n1, n2, cos_t):
-    """Schlick's Fresnel reflectance; uses the cosine on the denser side."""
-    r0 = (n1 - n2) / (n1 + n2)
-    r0 *= r0
-    c = cos_i if n1 <= n2 else cos_t
-    x = 1.0 - c
-    return r0 + (1.0 - r0) * x * x * x * x * x
+def fresnel(cos_i, n1, n2, cos_t):
+    """The exact Fresnel reflectance for unpolarised light at a surface between two
+    dielectrics (indices ``n1`` on the side the ray arrives from, ``n2`` beyond), given the
+    cosines of the angles of incidence and refraction (both >= 0; no total internal
+    reflection): the mean of the s- and p-polarised reflectances. Equal indices reflect
+    nothing; grazing incidence reflects everything."""
+    a = n1 * cos_i
+    b = n2 * cos_t
+    c = n1 * cos_t
+    e = n2 * cos_i
+    if a + b <= 0.0 or c + e <= 0.0:
+        return 1.0
+    rs = (a - b) / (a + b)
+    rp = (c - e) / (c + e)
+    return min(1.0, 0.5 * (rs * rs + rp * rp))
 
 
 @kernel(inline="always")
@@ -88,7 +96,7 @@ def split_at_surface(geo, mats, prim, m, entering, media, n_media, scratch, d, n
     if not ok:  # total internal reflection: the reflected ray carries it all
         return False, tdir, kr + kt, 0.0, n_out
     if mats[m, MAT_FRESNEL] != 0.0:
-        f = schlick(-dot(d, n_shade), n1, n2, -dot(tdir, n_shade))
+        f = fresnel(-dot(d, n_shade), n1, n2, -dot(tdir, n_shade))
         return True, tdir, kr + kt * f, kt * (1.0 - f), n_out
     return True, tdir, kr, kt, n_out
 

@@ -22,6 +22,12 @@ way: every root of the cubic first, cutting monotonic pieces. A root where the q
 touches zero (a ray exactly tangent to the surface) is no crossing
 and is not reported. Every root is computed from the ray alone, not from ``tmin``: asking
 again from past one root gives the next one exactly (CSG walks rely on it).
+
+A spindle torus (minor radius above the major) is the solid of every point within the minor
+radius of the centre circle: the lemon-shaped region around the centre, where the tube
+overlaps itself, is inside it. The quartic also vanishes on that lemon's surface; those
+crossings bound nothing and are dropped, so a ray meets only the outer (apple-shaped)
+surface, in the renderer and in CSG alike.
 """
 
 from __future__ import annotations
@@ -231,14 +237,54 @@ def _axis_distance2(o, d, s):
 @kernel
 def torus_roots(o, d, major, minor):
     """The crossings of the ray (o, d) (torus space: centre 0, axis y) with the torus: four
-    ray parameters, sorted, inf-padded (a tangent touch is no crossing)."""
+    ray parameters, sorted, inf-padded (a tangent touch is no crossing). A spindle torus's
+    (minor > major) inner lemon is inside the solid: its crossings are left out
+    (:func:`_outer_only`)."""
     near, shift, inv, a, b, c, e, lo, hi, q0, q1 = torus_quartic(o, d, major, minor)
     if not near:
         return INF, INF, INF, INF
     ok, r0, r1, r2, r3 = _roots_by_curvature(a, b, c, e, lo, hi, q0, q1)
     if not ok:
         r0, r1, r2, r3 = _roots_by_cubic(a, b, c, e, lo, hi, q0, q1)
-    return ((r0 + shift) * inv, (r1 + shift) * inv, (r2 + shift) * inv, (r3 + shift) * inv)
+    r0, r1, r2, r3 = ((r0 + shift) * inv, (r1 + shift) * inv, (r2 + shift) * inv,
+                      (r3 + shift) * inv)
+    if minor > major:
+        return _outer_only(o, d, major, minor, r0, r1, r2, r3)
+    return r0, r1, r2, r3
+
+
+@kernel(inline="always")
+def _on_lemon(o, d, major, minor, t):
+    """Is the crossing at ray parameter ``t`` on a spindle torus's inner lemon? The quartic
+    is the surface swept by the whole tube circle: a point at distance rho from the axis
+    lies on the outer surface where (rho - R)^2 + y^2 = r^2, on the lemon (the circle's part
+    across the axis, swept) where (rho + R)^2 + y^2 = r^2, i.e. (rho - R)^2 + y^2 =
+    r^2 - 4 rho R: inside the tube. The test splits the difference."""
+    if t == INF:
+        return False
+    x = o[0] + t * d[0]
+    y = o[1] + t * d[1]
+    z = o[2] + t * d[2]
+    rho = math.sqrt(x * x + z * z)
+    return (rho - major) * (rho - major) + y * y < minor * minor - 2.0 * rho * major
+
+
+@kernel
+def _outer_only(o, d, major, minor, r0, r1, r2, r3):
+    """The crossings r0..r3 (sorted, inf-padded) without those on a spindle torus's inner
+    lemon: the solid is every point within the minor radius of the centre circle, the lemon
+    included (as POV-Ray 3.7's inside test has it), so the lemon's surface bounds nothing
+    and the solid's inside is where an odd number of the crossings left lie behind."""
+    n, out0, out1, out2, out3 = 0, INF, INF, INF, INF
+    if not _on_lemon(o, d, major, minor, r0):
+        n, out0, out1, out2, out3 = _append(n, r0, out0, out1, out2, out3)
+    if not _on_lemon(o, d, major, minor, r1):
+        n, out0, out1, out2, out3 = _append(n, r1, out0, out1, out2, out3)
+    if not _on_lemon(o, d, major, minor, r2):
+        n, out0, out1, out2, out3 = _append(n, r2, out0, out1, out2, out3)
+    if not _on_lemon(o, d, major, minor, r3):
+        n, out0, out1, out2, out3 = _append(n, r3, out0, out1, out2, out3)
+    return out0, out1, out2, out3
 
 
 @kernel(inline="always")

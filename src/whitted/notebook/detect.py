@@ -13,7 +13,7 @@ import importlib.util
 import os
 import sys
 
-__all__ = ["in_notebook", "widgets_installed"]
+__all__ = ["in_notebook", "live_view", "widgets_installed"]
 
 
 def widgets_installed() -> bool:
@@ -52,3 +52,15 @@ def in_notebook() -> bool:
     if forced in ("1", "true", "yes", "on"):
         return True
     return _kernel_shell()
+
+
+def live_view(live: bool | None) -> bool:
+    """Whether a call shows its widgets: ``live`` None -> :func:`in_notebook`; True needs the
+    ``notebook`` extra (one-line :class:`~whitted.WhittedError` without it)."""
+    if live is None:
+        return in_notebook()
+    if live and not widgets_installed():
+        from ..errors import WhittedError
+
+        raise WhittedError("live=True needs ipywidgets: pip install 'whitted[notebook]'")
+    return bool(live)

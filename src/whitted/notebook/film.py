@@ -12,7 +12,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from .detect import in_notebook
+from .detect import live_view
 
 if TYPE_CHECKING:
     from ..animation.sheet import ContactSheet
@@ -73,7 +73,7 @@ def render_film(
         output = folder / ("film.mp4" if mp4_encoder() else "film.gif")
     plan = prepare_film(scene, output, frames=frames, fps=fps, crf=crf, scene_path=scene_path)
     cancel = cancel or CancelToken()
-    live = in_notebook() if live is None else live
+    live = live_view(live)
     view = None
     progress = None
     if live:
@@ -166,7 +166,7 @@ def sweep(
 
     scene, _ = _scene(scene, settings)
     cancel = cancel or CancelToken()
-    live = in_notebook() if live is None else live
+    live = live_view(live)
     if not live:
         return render_sweep(scene, values, columns=columns, title=title, threads=threads,
                             cancel=cancel)

@@ -4,10 +4,10 @@ as tiles finish, and a Stop button.
 The render runs on its own thread (:meth:`RenderJob.start`); the notebook's thread watches it
 and repaints. The render's progress callback only notes which tiles finished (a list append):
 converting them to sRGB, encoding the picture and sending it to the browser happen on the
-watching thread, at most :data:`MAX_RATE` times a second and never taking more than
-:data:`BUDGET` of the time (a slow encode spaces the updates out), so the view slows the
-render by a few per cent at most. Between updates only the rows of the tiles finished since
-the last one are converted.
+watching thread, at most :data:`MAX_RATE` times a second and, all together, never more than
+:data:`BUDGET` of the time since the render began (slow encodes space the updates out), so
+the view slows the render by a few per cent at most. Between updates only the rows of the
+tiles finished since the last one are converted.
 
 Stopping keeps the picture so far: the Stop button (while the kernel can hear it: in
 ``await whitted.render_async(...)``; a running cell holds the kernel, so a plain call stops
@@ -40,9 +40,11 @@ MAX_RATE = 4.0
 #: The live picture's longest side in pixels at most: a bigger render is shown every n-th
 #: pixel while it runs (the browser scales it up), so an update costs the same at any size.
 PREVIEW_SIDE = 512
-#: The watching thread's own work (converting, encoding, sending) takes at most this part of
-#: the time: an update that took 10 ms waits 0.5 s for the next.
-BUDGET = 0.02
+#: The watching thread's own work (converting, encoding, sending), all updates together,
+#: takes at most this part of the time since the render began: 30 ms of updates in the first
+#: second hold the next one back to 1 s. (It competes with the render's lanes for the cores
+#: and the GIL: a render on one core is slowed by this part at most, on more cores by less.)
+BUDGET = 0.03
 
 
 def _widgets():
@@ -165,7 +167,7 @@ class LiveRender:
         spent = time.perf_counter() - now
         self.view_seconds += spent
         self.longest_update = max(self.longest_update, spent)
-        self._next = now + max(1.0 / MAX_RATE, spent / BUDGET)
+        self._next = max(now + 1.0 / MAX_RATE, self.started + self.view_seconds / BUDGET)
 
     def _paint(self, final: bool = False) -> None:
         with self._lock:

@@ -11,7 +11,7 @@ import os
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from .detect import in_notebook
+from .detect import live_view
 
 if TYPE_CHECKING:
     from ..output.image import Image
@@ -55,8 +55,7 @@ def render(
     kernel stops it and the tiles finished are returned (``image.meta["stats"].cancelled``).
     Everywhere else (``live=False``, a terminal, a script, no ``notebook`` extra) it is
     :func:`whitted.render.api.render`."""
-    if live is None:
-        live = in_notebook()
+    live = live_view(live)
     if not live:
         from ..render.api import render as plain
 
@@ -84,8 +83,7 @@ async def render_async(
     thread and awaits it."""
     import asyncio
 
-    if live is None:
-        live = in_notebook()
+    live = live_view(live)
     job = _job(scene, progress, cancel, overrides)
     if not live:
         job.start()

@@ -11,7 +11,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from .detect import in_notebook
+from .detect import live_view
 
 if TYPE_CHECKING:
     from ..stefan.case import Case
@@ -77,7 +77,7 @@ def run_stefan(
     the_case, text, path = _case(case, changes)
     out = Path(tempfile.mkdtemp(prefix="whitted-stefan-")) if out is None else Path(out)
     cancel = CancelToken()
-    live = in_notebook() if live is None else live
+    live = live_view(live)
     view = None
     progress = None
     if live:

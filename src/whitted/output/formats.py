@@ -5,7 +5,11 @@ top of the picture. This module turns it into files:
 
 * HDR formats (``.exr``, ``.pfm``, ``.npy``) always store the raw linear float32 data: no tone
   mapping, no transfer curve, NaN and infinities kept as they are.
-* LDR formats (``.png``, ``.jpg``/``.jpeg``) go through tonemap -> transfer -> quantize.
+* LDR formats (``.png``, ``.jpg``/``.jpeg``, ``.tif``/``.tiff``, ``.webp``) go through
+  tonemap -> transfer -> quantize.
+* An alpha channel (a coverage plane, 0 where the primary rays missed everything) goes into
+  PNG, TIFF and WebP as straight (unassociated) alpha, and into EXR and NPY with the colour
+  premultiplied, as those formats expect; JPEG and PFM have none.
 
 Every file is written atomically (see :func:`atomic_write`): a reader never sees a partial file.
 """
@@ -36,6 +40,7 @@ from .colour import (
 _apply_tonemap = tonemap  # the name ``tonemap`` is shadowed by keyword parameters below
 
 __all__ = [
+    "ALPHA_FORMATS",
     "FORMATS",
     "HDR_FORMATS",
     "LDR_FORMATS",
@@ -45,6 +50,7 @@ __all__ = [
     "check_bit_depth",
     "check_pixels",
     "check_tonemap",
+    "check_image_options",
     "check_transfer",
     "encode_ldr",
     "image_format",
@@ -62,12 +68,19 @@ FORMATS: dict[str, str] = {
     ".png": "png",
     ".jpg": "jpeg",
     ".jpeg": "jpeg",
+    ".tif": "tiff",
+    ".tiff": "tiff",
+    ".webp": "webp",
     ".exr": "exr",
     ".pfm": "pfm",
     ".npy": "npy",
 }
 HDR_FORMATS: frozenset[str] = frozenset({"exr", "pfm", "npy"})
-LDR_FORMATS: frozenset[str] = frozenset({"png", "jpeg"})
+LDR_FORMATS: frozenset[str] = frozenset({"png", "jpeg", "tiff", "webp"})
+#: formats that hold an alpha channel
+ALPHA_FORMATS: frozenset[str] = frozenset({"png", "tiff", "webp", "exr", "npy"})
+#: formats whose encoder takes a quality (1..100; WebP without one is lossless)
+QUALITY_FORMATS: frozenset[str] = frozenset({"jpeg", "webp"})
 
 JPEG_QUALITY = 95  # written with 4:4:4 chroma (no subsampling): renders have sharp colour edges
 #: zlib level of PNG stills (output/png.py). Measured on renders (809x817 seed000, 800x300,
@@ -90,8 +103,24 @@ def image_format(path: PathLike) -> str:
         return FORMATS[suffix.lower()]
     except KeyError:
         raise ArgumentError(
-            f"unsupported image format '{suffix}' (use .png, .jpg, .exr, .pfm or .npy)"
+            f"unsupported image format '{suffix}' (use .png, .jpg, .tif, .webp, .exr, .pfm "
+            "or .npy)"
         ) from None
+
+
+def check_image_options(fmt: str, *, alpha: bool = False, quality: int | None = None) -> None:
+    """ArgumentError (one line) when ``fmt`` cannot take an alpha channel or a quality."""
+    if alpha and fmt not in ALPHA_FORMATS:
+        raise ArgumentError(f"{fmt.upper()} has no alpha channel (use .png, .tif, .webp, .exr "
+                            "or .npy)")
+    if quality is not None:
+        if isinstance(quality, bool) or not isinstance(quality, int) \
+                or not 1 <= quality <= 100:
+            raise ArgumentError(f"quality must be a whole number from 1 to 100, got "
+                                f"{quality!r}")
+        if fmt not in QUALITY_FORMATS:
+            raise ArgumentError(f"a quality is for .jpg and .webp, not {fmt.upper()} "
+                                "(lossless)")
 
 
 
@@ -143,16 +172,43 @@ def _write_png(tmp: str, pixels: np.ndarray, transfer: str, tonemap: str, bits: 
         write_png(f, h, w, bits, encode_rows, PNG_COMPRESS_LEVEL)
 
 
-def _write_jpeg(tmp: str, pixels: np.ndarray, transfer: str, tonemap: str) -> None:
-    _pil_rgb(pixels, transfer, tonemap).save(tmp, format="JPEG", quality=JPEG_QUALITY,
-                                             subsampling=0)
+def _write_jpeg(tmp: str, pixels: np.ndarray, transfer: str, tonemap: str,
+                quality: int | None = None) -> None:
+    _pil_rgb(pixels, transfer, tonemap).save(tmp, format="JPEG",
+                                             quality=quality or JPEG_QUALITY, subsampling=0)
 
 
-def _write_exr(tmp: str, data: np.ndarray) -> None:
+def _with_alpha(image, alpha: np.ndarray | None):
+    """The Pillow RGB image with ``alpha`` (0..1, straight) as its A channel (RGBA)."""
+    if alpha is None:
+        return image
+    from PIL import Image as PILImage
+
+    image.putalpha(PILImage.fromarray(quantize(np.clip(alpha, 0.0, 1.0), 8)))
+    return image
+
+
+def _write_pillow(tmp: str, fmt: str, pixels: np.ndarray, transfer: str, tonemap: str,
+                  alpha: np.ndarray | None, quality: int | None) -> None:
+    """TIFF (deflate) or WebP (lossless, or lossy at ``quality``), through Pillow."""
+    image = _with_alpha(_pil_rgb(pixels, transfer, tonemap), alpha)
+    if fmt == "tiff":
+        image.save(tmp, format="TIFF", compression="tiff_adobe_deflate")
+    elif quality is None:
+        image.save(tmp, format="WEBP", lossless=True, quality=100, method=4)
+    else:
+        image.save(tmp, format="WEBP", quality=quality, method=4)
+
+
+def _write_exr(tmp: str, data: np.ndarray, alpha: np.ndarray | None = None) -> None:
     import OpenEXR
 
     header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
-    OpenEXR.File(header, {"RGB": data}).write(tmp)
+    if alpha is None:
+        OpenEXR.File(header, {"RGB": data}).write(tmp)
+        return
+    rgba = np.concatenate([data, alpha[..., None].astype(np.float32)], axis=2)
+    OpenEXR.File(header, {"RGBA": np.ascontiguousarray(rgba)}).write(tmp)
 
 
 def _write_pfm(tmp: str, data: np.ndarray) -> None:
@@ -177,26 +233,71 @@ def write_image(
     bit_depth: int = 8,
     transfer: str = "srgb",
     tonemap: str = "clamp",
+    alpha: np.ndarray | None = None,
+    quality: int | None = None,
 ) -> pathlib.Path:
     """Write linear float pixels (H, W, 3) to ``path`` atomically, format by extension.
 
     ``.exr`` / ``.pfm`` / ``.npy`` get the raw linear float32 data (``transfer`` and
-    ``tonemap`` are ignored); ``.png`` (8 or 16-bit, encoded on threads: output/png.py) and
-    ``.jpg``/``.jpeg`` (8-bit, quality 95) get tonemap -> transfer -> quantize. Everything is
-    validated before the disk is touched. Returns ``path`` as a :class:`pathlib.Path`.
+    ``tonemap`` are ignored); ``.png`` (8 or 16-bit, encoded on threads: output/png.py),
+    ``.jpg``/``.jpeg`` (8-bit, ``quality`` 95 unless given), ``.tif``/``.tiff`` (8-bit,
+    deflate) and ``.webp`` (lossless, or lossy at ``quality``) get tonemap -> transfer ->
+    quantize. ``alpha``: an (H, W) coverage plane in 0..1 for the formats that hold one, with
+    ``pixels`` straight (not premultiplied): LDR files store it so, EXR and NPY store the
+    colour premultiplied by it (RGBA). Everything is validated before the disk is touched.
+    Returns ``path`` as a :class:`pathlib.Path`.
     """
     fmt = image_format(path)
     check_transfer(transfer)
     check_tonemap(tonemap)
     check_bit_depth(bit_depth, fmt)
+    check_image_options(fmt, alpha=alpha is not None, quality=quality)
     data = check_pixels(pixels)
+    if alpha is not None:
+        alpha = np.asarray(alpha, dtype=np.float32)
+        if alpha.shape != data.shape[:2]:
+            raise ArgumentError(f"alpha must be (height, width) = {data.shape[:2]}, got "
+                                f"{alpha.shape}")
 
     if fmt in HDR_FORMATS:
+        if alpha is not None:  # premultiplied, as EXR readers expect
+            premultiplied = data * alpha[..., None]
+            if fmt == "exr":
+                return atomic_write(path, lambda tmp: _write_exr(tmp, premultiplied, alpha))
+            rgba = np.concatenate([premultiplied, alpha[..., None]], axis=2)
+            return atomic_write(path, lambda tmp: _write_npy(tmp, rgba))
         writer = {"exr": _write_exr, "pfm": _write_pfm, "npy": _write_npy}[fmt]
         return atomic_write(path, lambda tmp: writer(tmp, data))
     if fmt == "jpeg":
-        return atomic_write(path, lambda tmp: _write_jpeg(tmp, data, transfer, tonemap))
+        return atomic_write(path, lambda tmp: _write_jpeg(tmp, data, transfer, tonemap,
+                                                          quality))
+    if fmt in ("tiff", "webp"):
+        return atomic_write(path, lambda tmp: _write_pillow(tmp, fmt, data, transfer, tonemap,
+                                                            alpha, quality))
+    if alpha is not None:
+        return atomic_write(path, lambda tmp: _write_png_alpha(tmp, data, alpha, transfer,
+                                                               tonemap, bit_depth))
     return atomic_write(path, lambda tmp: _write_png(tmp, data, transfer, tonemap, bit_depth))
+
+
+def _write_png_alpha(tmp: str, pixels: np.ndarray, alpha: np.ndarray, transfer: str,
+                     tonemap: str, bits: int) -> None:
+    """An RGBA PNG (8 or 16-bit) through Pillow (output/png.py writes RGB only)."""
+    from PIL import Image as PILImage
+
+    rgb = encode_ldr(pixels, bits=bits, transfer=transfer, tonemap=tonemap)
+    a = quantize(np.clip(alpha, 0.0, 1.0), bits)
+    rgba = np.concatenate([rgb, a[..., None]], axis=2)
+    if bits == 8:
+        PILImage.fromarray(rgba, "RGBA").save(tmp, format="PNG",
+                                             compress_level=PNG_COMPRESS_LEVEL)
+        return
+    import png as pypng  # 16-bit RGBA: Pillow has no such mode
+
+    with open(tmp, "wb") as f:
+        writer = pypng.Writer(pixels.shape[1], pixels.shape[0], bitdepth=16, greyscale=False,
+                              alpha=True)
+        writer.write(f, rgba.reshape(pixels.shape[0], -1))
 
 
 # --------------------------------------------------------------------------------------------
@@ -302,9 +403,10 @@ def read_image(path: PathLike, *, transfer: str = "srgb") -> np.ndarray:
     """Read an image file as a float32 (H, W, 3) linear array, row 0 at the top.
 
     ``.exr``, ``.pfm`` and ``.npy`` are returned as stored. ``.png`` (8- or 16-bit, any colour
-    type) and ``.jpg``/``.jpeg`` are normalised to [0, 1] and decoded with ``transfer``: the
-    sRGB curve by default, or ``"linear"`` for files holding linear data (e.g. written with
-    ``transfer="linear"``). Grey images are expanded to RGB and alpha is dropped.
+    type), ``.jpg``/``.jpeg``, ``.tif``/``.tiff`` and ``.webp`` are normalised to [0, 1] and
+    decoded with ``transfer``: the sRGB curve by default, or ``"linear"`` for files holding
+    linear data (e.g. written with ``transfer="linear"``). Grey images are expanded to RGB
+    and alpha is dropped.
     """
     check_transfer(transfer)
     fmt = image_format(path)

@@ -94,12 +94,17 @@ class Image:
         bit_depth: int = 8,
         transfer: str | None = None,
         tonemap: str | None = None,
+        alpha: np.ndarray | None = None,
+        quality: int | None = None,
     ) -> pathlib.Path:
         """Write the image atomically; the format comes from the extension of ``path``.
 
         ``.png`` (``bit_depth`` 8 or 16), ``.jpg``/``.jpeg`` (8-bit, quality 95): tonemap ->
         transfer -> quantize, using this image's ``transfer`` / ``tonemap`` unless overridden.
-        ``.exr``, ``.pfm``, ``.npy``: raw linear float32. ValueError for an unknown extension,
+        ``.tif``/``.tiff``, ``.webp``: 8-bit, as .png (WebP lossless, or lossy at
+        ``quality``). ``.exr``, ``.pfm``, ``.npy``: raw linear float32. ``alpha``: an (H, W)
+        coverage plane for .png, .tif, .webp (straight) and .exr, .npy (premultiplied)
+        (:func:`whitted.output.formats.write_image`). ValueError for an unknown extension,
         transfer or tonemap, or a bit depth other than 8 (16 is accepted for .png only).
         Returns the path written.
         """
@@ -109,6 +114,8 @@ class Image:
             bit_depth=bit_depth,
             transfer=self.transfer if transfer is None else transfer,
             tonemap=self.tonemap if tonemap is None else tonemap,
+            alpha=alpha,
+            quality=quality,
         )
 
     @classmethod

@@ -13,6 +13,7 @@ import base64
 import html
 import os
 import re
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -27,13 +28,13 @@ _NUMBERED = re.compile(r"(\d+)\.png$", re.IGNORECASE)
 
 
 def mp4_encoder() -> bool:
-    """An MP4 encoder is there: imageio-ffmpeg and the ffmpeg it finds."""
+    """An MP4 encoder is there: imageio-ffmpeg's ffmpeg, or an ``ffmpeg`` on the PATH."""
     try:
         import imageio_ffmpeg
 
         return bool(imageio_ffmpeg.get_ffmpeg_exe())
     except (ImportError, RuntimeError, OSError):
-        return False
+        return shutil.which("ffmpeg") is not None
 
 
 def frame_files(folder: str | os.PathLike[str]) -> list[Path]:

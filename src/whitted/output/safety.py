@@ -12,6 +12,7 @@ from pathlib import Path
 
 from ..errors import OutputError
 from ..files import kind_of, same_file
+from ..files.memory import memory_room
 
 #: Bytes per pixel held while rendering (the float32 RGB framebuffer).
 FRAMEBUFFER_BYTES = 12
@@ -68,7 +69,7 @@ def input_files(scene: object, scene_path: str | os.PathLike[str] | None) -> lis
         except (OSError, RuntimeError, ValueError):
             continue
         files.append(path)
-        if keys[-1] == "file" and keys[0] == "objects" and len(keys) == 3:
+        if len(keys) >= 3 and keys[-1] == "file" and keys[-3] == "objects":
             # a model's own material libraries and textures (loaded once, cached for the
             # render; a model that cannot be loaded is reported by the render itself)
             try:
@@ -97,15 +98,10 @@ def check_outputs(outputs: Iterable[str | os.PathLike[str]], scene: object = Non
 
 
 def available_memory() -> int | None:
-    """Bytes of memory available to a new allocation (Linux's MemAvailable), or None."""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        return None
-    return None
+    """Bytes of memory this process may still allocate: the machine's free memory or the
+    process's own limit (``ulimit -v``, RLIMIT_AS), the tighter; None when unknown."""
+    room = memory_room()
+    return None if room is None else room.bytes
 
 
 def memory_need(width: int, height: int, fmt: str) -> int:
@@ -116,8 +112,8 @@ def memory_need(width: int, height: int, fmt: str) -> int:
 def check_memory(width: int, height: int, fmt: str, bit_depth: int = 8) -> None:
     """:class:`OutputError` before the work starts when the image cannot be held and written."""
     need = memory_need(width, height, fmt)
-    have = available_memory()
-    if have is not None and need > have:
+    room = memory_room()
+    if room is not None and need > room.bytes:
         raise OutputError(
             f"a {width}x{height} render to .{fmt} needs about {need / 2**30:.1f} GiB of memory; "
-            f"{have / 2**30:.1f} GiB is available")
+            f"{room.describe()}")

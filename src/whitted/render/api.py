@@ -184,13 +184,17 @@ def run_lanes(fn: Callable[[int, int], object], lanes: int, pool: ThreadPoolExec
 
 
 def tile_grid(width: int, height: int, tile: int = DEFAULT_TILE,
-              rows: tuple[int, int] | None = None) -> np.ndarray:
+              rows: tuple[int, int] | None = None,
+              region: tuple[int, int, int, int] | None = None) -> np.ndarray:
     """All tiles of the image in row-major order, rows of (x0, y0, x1, y1); only those of the
-    image rows ``rows = (start, stop)`` when given."""
-    y_start, y_stop = (0, height) if rows is None else rows
-    xs = np.arange(0, width, tile)
+    image rows ``rows = (start, stop)`` when given, and only those covering ``region = (x0,
+    y0, x1, y1)`` (pixels, ends excluded), cut to it, when given."""
+    x_start, y_start, x_stop, y_stop = (0, 0, width, height) if region is None else region
+    if rows is not None:
+        y_start, y_stop = max(y_start, rows[0]), min(y_stop, rows[1])
+    xs = np.arange(x_start, x_stop, tile)
     ys = np.arange(y_start, y_stop, tile)
-    grid = [(x, y, min(x + tile, width), min(y + tile, y_stop)) for y in ys for x in xs]
+    grid = [(x, y, min(x + tile, x_stop), min(y + tile, y_stop)) for y in ys for x in xs]
     return np.array(grid, dtype=np.int32).reshape(-1, 4)
 
 
@@ -208,10 +212,18 @@ class RenderJob:
         tile_size: int = DEFAULT_TILE,
         compiled: CompiledScene | None = None,
         rows: tuple[int, int] | None = None,
+        region: tuple[int, int, int, int] | None = None,
+        resume: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> None:
         """``scene``: a Scene (or the path of a scene file); ``threads``: 1..1024, 0 or None
         for the scene's setting (0 there: every core); ``tile_size``: pixels per tile side,
-        1..4096. Bad arguments raise :class:`~whitted.errors.ArgumentError`."""
+        1..4096; ``region``: render only the pixels (x0, y0, x1, y1) (ends excluded) of the
+        full-size image, the rest black; ``resume``: (the tiles already finished, a bool per
+        tile of :attr:`tiles`, and the framebuffer holding them) of an earlier job of the
+        same scene, region and tile size: only the others are rendered, and the image is the
+        one an uninterrupted job makes, byte for byte (a pixel does not depend on the tile or
+        the lane that renders it). Bad arguments raise
+        :class:`~whitted.errors.ArgumentError`."""
         scene = _as_scene(scene)
         if scene.is_animated:  # an animated scene renders as its first frame
             scene = scene.at_frame(0)
@@ -234,7 +246,25 @@ class RenderJob:
         self.rendering = False  # True while tiles are being rendered (after the compile)
         #: render only the image rows [start, stop) (the farm's bands); the other rows stay 0
         self.rows = None if rows is None else _checked_rows(rows, self.settings.height)
+        self.region = None if region is None else _checked_region(
+            region, self.settings.width, self.settings.height)
+        #: the job's tiles, rows of (x0, y0, x1, y1), in the order they are taken
+        self.tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size,
+                               self.rows, self.region)
+        #: which of :attr:`tiles` are finished (kept in the framebuffer)
+        self.tiles_finished = np.zeros(len(self.tiles), bool)
         self.framebuffer = np.zeros((self.settings.height, self.settings.width, 3), np.float32)
+        if resume is not None:
+            finished, framebuffer = resume
+            finished = np.asarray(finished, dtype=bool)
+            if finished.shape != self.tiles_finished.shape or \
+                    np.shape(framebuffer) != self.framebuffer.shape:
+                raise ArgumentError(f"resume: {finished.shape[0] if finished.ndim else 0} "
+                                    f"tiles and a {np.shape(framebuffer)} framebuffer do not "
+                                    f"fit this job's {len(self.tiles)} tiles of a "
+                                    f"{self.framebuffer.shape} image")
+            self.tiles_finished[:] = finished
+            self.framebuffer[:] = framebuffer
         self.stats = RenderStats(
             width=self.settings.width,
             height=self.settings.height,
@@ -291,6 +321,10 @@ class RenderJob:
         """The picture as it is now as display values: uint8 (H, W, 3), the scene's tone map
         and transfer (sRGB by default), tiles not rendered yet black."""
         return self.partial_image().to_srgb8()
+
+    def _repr_png_(self) -> bytes:
+        """The picture so far, for a notebook's rich display."""
+        return self.partial_image()._repr_png_()
 
     def __repr__(self) -> str:
         s = self.settings
@@ -402,7 +436,8 @@ class RenderJob:
         if self.settings.caustics.photons > 0:  # the photon map (compile/photon_map.py)
             with caustics_compile():  # the first time: compiling, shown as such
                 lights, photon_seconds = self._caustics_stage(compiled, params, stats)
-        tiles = tile_grid(self.settings.width, self.settings.height, self.tile_size, self.rows)
+        tiles = self.tiles
+        todo = np.flatnonzero(~self.tiles_finished)  # all of them, unless resumed
         counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
         stats.tiles_total = self.tiles_total = len(tiles)
         lanes = self.threads
@@ -423,12 +458,13 @@ class RenderJob:
                                   float(antialias.threshold), levels, 0, 1)
             stats.compile_seconds += time.perf_counter() - start
         render_start = time.perf_counter() - photon_seconds  # shooting photons is rendering
-        done = 0
+        done = len(tiles) - len(todo)
+        self.tiles_done = done
         lock = threading.Lock()
         self.rendering = True
 
         next_tile = 0
-        most_per_call = max(1, -(-len(tiles) // (64 * lanes)))  # ~64 progress updates a lane
+        most_per_call = max(1, -(-len(todo) // (64 * lanes)))  # ~64 progress updates a lane
         tile_seconds = [0.0]  # the last run's seconds a tile (0: none yet)
 
         def take_tiles(n: int) -> np.ndarray:
@@ -440,14 +476,14 @@ class RenderJob:
             made 26 runs a lane of a 1200-tile image, and its two-thread render 7 % slower.)"""
             nonlocal next_tile
             with lock:
-                left = len(tiles) - next_tile
+                left = len(todo) - next_tile
                 size = most_per_call
                 if tile_seconds[0] > 0.0:
                     size = max(size, int(RUN_SECONDS / tile_seconds[0]))
                 count = min(left, size, max(1, left // (2 * n)))
                 start = next_tile
                 next_tile += count
-            return np.arange(start, start + count)
+            return todo[start:start + count]
 
         failed = threading.Event()  # a lane raised: the others stop
 
@@ -488,6 +524,7 @@ class RenderJob:
                 with lock:
                     tile_seconds[0] = (time.perf_counter() - run_start) / len(idx)
                     counters[idx] = part_counters
+                    self.tiles_finished[idx] = True
                     done += len(idx)
                     self.tiles_done = done
                     self._report(done, len(tiles), counters, render_start, part,
@@ -510,6 +547,19 @@ class RenderJob:
         self.image = Image(self.framebuffer, transfer=self.settings.transfer,
                            tonemap=self.settings.tonemap, meta={"stats": stats})
         return self.image
+
+
+def _checked_region(region: tuple[int, int, int, int], width: int,
+                    height: int) -> tuple[int, int, int, int]:
+    try:
+        x0, y0, x1, y1 = (_whole_number("region", v, 0, max(width, height)) for v in region)
+    except (TypeError, ValueError):
+        raise ArgumentError(f"region must be (x0, y0, x1, y1) in pixels, got {region!r}") \
+            from None
+    if not (0 <= x0 < x1 <= width and 0 <= y0 < y1 <= height):
+        raise ArgumentError(f"region ({x0}, {y0}, {x1}, {y1}) is not a part of the "
+                            f"{width}x{height} image")
+    return x0, y0, x1, y1
 
 
 def _checked_rows(rows: tuple[int, int], height: int) -> tuple[int, int]:

@@ -17,12 +17,19 @@ if TYPE_CHECKING:
 def named_files(scene: Scene) -> list[tuple[list[str | int], str]]:
     """(key path, file name) of every model and texture file the scene names."""
     named: list[tuple[list[str | int], str]] = []
-    for i, obj in enumerate(scene.objects):
-        if getattr(obj, "file", None):
-            named.append((["objects", i, "file"], obj.file))
-        mat = obj.material
-        if isinstance(mat, Material) and getattr(mat.texture, "file", None):
-            named.append((["objects", i, "material", "texture", "file"], mat.texture.file))
+
+    def walk(objects, keys: list[str | int]) -> None:  # CSG objects' children too
+        for i, obj in enumerate(objects):
+            if getattr(obj, "file", None):
+                named.append(([*keys, i, "file"], obj.file))
+            mat = obj.material
+            if isinstance(mat, Material) and getattr(mat.texture, "file", None):
+                named.append(([*keys, i, "material", "texture", "file"], mat.texture.file))
+            children = getattr(obj, "objects", None)
+            if obj.type == "csg" and children:
+                walk(children, [*keys, i, "objects"])
+
+    walk(scene.objects, ["objects"])
     for key, mat in scene.materials.items():
         if mat.texture is not None and getattr(mat.texture, "file", None):
             named.append((["materials", key, "texture", "file"], mat.texture.file))
@@ -63,16 +70,22 @@ def rebase_files(scene: Scene, folder: str | Path) -> Scene:
     def moved(name: str) -> str:
         return _moved_name(name, old, folder)
 
-    objects = []
-    for obj in scene.objects:
-        update: dict[str, Any] = {}
-        if getattr(obj, "file", None):
-            update["file"] = moved(obj.file)
-        mat = obj.material
-        if isinstance(mat, Material) and getattr(mat.texture, "file", None):
-            tex = mat.texture.model_copy(update={"file": moved(mat.texture.file)})
-            update["material"] = mat.model_copy(update={"texture": tex})
-        objects.append(obj.model_copy(update=update) if update else obj)
+    def rebased(objects: list) -> list:  # CSG objects' children too
+        out = []
+        for obj in objects:
+            update: dict[str, Any] = {}
+            if getattr(obj, "file", None):
+                update["file"] = moved(obj.file)
+            mat = obj.material
+            if isinstance(mat, Material) and getattr(mat.texture, "file", None):
+                tex = mat.texture.model_copy(update={"file": moved(mat.texture.file)})
+                update["material"] = mat.model_copy(update={"texture": tex})
+            if obj.type == "csg":
+                update["objects"] = rebased(obj.objects)
+            out.append(obj.model_copy(update=update) if update else obj)
+        return out
+
+    objects = rebased(scene.objects)
     materials = {}
     for key, mat in scene.materials.items():
         if getattr(mat.texture, "file", None):

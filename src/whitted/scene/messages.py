@@ -129,8 +129,15 @@ def clean_message(error: dict[str, Any]) -> str:
         in_list = bool(error["loc"]) and isinstance(error["loc"][-1], int)
         return "missing list item" if in_list else "missing required value"
     if kind == "union_tag_invalid":
-        tag = error.get("input", {}).get("type") if isinstance(error.get("input"), dict) else None
+        given = error.get("input")
         expected = error.get("ctx", {}).get("expected_tags", "")
+        if isinstance(given, BaseModel):  # a whole object of the wrong kind (Python)
+            name = shorten(type(given).__name__, 40)
+            if name.endswith("Light"):
+                return (f"a {name} is a light, not a shape (lights go in the scene's "
+                        f"lights; expected one of {expected})")
+            return f"a {name} cannot go here (expected one of {expected})"
+        tag = given.get("type") if isinstance(given, dict) else None
         shown = shorten(repr(tag), 40)
         return f"unknown type {shown} (expected one of {expected})"
     if kind == "union_tag_not_found":

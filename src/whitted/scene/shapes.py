@@ -316,6 +316,17 @@ class CSG(_Shape):
     operation: Literal["union", "intersection", "difference", "merge"]
     objects: list[Shape] = Field(min_length=1)
 
+    @model_validator(mode="before")
+    @classmethod
+    def _whole_tree_fits(cls, data: Any) -> Any:
+        """The size of the whole tree, counted before its nested objects are validated (they
+        are validated first, and each would report only its own part of a tree too big)."""
+        if isinstance(data, dict):
+            leaves, operations, depth = _tree_counts(data)
+            if leaves + operations > CSG_MAX_SOLIDS:
+                raise ValueError(_too_big(leaves, operations, depth))
+        return data
+
     @model_validator(mode="after")
     def _solid_children(self) -> CSG:
         for k, child in enumerate(self.objects):
@@ -331,9 +342,7 @@ class CSG(_Shape):
                                  "no volume, so it cannot take part in CSG")
         leaves, rows = self.leaves(), self.rows()
         if leaves > CSG_MAX_SOLIDS or rows > CSG_MAX_SOLIDS:
-            raise ValueError(f"a CSG object holds at most {CSG_MAX_SOLIDS} solids and "
-                             f"operations together; this one has {leaves} solids in "
-                             f"{rows - leaves} operations")
+            raise ValueError(_too_big(leaves, rows - leaves, _tree_counts(self)[2]))
         return self
 
     def rows(self) -> int:
@@ -362,6 +371,33 @@ class CSG(_Shape):
     def leaves(self) -> int:
         """Solids at the bottom of the tree (every nested CSG opened)."""
         return sum(c.leaves() if isinstance(c, CSG) else 1 for c in self.objects)
+
+
+def _too_big(leaves: int, operations: int, depth: int) -> str:
+    solids = f"{leaves} solid" + ("s" if leaves != 1 else "")
+    ops = f"{operations} operation" + ("s" if operations != 1 else "")
+    return (f"a CSG object holds at most {CSG_MAX_SOLIDS} solids and operations together; "
+            f"this one has {solids} in {ops}, nested {depth} deep")
+
+
+def _tree_counts(node: Any) -> tuple[int, int, int]:
+    """(solids, operations, depth) of a CSG tree given as a CSG or as its table (a dict,
+    not yet validated), counted without recursion."""
+    leaves = operations = depth = 0
+    stack = [(node, 1)]
+    while stack:
+        item, level = stack.pop()
+        children = (item.get("objects") if isinstance(item, dict) else
+                    item.objects if isinstance(item, CSG) else None)
+        is_csg = (isinstance(item, CSG) or isinstance(item, dict)
+                  and item.get("type", "csg" if item is node else None) == "csg")
+        if is_csg and isinstance(children, list | tuple):
+            operations += 1
+            depth = max(depth, level)
+            stack.extend((child, level + 1) for child in children)
+        else:
+            leaves += 1
+    return leaves, operations, depth
 
 
 Shape = Annotated[

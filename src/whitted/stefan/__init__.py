@@ -15,6 +15,7 @@ In Python::
                                    air=case.solver_air())
     solver.advance(600.0)
     outer, inner = stefan.extract_surfaces(solver.H, solver.kind, case.properties, frame)
+    stefan.load_results("out/")      # the run's time series; plots itself in a notebook
 """
 
 import importlib.util
@@ -38,10 +39,12 @@ if missing_packages():
 from .case import Case, CaseError, case_from_dict, load_case  # noqa: E402
 from .geometry import GridFrame, initial_state  # noqa: E402
 from .properties import ICE, LATENT_HEAT, WATER, Phase, Properties  # noqa: E402
+from .results import StefanResults, load_results  # noqa: E402
 from .run import RunResult, run_case  # noqa: E402
 from .solver import Air, EnthalpySolver, Faces, stability_limit  # noqa: E402
 from .surfaces import extract_surfaces  # noqa: E402
 
 __all__ = ["ICE", "LATENT_HEAT", "WATER", "Air", "Case", "CaseError", "EnthalpySolver", "Faces",
-           "GridFrame", "Phase", "Properties", "RunResult", "case_from_dict", "extract_surfaces",
-           "initial_state", "load_case", "run_case", "stability_limit"]
+           "GridFrame", "Phase", "Properties", "RunResult", "StefanResults", "case_from_dict",
+           "extract_surfaces", "initial_state", "load_case", "load_results", "run_case",
+           "stability_limit"]

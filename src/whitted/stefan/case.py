@@ -83,16 +83,25 @@ class Block(_Strict):
 class Cavity(_Strict):
     """The closed cavity full of water: a sphere of ``radius`` or a box of ``size``, its
     centre ``center`` relative to the block's centre (off centre allowed). ``convection``:
-    the water's natural convection as an effective conductivity k Nu(Ra) (Catton's enclosure
-    correlation, Kell's density with its 4 °C maximum: :mod:`whitted.stefan.convection`);
-    false: conduction only."""
+    the water's natural convection, ``"effective"`` (or true: an effective conductivity from
+    Catton's enclosure correlation and Kell's density with its 4 °C maximum,
+    :mod:`whitted.stefan.convection`; fast), ``"flow"`` (the water's flow computed,
+    Navier-Stokes with Kell's buoyancy coupled to the melt: :mod:`whitted.stefan.flow`), or
+    ``"off"`` (or false: conduction only)."""
 
     shape: Literal["sphere", "box"] = "sphere"
     radius: Positive = 0.012
     size: CavitySize3 = (0.02, 0.02, 0.02)
     center: Vec3 = (0.0, 0.0, 0.0)
     temperature: _num(ge=0.0, le=100.0) = 20.0
-    convection: Annotated[bool, Field(strict=True)] = True
+    convection: Annotated[bool, Field(strict=True)] | Literal["effective", "flow", "off"] = True
+
+    @property
+    def model(self) -> str:
+        """``"effective"``, ``"flow"`` or ``"off"`` (true and false name the first and last)."""
+        if isinstance(self.convection, bool):
+            return "effective" if self.convection else "off"
+        return self.convection
 
     def half_extent(self) -> tuple[float, float, float]:
         if self.shape == "sphere":
@@ -248,6 +257,29 @@ class Case(_Strict):
                           relative_humidity=a.relative_humidity)
         return SolverAir(film.temperature, film.h)
 
+    def condensation_share(self) -> float:
+        """The share of the heat into the melting (0 °C) outer surface that the condensing
+        vapour brings (0 without humidity): per face direction with ``air.h = "auto"``,
+        weighted by the block's face areas in air (its four sides and top)."""
+        from .room import outer_film
+
+        a = self.air
+        if a.h == "auto":
+            from .convection import face_coefficients
+
+            hs = face_coefficients(self.block.size, a.temperature)
+            sx, sy, sz = self.block.size
+            areas = (sy * sz, sy * sz, 0.0, sx * sz, sx * sy, sx * sy)  # y- is the table
+        else:
+            hs, areas = (a.h,), (1.0,)
+        cond = total = 0.0
+        for h, area in zip(hs, areas, strict=True):
+            f = outer_film(a.temperature, h, t_sur=a.surroundings, emissivity=a.emissivity,
+                           relative_humidity=a.relative_humidity)
+            cond += area * f.condensation
+            total += area * (f.convection + f.radiation + f.condensation)
+        return cond / total if total > 0.0 and cond > 0.0 else 0.0
+
     def cavity_length(self) -> float:
         """The cavity's equivalent diameter (6 V / π)^(1/3) (m): Catton's L."""
         import math
@@ -262,7 +294,7 @@ class Case(_Strict):
         conductivity is the largest k_eff the cavity can reach (the time step's bound; the
         solver refreshes the actual one, :meth:`solver_convection`)."""
         props = self.properties
-        if not self.cavity.convection:
+        if self.cavity.model != "effective":
             return props
         from .convection import largest_conductivity
 
@@ -272,13 +304,34 @@ class Case(_Strict):
         return Properties(props.ice, Phase(w.rho, w.c, max(w.k, k_max)), props.latent_heat)
 
     def solver_convection(self):
-        """The solver's cavity convection (None when ``cavity.convection`` is false)."""
-        if not self.cavity.convection:
+        """The solver's effective cavity convection (None unless ``cavity.convection`` is
+        ``"effective"``)."""
+        if self.cavity.model != "effective":
             return None
         from .convection import CavityConvection
 
         w = self.properties.water
         return CavityConvection(w.k, w.capacity, self.solver_properties().water.k)
+
+    def solver_flow(self, H, kind):
+        """The cavity water's flow (:class:`whitted.stefan.flow.MeltFlow`) when
+        ``cavity.convection`` is ``"flow"``, else None: solved in the box of the liquid cells
+        of ``H`` (unpadded) widened by half the shell and two cells each way."""
+        if self.cavity.model != "flow":
+            return None
+        import math
+
+        import numpy as np
+
+        from .flow import MeltFlow, cavity_box
+
+        props = self.properties
+        liquid = (np.asarray(kind) == 1) & (np.asarray(H) >= props.latent_per_volume)
+        half = [0.5 * s for s in self.block.size]
+        ext = self.cavity.half_extent()
+        shell = min(half[a] - (abs(self.cavity.center[a]) + ext[a]) for a in range(3))
+        margin = 2 + int(math.ceil(0.5 * shell / self.dx))
+        return MeltFlow(cavity_box(liquid, margin), self.dx, props)
 
     def solver_faces(self):
         from .solver import Faces

@@ -15,12 +15,14 @@ Air (Incropera, DeWitt, Bergman & Lavine, *Fundamentals of Heat and Mass Transfe
   (10⁴-10⁹, Pr ≥ 0.7; Radziemska & Lewandowski 2001; Incropera eq. 9.32).
 
 Water in the cavity: a closed enclosure with a cold wall (0 °C) around warmer water; its
-effective conductivity k_eff = k Nu with Catton's (1978) enclosure correlation (Proc. 6th Int.
+effective conductivity makes the bulk-to-wall coefficient of a sphere of conducting water,
+(2π²/3) k_eff / D, the 2 Nu k / D of Catton's (1978) enclosure correlation (Proc. 6th Int.
 Heat Transfer Conf., Toronto, vol. 6, 13; Incropera eq. 9.51 with H/L = 1):
 Nu = 0.18 (Pr/(0.2 + Pr) Ra_L)^0.29, 10³ < Ra_L Pr/(0.2 + Pr), 10⁻³ < Pr < 10⁵, 1 ≤ H/L ≤ 2,
-(Nu = 1 below: conduction). The buoyancy is the density difference between the wall (0 °C)
-and the bulk water from Kell's (1975) equation of state (J. Chem. Eng. Data 20, 97), which has
-the density maximum at 3.98 °C: Ra = g (Δρ/ρ) L³ / (ν α). Viscosity: the Vogel equation
+(Nu = 1 below: conduction), so k_eff = k max(1, 3 Nu / π²). The buoyancy is the largest
+density difference present between the wall (0 °C) and the bulk water, from Kell's (1975)
+equation of state (J. Chem. Eng. Data 20, 97), which has the density maximum at 3.98 °C:
+Ra = g (Δρ/ρ) L³ / (ν α). Viscosity: the Vogel equation
 μ = A exp(B / (T − C)), A = 0.02939 mPa s, B = 507.88 K, C = 149.3 K (Viswanath & Natarajan,
 *Data Book on the Viscosity of Liquids*, 1989; 1.003 mPa s at 20 °C against the CRC's 1.002).
 Sources and ranges of validity in docs/stefan.md.
@@ -113,14 +115,31 @@ def water_viscosity(t_c: float) -> float:
     return 0.02939e-3 * math.exp(507.88 / (t_c + T0 - 149.3))
 
 
+TEMPERATURE_OF_MAXIMUM_DENSITY = 3.983  # °C: the maximum of Kell's equation (999.972 kg/m³)
+
+
+def density_span(t_a: float, t_b: float) -> float:
+    """The largest density difference (kg/m³) between two water temperatures in [t_a, t_b]
+    (Kell): the densest water present (3.98 °C when the range holds it) against the
+    lightest. Between a 0 °C wall and 8.14 °C bulk, where ρ(0) = ρ(bulk), it is the 4 °C water
+    of the boundary layer against both (0.13 kg/m³), never the false zero of
+    |ρ(wall) − ρ(bulk)|."""
+    lo, hi = min(t_a, t_b), max(t_a, t_b)
+    values = [water_density(lo), water_density(hi)]
+    if lo < TEMPERATURE_OF_MAXIMUM_DENSITY < hi:
+        values.append(water_density(TEMPERATURE_OF_MAXIMUM_DENSITY))
+    return max(values) - min(values)
+
+
 def rayleigh_water(t_bulk: float, length: float, k: float, rho_c: float,
                    t_wall: float = 0.0) -> tuple[float, float]:
     """(Ra_L, Pr) of water at t_bulk °C in an enclosure of size ``length`` with walls at
-    t_wall: buoyancy |ρ(t_wall) − ρ(t_bulk)| / ρ from Kell's equation (the density maximum
-    at 3.98 °C included), ν and Pr at the mean of the two, α = k / (ρ c) of the case."""
+    t_wall: buoyancy from the largest density difference present between the wall and the
+    bulk (:func:`density_span`, Kell's equation, the 3.98 °C maximum included), ν and Pr at
+    the mean of the two, α = k / (ρ c) of the case."""
     mean = 0.5 * (t_bulk + t_wall)
     rho = water_density(mean)
-    drho = abs(water_density(t_wall) - water_density(t_bulk)) / rho
+    drho = density_span(t_wall, t_bulk) / rho
     nu = water_viscosity(mean) / rho
     alpha = k / rho_c
     return G * drho * length ** 3 / (nu * alpha), nu / alpha
@@ -135,19 +154,32 @@ def nusselt_enclosure(ra: float, pr: float) -> float:
     return max(1.0, 0.18 * x ** 0.29)
 
 
-def water_conductivity(t_bulk: float, length: float, k: float, rho_c: float) -> float:
-    """k_eff = k Nu of the cavity's water at a mean t_bulk °C inside walls at 0 °C."""
+SPHERE_MODE = math.pi ** 2 / 3.0  # (2π²/3) k / D: a conducting sphere's bulk-to-wall h, × D / 2k
+
+
+def wall_coefficient(t_bulk: float, length: float, k: float, rho_c: float) -> float:
+    """The bulk-to-wall heat transfer coefficient (W/m²K) Catton's correlation implies: its Nu
+    is the wall-to-wall flux over k ΔT / L, and the bulk sits halfway (ΔT / 2 from each wall),
+    so h = 2 Nu k / L."""
     ra, pr = rayleigh_water(t_bulk, length, k, rho_c)
-    return k * nusselt_enclosure(ra, pr)
+    return 2.0 * nusselt_enclosure(ra, pr) * k / length
 
 
+def water_conductivity(t_bulk: float, length: float, k: float, rho_c: float) -> float:
+    """k_eff of the cavity's water at a mean t_bulk °C inside walls at 0 °C, for a sphere of
+    diameter ``length`` cooled all round: a conducting sphere's slowest mode gives a
+    bulk-to-wall coefficient (2π²/3) k_eff / D, which k_eff = k · 3 Nu / π² makes the
+    correlation's 2 Nu k / D (:func:`wall_coefficient`); never below k (conduction)."""
+    ra, pr = rayleigh_water(t_bulk, length, k, rho_c)
+    return k * max(1.0, nusselt_enclosure(ra, pr) / SPHERE_MODE)
 
 
 class CavityConvection:
     """The cavity water's effective conductivity, refreshed every ``interval`` seconds of
     simulated time (a whole number of steps, ``every``) from the field: the largest body of
     all-liquid cells, its mean temperature and its equivalent diameter (6 V / π)^(1/3) as
-    Catton's L, k_eff = k Nu, at most ``k_max`` (the value the time step was chosen for).
+    Catton's L, k_eff = k max(1, 3 Nu / π²) (:func:`water_conductivity`), at most ``k_max``
+    (the value the time step was chosen for).
     The kernels have one water conductivity: every all-liquid cell takes the cavity's k_eff
     (open meltwater drains at once, so in practice the cavity is the only liquid region)."""
 
@@ -181,6 +213,7 @@ def largest_conductivity(t_cavity: float, length: float, k: float, rho_c: float)
     return max(water_conductivity(t_cavity * q / 200.0, length, k, rho_c) for q in range(201))
 
 
-__all__ = ["CavityConvection", "air_properties", "face_coefficients", "largest_conductivity",
+__all__ = ["CavityConvection", "TEMPERATURE_OF_MAXIMUM_DENSITY", "air_properties",
+           "density_span", "wall_coefficient", "face_coefficients", "largest_conductivity",
            "nusselt_enclosure", "nusselt_horizontal", "nusselt_vertical", "rayleigh_air",
            "rayleigh_water", "water_conductivity", "water_density", "water_viscosity"]

@@ -260,11 +260,13 @@ def _neighbour(i, j, k, face):
 
 @builder(entry=False, numba_inline=True)
 def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain, air_h,
-                  air_inv_h, air_t, i, j, k, scale, out, m, rescale, occ, is_surface):
+                  air_ice, air_t, i, j, k, scale, out, m, rescale, occ, is_surface):
     """The boundary heat of one surface cell, added to Hn; drain if it is all liquid and a
     face drains. ``out[m]``: heat in (J/m² of face), drained (J/m³), breach signal, drains.
-    ``air_h``, ``air_inv_h``, ``air_t``: the air's film per face direction (x-, x+, y-, y+,
-    z-, z+; the same six values give the uniform film of before, to the last bit)."""
+    ``air_h``, ``air_t``: the air's film per face direction (x-, x+, y-, y+, z-, z+).
+    An air face carries ``(T_air - T) c`` with ``c`` the film's h on a cell at or above 0 °C
+    (its meltwater drains: no half cell) and ``air_ice`` = 1 / (1/h + dx / 2 k_i) on ice
+    (:func:`_air_coefficients`): no division per face."""
     out[m, 0] = 0.0
     out[m, 1] = 0.0
     out[m, 2] = 0.0
@@ -274,26 +276,25 @@ def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain
     hl = p[P_HL]
     hc = H[i, j, k]
     tc = _temperature(hc, p)
-    kc = _conductivity(hc, p)
     outer = 0.0
     air_faces = 0.0
     n_air = 0
     wet = False
+    coef = air_h if hc >= 0.0 else air_ice
     for face in range(6):
         ii, jj, kk = _neighbour(i, j, k, face)
         kn = kind[ii, jj, kk]
         if kn == GHOST:
             d = face_drain[face] != 0
-            outer += _boundary_flux(face_h[face], face_inv_h[face], face_t[face], d, tc, kc,
-                                    hc, dx)
+            outer += _boundary_flux(face_h[face], face_inv_h[face], face_t[face], d, tc,
+                                    _conductivity(hc, p), hc, dx)
             if d and face_h[face] > 0.0:
                 wet = True
         elif kn == AIR:  # the air's film of this face's direction (h per face: room.py)
             n_air += 1
             if air_h[face] > 0.0:
                 wet = True
-            air_faces += _boundary_flux(air_h[face], air_inv_h[face], air_t[face], True, tc,
-                                        kc, hc, dx)
+            air_faces += (air_t[face] - tc) * coef[face]
     if n_air > 0 and air_faces != 0.0:
         if rescale or scale[m] < 0.0:
             scale[m] = _surface_scale(H, kind, i, j, k, hl, occ)
@@ -309,6 +310,22 @@ def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain
             if (kind[ii, jj, kk] == BODY and is_surface[ii, jj, kk] == 0
                     and H[ii, jj, kk] >= 0.5 * hl):
                 out[m, 2] += 1.0
+
+
+@builder(entry=False)
+def _air_coefficients(air_h, p, dx):
+    """Per face direction, the air film's conductance to an ice cell's centre,
+    1 / (1/h + dx / 2 k_i) (0 where h is 0; 2 k_i / dx where h is infinite)."""
+    out = np.empty(6)
+    for f in range(6):
+        h = air_h[f]
+        if h == 0.0:
+            out[f] = 0.0
+        elif h == np.inf:
+            out[f] = 2.0 * p[P_KI] / dx
+        else:
+            out[f] = 1.0 / (1.0 / h + 0.5 * dx / p[P_KI])
+    return out
 
 
 @builder(entry=False)
@@ -400,9 +417,7 @@ def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h
     face_inv_h = np.empty(6)
     for f in range(6):
         face_inv_h[f] = _inverse(face_h[f])
-    air_inv_h = np.empty(6)
-    for f in range(6):
-        air_inv_h[f] = _inverse(air_h[f])
+    air_ice = _air_coefficients(air_h, p, dx)
     g = dt / (dx * dx)
     done = 0
     src = H
@@ -426,7 +441,7 @@ def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h
             for e in range(plane_start[i0 - 1], plane_start[i1 - 1]):
                 m = plane_cells[e]
                 _surface_cell(src, kind, dst, p, dt, dx, face_h, face_inv_h, face_t,
-                              face_drain, air_h, air_inv_h, air_t, surface[m, 0],
+                              face_drain, air_h, air_ice, air_t, surface[m, 0],
                               surface[m, 1], surface[m, 2], scale, out, m, rescale, occ,
                               is_surface)
         breach = 0.0
@@ -462,9 +477,7 @@ def run_steps_serial(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
     face_inv_h = np.empty(6)
     for f in range(6):
         face_inv_h[f] = _inverse(face_h[f])
-    air_inv_h = np.empty(6)
-    for f in range(6):
-        air_inv_h[f] = _inverse(air_h[f])
+    air_ice = _air_coefficients(air_h, p, dx)
     g = dt / (dx * dx)
     done = 0
     src = H
@@ -480,7 +493,7 @@ def run_steps_serial(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
         rescale = (first_step + step) % rescale_every == 0
         for m in range(ns):
             _surface_cell(src, kind, dst, p, dt, dx, face_h, face_inv_h,
-                          face_t, face_drain, air_h, air_inv_h, air_t, surface[m, 0],
+                          face_t, face_drain, air_h, air_ice, air_t, surface[m, 0],
                           surface[m, 1], surface[m, 2], scale, out, m, rescale, occ,
                               is_surface)
         breach = 0.0

@@ -6,7 +6,8 @@ notebook.
 The heat budget of each saved time: the heat that came in through the surfaces, the
 enthalpy drained away with meltwater, and what the block holds more than at the start
 (``stored = heat in - drained + imbalance``, the imbalance being the solver's energy error,
-zero to round-off): read from the saved states' totals and ``series.csv``.
+zero to round-off): read from ``series.csv`` (from the saved states' totals for a run
+written before the series had those columns).
 """
 
 from __future__ import annotations
@@ -129,8 +130,13 @@ def load_results(folder: str | os.PathLike[str]) -> StefanResults:
     except (TypeError, ValueError) as exc:
         raise CaseError(f"series.csv is damaged: {exc}", file=str(folder)) from None
     n = len(rows)
-    heat_in = np.full(n, np.nan)
-    drained = np.full(n, np.nan)
+    try:  # series.csv has the budget's columns (runs before them: the saved states' totals)
+        heat_in = np.array([_number(r.get("heat_in_J")) for r in rows])
+        drained = np.array([_number(r.get("heat_drained_J")) for r in rows])
+    except (TypeError, ValueError) as exc:
+        raise CaseError(f"series.csv is damaged: {exc}", file=str(folder)) from None
+    if n and not (np.isnan(heat_in).any() or np.isnan(drained).any()):
+        return _results(folder, columns, heat_in, drained)
     for path in state_files(folder / "fields"):
         try:
             with np.load(path) as z:
@@ -142,6 +148,11 @@ def load_results(folder: str | os.PathLike[str]) -> StefanResults:
                     drained[index] = float(totals[1]) * dx ** 3
         except (OSError, ValueError, KeyError):
             continue  # a damaged state: that time's budget stays unknown (NaN)
+    return _results(folder, columns, heat_in, drained)
+
+
+def _results(folder: Path, columns: dict, heat_in: np.ndarray,
+             drained: np.ndarray) -> StefanResults:
     summary = {}
     with contextlib.suppress(OSError, ValueError):
         summary = json.loads((folder / "summary.json").read_text())

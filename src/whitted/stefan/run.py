@@ -9,7 +9,9 @@ Output folder::
     surfaces/outer_0003.ply, inner_0003.ply   ice/air and ice/water surfaces
     scenes/frame_0003.toml a whitted scene rendering that saved time
     series.csv             time series: ice, cavity and water volume, minimum shell,
-                           breach time (empty until the shell opens)
+                           breach time (empty until the shell opens), energy imbalance,
+                           heat in, heat drained with the meltwater (J), water condensed
+                           from the air (cm³)
     series.png             the same as plots
     summary.json           breach time, end time, energy balance
 
@@ -40,7 +42,8 @@ from .surfaces import extract_surfaces, write_ply
 
 _STATE_NAME = re.compile(r"state_(\d+)\.npz")
 SERIES_COLUMNS = ("time_s", "ice_volume_cm3", "cavity_volume_cm3", "water_volume_cm3",
-                  "min_shell_mm", "breached", "breach_time_s", "energy_imbalance_J")
+                  "min_shell_mm", "breached", "breach_time_s", "energy_imbalance_J",
+                  "heat_in_J", "heat_drained_J", "condensed_cm3")
 
 
 @dataclass
@@ -105,7 +108,7 @@ def _write_series(path: Path, rows: list[dict]) -> None:
     w = csv.DictWriter(buf, fieldnames=SERIES_COLUMNS, lineterminator="\n")
     w.writeheader()
     for row in rows:
-        w.writerow({k: row[k] for k in SERIES_COLUMNS})
+        w.writerow({k: row.get(k) for k in SERIES_COLUMNS})  # (older series lack the last)
     _atomic_bytes(path, buf.getvalue().encode())
 
 
@@ -203,6 +206,7 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
             solver = EnthalpySolver(z["H"], z["kind"], float(z["dx"]), case.solver_properties(),
                                     faces=case.solver_faces(), air=air, dt=case.time.dt,
                                     cfl=case.time.cfl, convection=case.solver_convection(),
+                                    flow=case.solver_flow(z["H"], z["kind"]),
                                     stop_on_breach=case.breach.action == "stop",
                                     time=float(z["time"]))
             solver.steps = int(z["steps"])
@@ -220,6 +224,7 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
         solver = EnthalpySolver(H, kind, case.dx, case.solver_properties(),
                                 faces=case.solver_faces(), air=air, dt=case.time.dt,
                                 cfl=case.time.cfl, convection=case.solver_convection(),
+                                flow=case.solver_flow(H, kind),
                                 stop_on_breach=case.breach.action == "stop")
         initial_cavity = float(cavity.sum()) * case.dx ** 3
         index = 0
@@ -300,11 +305,23 @@ def film_bubbles(out: Path, frames: list[FilmFrame]) -> list:
             for f in frames if f.inner is not None]
 
 
-def meltwater(case: Case, first: tuple[float, float], now: tuple[float, float]) -> float:
+def meltwater(case: Case, first: tuple[float, float], now: tuple[float, float],
+              condensed: float = 0.0) -> float:
     """The water that left the block (m³): the ice and cavity water of the start less those
-    of now, in water's volume: (rho_i / rho_w) (V_ice,0 - V_ice) - (V_w - V_w,0)."""
+    of now, in water's volume, (rho_i / rho_w) (V_ice,0 - V_ice) - (V_w - V_w,0), and the
+    water the air condensed on it (``condensed``, m³: it runs off with the melt)."""
     ratio = case.ice.rho / case.water.rho
-    return max(0.0, ratio * (first[0] - now[0]) - (now[1] - first[1]))
+    return max(0.0, ratio * (first[0] - now[0]) - (now[1] - first[1])) + max(0.0, condensed)
+
+
+def condensed_volume(case: Case, heat_in: float) -> float:
+    """The water (m³) the air's vapour condensed on the block while ``heat_in`` J entered it:
+    the condensation's share of the heat into a surface at 0 °C
+    (:meth:`~whitted.stefan.case.Case.condensation_share`) over the latent heat of
+    vaporisation, in water's volume."""
+    from .room import L_VAPORISATION
+
+    return max(0.0, heat_in) * case.condensation_share() / (L_VAPORISATION * case.water.rho)
 
 
 def film_puddles(out: Path, frames: list[FilmFrame], case: Case) -> list[float]:
@@ -314,8 +331,12 @@ def film_puddles(out: Path, frames: list[FilmFrame], case: Case) -> list[float]:
     def volumes(row: dict) -> tuple[float, float]:
         return 1e-6 * float(row["ice_volume_cm3"]), 1e-6 * float(row["water_volume_cm3"])
 
-    return [puddle_radius(meltwater(case, volumes(rows[0]), volumes(rows[f.index])),
-                          case.block.size) for f in frames]
+    def condensed(row: dict) -> float:
+        return 1e-6 * float(row.get("condensed_cm3") or 0.0)
+
+    return [puddle_radius(meltwater(case, volumes(rows[0]), volumes(rows[f.index]),
+                                    condensed(rows[f.index])), case.block.size)
+            for f in frames]
 
 
 def film_frames(out: Path) -> list[FilmFrame]:
@@ -347,7 +368,8 @@ def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, dig
                                                      m.cavity_volume - m.water_volume)]
     first = (m.ice_volume, m.water_volume) if not rows else (
         1e-6 * float(rows[0]["ice_volume_cm3"]), 1e-6 * float(rows[0]["water_volume_cm3"]))
-    puddle = puddle_radius(meltwater(case, first, (m.ice_volume, m.water_volume)),
+    condensed = condensed_volume(case, solver.heat_in)
+    puddle = puddle_radius(meltwater(case, first, (m.ice_volume, m.water_volume), condensed),
                            case.block.size)
     text = still_life_scene(None if outer is None else "../" + outer,
                             None if inner is None else "../" + inner, solver.time,
@@ -360,7 +382,8 @@ def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, dig
                  "cavity_volume_cm3": m.cavity_volume * 1e6,
                  "water_volume_cm3": m.water_volume * 1e6, "min_shell_mm": m.min_shell * 1e3,
                  "breached": int(m.breached), "breach_time_s": solver.breach_time,
-                 "energy_imbalance_J": solver.energy_error()})
+                 "energy_imbalance_J": solver.energy_error(), "heat_in_J": solver.heat_in,
+                 "heat_drained_J": solver.drained, "condensed_cm3": condensed * 1e6})
     _write_series(out / "series.csv", rows)
     _save_state(out / "fields" / f"state_{index:04d}.npz", solver, digest, index,
                 initial_cavity)
@@ -368,4 +391,4 @@ def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, dig
 
 
 __all__ = ["FilmFrame", "RunResult", "asdict", "film_bubbles", "film_frames", "film_puddles",
-           "inner_top", "meltwater", "run_case", "state_files"]
+           "condensed_volume", "inner_top", "meltwater", "run_case", "state_files"]

@@ -95,7 +95,7 @@ class EnthalpySolver:
     def __init__(self, H: np.ndarray, kind: np.ndarray, dx: float, props: Properties,
                  faces: Faces | None = None, air: Air | None = None, dt: float | None = None,
                  cfl: float = 0.9, stop_on_breach: bool = True, time: float = 0.0,
-                 rescale_every: int = 8, convection=None) -> None:
+                 rescale_every: int = 8, convection=None, flow=None) -> None:
         if H.ndim != 3 or H.shape != kind.shape:
             raise ValueError("H and kind must be 3-D arrays of one shape")
         self.dx = float(dx)
@@ -109,6 +109,9 @@ class EnthalpySolver:
         elif dt > self.dt_limit:
             raise ValueError(f"time step {dt:g} s is over the stability limit "
                              f"{self.dt_limit:.4g} s")
+        # the cavity water's flow (flow.MeltFlow): stepped after every enthalpy step, in
+        # shorter steps of its own when its limit (viscosity, the speed) is below dt
+        self.flow = flow
         self.dt = float(dt)
         self.stop_on_breach = stop_on_breach
         # the cavity water's effective conductivity (convection.CavityConvection), refreshed
@@ -191,6 +194,19 @@ class EnthalpySolver:
         """Up to n steps; fewer at the first sign of a breach (checked here on the field: a
         true one sets ``breach_time``; in drain mode the cavity's water open to the air then
         drains, and the next call goes on)."""
+        if self.flow is not None:
+            done = 0
+            while done < n:
+                did = self._run(1)
+                if did == 0:
+                    break
+                done += 1
+                sub = max(1, int(math.ceil(self.dt / self.flow.stable_dt())))
+                for _ in range(sub):
+                    self.flow.step(self._Hp, self._kindp, self.dt / sub)
+                if self.breached and self.stop_on_breach:
+                    break
+            return done
         if self.convection is not None:
             done = 0
             while done < n:

@@ -1,0 +1,121 @@
+"""IEEE twins of kernels: the same code compiled without fast-math, every kernel and overload
+it calls twinned the same way, so that it computes the same bits however it was obtained.
+
+Render kernels are compiled with fast-math (kernels/jit.py): LLVM may fuse a multiply and an
+add into one FMA instruction, reassociate sums, replace a division by a multiplication with
+a reciprocal. What it does depends on the CPU target (``NUMBA_CPU_NAME=generic`` has no FMA)
+and on what it sees of the code around (a callee inlined or not, which depends on the order
+kernels were compiled in, in this process or in the one whose cache it loads). For the image
+that is a last-bit difference. The photons of caustics amplify such differences: a photon
+landing 1e-16 on the other side of a grid cell or a decision moves the fitted gather radius
+and the whole caustic with it. So the photon tracer runs as a twin made here
+(:func:`strict`): every floating-point operation rounded as IEEE 754 prescribes, in source
+order, nothing fused or reordered, so the photons are the same bits on every CPU target, cold
+compiled or loaded from the cache. (The C library's sin, cos and exp are the one thing
+left: the same on one machine; docs/caustics.md.)
+
+A twin is a copy of the kernel's Python function with its own globals, where each kernel it
+calls is that kernel's twin and each function with an overload (kernels/jit.py ``overload``)
+a copy whose overload builds its lambdas with twinned globals. A twin's name ends in
+``__ieee`` (its cache files are its own) and its options are the kernel's with
+``fastmath=False``.
+"""
+
+from __future__ import annotations
+
+import types
+
+from . import jit
+
+SUFFIX = "__ieee"
+
+_twins: dict = {}  # the original Python function -> its twin (Kernel or function)
+
+
+def strict(target):
+    """The IEEE twin of kernel ``target`` (a Kernel, or its dispatcher): called like it."""
+    if jit._jit_disabled():  # kernels are plain Python: nothing to compile either way
+        return target
+    jit.load_numba()
+    kern = _kernel_of(target)
+    if kern is None:
+        raise TypeError(f"{target!r} is not a whitted kernel")
+    with jit._lock:
+        twin = _twin_kernel(kern)
+    return twin if twin.entry else twin.dispatcher
+
+
+def _kernel_of(value):
+    if isinstance(value, jit.Kernel):
+        return value
+    py_func = getattr(value, "py_func", None)
+    if py_func is None:
+        return None
+    return jit.kernels_by_function.get(py_func)
+
+
+def _names(code) -> set[str]:
+    """Global names ``code`` and the code nested in it (lambdas, closures) may read."""
+    found = set(code.co_names)
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            found |= _names(const)
+    return found
+
+
+def _copy(f, qualname: str):
+    """A copy of function ``f`` with globals of its own (a copy of its module's)."""
+    made = types.FunctionType(f.__code__, dict(f.__globals__), f.__name__, f.__defaults__,
+                              f.__closure__)
+    made.__qualname__ = qualname
+    made.__module__ = f.__module__
+    made.__doc__ = f.__doc__
+    made.__kwdefaults__ = f.__kwdefaults__
+    return made
+
+
+def _twin_globals(f, copy) -> None:
+    """Point the names ``copy`` (a copy of ``f``) reads at the twins of the kernels and
+    overloaded functions they name."""
+    g = copy.__globals__
+    for name in _names(f.__code__):
+        value = g.get(name)
+        if value is None or value is f:
+            continue
+        kern = _kernel_of(value)
+        if kern is not None:
+            twin = _twin_kernel(kern)
+            g[name] = twin if twin.entry else twin.dispatcher
+        elif callable(value) and value in jit.overloads_by_function:
+            g[name] = _twin_overloaded(value)
+
+
+def _twin_kernel(kern):
+    f = kern.py_func
+    twin = _twins.get(f)
+    if twin is not None:
+        return twin
+    copy = _copy(f, f.__qualname__ + SUFFIX)
+    options = dict(kern.options)
+    options["fastmath"] = False
+    twin = jit.Kernel(copy, options, kern.specialise_constants, kern.cache, kern.entry)
+    _twins[f] = twin
+    _twin_globals(f, copy)
+    return twin
+
+
+def _twin_overloaded(function):
+    """A copy of ``function`` (a Python function kernels call, with an overload) whose
+    overload is the original's with twinned globals: the lambdas it returns call twins."""
+    twin = _twins.get(function)
+    if twin is not None:
+        return twin
+    from numba.extending import overload as numba_overload
+
+    implementation, options = jit.overloads_by_function[function]
+    twin = _copy(function, function.__qualname__ + SUFFIX)
+    _twins[function] = twin
+    twin_impl = _copy(implementation, implementation.__qualname__ + SUFFIX)
+    _twin_globals(implementation, twin_impl)
+    numba_overload(twin, **options)(twin_impl)
+    return twin
