@@ -67,6 +67,9 @@ def as_run(argv: list[str], folder: Path) -> list[str] | str:
         run[run.index("--turntable") + 1] = "4"
     if command == "animate":
         return [*run, *TINY, "--frames", "0:3"]
+    if "--region" in run and ":" in run[run.index("--region") + 1] \
+            and "." not in run[run.index("--region") + 1]:
+        return run  # a region in pixels needs the scene's own size
     if command in ("render", "sweep"):
         return [*run, *TINY]
     if argv[1:3] == ["stefan", "validate"]:
