@@ -96,10 +96,15 @@ def test_a_selects_all_and_the_header_counts_them(make_window, qtbot):  # noqa: 
         *(("lights", i) for i in range(len(scene.lights))),
         *(("objects", i) for i in range(len(scene.objects)))}
     assert window.doc.selection == ("objects", 1)  # the active one stays
-    assert window.properties.title.full_text == \
-        "2 objects and 2 lights selected · ball (sphere)"
+    panel = window.properties
+    assert panel.title.full_text == "Object: ball (sphere)"  # what the panel edits
+    assert panel.selection_note.isVisible()
+    assert panel.selection_note.full_text == \
+        "2 objects and 2 lights selected (this panel edits the one above)"
     window.select([("objects", 0), ("objects", 1)])
-    assert window.properties.title.full_text.startswith("2 objects selected · ")
+    assert panel.selection_note.full_text.startswith("2 objects selected")
+    click_tree(qtbot, window.tree, ("objects", 0))
+    assert not panel.selection_note.isVisible()
 
 
 def test_shift_a_opens_the_add_menu_at_the_pointer(make_window, qtbot):  # noqa: F811

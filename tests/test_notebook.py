@@ -233,6 +233,7 @@ def test_render_film_returns_a_film_that_plays(tmp_path, shown, examples_dir):
     assert (film.frames, film.fps, film.size) == (2, 4.0, (32, 18))
     assert "<video" in film._repr_html_()
     assert film.result.rendered == [0, 24]
+    assert film.frames_folder == tmp_path / "orbit_frames"
     view = shown[0]
     assert "2 rendered" in view.children[1].value
     # again: every frame is kept (resume), the film encoded again
@@ -498,6 +499,7 @@ def test_render_film_into_a_folder_makes_the_film_in_memory(tmp_path, examples_d
     film = whitted.render_film(examples_dir / "camera_orbit.toml", tmp_path / "frames",
                                frames=[0, 1], width=16, height=10, fps=2, live=False)
     assert film.path is None and film.frames == 2 and film.kind in ("mp4", "gif")
+    assert film.frames_folder == tmp_path / "frames"
     assert sorted(p.name for p in (tmp_path / "frames").iterdir()) == ["0000.png", "0001.png"]
 
 

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from PIL import Image as PILImage
 
 from cli_run import one_line_error, run_main
@@ -213,3 +215,15 @@ def test_a_file_of_someone_elses_by_the_state_files_name_is_never_touched(tmp_pa
     assert theirs.read_text(encoding="utf-8") == "my notes\n"
     assert run_main(*args, "-o", "cut.png", cwd=tmp_path)[0] == 0  # whole: not removed
     assert theirs.read_text(encoding="utf-8") == "my notes\n"
+
+
+@given(text=st.text(alphabet="0123456789.:,-e naif", max_size=16),
+       width=st.integers(1, 5000), height=st.integers(1, 5000))
+def test_fuzz_region(text, width, height):
+    """Any text: a region inside the image, or one ValueError sentence."""
+    try:
+        x0, y0, x1, y1 = parse_region(text, width, height)
+    except ValueError as exc:
+        assert str(exc) and "\n" not in str(exc)
+        return
+    assert 0 <= x0 < x1 <= width and 0 <= y0 < y1 <= height

@@ -169,13 +169,14 @@ def test_film_renders_one_frame_per_saved_time_with_the_time_in_it(tmp_path):
         assert r == pytest.approx(max(1e-4, (3 * void / (4 * math.pi)) ** (1 / 3)), abs=1e-5)
     assert radii[0] == 1e-4 and radii[-1] > 0.1  # none at first, then 9 % of the melt
     # the meltwater's disc, 2.7 mm thick: pi (R² - 2²) 0.27 cm = the water that left the
-    # block, (917/1000) (ice lost) - (cavity water gained)
+    # block, (917/1000) (ice lost) - (cavity water gained), and the water condensed on it
     puddle = tracks["objects[meltwater].radius"]
     ice0, w0 = float(rows[0]["ice_volume_cm3"]), float(rows[0]["water_volume_cm3"])
     assert puddle[0] == 1e-4
     for r, row in list(zip(puddle, rows, strict=True))[1:]:
         water = (0.917 * (ice0 - float(row["ice_volume_cm3"]))
-                 - (float(row["water_volume_cm3"]) - w0))
+                 - (float(row["water_volume_cm3"]) - w0) + float(row["condensed_cm3"]))
+        assert float(row["condensed_cm3"]) > 0.0
         assert math.pi * (r * r - 4.0) * 0.27 == pytest.approx(water, rel=1e-3)
     assert puddle[-1] > puddle[1] > 2.0
     raw = iio.imread(tmp_path / "melt_stefan" / "frames" / "0000.png")

@@ -24,10 +24,16 @@ def id_size(scene: Scene, max_side: int = MAX_SIDE) -> tuple[int, int]:
     return max(1, round(w * scale)), max(1, round(h * scale))
 
 
+#: one id image at a time in this process: the picture's and a CSG child's buffers (and the
+#: warm-up) never load or run the id kernel at once on two threads
+_ID_LOCK = threading.Lock()
+
+
 def object_ids(scene: Scene, width: int, height: int) -> np.ndarray:
     """(height, width) int32: the index in ``scene.objects`` seen through each pixel's
     centre, -1 where no object is."""
-    return render_aovs(scene, width=width, height=height, samples=1)["id"]
+    with _ID_LOCK:
+        return render_aovs(scene, width=width, height=height, samples=1)["id"]
 
 
 def id_at(ids: np.ndarray, u: float, v: float) -> int:

@@ -108,6 +108,11 @@ class PropertyPanel(QWidget):
         box = QVBoxLayout(self)
         box.setContentsMargins(4, 4, 4, 4)
         box.addWidget(self.title)
+        #: with several items selected: how many, and that the panel edits the active one
+        self.selection_note = ElidedLabel("", self)
+        self.selection_note.setStyleSheet("color: #555;")
+        self.selection_note.hide()
+        box.addWidget(self.selection_note)
         box.addWidget(self.scroll, 1)
         self.form: QWidget | None = None
         doc.changed.connect(self.refresh)
@@ -177,12 +182,16 @@ class PropertyPanel(QWidget):
         item = self.doc.item(key)
         self.key = key if item is not None else None
         if item is None:
+            self.selection_note.hide()
             self.title.setText("Nothing selected")
             self._signature = None
             self._rebuild(key, [])
             return
         specs = self.specs_for(key, item)
         self.title.setText(self.describe(key, item))
+        note = self.selection_text()
+        self.selection_note.setText(note)
+        self.selection_note.setVisible(bool(note))
         signature = (key[0], key[1] if len(key) > 1 else None, getattr(item, "type", None),
                      tuple(specs))
         if signature != self._signature:
@@ -198,15 +207,17 @@ class PropertyPanel(QWidget):
         if key == BACKGROUND:
             return "Background"
         kind = "Light" if key[0] == "lights" else "Object"
-        one = f"{kind}: {label_of(item)} ({item.type})"
+        return f"{kind}: {label_of(item)} ({item.type})"
+
+    def selection_text(self) -> str:
+        """"3 objects and 2 lights selected" (the panel shows the active one); "" for one."""
         keys = self.doc.selected_keys()
         if len(keys) < 2:
-            return one
+            return ""
         counts = [(sum(k[0] == kind for k in keys), word) for kind, word in
                   (("objects", "object"), ("lights", "light"))]
         parts = [f"{n} {word}{'s' if n > 1 else ''}" for n, word in counts if n]
-        # the panel edits the active one: say which
-        return f"{' and '.join(parts)} selected · {label_of(item)} ({item.type})"
+        return f"{' and '.join(parts)} selected (this panel edits the one above)"
 
     def _rebuild(self, key: tuple, specs: list[F.Spec]) -> None:
         # the focus must not stay in the old form (a window of its own once taken out of

@@ -1,7 +1,7 @@
 """IEEE twins of kernels: the same code compiled without fast-math, every kernel and overload
 it calls twinned the same way, so that it computes the same bits however it was obtained.
 
-Render kernels are compiled with fast-math (kernels/jit.py): LLVM may fuse a multiply and an
+Render kernels are compiled with fast-math (jit/decorators.py): LLVM may fuse a multiply and an
 add into one FMA instruction, reassociate sums, replace a division by a multiplication with
 a reciprocal. What it does depends on the CPU target (``NUMBA_CPU_NAME=generic`` has no FMA)
 and on what it sees of the code around (a callee inlined or not, which depends on the order
@@ -15,7 +15,7 @@ compiled or loaded from the cache. (The C library's sin, cos and exp are the one
 left: the same on one machine; docs/caustics.md.)
 
 A twin is a copy of the kernel's Python function with its own globals, where each kernel it
-calls is that kernel's twin and each function with an overload (kernels/jit.py ``overload``)
+calls is that kernel's twin and each function with an overload (jit/decorators.py ``overload``)
 a copy whose overload builds its lambdas with twinned globals. A twin's name ends in
 ``__ieee`` (its cache files are its own) and its options are the kernel's with
 ``fastmath=False``.
@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import types
 
-from . import jit
+from ..jit import decorators as jit
 
 SUFFIX = "__ieee"
 

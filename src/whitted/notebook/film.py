@@ -120,10 +120,11 @@ def render_film(
         raise RenderCancelled("the film was stopped before its first frame was finished")
     if result.film is not None:
         film = Film(result.film, frames=len(result.files), fps=plan.fps, size=result.size,
-                    result=result)
+                    result=result, frames_folder=plan.paths.frames)
     else:  # frames only, or stopped: the frames finished, made into a film in memory
         film = Film.from_frames(list(result.files), plan.fps)
         film.result = result
+        film.frames_folder = plan.paths.frames
     if view is not None:
         if result.cancelled:
             view.end(f"stopped: {len(result.files)} of {len(plan.frames)} frames in "

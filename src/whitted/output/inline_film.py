@@ -63,7 +63,8 @@ class Film:
 
     def __init__(self, path: str | os.PathLike[str] | None = None, *, frames: int, fps: float,
                  size: tuple[int, int], data: bytes | None = None, kind: str | None = None,
-                 result: object = None) -> None:
+                 result: object = None, frames_folder: str | os.PathLike[str] | None = None
+                 ) -> None:
         if path is None and data is None:
             raise ValueError("a Film needs a path or its data")
         self.path = None if path is None else Path(path)
@@ -74,6 +75,8 @@ class Film:
         self._data = data
         #: what made it (``whitted.render_film``'s :class:`~whitted.animation.film.FilmResult`)
         self.result = result
+        #: the folder of its frames (PNGs), where known
+        self.frames_folder = None if frames_folder is None else Path(frames_folder)
 
     @classmethod
     def from_frames(cls, folder: str | os.PathLike[str] | list, fps: float = 24.0, *,
@@ -109,7 +112,8 @@ class Film:
             data = out.read_bytes()
         if kind == "mp4":
             size = (size[0] + size[0] % 2, size[1] + size[1] % 2)  # yuv420p: even sides
-        return cls(None, frames=len(files), fps=fps, size=size, data=data, kind=kind)
+        return cls(None, frames=len(files), fps=fps, size=size, data=data, kind=kind,
+                   frames_folder=None if isinstance(folder, list) else folder)
 
     # ------------------------------------------------------------------ bytes and files
     @property

@@ -30,6 +30,11 @@ DISK_PER_SAVE = 16 * 2**10  # the scene file, a row of the series
 #: Cell updates per second the documentation's figures assume (2 cores); for the time estimate.
 CELL_UPDATES_PER_SECOND = 50e6
 
+#: A flow cell's step (three predictors, the divergence, two cosine transforms, the correction
+#: and the heat it carries) in enthalpy cell updates: an estimate from the operation count
+#: (about 12 passes over the box against 1), for the time estimate and the soft limit.
+FLOW_CELL_COST = 12.0
+
 SOFT_LIMITS = {
     "cell_updates": 1.0e12,  # about 5.5 h at 50 M cell updates/s
     "steps": 1.0e8,
@@ -47,10 +52,15 @@ class Estimate:
     saves: int
     memory_bytes: int
     disk_bytes: int
+    #: with ``cavity.convection = "flow"``: the flow box's cells and its steps per step
+    flow_cells: int = 0
+    flow_substeps: int = 0
 
     @property
     def cell_updates(self) -> float:
-        return float(self.cells) * self.steps
+        """Enthalpy cell updates, the flow's counted at ``FLOW_CELL_COST`` each."""
+        flow = FLOW_CELL_COST * self.flow_cells * self.flow_substeps
+        return (float(self.cells) + flow) * self.steps
 
     @property
     def seconds(self) -> float:
@@ -83,7 +93,22 @@ def estimate(case: Case) -> Estimate:
     saves = math.ceil(case.time.end / case.time.save_every) + 1
     memory = BASE_BYTES + BYTES_PER_CELL * cells
     disk = saves * (DISK_PER_CELL * cells + DISK_PER_SAVE)
-    return Estimate(cells, shape, dt, int(min(steps, 2**62)), int(saves), int(memory), int(disk))
+    flow_cells = substeps = 0
+    if case.cavity.model == "flow":  # the box around the cavity (Case.solver_flow), at rest
+        from .convection import water_density, water_viscosity
+
+        half = [0.5 * s for s in case.block.size]
+        ext = case.cavity.half_extent()
+        shell = min(half[a] - (abs(case.cavity.center[a]) + ext[a]) for a in range(3))
+        margin = 2 + int(math.ceil(0.5 * shell / case.dx))
+        flow_cells = 1
+        for a in range(3):
+            flow_cells *= min(shape[a], int(math.ceil(2 * ext[a] / case.dx)) + 2 * margin)
+        nu = water_viscosity(2.0) / water_density(2.0)
+        substeps = max(1, math.ceil(dt / (0.9 * case.dx ** 2 / (6.0 * nu)))) if dt > 0 else 1
+        memory += 160 * flow_cells  # 3 velocities and their copies, scratch, the transforms
+    return Estimate(cells, shape, dt, int(min(steps, 2**62)), int(saves), int(memory), int(disk),
+                    flow_cells, substeps)
 
 
 def machine_memory() -> int | None:

@@ -86,7 +86,7 @@ def render_melt_film(
     from ..animation.film import FilmPaths, render_film
     from ..output.video import encode_film
     from ..scene import load_scene
-    from .run import film_bubbles, film_frames, film_puddles
+    from .run import film_bubbles, film_frames, film_puddles, film_tracers
     from .scene import ABSORPTION_BOOST, still_life_scene, write_scene
 
     work = Path(work)
@@ -101,7 +101,7 @@ def render_melt_film(
             "surfaces/outer_{frame:04d}.ply", "surfaces/inner_{frame:04d}.ply", None,
             width=width, height=height, size_cm=100 * max(case.block.size),
             frames=len(shown), fps=fps, bubbles=film_bubbles(work, shown),
-            puddles=film_puddles(work, shown, case)))
+            puddles=film_puddles(work, shown, case), tracers=film_tracers(work, shown)))
         frames = render_film(load_scene(scene_path), FilmPaths(None, work / "frames"),
                              fps=fps, scene_path=scene_path, cancel=cancel,
                              progress=progress, executor=executor)

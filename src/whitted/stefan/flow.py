@@ -75,6 +75,76 @@ class Poisson:
         return idctn(hat, type=2, axes=self.axes, norm="ortho", workers=self.workers)
 
 
+class MaskedPoisson:
+    """div(grad phi) = rhs on the fluid cells of a box, no flux through the faces to other
+    cells or the walls: conjugate gradients (SciPy) on the cells' graph Laplacian, started
+    from the last solution, Jacobi-preconditioned; the matrix is rebuilt when the fluid
+    changes. Each connected body of fluid is singular (phi up to a constant): a 10⁻¹⁰ shift of
+    the diagonal fixes the constant without moving the gradient measurably."""
+
+    def __init__(self, shape: tuple[int, int, int], dx: float) -> None:
+        self.shape = tuple(shape)
+        self.dx = float(dx)
+        self._mask: np.ndarray | None = None
+        self._phi = np.zeros(shape)
+
+    def _build(self, fluid: np.ndarray) -> None:
+        import scipy.sparse as sp
+
+        index = -np.ones(self.shape, dtype=np.int64)
+        cells = np.flatnonzero(fluid)
+        index.flat[cells] = np.arange(len(cells))
+        rows, cols = [], []
+        for a in range(3):
+            if self.shape[a] < 2:
+                continue
+            lo = [slice(None)] * 3
+            hi = [slice(None)] * 3
+            lo[a] = slice(0, -1)
+            hi[a] = slice(1, None)
+            both = fluid[tuple(lo)] & fluid[tuple(hi)]
+            i = index[tuple(lo)][both]
+            j = index[tuple(hi)][both]
+            rows += [i, j]
+            cols += [j, i]
+        r = np.concatenate(rows) if rows else np.zeros(0, dtype=np.int64)
+        c = np.concatenate(cols) if cols else np.zeros(0, dtype=np.int64)
+        n = len(cells)
+        off = sp.coo_matrix((np.ones(len(r)), (r, c)), shape=(n, n)).tocsr()
+        degree = np.asarray(off.sum(axis=1)).ravel()
+        h2 = 1.0 / (self.dx * self.dx)
+        self.matrix = ((off - sp.diags(degree + 1e-10 * np.maximum(degree, 1.0))) * h2).tocsr()
+        self.jacobi = sp.diags(1.0 / (-(degree + 1e-10 * np.maximum(degree, 1.0)) * h2
+                                      - 1e-300))
+        self.cells = cells
+        self._mask = fluid.copy()
+
+    def zero_closed(self, u, v, w, fluid: np.ndarray) -> None:
+        """No flow through a face unless both its cells are fluid (the walls' faces stay 0)."""
+        u[1:-1][~(fluid[1:] & fluid[:-1])] = 0.0
+        v[:, 1:-1][~(fluid[:, 1:] & fluid[:, :-1])] = 0.0
+        if fluid.shape[2] > 1:
+            w[:, :, 1:-1][~(fluid[:, :, 1:] & fluid[:, :, :-1])] = 0.0
+
+    def solve(self, fluid: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+        from scipy.sparse.linalg import cg
+
+        if self._mask is None or not np.array_equal(self._mask, fluid):
+            self._build(fluid)
+        phi = np.zeros(self.shape)
+        if len(self.cells) == 0:
+            return phi
+        b = rhs.flat[self.cells]
+        x0 = self._phi.flat[self.cells]
+        scale = float(np.abs(b).max())
+        if scale == 0.0:
+            return phi
+        x, _ = cg(self.matrix, b, x0=x0, rtol=1e-9, atol=0.0, maxiter=2000, M=self.jacobi)
+        phi.flat[self.cells] = x
+        self._phi = phi
+        return phi
+
+
 class Flow:
     """Velocities on the faces of a box of ``shape`` cells (2-D when the last is 1), with
     kinematic viscosity ``nu`` (m²/s, or Pr in the benchmark's units)."""
@@ -94,6 +164,7 @@ class Flow:
         self._div = np.zeros(shape)
         self._zero = np.zeros(shape)
         self.poisson = Poisson(shape, dx, workers=-1)
+        self._masked = MaskedPoisson(shape, dx)
 
     def stable_dt(self, cfl: float = 0.5) -> float:
         """The explicit step's limit: diffusion (dx²/(2 d nu)) and advection (cfl dx / |u|)."""
@@ -105,9 +176,11 @@ class Flow:
             dt = min(dt, cfl * self.dx / speed)
         return dt
 
-    def step(self, dt: float, buoyancy: np.ndarray, sink: np.ndarray | None = None) -> None:
-        """One step: ``buoyancy`` (m/s², per cell, along +axis 1, which is up) and the
-        enthalpy-porosity ``sink`` (1/s per cell; None: none)."""
+    def step(self, dt: float, buoyancy: np.ndarray, sink: np.ndarray | None = None,
+             fluid: np.ndarray | None = None) -> None:
+        """One step: ``buoyancy`` (m/s², per cell, along +axis 1, which is up), the
+        enthalpy-porosity ``sink`` (1/s per cell; None: none) and, with ``fluid``, the
+        projection on those cells only (:meth:`project`)."""
         sink = self._zero if sink is None else sink
         dx, nu, flat = self.dx, self.nu, self.flat
         t = (1, 0, 2)
@@ -122,9 +195,19 @@ class Flow:
         self.u, self._u = self._u, self.u
         self.v, self._v = self._v, self.v
         self.w, self._w = self._w, self.w
-        self.project(dt)
+        self.project(dt, fluid)
 
-    def project(self, dt: float) -> None:
+    def project(self, dt: float, fluid: np.ndarray | None = None) -> None:
+        """Make the velocity divergence-free: in the whole box (cosine transform), or, with
+        ``fluid`` (a mask of cells), in the fluid cells only, with no flow through the faces
+        of the others (:class:`MaskedPoisson`)."""
+        if fluid is not None:
+            self._masked.zero_closed(self.u, self.v, self.w, fluid)
+            fk.divergence(self.u, self.v, self.w, self.dx, self._div, self.flat)
+            phi = self._masked.solve(fluid, self._div / dt)
+            fk.correct(self.u, self.v, self.w, phi, dt, self.dx, self.flat)
+            self._masked.zero_closed(self.u, self.v, self.w, fluid)
+            return
         fk.divergence(self.u, self.v, self.w, self.dx, self._div, self.flat)
         phi = self.poisson.solve(self._div / dt)
         fk.correct(self.u, self.v, self.w, phi, dt, self.dx, self.flat)
@@ -259,10 +342,13 @@ class MeltFlow:
         self.props = props
         self.dx = float(dx)
         self._out = np.zeros(shape)
+        self._open = np.ones(shape)  # the faces' weights: the velocity is 0 off the fluid
         self.box0 = np.array([s.start + 1 for s in box], dtype=np.int64)  # padded indices
         self.sink_c = MUSHY_CONSTANT / props.water.rho
         self.time = 0.0
-        self.largest_speed = 0.0
+        #: tracer particles carried by the flow (for the film): positions in cell units of the
+        #: box (a cell's centre at i + 1/2), seeded by :meth:`seed_tracers`
+        self.tracers = np.zeros((0, 3))
 
     def stable_dt(self) -> float:
         return 0.9 * self.flow.stable_dt(0.4)
@@ -283,10 +369,66 @@ class MeltFlow:
         f, T, heat = self.fields(Hp, kindp)
         buoy = self.G * (self.rho0 - water_density_array(T)) / self.rho0 * f
         sink = self.sink_c * (1.0 - f) ** 2 / (f ** 3 + 1.0e-3)
-        self.flow.step(dt, buoy, sink)
-        fk.advect_enthalpy(Hp, self.box0, self.flow.u, self.flow.v, self.flow.w, f, heat, dt,
-                           self.dx, self.flow.flat, self._out)
+        self.flow.step(dt, buoy, sink, fluid=f >= 0.5)
+        # the heat goes with the new velocity: in as many parts as keep each under half a cell
+        parts = max(1, int(math.ceil(self.speed() * dt / (0.5 * self.dx))))
+        for q in range(parts):
+            if q > 0:
+                f, T, heat = self.fields(Hp, kindp)
+            fk.advect_enthalpy(Hp, self.box0, self.flow.u, self.flow.v, self.flow.w,
+                               self._open, heat, dt / parts, self.dx, self.flow.flat,
+                               self._out)
+            self.move_tracers(f, dt / parts)
         self.time += dt
+
+    def seed_tracers(self, Hp: np.ndarray, kindp: np.ndarray, count: int = 48,
+                     seed: int = 1) -> None:
+        """``count`` tracers at random points of the liquid cells of now (a fixed seed: the
+        same run seeds the same tracers)."""
+        f, _, _ = self.fields(Hp, kindp)
+        cells = np.argwhere(f >= 1.0)
+        if len(cells) == 0:
+            return
+        rng = np.random.default_rng(seed)
+        pick = cells[rng.integers(0, len(cells), size=count)]
+        self.tracers = pick + rng.uniform(0.15, 0.85, size=(count, 3))
+
+    def move_tracers(self, f: np.ndarray, dt: float) -> None:
+        """Carry the tracers one step with the velocity at their cell (the mean of its faces);
+        one that would leave the liquid (a cell under half liquid) stays where it is."""
+        if len(self.tracers) == 0:
+            return
+        fl = self.flow
+        idx = np.clip(self.tracers.astype(np.int64), 0, np.array(fl.shape) - 1)
+        i, j, k = idx[:, 0], idx[:, 1], idx[:, 2]
+        vel = np.stack([0.5 * (fl.u[i, j, k] + fl.u[i + 1, j, k]),
+                        0.5 * (fl.v[i, j, k] + fl.v[i, j + 1, k]),
+                        0.5 * (fl.w[i, j, k] + fl.w[i, j, k + 1])], axis=1)
+        moved = self.tracers + vel * dt / self.dx
+        new = np.clip(moved.astype(np.int64), 0, np.array(fl.shape) - 1)
+        ok = (f[new[:, 0], new[:, 1], new[:, 2]] >= 0.5) & np.all(moved >= 0.0, axis=1) \
+            & np.all(moved < np.array(fl.shape), axis=1)
+        self.tracers[ok] = moved[ok]
+
+    def tracer_points(self) -> np.ndarray:
+        """The tracers in the unpadded grid's cell-index units (cell centres at integers)."""
+        return self.tracers + np.array([s.start for s in self.box]) - 0.5
+
+    def state(self) -> dict:
+        """What a resumed run needs to go on with the flow as it was."""
+        return {"flow_u": self.flow.u, "flow_v": self.flow.v, "flow_w": self.flow.w,
+                "flow_tracers": self.tracers, "flow_box": np.array(
+                    [[s.start, s.stop] for s in self.box])}
+
+    def restore(self, z) -> None:
+        """The flow of a saved state (:meth:`state`), when its box is this one's."""
+        if "flow_box" not in z or not np.array_equal(
+                z["flow_box"], np.array([[s.start, s.stop] for s in self.box])):
+            return
+        self.flow.u[...] = z["flow_u"]
+        self.flow.v[...] = z["flow_v"]
+        self.flow.w[...] = z["flow_w"]
+        self.tracers = np.array(z["flow_tracers"], dtype=np.float64).reshape(-1, 3)
 
     def speed(self) -> float:
         """The largest speed (m/s) on the faces now."""

@@ -78,7 +78,8 @@ def _save_state(path: Path, solver: EnthalpySolver, digest: str, index: int,
         steps=solver.steps, totals=solver.totals, dx=solver.dx, digest=digest, index=index,
         breached=solver.breached,
         breach_time=np.nan if solver.breach_time is None else solver.breach_time,
-        initial_enthalpy=solver.initial_enthalpy, initial_cavity=initial_cavity)
+        initial_enthalpy=solver.initial_enthalpy, initial_cavity=initial_cavity,
+        **({} if solver.flow is None else solver.flow.state()))
     _atomic_bytes(path, buf.getvalue())
 
 
@@ -210,6 +211,8 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
                                     stop_on_breach=case.breach.action == "stop",
                                     time=float(z["time"]))
             solver.steps = int(z["steps"])
+            if solver.flow is not None:
+                solver.flow.restore(z)
             solver.totals[:] = z["totals"]
             solver.initial_enthalpy = float(z["initial_enthalpy"])
             solver.breached = bool(z["breached"])
@@ -227,6 +230,8 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
                                 flow=case.solver_flow(H, kind),
                                 stop_on_breach=case.breach.action == "stop")
         initial_cavity = float(cavity.sum()) * case.dx ** 3
+        if solver.flow is not None:
+            solver.flow.seed_tracers(solver._Hp, solver._kindp)
         index = 0
         rows = []
         _record(out, solver, case, frame, digest, index, initial_cavity, rows, result,
@@ -339,6 +344,37 @@ def film_puddles(out: Path, frames: list[FilmFrame], case: Case) -> list[float]:
             for f in frames]
 
 
+def tracer_points(solver: EnthalpySolver, frame: GridFrame) -> list[tuple[float, ...]]:
+    """The flow's tracer particles now, in scene centimetres (none without the flow)."""
+    if solver.flow is None or len(solver.flow.tracers) == 0:
+        return []
+    world = frame.to_world(solver.flow.tracer_points())
+    return [tuple(100.0 * c for c in p) for p in world]
+
+
+def film_tracers(out: Path, frames: list[FilmFrame]) -> list[list[tuple[float, ...]]] | None:
+    """The tracers of each frame (scene centimetres) from the saved states; None when the
+    run has none (no flow)."""
+    from .geometry import grid_frame
+
+    fields = Path(out) / "fields"
+    found = []
+    frame = None
+    for f in frames:
+        with np.load(fields / f"state_{f.index:04d}.npz") as z:
+            if "flow_tracers" not in z:
+                return None
+            if frame is None:
+                from .case import load_case
+
+                frame = grid_frame(load_case(Path(out) / "case.toml"))
+            pts = np.array(z["flow_tracers"]).reshape(-1, 3)
+            box = np.array(z["flow_box"])
+        world = frame.to_world(pts + box[:, 0] - 0.5)
+        found.append([tuple(100.0 * c for c in p) for p in world])
+    return found
+
+
 def film_frames(out: Path) -> list[FilmFrame]:
     """The saved times of the run in ``out`` that a film shows, from t = 0 to the end of the
     run: every saved time with an outer surface (in ``drain`` mode the frames after the
@@ -375,7 +411,8 @@ def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, dig
                             None if inner is None else "../" + inner, solver.time,
                             width=scene_size[0], height=scene_size[1],
                             size_cm=100 * max(case.block.size), bubbles=bubble,
-                            puddles=[puddle])
+                            puddles=[puddle], tracers=None if inner is None else
+                            [tracer_points(solver, frame)])
     write_scene(out / "scenes" / f"frame_{index:04d}.toml", text)
     rows[:] = [r for r in rows if r["time_s"] < solver.time - 1e-9]
     rows.append({"time_s": solver.time, "ice_volume_cm3": m.ice_volume * 1e6,
@@ -391,4 +428,4 @@ def _record(out: Path, solver: EnthalpySolver, case: Case, frame: GridFrame, dig
 
 
 __all__ = ["FilmFrame", "RunResult", "asdict", "film_bubbles", "film_frames", "film_puddles",
-           "condensed_volume", "inner_top", "meltwater", "run_case", "state_files"]
+           "condensed_volume", "film_tracers", "inner_top", "meltwater", "run_case", "state_files"]

@@ -52,6 +52,8 @@ def void_bubble(top_m: tuple[float, float, float], void_m3: float) -> tuple[tupl
 #: e = 2 l_c sin(theta / 2): 2.7 mm for a contact angle of 60° on varnished wood (de Gennes,
 #: Brochard-Wyart & Quéré, *Capillarity and Wetting Phenomena*, 2004, section 2.1.3)
 PUDDLE_CM = 0.27
+#: the flow's tracer particles: bubbles of air this big (cm), as a film's tracer bubbles are
+TRACER_CM = 0.03
 
 
 def puddle_radius(water_m3: float, block_size_m: tuple[float, float, float]) -> float:
@@ -72,12 +74,15 @@ def still_life_scene(outer: str | None, inner: str | None, time_s: float | None,
                      absorption_boost: float = ABSORPTION_BOOST,
                      caustic_photons: int | None = None,
                      bubbles: list[tuple[tuple[float, ...], float]] | None = None,
-                     puddles: list[float] | None = None) -> str:
+                     puddles: list[float] | None = None,
+                     tracers: list[list[tuple[float, ...]]] | None = None) -> str:
     """The scene file's text; ``outer``/``inner`` are PLY paths relative to the scene file.
     With ``frames``, an animated scene whose meshes are sequences (``{frame:04d}`` in the
     names): frame k shows saved time k. ``bubbles``: the void's bubble (:func:`void_bubble`)
     in the cavity's water, one per frame (one for a still), keyed per frame in a film;
     ``puddles``: the meltwater's disc radius on the table (:func:`puddle_radius`), likewise;
+    ``tracers``: the flow's tracer particles (scene centimetres), one list per frame, drawn as
+    small bubbles of air (radius ``TRACER_CM``) that the water carries, likewise;
     ``caustic_photons``: photons per frame for the light the piece focuses (0: none; None:
     CAUSTIC_PHOTONS_PER_PIXEL of the frame)."""
     if caustic_photons is None:
@@ -177,6 +182,13 @@ def still_life_scene(outer: str | None, inner: str | None, time_s: float | None,
                   f"center = [{cx:.4f}, {cy:.4f}, {cz:.4f}]", f"radius = {r:.5f}",
                   "material = { color = [1.0, 1.0, 1.0], ka = 0.0, kd = 0.0, ks = 0.0, "
                   "kr = 0.0, kt = 1.0, ior = 1.0, fresnel = true }"]
+    shown = tracers[0] if tracers and inner is not None else []
+    for k, (tx, ty, tz) in enumerate(shown):  # tracer bubbles in the water, like the void's
+        lines += ["", "[[objects]]", f'name = "tracer {k}"', 'type = "sphere"',
+                  f"center = [{tx:.4f}, {ty + LIFT_CM:.4f}, {tz:.4f}]",
+                  f"radius = {TRACER_CM:g}",
+                  "material = { color = [1.0, 1.0, 1.0], ka = 0.0, kd = 0.0, ks = 0.0, "
+                  "kr = 0.0, kt = 1.0, ior = 1.0, fresnel = true }"]
     if puddles:
         lines += ["", "[[objects]]", 'name = "meltwater"', 'type = "cylinder"',
                   "base = [0.0, 0.0, 0.0]", f"top = [0.0, {PUDDLE_CM:g}, 0.0]",
@@ -195,6 +207,13 @@ def still_life_scene(outer: str | None, inner: str | None, time_s: float | None,
                       'interpolation = "step"', f"keys = [{centres}]",
                       "", "[[animation.tracks]]", 'path = "objects[void bubble].radius"',
                       'interpolation = "step"', f"keys = [{radii}]"]
+        if shown and len(tracers) > 1:
+            for k in range(len(shown)):
+                keys = ", ".join(
+                    f"[{n}, [{p[k][0]:.4f}, {p[k][1] + LIFT_CM:.4f}, {p[k][2]:.4f}]]"
+                    for n, p in enumerate(tracers) if k < len(p))
+                lines += ["", "[[animation.tracks]]", f'path = "objects[tracer {k}].center"',
+                          'interpolation = "step"', f"keys = [{keys}]"]
     return "\n".join(lines) + "\n"
 
 

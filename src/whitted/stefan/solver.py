@@ -110,7 +110,7 @@ class EnthalpySolver:
             raise ValueError(f"time step {dt:g} s is over the stability limit "
                              f"{self.dt_limit:.4g} s")
         # the cavity water's flow (flow.MeltFlow): stepped after every enthalpy step, in
-        # shorter steps of its own when its limit (viscosity, the speed) is below dt
+        # shorter steps of its own when its limit (viscosity, the speed of now) is below dt
         self.flow = flow
         self.dt = float(dt)
         self.stop_on_breach = stop_on_breach
@@ -201,9 +201,13 @@ class EnthalpySolver:
                 if did == 0:
                     break
                 done += 1
-                sub = max(1, int(math.ceil(self.dt / self.flow.stable_dt())))
-                for _ in range(sub):
-                    self.flow.step(self._Hp, self._kindp, self.dt / sub)
+                left = self.dt  # in steps under the flow's limit at its velocity of now
+                while left > 1e-12 * self.dt:
+                    h = min(left, self.flow.stable_dt())
+                    if left - h < 0.05 * h:
+                        h = left
+                    self.flow.step(self._Hp, self._kindp, h)
+                    left -= h
                 if self.breached and self.stop_on_breach:
                     break
             return done

@@ -45,9 +45,16 @@ def local_points(obj, scene: Scene | None = None) -> np.ndarray | None:
     if t == "torus":  # about the y axis through the origin
         a = obj.major_radius + obj.minor_radius
         return _corners((-a, -obj.minor_radius, -a), (a, obj.minor_radius, a))
-    if t == "csg":  # the union of the parts bounds every operation
-        parts = [p for o in obj.objects if (p := world_points(o, scene)) is not None]
-        return np.concatenate(parts) if parts else None
+    if t == "csg":  # in the CSG object's space, from its parts
+        children = obj.objects[:1] if obj.operation == "difference" else obj.objects
+        parts = [p for o in children if (p := world_points(o, scene)) is not None]
+        if not parts:
+            return None
+        if obj.operation == "intersection" and len(parts) == len(children):
+            lo = np.max([p.min(axis=0) for p in parts], axis=0)
+            hi = np.maximum(np.min([p.max(axis=0) for p in parts], axis=0), lo)
+            return _corners(lo, hi)  # within every part's box
+        return np.concatenate(parts)  # a difference within its first part; a union, all
     if t == "mesh":
         try:
             if obj.file is not None:
