@@ -22,9 +22,11 @@ install: $(BIN)/whitted
 
 install-test: $(VENV)/.test-deps
 
-## Install, then render the built-in default scene to render.png, and say how to use the
-## `whitted` command from here on (it lives in $(VENV)/bin)
+## Install, compile every kernel into the per-user cache (whitted warm), render the built-in
+## default scene to render.png, and say how to use the `whitted` command from here on (it lives
+## in $(VENV)/bin)
 demo: install
+	$(BIN)/whitted warm
 	$(BIN)/whitted render -o render.png
 	@echo "whitted is installed in $(VENV)/; to use the whitted command in this shell, type:"
 	@echo "    . $(VENV)/bin/activate"

@@ -62,7 +62,8 @@ def as_run(argv: list[str], folder: Path) -> list[str] | str:
     if command == "bench":
         if "povray" in argv and shutil.which("povray") is None:
             return "POV-Ray is not installed"
-        return [*run, "--quick", "--scene", "seed000", "--runs", "1"]
+        scene = [] if "--scene" in run else ["--scene", "seed000"]
+        return [*run, "--quick", *scene, "--runs", "1"]
     if "--turntable" in run:  # four frames of the film are enough to show it runs
         run[run.index("--turntable") + 1] = "4"
     if command == "animate":
