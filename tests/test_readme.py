@@ -3,9 +3,10 @@ that holds what a user has after `whitted examples examples` (the README's pip r
 shell command and every Python block, at tiny picture sizes (-W/-H added, width=/height=
 rewritten, films cut to four frames) and on a small Stefan case. Left out: installing (make,
 pip, activating the virtual environment: CI's `make check-wheel` does that for real),
-`whitted gui` (a desktop window), POV-Ray's comparison when POV-Ray is not installed, and
-`whitted stefan validate` (a minute or more of solving; tests/test_cov_stefan_validate.py
-checks the studies behind its tables)."""
+`whitted gui` (a desktop window), POV-Ray's comparison when POV-Ray is not installed,
+`whitted warm` (every kernel variant compiled: minutes on a cold cache; its own tests are in
+tests/test_warm_command.py) and `whitted stefan validate` (a minute or more of solving;
+tests/test_cov_stefan_validate.py checks the studies behind its tables)."""
 
 from __future__ import annotations
 
@@ -73,6 +74,8 @@ def as_run(argv: list[str], folder: Path) -> list[str] | str:
         return run  # a region in pixels needs the scene's own size
     if command in ("render", "sweep"):
         return [*run, *TINY]
+    if command == "warm":
+        return "compiles every kernel variant (minutes when cold); tests/test_warm_command.py"
     if argv[1:3] == ["stefan", "validate"]:
         return "a minute of solving; tests/test_cov_stefan_validate.py checks its studies"
     if command == "stefan":
