@@ -133,3 +133,12 @@ def test_a_flow_run_saves_its_flow_and_tracers_and_the_scene_shows_them(tmp_path
     assert sum(n.startswith("tracer ") for n in names) == 48
     tracers = film_tracers(out, film_frames(out))
     assert len(tracers) == 3 and len(tracers[0]) == 48
+    # a solver rebuilt from a saved state (a resume) goes on with its flow, not water at rest
+    with np.load(out / "fields" / "state_0001.npz") as z:
+        solver = EnthalpySolver(z["H"], z["kind"], float(z["dx"]), case.solver_properties(),
+                                flow=case.solver_flow(z["H"], z["kind"]))
+        solver.flow.restore(z)
+        assert np.abs(z["flow_v"]).max() > 0.0
+        np.testing.assert_array_equal(solver.flow.flow.v, z["flow_v"])
+        np.testing.assert_array_equal(solver.flow.tracers, z["flow_tracers"])
+

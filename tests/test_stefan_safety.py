@@ -261,7 +261,7 @@ scalars = st.one_of(
     st.sampled_from([0.0, -0.0, 1e-300, 1e300, 1e308, 917.0, 0.04, 0.012, 3600.0, 8, 12, 512]),
     st.text(alphabet=string.printable, max_size=8),
     st.sampled_from(["sphere", "box", "stop", "drain", "adiabatic", "conducting", "917",
-                     "auto"]))
+                     "auto", "flow", "effective", "off"]))
 values = st.one_of(scalars, st.lists(scalars, max_size=4))
 
 

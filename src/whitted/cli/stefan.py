@@ -136,7 +136,9 @@ def validate(
     plot: Annotated[Path | None, typer.Option("--plot", help="Front against time (PNG)")] = None,
 ) -> None:
     """Check the solver against exact answers and print the tables: Neumann's lambda, front
-    error against cell size, the axes, the convective slab, the sphere, the energy balance."""
+    error against cell size, the axes, the cavity's convection, the flow solver on de Vahl
+    Davis's square cavity (32², with --full 32² to 128²), the convective slab, the sphere,
+    the energy balance."""
     from rich.table import Table
 
     from ..stefan import validate as v

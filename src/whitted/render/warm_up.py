@@ -45,6 +45,7 @@ from ..assets.mesh import load_obj_bytes
 from ..compile.params import render_params
 from ..compile.scene import CompiledScene, compile_scene
 from ..jit.cache import HELPER_ENV, prepare
+from ..jit.progress import CompileReport
 from ..kernels.features import EXTRAS_DTYPE
 from ..kernels.layout import N_RAY_KINDS
 from ..scene.lights import PointLight
@@ -146,6 +147,13 @@ def _marker(instances: bool) -> Path | None:
     if folder is None:
         return None
     return Path(folder) / ("whitted-ready-instances" if instances else "whitted-ready-plain")
+
+
+def kernels_cached(instances: bool = False) -> bool:
+    """Whether the render kernels of the variant are complete in the kernel cache (a render
+    loads them in a fraction of a second instead of compiling them)."""
+    marker = _marker(instances)
+    return marker is not None and marker.exists()
 
 
 def _mark(marker: Path | None) -> None:
@@ -278,6 +286,7 @@ def caustics_compile():
             if _progress is None:
                 _label = "the caustics kernels"
                 _progress = count
+                _report_of(count, "the caustics kernels")  # the first compile: said
             count.check_interrupt()
 
         def on_end(self, ev) -> None:
@@ -286,14 +295,33 @@ def caustics_compile():
 
     listener = Listener()
     event.register("numba:compile", listener)
+    report = None
     try:
         with _interrupt_at_safe_points(count):
             yield
+    except BaseException as exc:
+        if _progress is count:
+            report = _report_of(count, "the caustics kernels")
+            report.__exit__(type(exc), exc, None)
+        raise
+    else:
+        if _progress is count:
+            _report_of(count, "the caustics kernels").__exit__(None, None, None)
     finally:
         event.unregister("numba:compile", listener)
         if _progress is count:
             _progress = None
             _label = "the kernels"
+
+
+def _report_of(count: _CompileCount, label: str) -> CompileReport:
+    """The report (jit/progress.py: log records, a bar in the Python API) of a first
+    compile, started with it."""
+    report = getattr(count, "report", None)
+    if report is None:
+        report = count.report = CompileReport(label, compile_progress)
+        report.__enter__()
+    return report
 
 
 def _start_helper(instances: bool) -> subprocess.Popen | None:
@@ -334,15 +362,21 @@ def _stop_helper(helper: subprocess.Popen | None) -> None:
         helper.wait()
 
 
-def warm_up_kernels(compiled: CompiledScene | None = None) -> float:
+def warm_up_kernels(compiled: CompiledScene | None = None,
+                    render_kernel: bool = True) -> float:
     """Compile (first run) or load from the on-disk cache (later runs) the render kernels for
     scenes like ``compiled`` (kernels are specialised for scenes with and without mesh
     instances; without when None); on the first run also the builders and the AOV kernel.
-    Returns the seconds it took; 0 when all of it was already loaded in this process."""
+    ``render_kernel=False``: a render that runs another kind of the render kernel (caustics,
+    adaptive anti-aliasing, loaded in its own stage) does not load the plain one when the
+    cache holds the variant. Returns the seconds it took; 0 when all of it was already loaded
+    in this process (or nothing had to be)."""
     with _lock:
         key = _loaded_key(compiled)
         if key in _ready:
             return 0.0
+        if not render_kernel and kernels_cached(key[0]):
+            return 0.0  # the render's own kind loads in its stage
         instances = key[0]
         start = time.perf_counter()
         cache = prepare()
@@ -427,8 +461,10 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
     if delegated and KernelCache is not None:
         KernelCache.wait_for_helper = count.wait_for_helper
     _progress = count
+    report = CompileReport("the instance kernels" if instances else "the kernels",
+                           compile_progress)
     try:
-        with _CountCompiles(count), _interrupt_at_safe_points(count):
+        with report, _CountCompiles(count), _interrupt_at_safe_points(count):
             _compile_render_kernels(compiled if compiled is not None
                                     else stand_in_scene(instances))
             if KernelCache is not None:
