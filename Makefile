@@ -22,8 +22,10 @@ install: $(BIN)/whitted
 
 install-test: $(VENV)/.test-deps
 
-## Install, then render the built-in default scene to render.png
+## Install, compile every kernel into the per-user cache (whitted warm), then render the
+## built-in default scene to render.png
 demo: install
+	$(BIN)/whitted warm
 	$(BIN)/whitted render -o render.png
 
 ## Install the test dependencies, lint, then run the whole test suite

@@ -54,14 +54,17 @@ def _install(place: Path, mtime: int) -> Path:
     return place
 
 
-def _run(place: Path, cache: Path) -> dict:
+def _run(place: Path, cache: Path, with_stderr: bool = False):
     env = {k: v for k, v in os.environ.items()
            if k not in ("NUMBA_CACHE_DIR", "NUMBA_CACHE_LOCATOR_CLASSES", "PYTHONPATH")}
     env.update(PYTHONPATH=str(place), WHITTED_CACHE_DIR=str(cache), WHITTED_COMPILE_HELPER="0")
     result = subprocess.run([sys.executable, "-c", RUN], env=env, capture_output=True,
                             text=True, timeout=600, cwd=place)
     assert result.returncode == 0, result.stderr
-    return json.loads(result.stdout.strip().splitlines()[-1])
+    found = json.loads(result.stdout.strip().splitlines()[-1])
+    if with_stderr:
+        return found, [line for line in result.stderr.splitlines() if line.strip()]
+    return found
 
 
 def test_two_installs_in_different_places_share_one_cache(tmp_path):
@@ -77,3 +80,23 @@ def test_two_installs_in_different_places_share_one_cache(tmp_path):
     assert (Path(first["folder"]) / "kernels").is_dir()
     names = {p.name for p in Path(first["folder"]).iterdir() if p.is_dir()}
     assert names == {"kernels"}, names
+
+
+def test_a_damaged_kernel_file_is_found_when_its_kernel_is_looked_up(tmp_path):
+    """Each process hashes only the cache files of the kernels it looks up (jit/locator.py):
+    a flipped bit in one of them is still found, deleted and compiled again, with one
+    warning; the next process loads the new file without a word."""
+    cache = tmp_path / "user-cache"
+    place = _install(tmp_path / "checkout", 1_600_000_000)
+    first = _run(place, cache)
+    folder = Path(first["folder"])
+    [machine_code] = sorted((folder / "kernels").glob("probe_kernel.twice_plus-*.nbc"))
+    data = bytearray(machine_code.read_bytes())
+    data[len(data) // 2] ^= 0x10
+    machine_code.write_bytes(data)  # in place: the inode the list records
+    second, warnings = _run(place, cache, with_stderr=True)
+    assert second["value"] == 42 and second["compiled"] == 1
+    assert warnings == ["warning: 1 damaged kernel cache file in "
+                        f"{folder} deleted; compiling it again"]
+    third, warnings = _run(place, cache, with_stderr=True)
+    assert third["compiled"] == 0 and warnings == []

@@ -32,7 +32,7 @@ def test_render_on_a_local_cluster_writes_the_local_image(tmp_path, examples_dir
     result = whitted("render", scene_path, "-W", 80, "-H", 45, "-s", 2, "-o",
                      tmp_path / "farm.png", "--cluster", "local:2", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
-    assert "farm: 2 workers (2 Dask threads) at tcp://127.0.0.1:" in result.stderr
+    assert "farm: 2 workers (2 Dask threads) at tcp://127.0.0.1:" in result.stdout
     assert "on 2 workers" in result.stdout
     scene = load_scene(scene_path).with_settings(width=80, height=45, samples=2)
     RenderJob(scene).run().save(tmp_path / "local.png")

@@ -193,7 +193,7 @@ def test_the_ssh_recipe_on_one_machine_renders_a_film_over_tls(tmp_path):
                 proc.wait()
     assert result.returncode == 0, result.stderr
     # one worker process with 2 Dask threads, on the pinned port
-    assert f"farm: 1 worker (2 Dask threads) at {address}" in result.stderr
+    assert f"farm: 1 worker (2 Dask threads) at {address}" in result.stdout
     assert "4 frames (4 rendered" in result.stdout
     assert len(list((tmp_path / "film_frames").glob("*.png"))) == 4
     assert intruder.returncode == 3

@@ -24,7 +24,8 @@ whitted.render(scene, width=16, height=12)   # kernels loaded before the clock m
 
 @pytest.fixture(scope="module")
 def kernel():
-    km, kc = jupyter_client.manager.start_new_kernel(kernel_name="python3")
+    km, kc = jupyter_client.manager.start_new_kernel(kernel_name="python3",
+                                                     startup_timeout=180)
     try:
         _run(kc, SETUP, timeout=600)
         yield km, kc

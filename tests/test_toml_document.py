@@ -320,8 +320,8 @@ def test_items_edited_in_place_removed_and_added_and_a_track_retimed():
     assert out == (
         '[[lights]]\n# key\ntype = "point"\nposition = [0, 5, 0]\n\n[[objects]]\n'
         'type = "sphere"\nradius = 2.0   # unit\n'
-        'material = { preset = "plastic", color = [1.0, 0, 0.0] }\n\n'
-        '\n[[objects]]\ntype = "sphere"\nname = "b"\nradius = 0.5\n'
+        'material = { preset = "plastic", color = [1.0, 0, 0.0] }\n'
+        '\n[[objects]]\ntype = "sphere"\nname = "b"\nradius = 0.5\n\n'
         '[animation]\nframes = 4\n[[animation.tracks]]\npath = "camera.fov"\n'
         'keys = [[0, 30], [3, 60]]\ninterpolation = "smooth"\n')
     assert load(out) == new

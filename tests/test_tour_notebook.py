@@ -48,7 +48,8 @@ def tour(tmp_path_factory):
     os.environ["TMPDIR"] = str(tmp)  # the kernel inherits it: film and run folders go there
     try:
         started = time.perf_counter()
-        client = nbclient.NotebookClient(nb, timeout=600, kernel_name="python3",
+        client = nbclient.NotebookClient(nb, timeout=600, startup_timeout=180,
+                                         kernel_name="python3",
                                          resources={"metadata": {"path": str(DOCS)}})
         client.execute()
         nb.metadata["seconds"] = time.perf_counter() - started

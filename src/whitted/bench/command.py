@@ -97,6 +97,7 @@ def bench_main(
               f"{available_threads()} usable core(s); "
               f"{'quick' if quick else f'median of {options.effective().runs} run(s)'}"
               " after a warm-up[/]")
+    _say_compile_time(options, err)
     try:
         if study:
             result = run_study(study, options, log)
@@ -131,3 +132,64 @@ def bench_main(
 
         markdown_path.write_text(markdown_table(result.rows) + "\n", encoding="utf-8")
         out.print(f"wrote {markdown_path}")
+
+
+def _say_compile_time(options: BenchOptions, err: Console) -> None:
+    """Before a bench whose first runs compile kernels: how long that takes here (the last
+    compile measured on this machine, jit/progress.py), said up front."""
+    from ..jit.progress import expected_seconds
+    from ..render.warm_up import kernels_cached
+    from .scenes import pick_scenes
+
+    if kernels_cached():
+        return
+    seconds = expected_seconds("the kernels")
+    names = [s.name for s in pick_scenes(options.scenes, options.quick)]
+    if "caustics" in names:
+        seconds += expected_seconds("the caustics kernels")
+    err.print(f"the kernels are not in the cache yet: the first runs compile them first, "
+              f"about {seconds:.0f} s (`whitted warm` compiles every variant ahead of use)",
+              highlight=False)
+
+
+def startup_main(*, scenes: list[str] | None, runs: int, threads: str | None,
+                 compare: str | None, json_path: Path | None, out: Console,
+                 err: Console) -> None:
+    """``whitted bench --startup``: the budget of a whole ``whitted render`` process for each
+    scene (a benchmark's name or a scene file), beside POV-Ray with ``--compare povray``."""
+    from .startup import budget_table, scene_file_of, startup_budget
+
+    if compare not in (None, "povray"):
+        raise BenchUsageError(f"--compare: --startup compares with povray only (got {compare!r})")
+    if runs < 1:
+        raise BenchUsageError("--runs: must be at least 1")
+    if compare == "povray":
+        from .povray import povray_executable
+
+        if povray_executable() is None:
+            raise BenchUsageError("--compare povray: povray is not installed "
+                                  "(Debian: apt-get install povray)")
+    counts = parse_threads(threads)
+    if counts is not None and len(counts) > 1:
+        raise BenchUsageError("--threads: --startup takes one thread count")
+    count = counts[0] if counts else None
+
+    names = scenes or ["seed000"]
+    for name in names:  # checked before the header line: a mistake is one line
+        scene_file_of(name)
+
+    def log(line: str) -> None:
+        err.print(f"[dim]{line}[/]", highlight=False)
+
+    err.print(f"[dim]whitted bench --startup on {platform.processor() or platform.machine()}, "
+              f"{available_threads()} usable core(s); median of {runs} run(s) after a "
+              "warm-up[/]")
+    results = []
+    for name in names:
+        budget = startup_budget(name, runs=runs, threads=count, povray=compare == "povray",
+                                log=log)
+        out.print(budget_table(budget))
+        results.append(budget.as_dict())
+    if json_path is not None:
+        write_json(results, json_path)
+        out.print(f"wrote {json_path}")

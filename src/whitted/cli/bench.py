@@ -38,11 +38,26 @@ def bench(
     in_process: Annotated[
         bool, typer.Option("--in-process", help="Render in this process, not a fresh one")
     ] = False,
+    startup: Annotated[bool, typer.Option(
+        "--startup", help="Where a whole `whitted render` process spends its time, for "
+                          "--scene (a benchmark or a scene file; default seed000)")] = False,
 ) -> None:
     """Render the benchmark scenes (benchmarks/) and print times, rays and memory."""
     from ..bench.command import bench_main
     from ..bench.scenes import SCENES
 
+    if startup:
+        from ..bench.command import startup_main
+        from ..output.safety import check_output_place
+
+        try:
+            if json_path is not None:
+                check_output_place(json_path)
+            startup_main(scenes=scene, runs=runs, threads=threads, compare=compare,
+                         json_path=json_path, out=out, err=err)
+        except WhittedError as exc:
+            raise fail(str(exc)) from None
+        return
     for name in scene or []:  # checked before the header line: a mistake is one line
         if name not in SCENES and not name.startswith("generated/"):
             raise fail(f"--scene: unknown benchmark scene {shorten(name)!r} "

@@ -9,7 +9,7 @@ before the end (frames, bands) is kept."""
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager, nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -73,6 +73,14 @@ def quiet_dask_logs() -> Iterator[None]:
             log.setLevel(level)
 
 
+def status(quiet: bool) -> Callable[[str], None] | None:
+    """Where the farm's status lines go (the cluster's size): stdout, as a local command's
+    progress lines; stderr keeps warnings and the one line of an error or interrupt."""
+    from .app import out
+
+    return None if quiet else (lambda line: out.print(line, markup=False, highlight=False))
+
+
 def bar(label: str, quiet: bool) -> Progress | None:
     from .app import err
 
@@ -107,7 +115,8 @@ def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
     starting, rendering = InterruptGuard(at_once=True), InterruptGuard()
     try:
         with quiet_dask_logs(), starting, \
-                farm.farm_client(cluster, scheduler, threads=threads, note=tell) as client, \
+                farm.farm_client(cluster, scheduler, threads=threads, note=tell,
+                                 status=status(quiet)) as client, \
                 rendering:
             progress = bar("rendering bands", quiet)
             with progress if progress is not None else nullcontext():
@@ -190,8 +199,8 @@ def animate_on_farm(scene: Scene, plan: FilmPlan, *, force: bool, quiet: bool,
         farm.check_farm_options(cluster, scheduler)
         todo, _ = missing_frames(scene, plan, force)
         # a cluster only when frames are missing: a finished film is only encoded
-        connect = (farm.farm_client(cluster, scheduler, threads=threads, note=note)
-                   if todo else nullcontext())
+        connect = (farm.farm_client(cluster, scheduler, threads=threads, note=note,
+                                    status=status(quiet)) if todo else nullcontext())
         with quiet_dask_logs(), starting, connect as client, rendering:
             progress = bar("frames", quiet)
 
@@ -204,7 +213,7 @@ def animate_on_farm(scene: Scene, plan: FilmPlan, *, force: bool, quiet: bool,
                 if progress is not None:
                     progress.update(task, completed=p.done, total=p.total)
                 elif not quiet and p.result.rendered:
-                    err.print(f"frame {p.frame} ({p.done}/{p.total})", highlight=False)
+                    out.line(f"frame {p.frame} ({p.done}/{p.total})")
 
             with progress if progress is not None else nullcontext():
                 task = progress.add_task("frames", total=total) if progress else None

@@ -19,6 +19,7 @@ except ImportError:  # pragma: no cover - depends on the installed typer
 
 # the commands register themselves on `app` when imported
 from ..errors import WhittedError
+from ..jit.progress import show_compile_bar
 from . import animate as _animate  # noqa: F401
 from . import bench as _bench  # noqa: F401
 from . import export as _export  # noqa: F401
@@ -26,6 +27,7 @@ from . import info as _info  # noqa: F401
 from . import render as _render  # noqa: F401
 from . import stefan as _stefan  # noqa: F401
 from . import sweep as _sweep  # noqa: F401
+from . import warm as _warm  # noqa: F401
 from .app import (
     EXIT_USER_ERROR,
     abandoned,
@@ -58,6 +60,7 @@ def main() -> None:
     # arithmetic (the renderer's threads are Numba's), and starting OpenBLAS's pool made
     # importing NumPy 0.05 s slower on a 2-core machine. A user's own setting is kept.
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    show_compile_bar(False)  # the commands show a first compile in their own progress bars
     abandoned.clear()
     ends_at_once.clear()
     try:

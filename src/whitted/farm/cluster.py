@@ -105,7 +105,9 @@ def local_cluster(workers: int, threads: int, dask_threads: int = 1) -> LocalClu
     its nanny starts again after a kill is spawned by the nanny, in this process, once the
     caller's handler is back: :func:`farm_client` registers the
     :class:`~whitted.farm.probe.WhittedProbe` with ``quiet_interrupt``, which ignores SIGINT
-    in every worker that (re)joins. They log errors only."""
+    in every worker that (re)joins. They log only what is critical: a worker stopped while it
+    readies or renders (the client closing the cluster after a Ctrl-C) logs its cancelled
+    work as errors, and the client says what happened in its own lines."""
     main = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
     try:
@@ -114,7 +116,7 @@ def local_cluster(workers: int, threads: int, dask_threads: int = 1) -> LocalClu
             host="127.0.0.1",
             dashboard_address="127.0.0.1:0",  # a free port (a page only with bokeh)
             env={"NUMBA_NUM_THREADS": str(threads)},
-            silence_logs=logging.ERROR,  # a worker stopped mid-task says so as a WARNING
+            silence_logs=logging.CRITICAL,  # not a stopped worker's cancelled work
         )
     finally:
         if main:  # the caller's handler (the interrupt guard's) again
@@ -228,11 +230,13 @@ def _states(client: Client, workers: list[str], wait: float = 2.0) -> dict[str, 
 @contextmanager
 def farm_client(cluster: str | None = None, scheduler: str | None = None, *,
                 threads: int | None = None, warm: bool = True,
-                note: Callable[[str], None] | None = None) -> Iterator[Client]:
+                note: Callable[[str], None] | None = None,
+                status: Callable[[str], None] | None = None) -> Iterator[Client]:
     """A client of a new local cluster (``cluster="local:N"``) or of the scheduler at
     ``scheduler``, with every worker readied (kernels warm, ``threads`` render threads each:
     by default the cores shared out among a local cluster's workers, one on a remote one).
-    Workers that cannot render are named through ``note`` and get no tasks."""
+    Workers that cannot render are named through ``note`` and get no tasks; the cluster's
+    size and address are told through ``status`` (default: ``note``)."""
     check_farm_options(cluster, scheduler)
     owned = None
     if cluster is not None:
@@ -247,11 +251,12 @@ def farm_client(cluster: str | None = None, scheduler: str | None = None, *,
         client = connect(scheduler, CONNECT_SECONDS)
     try:
         link = dashboard_link(client)
-        if note is not None:
+        status = status or note
+        if status is not None:
             info = client.scheduler_info(n_workers=-1).get("workers", {})
             n = len(info)
             total = sum(w.get("nthreads", 1) for w in info.values())
-            note(f"farm: {n} worker{'s' if n != 1 else ''} ({total} Dask thread"
+            status(f"farm: {n} worker{'s' if n != 1 else ''} ({total} Dask thread"
                  f"{'s' if total != 1 else ''}) at {client.scheduler.address}, "
                  f"{threads} render thread{'s' if threads != 1 else ''} a task"
                  + (f"; dashboard {link}" if link else ""))

@@ -111,7 +111,8 @@ class FileControl(QObject):
         history = list(getattr(self, "history", [])) if same_file else []
         if same_file and self.source_text is not None and self.source_scene is not None:
             history.append((self.source_text, self.source_scene))
-        self.history: list[tuple[str, Scene]] = history[-20:]
+        # the file as first read, and the last few saves (each is parsed at every save)
+        self.history: list[tuple[str, Scene]] = history[:1] + history[1:][-3:]
         self.source_path = path
         self.source_text: str | None = text
         self.source_scene: Scene | None = scene

@@ -32,6 +32,7 @@ class RenderControl(QObject):
         c.finished.connect(self._finished)
         c.failed.connect(self._failed)
         c.kernels_ready.connect(self._kernels_ready)
+        c.kernels_progress.connect(self._kernels_progress)
         self.viewport.installEventFilter(self)  # laid out, resized: a new preview size
 
     @property
@@ -113,6 +114,16 @@ class RenderControl(QObject):
             self.progress.hide()
         self.update_actions()
 
+    def _kernels_progress(self, fraction: float, left) -> None:
+        """A first compile of the kernels: the status bar's progress bar and the time left
+        (the picture's caption says it too, ``show_warm_up``)."""
+        if self.controller.rendering:
+            return
+        self.progress.setValue(round(fraction * 1000))
+        self.progress.show()
+        self.eta.setText("compiling the kernels" + (f": about {left:.0f} s left"
+                                                     if left is not None else ""))
+
     #: the captions of the kernels' loading (replaced as it goes, cleared when ready)
     WARM_UP_CAPTIONS = ("Loading", "Compiling", "Waiting for another whitted")
 
@@ -142,6 +153,9 @@ class RenderControl(QObject):
         if self.viewport.caption.startswith(self.WARM_UP_CAPTIONS):
             self.viewport.caption = ""
             self.viewport.update()
+        if not self.controller.rendering:
+            self.progress.hide()
+            self.eta.setText("")
         if seconds > 1:
             self.window_.statusBar().showMessage(f"Render kernels ready ({seconds:.0f} s)", 4000)
 

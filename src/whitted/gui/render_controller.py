@@ -128,6 +128,8 @@ class RenderController(QObject):
     finished = Signal(str, str)
     failed = Signal(str, str)
     kernels_ready = Signal(float)
+    #: while the first run compiles the kernels: (fraction done, seconds left or None)
+    kernels_progress = Signal(float, object)
 
     def __init__(self, parent=None, *, preview_delay_ms: int = 30) -> None:
         super().__init__(parent)
@@ -164,6 +166,7 @@ class RenderController(QObject):
         self._compiled: tuple | None = None  # (geometry key, CompiledScene) of a preview
         self._warm = threading.Event()
         self._warm_seconds = 0.0
+        self._warm_started = time.perf_counter()
 
     # ------------------------------------------------------------------ kernels
 
@@ -197,8 +200,10 @@ class RenderController(QObject):
         elapsed = time.perf_counter() - getattr(self, "_warm_started", time.perf_counter())
         fraction = compile_progress()
         if fraction is not None:
+            left = (f", about {elapsed * (1 - fraction) / fraction:.0f} s left"
+                    if fraction > 0.02 else "")
             return (f"Compiling {compile_label()} (the first run only): {fraction:.0%}, "
-                    f"{elapsed:.0f} s")
+                    f"{elapsed:.0f} s{left}")
         cache = getattr(self, "_kernel_cache", None)
         if cache is not None:
             try:
@@ -370,6 +375,8 @@ class RenderController(QObject):
     # ------------------------------------------------------------------ polling
 
     def _tick(self) -> None:
+        if not self._warm.is_set():
+            self._compile_tick()
         if self._warm.is_set() and self._warm_seconds >= 0:
             self.kernels_ready.emit(self._warm_seconds)
             self._warm_seconds = -1.0
@@ -381,6 +388,17 @@ class RenderController(QObject):
             self._full_tick(self.full)
         if self.full is None and self.preview is None and self._warm_seconds < 0:
             self._poll.stop()
+
+    def _compile_tick(self) -> None:
+        """A first compile's progress (render/warm_up.py), with the time left at its pace."""
+        from ..render.warm_up import compile_progress
+
+        fraction = compile_progress()
+        if fraction is None:
+            return
+        elapsed = time.perf_counter() - self._warm_started
+        left = elapsed * (1 - fraction) / fraction if fraction > 0.02 else None
+        self.kernels_progress.emit(fraction, left)
 
     def _preview_done(self, active: _Active) -> None:
         self.preview = None

@@ -98,9 +98,14 @@ def _user_base() -> str:
 def toolchain() -> str:
     """The Numba and llvmlite versions that compile the kernels (imports Numba, through
     lean_numba.py's hook)."""
+    from .. import marks
+
+    if "numba" not in sys.modules:
+        marks.mark("numba:start")  # whitted bench --startup counts it with the imports
     import llvmlite
     import numba
 
+    marks.mark("numba:end")
     return f"numba{numba.__version__}-llvmlite{llvmlite.__version__}"
 
 
@@ -172,6 +177,8 @@ class KernelCache:
         self.read_only = read_only
         self.missed = False  # a kernel it lacked was compiled in memory (and said so)
         self._seen: dict[str, tuple[int, int, int]] = {}  # file -> (inode, size, mtime)
+        #: files whose content verify() left to check when their kernel is looked up
+        self._deferred: dict[str, str] = {}
         self._lock = threading.RLock()
         self._file_lock = None  # the folder's lock file, held (filelock.FileLock)
         self._lock_depth = 0
@@ -313,9 +320,12 @@ class KernelCache:
         except OSError:
             return None
 
-    def verify(self) -> int:
+    def verify(self, lazy: bool = False) -> int:
         """Check every cache file against the list (module docstring); delete what fails.
-        Returns how many damaged files were deleted."""
+        Returns how many damaged files were deleted. ``lazy``: a file that is as sealed (its
+        entry's size and inode) has its content checked only when a kernel of its is first
+        looked up in this process (:meth:`check_function`, from jit/locator.py), so a process
+        hashes the few files it loads, not the whole cache of every variant."""
         if self.folder is None or self.helper:
             return 0
         with self.locked():
@@ -327,6 +337,11 @@ class KernelCache:
             for name, st in files.items():
                 path = os.path.join(self.folder, name)
                 entry = sums.get(name)
+                if lazy and not damaged_list and entry is not None \
+                        and entry[1] == st.st_size and entry[2:] == [st.st_ino]:
+                    self._deferred[name] = entry[0]
+                    self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
+                    continue
                 good = entry is not None and entry[1] == st.st_size \
                     and self._digest(path) == entry[0]
                 if good:
@@ -367,6 +382,34 @@ class KernelCache:
                 self.unsealed = True
                 self.seal()
             return damaged
+
+    def check_function(self, subfolder: str, filename_base: str) -> int:
+        """Before Numba looks up a kernel (its cache files ``<subfolder>/<filename_base>.*``):
+        check the content of those of its files :meth:`verify` left for later; a damaged one
+        is deleted (compiled again) with one ``warning:`` line. Returns how many were."""
+        prefix = f"{subfolder}/{filename_base}."
+        with self._lock:
+            names = [n for n in self._deferred if n.startswith(prefix)]
+            if not names:
+                return 0
+            wanted = {n: self._deferred.pop(n) for n in names}
+        bad = [n for n, digest in wanted.items()
+               if self._digest(os.path.join(self.folder, n)) != digest]
+        if not bad:
+            return 0
+        with self.locked():
+            sums, _ = self._read_sums()
+            for name in bad:
+                with contextlib.suppress(OSError):
+                    os.unlink(os.path.join(self.folder, name))
+                sums.pop(name, None)
+                self._seen.pop(name, None)
+            if not self.read_only:
+                self._write_sums(sums)
+                self._clear_markers()
+        _warn(f"{len(bad)} damaged kernel cache file{'s' * (len(bad) > 1)} in {self.folder} "
+              f"deleted; compiling {'them' if len(bad) > 1 else 'it'} again")
+        return len(bad)
 
     def intact(self) -> bool:
         """For a folder used read-only: whether it holds a list of sums that every cache file
@@ -493,9 +536,17 @@ def prepare() -> KernelCache:
         else:
             _set_numba_cache_dir(folder)
         state = KernelCache(folder, own, helper)
-        state.verify()
+        state.verify(lazy=_locator_checks())
         _state = state
         return state
+
+
+def _locator_checks() -> bool:
+    """Whether Numba takes jit/locator.py's locator (its NUMBA_CACHE_LOCATOR_CLASSES setting),
+    which checks each kernel's files when the kernel is first looked up."""
+    import numba
+
+    return hasattr(numba.config, "CACHE_LOCATOR_CLASSES")
 
 
 def _warm_to_read(folder: str) -> bool:

@@ -30,6 +30,7 @@ This module imports Numba: Numba imports it when it first makes a cache (never b
 from __future__ import annotations
 
 import os
+import sys
 
 from numba import config
 from numba.core.caching import UserProvidedCacheLocator
@@ -69,7 +70,26 @@ class KernelLocator(UserProvidedCacheLocator):
     def from_function(cls, py_func, py_file):
         if not config.CACHE_DIR or package_folder(py_file) is None:
             return None  # not whitted's: Numba's own locators decide
-        return super().from_function(py_func, py_file)
+        locator = super().from_function(py_func, py_file)
+        if locator is not None:
+            locator.check_files(py_func, py_file)
+        return locator
+
+    def check_files(self, py_func, py_file: str) -> None:
+        """Before Numba reads this function's cache files: have jit/cache.py check the ones
+        whose content it left for now (it hashes only the files a process loads). Their
+        names are Numba's: ``<module>.<qualname>-<line>.py<version>`` then ``.nbi`` or
+        ``.<n>.nbc``."""
+        from .cache import _state
+
+        if _state is None or _state.folder is None:
+            return
+        modname = os.path.splitext(os.path.basename(py_file))[0]
+        qualname = py_func.__qualname__.replace("<", "").replace(">", "")
+        base = (f"{modname}.{qualname}-{self.get_disambiguator()}.py{sys.version_info[0]}"
+                f"{sys.version_info[1]}{getattr(sys, 'abiflags', '')}")
+        subfolder = os.path.relpath(self.get_cache_path(), _state.folder).replace(os.sep, "/")
+        _state.check_function(subfolder, base)
 
     def ensure_cache_path(self):
         path = self.get_cache_path()

@@ -82,6 +82,8 @@ def _twin_globals(f, copy) -> None:
         value = g.get(name)
         if value is None or value is f:
             continue
+        if isinstance(value, jit.NumbaObject):  # not swapped in yet (jit/decorators.py)
+            g[name] = value = value.resolve()
         kern = _kernel_of(value)
         if kern is not None:
             twin = _twin_kernel(kern)

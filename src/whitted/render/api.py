@@ -30,7 +30,7 @@ from ..kernels.layout import (
 )
 from ..output.image import Image
 from ..scene.scene import RenderSettings, Scene
-from .warm_up import caustics_compile, warm_up_kernels
+from .warm_up import caustics_compile, kernels_cached, warm_up_kernels
 
 RAY_KIND_NAMES = {
     RAY_PRIMARY: "primary",
@@ -423,10 +423,16 @@ class RenderJob:
 
         wall_start = time.perf_counter()
         stats = self.stats
-        stats.compile_seconds = warm_up_kernels()
+        # the plain render kernel only where this render runs it: caustics and adaptive
+        # anti-aliasing run kinds of their own, loaded in their stages below
+        plain_kernel = (self.settings.caustics.photons == 0
+                        and self.settings.antialias is None)
+        stats.compile_seconds = 0.0
+        if not kernels_cached():  # a first run: the default variant, builders and the OBJ
+            stats.compile_seconds = warm_up_kernels()  # reader, compiled on both cores
         compiled: CompiledScene = (self.compiled if self.compiled is not None
                                    else compile_scene(self.scene, threads=self.threads))
-        stats.compile_seconds += warm_up_kernels(compiled)
+        stats.compile_seconds += warm_up_kernels(compiled, render_kernel=plain_kernel)
         stats.build_seconds = compiled.build_seconds
         stats.warnings = list(compiled.warnings)
         stats.triangles = compiled.triangles

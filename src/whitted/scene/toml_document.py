@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any
 
 import tomlkit
 from pydantic import BaseModel, ValidationError
-from tomlkit.items import AoT, Array, Comment, InlineTable, Table
+from tomlkit.items import AoT, Array, Comment, InlineTable, Table, Whitespace
 
 from .materials import Material
 
@@ -278,9 +278,45 @@ def _update_items(node: AoT | Array, old: list, new: list, kind: str) -> None:
             else:
                 node[i1 + k] = fresh(n)
         for index in range(i2 - 1, i1 + paired - 1, -1):  # removed
+            gap = _take_gap(node, index) if index == len(node) - 1 > 0 else []
             del node[index]
+            _give_gap(node, len(node) - 1, gap)  # the last one's blank line stays
         for k in range(j2 - 1, j1 + paired - 1, -1):  # added, in order
-            node.insert(i1 + paired, fresh(new[k]))
+            at = i1 + paired
+            item = fresh(new[k])
+            gap = _take_gap(node, at - 1) if at == len(node) > 0 and isinstance(
+                item, Table) and not _gap(item.value.body) else []
+            node.insert(at, item)
+            _give_gap(node, at, gap)  # the blank line after the last one moves after it
+
+
+def _gap(body: list) -> int:
+    """How many blank-line items end ``body`` (a table's items)."""
+    n = 0
+    while n < len(body) and body[-1 - n][0] is None and isinstance(body[-1 - n][1], Whitespace):
+        n += 1
+    return n
+
+
+def _take_gap(node: Any, index: int) -> list:
+    """Take the blank lines that end table ``index`` of an array of tables (what keeps the
+    next section apart from the last table)."""
+    if not isinstance(node, AoT) or not 0 <= index < len(node):
+        return []
+    body = node[index].value.body
+    n = _gap(body)
+    if not n:
+        return []
+    taken = [item for _, item in body[-n:]]
+    del body[-n:]
+    return taken
+
+
+def _give_gap(node: Any, index: int, gap: list) -> None:
+    if gap and isinstance(node, AoT) and 0 <= index < len(node) and \
+            not _gap(node[index].value.body):
+        for item in gap:
+            node[index].add(item)
 
 
 def _update_list(doc: Any, name: str, old: list, new: list) -> None:
@@ -425,6 +461,10 @@ def edit_toml(text: str, old: Scene, new: Scene, *,
     the file's are; ``history`` (earlier versions: text and scene) lends its spellings."""
     if old == new:
         return text
+    history = list(history)
+    for version_text, version in reversed(history):
+        if version == new:  # everything set back to what a version said: its very text
+            return version_text
     doc = tomlkit.parse(text)
     _own_comments(doc)
     memory = _Memory([*history, (text, old)])

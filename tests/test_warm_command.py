@@ -1,0 +1,61 @@
+"""``whitted warm``: one command compiles every kernel variant a scene can reach; each tiny
+scene it renders reaches the variant it is named after."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from whitted.compile.scene import compile_scene
+from whitted.kernels.features import EXTRAS_DTYPE
+from whitted.render.variants import GEOMETRY, KINDS, tiny_scene, variant_names
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _whitted(*args: str) -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
+    return subprocess.run([sys.executable, "-m", "whitted", *args], capture_output=True,
+                          text=True, timeout=900, env=env)
+
+
+def test_every_variant_is_named_once():
+    names = variant_names()
+    assert len(names) == len(set(names)) == len(GEOMETRY) * len(KINDS) == 16
+
+
+@pytest.mark.parametrize("geometry", list(GEOMETRY))
+def test_each_tiny_scene_reaches_its_variant(geometry):
+    instances, extras = GEOMETRY[geometry]
+    for kind in KINDS:
+        scene = tiny_scene(extras, kind)
+        compiled = compile_scene(scene, flatten_limit=0 if instances else 65_536)
+        geo = compiled.geometry
+        assert (geo.inst_box.dtype == np.float64) == instances, kind
+        assert (geo.unbounded.dtype == np.dtype(EXTRAS_DTYPE)) == extras, kind
+        assert (scene.render.caustics.photons > 0) == (kind == "caustics")
+        assert (scene.render.antialias is not None) == (kind == "adaptive")
+
+
+def test_a_variant_already_in_the_cache_loads(tmp_path):
+    result = _whitted("warm", "--variant", "plain/render")
+    assert result.returncode == 0, result.stderr
+    entry = json.loads(result.stdout.strip().splitlines()[-1])
+    assert entry["name"] == "plain/render" and entry["seconds"] >= 0
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--jobs", "-1"], "--jobs: must be 0"),
+    (["--jobs", "5000"], "--jobs: must be 0"),
+    (["--variant", "nope/render"], "unknown variant 'nope/render'"),
+])
+def test_mistakes_are_one_line(args, message):
+    result = _whitted("warm", *args)
+    assert result.returncode == 2
+    assert result.stderr.strip().count("\n") == 0 and message in result.stderr
