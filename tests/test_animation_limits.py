@@ -1,4 +1,4 @@
-"""Issue 25, the animation, sweep and file-reading items (6-10, 15, 16): limits that keep a
+"""The animation, sweep and file-reading limits that keep a
 hostile but fair input from running away, and one clean line for every mistake."""
 
 from __future__ import annotations
