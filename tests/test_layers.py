@@ -1,6 +1,8 @@
 """The architecture's layers, checked on the source: every import (at module level or inside a
-function) goes from a package to one on a lower layer, and no modules import each other in a
-circle. The layer order is written once, in docs/architecture.md (the ``layers`` block)."""
+function) goes from a package to one on a lower layer, none reaches up to the top package
+``whitted`` itself, and no modules import each other in a circle. The layer order is written
+once, in docs/architecture.md (the ``layers`` block), and the same file maps every source file
+under its package, in that order."""
 
 from __future__ import annotations
 
@@ -79,7 +81,8 @@ def test_every_package_has_a_layer():
 
 def upward_imports(found: dict[str, set[tuple[str, int]]],
                    order: list[list[str]]) -> list[str]:
-    """``module:line imports target`` for each import that does not go down a layer."""
+    """``module:line imports target`` for each import that does not go down a layer (the top
+    package ``whitted``, its lazy public API, is above every layer)."""
     level = {p: i for i, row in enumerate(order) for p in row}
     wrong = []
     for module, targets in found.items():
@@ -87,6 +90,9 @@ def upward_imports(found: dict[str, set[tuple[str, int]]],
         if here in ("", "__main__"):  # the lazy public API and `python -m whitted`: the top
             continue
         for target, line in targets:
+            if target == "whitted":
+                wrong.append(f"{module}:{line} imports the top package whitted")
+                continue
             there = package_of(target)
             if there and there != here and level[there] >= level[here]:
                 wrong.append(f"{module}:{line} imports {target}")
@@ -150,11 +156,13 @@ def _strongly_connected(graph: dict[str, set[str]]) -> list[list[str]]:
 
 def test_the_checks_catch_an_upward_import_and_a_circle(tmp_path):
     """The checker itself, on a made-up package: scene importing render (upward), errors
-    importing scene (upward from the bottom), two render modules importing each other."""
+    importing scene (upward from the bottom), marks importing the top package, two render
+    modules importing each other."""
     src = tmp_path / "whitted"
     files = {
         "__init__.py": "",
         "errors.py": "def f():\n    from .scene import model\n",
+        "marks.py": "from whitted import load_scene\n",
         "scene/__init__.py": "",
         "scene/model.py": "from ..render.api import go\nfrom ..errors import E\n",
         "render/__init__.py": "",
@@ -165,11 +173,98 @@ def test_the_checks_catch_an_upward_import_and_a_circle(tmp_path):
         (src / name).parent.mkdir(parents=True, exist_ok=True)
         (src / name).write_text(text)
     found = imports(src)
-    order = [["errors"], ["scene"], ["render"]]
+    order = [["errors", "marks"], ["scene"], ["render"]]
     assert upward_imports(found, order) == [
         "whitted.errors:2 imports whitted.scene.model",
+        "whitted.marks:1 imports the top package whitted",
         "whitted.scene.model:1 imports whitted.render.api",
     ]
     assert [sorted(c) for c in module_circles(found)] == [
         ["whitted.errors", "whitted.render.api", "whitted.render.jobs", "whitted.scene.model"],
+    ]
+
+
+MAP_HEADING = "## Every file, layer by layer"
+TOP = "the package"
+
+
+def file_map(text: str) -> list[tuple[str, list[tuple[str, str]]]]:
+    """(package, [(file, what it holds)]) in the order docs/architecture.md lists them."""
+    start = text.index(MAP_HEADING) + len(MAP_HEADING)
+    end = text.find("\n## ", start)
+    sections: list[tuple[str, list[tuple[str, str]]]] = []
+    for line in text[start:end if end >= 0 else None].splitlines():
+        if line.startswith("### "):
+            sections.append((line[4:].strip(), []))
+        elif line.startswith("- `"):
+            path, _, what = line[3:].partition("`")
+            sections[-1][1].append((path, what.removeprefix(":").strip()))
+    return sections
+
+
+def map_problems(text: str, src: Path, order: list[list[str]]) -> list[str]:
+    """What the map gets wrong: files missing or listed twice or not there, files under the
+    wrong package, packages out of the layers' order, lines that say nothing."""
+    sections = file_map(text)
+    files = {p.relative_to(src).as_posix() for p in src.rglob("*.py")}
+    packages_top_first = [TOP] + [p for row in order[::-1] for p in row]
+    problems = []
+    listed: list[str] = []
+    for package, rows in sections:
+        for path, what in rows:
+            listed.append(path)
+            owner = TOP if "/" not in path and path in ("__init__.py", "__main__.py") \
+                else path.split("/")[0].removesuffix(".py")
+            if owner != package:
+                problems.append(f"{path} is listed under {package}, not {owner}")
+            if not what:
+                problems.append(f"{path}: no line on what it holds")
+    problems += [f"{p} is not in the map" for p in sorted(files - set(listed))]
+    problems += [f"{p} is in the map but not in src/whitted" for p in sorted(set(listed) - files)]
+    problems += [f"{p} is listed twice" for p in sorted({p for p in listed if listed.count(p) > 1})]
+    named = [package for package, _ in sections]
+    unknown = [p for p in named if p not in packages_top_first]
+    problems += [f"section {p!r} is no package of the layers block" for p in unknown]
+    known = [p for p in named if p in packages_top_first]
+    if known != sorted(known, key=packages_top_first.index):
+        problems.append("the packages are not in the layers block's order: " + ", ".join(known))
+    return problems
+
+
+def test_the_map_lists_every_file_under_its_layer():
+    text = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    problems = map_problems(text, SRC, layers())
+    assert not problems, "docs/architecture.md:\n" + "\n".join(problems)
+
+
+def test_the_concept_table_names_files_that_exist():
+    text = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    table = text[text.index("## Where each concept lives"):]
+    table = table[: table.index("\n## ")]
+    named, missing = 0, set()
+    for row in (r for r in table.splitlines() if r.startswith("| ")):
+        cell = row.rsplit("|", 2)[-2]
+        folders = [""] + [f + "/" for f in re.findall(r"`(\w+)/`", cell)]  # `farm/` (`still.py`)
+        for name in re.findall(r"`([\w/]+\.py)`", cell):
+            named += 1
+            if not any((SRC / (folder + name)).is_file() for folder in folders):
+                missing.add(name)
+    assert named and not missing, f"the concept table names missing files: {missing}"
+
+
+def test_the_map_check_finds_a_missing_a_misplaced_and_a_disordered_file(tmp_path):
+    src = tmp_path / "whitted"
+    for name in ("__init__.py", "errors.py", "scene/__init__.py", "scene/shapes.py",
+                 "render/api.py"):
+        (src / name).parent.mkdir(parents=True, exist_ok=True)
+        (src / name).write_text("")
+    order = [["errors"], ["scene"], ["render"]]
+    text = (f"{MAP_HEADING}\n\n### the package\n\n- `__init__.py`: the API\n\n"
+            "### errors\n\n- `errors.py`:\n\n"
+            "### scene\n\n- `scene/__init__.py`: scenes\n- `render/api.py`: jobs\n\n## Next\n")
+    assert map_problems(text, src, order) == [
+        "errors.py: no line on what it holds",
+        "render/api.py is listed under scene, not render",
+        "scene/shapes.py is not in the map",
+        "the packages are not in the layers block's order: the package, errors, scene",
     ]

@@ -61,12 +61,9 @@ __all__ = [
 
 
 def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
+    from .fingerprint import whitted_version
 
-    try:
-        return version("whitted")
-    except PackageNotFoundError:  # running from a source tree without installing
-        return "0+unknown"
+    return whitted_version()
 
 
 def __getattr__(name: str):

@@ -47,6 +47,11 @@ def _version(distribution: str) -> str:
         return "0+unknown"
 
 
+def whitted_version() -> str:
+    """whitted's installed version (``0+unknown`` in a source tree that is not installed)."""
+    return _version("whitted")
+
+
 def package_files(root: Path | None = None) -> list[Path]:
     """Every file of the whitted package (``root``: its folder), sorted by relative path,
     compiled bytecode left out."""
@@ -99,7 +104,7 @@ def cpu_target() -> str:
 @functools.cache
 def renderer_fingerprint() -> str:
     """This process's fingerprint (computed once; module docstring)."""
-    fields = [("whitted", _version("whitted")), ("source", source_hash()),
+    fields = [("whitted", whitted_version()), ("source", source_hash()),
               ("numba", _version("numba")), ("llvmlite", _version("llvmlite")),
               ("numpy", _version("numpy")), ("cpu", cpu_target())]
     if os.environ.get("WHITTED_NUMBA_TUNING", "1") == "0":  # stock Numba's compile options

@@ -66,9 +66,9 @@ def note(message: str) -> None:
 
 def _version(value: bool) -> None:
     if value:
-        from .. import __version__
+        from ..fingerprint import whitted_version
 
-        out.print(f"whitted {__version__}")
+        out.print(f"whitted {whitted_version()}")
         raise typer.Exit()
 
 

@@ -16,6 +16,7 @@ TEXT, NUMBER, INT, OPT_INT, VEC3, ANGLES, SCALE, COLOUR, COEF, CHOICE, BOOL, FIL
     "text", "number", "int", "opt_int", "vec3", "angles", "scale", "colour", "coef", "choice",
     "bool", "file", "attenuation",
 )
+UV = "uv"  # two numbers u, v (texture coordinates)
 # the headings the panel groups fields under
 GEOMETRY, TRANSFORM, MATERIAL, TEXTURE, LIGHT, VIEW, IMAGE, QUALITY, OUTPUT, BLUR = (
     "Shape", "Placement (transform)", "Material", "Texture", "Light", "View", "Image", "Quality",
@@ -185,6 +186,8 @@ def object_specs(obj: Any) -> list[Spec]:
                   Spec(("radius",), "Radius", NUMBER, g)]
     elif kind == "triangle":
         specs += [Spec(("vertices", i), f"Vertex {'abc'[i]}", VEC3, g) for i in range(3)]
+        specs += [Spec(("uvs", i), f"UV at {'abc'[i]}", UV, g,
+                       tip=f"texture coordinates of vertex {'abc'[i]}") for i in range(3)]
     elif kind == "box":
         if obj.min is not None:
             specs += [Spec(("min",), "Min corner", VEC3, g), Spec(("max",), "Max corner", VEC3, g)]
@@ -202,7 +205,10 @@ def object_specs(obj: Any) -> list[Spec]:
             specs.append(Spec(("file",), "Model file", FILE, g, filters=MODEL_FILTER))
         specs += [Spec(("smooth",), "Smooth shading", CHOICE, g, choices=("auto", "on", "off")),
                   Spec(("crease_angle",), "Crease angle (°)", COEF, g, 0.0, 180.0),
-                  Spec(("solid",), "Solid (refracts)", BOOL, g)]
+                  Spec(("solid",), "Solid (refracts)", BOOL, g),
+                  Spec(("outside",), "Outside medium", TEXT, g,
+                       tip="the material just outside a solid mesh, by name; empty: the "
+                           "medium the ray arrives through")]
     return specs + transform_specs(obj)
 
 

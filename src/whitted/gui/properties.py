@@ -55,6 +55,8 @@ from .widgets import (
 )
 
 SMOOTH = {None: "auto", True: "on", False: "off"}
+#: what the Outside medium field shows for a material given inline in the file
+INLINE = "(inline material)"
 
 
 def make_editor(spec: F.Spec) -> FieldEditor:
@@ -67,6 +69,8 @@ def make_editor(spec: F.Spec) -> FieldEditor:
         return VectorEditor()
     if k == F.SCALE:
         return VectorEditor(scalar_ok=True)
+    if k == F.UV:
+        return VectorEditor(axes="uv")
     if k in (F.COEF, F.ATTEN):
         return CoefficientEditor(spec.lo, spec.hi, triple_ok=k == F.ATTEN)
     if k == F.COLOUR:
@@ -335,6 +339,10 @@ class PropertyPanel(QWidget):
             return F.focus_mode(item)
         if path == ("smooth",):
             return SMOOTH[item.smooth]
+        if path == ("outside",):  # a material's name; an inline one is shown, kept as it is
+            if isinstance(item.outside, BaseModel):
+                return INLINE
+            return item.outside or ""
         value = get_path(item, path)
         if path == ("transform", "rotate") and value is None:
             return (0.0, 0.0, 0.0)
@@ -458,6 +466,8 @@ class PropertyPanel(QWidget):
             return self._focus_data(item, data, value)
         if path == ("smooth",):
             value = {v: k for k, v in SMOOTH.items()}[value]
+        if path == ("outside",):
+            value = (value or "").strip() or None
         return set_path(data, path, value)
 
     @staticmethod

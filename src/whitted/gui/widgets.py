@@ -175,17 +175,18 @@ class NumberEditor(FieldEditor):
 
 
 class VectorEditor(FieldEditor):
-    """Three number fields x, y, z. ``scalar_ok``: three equal numbers commit one number (a
-    uniform scale)."""
+    """Three number fields x, y, z (or one per letter of ``axes``: "uv" for texture
+    coordinates). ``scalar_ok``: three equal numbers commit one number (a uniform scale)."""
 
-    def __init__(self, parent=None, *, scalar_ok: bool = False) -> None:
+    def __init__(self, parent=None, *, scalar_ok: bool = False, axes: str = "xyz") -> None:
         super().__init__(parent)
         self.scalar_ok = scalar_ok
+        self.axes = axes
         self.lines = []
         box = QHBoxLayout(self)
         box.setContentsMargins(0, 0, 0, 0)
         box.setSpacing(2)
-        for axis in "xyz":
+        for axis in axes:
             line = _Line(self)
             line.setToolTip(axis)
             line.setPlaceholderText(axis)
@@ -195,9 +196,9 @@ class VectorEditor(FieldEditor):
 
     def set_value(self, value: object) -> None:
         if value is None:
-            values = ("", "", "")
+            values = ("",) * len(self.axes)
         elif isinstance(value, int | float):
-            values = (fmt(value),) * 3
+            values = (fmt(value),) * len(self.axes)
         else:
             values = tuple(fmt(v) for v in value)
         for line, text in zip(self.lines, values, strict=True):
@@ -208,13 +209,13 @@ class VectorEditor(FieldEditor):
             self.restored.emit()
             return
         out = []
-        for axis, line in zip("xyz", self.lines, strict=True):
+        for axis, line in zip(self.axes, self.lines, strict=True):
             try:
                 out.append(float(parse_number(line.text())))
             except ValueError as exc:
                 self.refused.emit(f"{axis}: {exc}")
                 return
-        if self.scalar_ok and out[0] == out[1] == out[2]:
+        if self.scalar_ok and len(set(out)) == 1:
             self.committed.emit(out[0], False)
         else:
             self.committed.emit(tuple(out), False)

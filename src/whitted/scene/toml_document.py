@@ -37,6 +37,7 @@ from pydantic import BaseModel, ValidationError
 from tomlkit.items import AoT, Array, Comment, InlineTable, Table, Whitespace
 
 from .materials import Material
+from .shapes import ArrayData
 
 if TYPE_CHECKING:
     from .scene import Scene
@@ -61,7 +62,10 @@ def _defaults_for(model: BaseModel) -> dict[str, Any]:
 
 
 def _plain(value: Any) -> Any:
-    """A value as TOML-ready plain data (tuples as lists, models compact)."""
+    """A value as TOML-ready plain data (tuples as lists, models compact, a mesh's inline
+    arrays as lists of rows)."""
+    if isinstance(value, ArrayData):
+        return value.array.tolist()
     if isinstance(value, BaseModel):
         return compact_data(value)
     if isinstance(value, dict):
