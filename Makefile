@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 # Compiled kernels are kept in the per-user cache (~/.cache/whitted, src/whitted/jit/cache.py),
 # the one every later `whitted` command uses, however whitted was installed.
 
-.PHONY: demo test test-oldest-numba test-timing coverage lint install install-test bench clean
+.PHONY: demo test test-oldest-numba test-timing check-wheel coverage lint install install-test bench clean
 
 $(BIN)/whitted: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -22,11 +22,14 @@ install: $(BIN)/whitted
 
 install-test: $(VENV)/.test-deps
 
-## Install, compile every kernel into the per-user cache (whitted warm), then render the
-## built-in default scene to render.png
+## Install, compile every kernel into the per-user cache (whitted warm), render the built-in
+## default scene to render.png, and say how to use the `whitted` command from here on (it lives
+## in $(VENV)/bin)
 demo: install
 	$(BIN)/whitted warm
 	$(BIN)/whitted render -o render.png
+	@echo "whitted is installed in $(VENV)/; to use the whitted command in this shell, type:"
+	@echo "    . $(VENV)/bin/activate"
 
 ## Install the test dependencies, lint, then run the whole test suite
 test: install-test
@@ -53,6 +56,26 @@ test-oldest-numba: $(OLDEST_VENV)/.ready
 		-p no:cacheprovider tests/test_kernel_cache.py tests/test_jit.py \
 		tests/test_shapes.py -k 'not two_cold'
 
+## What a pip user gets: build the wheel, install it into a fresh virtual environment (only
+## the wheel and its core dependencies), then from an empty folder render an example by its
+## name, copy the examples out and render one by path, and run the quick benchmark
+WHEEL_VENV ?= .venv-wheel
+check-wheel: $(VENV)/.test-deps
+	rm -rf dist $(WHEEL_VENV)
+	$(BIN)/python -m build --wheel --outdir dist .
+	$(PYTHON) -m venv $(WHEEL_VENV)
+	$(WHEEL_VENV)/bin/python -m pip install --quiet dist/whitted-*.whl
+	set -e; here=$$(mktemp -d); cd $$here; \
+	  $(abspath $(WHEEL_VENV))/bin/whitted render glass_cube -W 96 -H 72 -o cube.png; \
+	  $(abspath $(WHEEL_VENV))/bin/whitted examples ex; \
+	  $(abspath $(WHEEL_VENV))/bin/whitted render ex/textured.toml -W 96 -H 72 -o textured.png; \
+	  $(abspath $(WHEEL_VENV))/bin/whitted render ex/models/teapot.obj -W 96 -H 72 -o teapot.png; \
+	  $(abspath $(WHEEL_VENV))/bin/whitted bench --quick --scene seed000; \
+	  ! $(abspath $(WHEEL_VENV))/bin/whitted stefan validate 2> stefan.err; \
+	  grep -q 'install whitted\[stefan\]' stefan.err; \
+	  cd $(CURDIR); rm -rf $$here
+	@echo "check-wheel: the installed wheel renders, copies its examples and runs the bench"
+
 ## The tests whose outcome depends on the machine's speed (marker `timing`), run apart
 test-timing: install-test
 	$(BIN)/python -m pytest -q -m timing
@@ -75,4 +98,5 @@ lint: install-test
 	$(BIN)/ruff check src tests
 
 clean:
-	rm -rf $(VENV) $(OLDEST_VENV) .cache .cache-oldest-numba build *.egg-info src/*.egg-info
+	rm -rf $(VENV) $(OLDEST_VENV) $(WHEEL_VENV) .cache .cache-oldest-numba build dist *.egg-info \
+		src/*.egg-info

@@ -273,7 +273,7 @@ def test_sweep_values():
     ("[9, 0.0]]", "[12, 0.0]]", 51,
      "animation.tracks[1].keys[1]: frame 12 is outside 0..9 (frames = 10)"),
     ("[9, 0.0]]", "[9, [0.0, 1.0]]]", 51,
-     "animation.tracks[1].keys[1]: objects[ball].material.kt: input should be a valid number"),
+     "animation.tracks[1].keys[1]: objects[ball].material.kt: expected a number"),
     ("[9, [6, 1, 0]]]", "[9, [6, 1]]]", 46,
      "animation.tracks[0].keys[1]: camera.position: expected a list of 3 numbers"),
     ("[9, 0.0]]", "[4, 1.0], [8, 0.2]]\ninterpolation = \"spline\"", None,

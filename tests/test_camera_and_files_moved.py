@@ -72,7 +72,7 @@ def test_benchmark_scene_checks(tmp_path):
     with pytest.raises(SceneError) as info:
         load_bench_scene("lecture", folder=tmp_path)
     assert str(info.value) == (f"{tmp_path / 'lecture.toml'}: no such benchmark scene file "
-                               "(is this a whitted checkout?)")
+                               "(whitted's benchmark scenes are not installed here)")
     scene = Scene(materials={"w": Material(texture=ImageTexture(file="w.png"))},
                   objects=[Mesh(file="m.obj", material=Material(
                       texture=ImageTexture(file="t.png")))]).with_base_dir(tmp_path)

@@ -10,7 +10,7 @@ from PIL import Image
 from whitted.stefan import validate
 
 
-def test_lambda_rows_match_the_issues_numbers():
+def test_lambda_rows_match_the_quoted_values():
     rows = {r["case"]: r for r in validate.lambda_rows()}
     assert list(rows) == ["one phase, St = 0.1", "one phase, St = 1",
                           "two phase, +10 / -10 °C", "two phase front after 1 h (mm)"]

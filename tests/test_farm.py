@@ -277,7 +277,7 @@ def test_chunk_size_packs_short_frames_and_keeps_every_thread_busy():
     assert chunk_size(1000, 10, 1.3) == 2  # ceil(2 / 1.3) frames of 1.3 s
     assert chunk_size(1000, 10, 60.0) == 1  # a long frame is a task of its own
     assert chunk_size(1000, 10, None) == 1  # not measured yet: one frame a task
-    # the 10 nodes x 32 threads: 1,000 frames are 1,000 tasks for the 320 threads
+    # 10 nodes x 32 threads: 1,000 frames are 1,000 tasks for the 320 threads
     assert chunk_size(1000, 320, 0.05) == 1
 
 

@@ -1,6 +1,6 @@
 """The farm on clusters a render wrangler meets: a scheduler and workers started with the
 ``dask scheduler`` / ``dask worker`` commands on 127.0.0.1, workers running another whitted or
-none, workers stopped (SIGSTOP), killed or lost, the scheduler lost (issue 26)."""
+none, workers stopped (SIGSTOP), killed or lost, the scheduler lost."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """docs/farm.md works when followed: every ``dask scheduler`` / ``dask worker`` command in it
 (shell lines, the Dockerfile, the Kubernetes YAML) uses options the installed ``dask`` command
 has; every ``whitted`` command uses options whitted has; and the SSH recipe, with 127.0.0.1
-for its hosts and free ports for its pinned ones, renders a film (issue 26)."""
+for its hosts and free ports for its pinned ones, renders a film."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """The one film API (whitted.animation.film), the one interrupt guard (cli/interrupt.py), and
-the output safety of every command that writes (issue 24 section 1; issue 25 items 1, 2, 4,
-5, 13, 14). Signals are sent from inside the work (a frame finished, a frame handed to
+the output safety of every command that writes.
+Signals are sent from inside the work (a frame finished, a frame handed to
 ffmpeg), never after a sleep."""
 
 from __future__ import annotations
@@ -218,7 +218,7 @@ def test_render_film_frames_only_into_a_folder(tmp_path):
         assert read_frame_digest(path) == frame_digest(scene.at_frame(k), k)
 
 
-# ----------------------------------------------------------------- issue 25 item 1
+# -----------------------------------------------------------------
 
 
 def test_animate_never_writes_over_files_whitted_did_not_write(tmp_path, monkeypatch):
@@ -307,7 +307,7 @@ def test_a_frame_made_for_another_cpu_target_is_not_kept(tmp_path):
         assert im.text[FINGERPRINT_KEY] == renderer_fingerprint()
 
 
-# ----------------------------------------------------------------- issue 25 item 2
+# -----------------------------------------------------------------
 
 
 def test_animate_sweep_export_refuse_to_write_over_their_inputs(tmp_path, monkeypatch):
@@ -348,7 +348,7 @@ def test_stefan_film_refuses_to_write_over_its_case_file(tmp_path, monkeypatch):
     assert not (tmp_path / "case_stefan").exists()
 
 
-# ----------------------------------------------------------------- issue 25 item 4 and 13
+# -----------------------------------------------------------------
 
 
 @pytest.mark.parametrize(("args", "needle"), [
@@ -452,7 +452,7 @@ def test_read_only_output_folder_is_one_line(tmp_path, command):
         locked.chmod(0o755)
 
 
-# ----------------------------------------------------------------- issue 25 item 5
+# -----------------------------------------------------------------
 
 
 def test_the_frame_record_covers_a_models_mtl_and_its_textures(tmp_path):
@@ -482,7 +482,7 @@ def test_the_frame_record_covers_a_models_mtl_and_its_textures(tmp_path):
     assert digest() != second  # the texture the MTL names changed
 
 
-# ----------------------------------------------------------------- issue 25 item 14
+# -----------------------------------------------------------------
 
 
 @pytest.mark.parametrize(("args", "needle"), [

@@ -1,4 +1,4 @@
-"""Property-based fuzzing (hypothesis) of what users type (issue 13): mutated example scenes
+"""Property-based fuzzing (hypothesis) of what users type: mutated example scenes
 (values, types, deleted and duplicated keys, nesting), random bytes and truncations of OBJ/MTL
 files, and random command options. Every case ends in success, or in exit status 2 with one
 ``error:`` line: never a traceback, an internal error, a hang or a crash.
@@ -295,7 +295,7 @@ def test_usage_mistakes_end_cleanly(tmp_path: Path, args: list[str]):
 
 
 # ------------------------------------------------- animation tables, --set values, sweeps
-# (issue 25). Stefan case files are fuzzed by their own section/module (the "stefan" work),
+# Stefan case files are fuzzed by their own section/module (test_stefan_safety.py),
 # not here.
 
 ANIMATED = SCENE.replace('type = "sphere"', 'type = "sphere"\nname = "ball"\n'

@@ -1,4 +1,4 @@
-"""The editor driven as a person drives it (issue 14, section 1): real clicks, key presses and
+"""The editor driven as a person drives it: real clicks, key presses and
 wheel turns on the real widgets, offscreen. Each test failed on the editor before its fix."""
 
 from __future__ import annotations

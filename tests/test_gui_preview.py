@@ -1,4 +1,4 @@
-"""The preview keeps up (issue 14, section 3): coarse while the user drags, refining to the
+"""The preview keeps up: coarse while the user drags, refining to the
 picture's full size on screen once the input stops, with no new edit. The times are written
 to the test log (``-s`` or the captured output), not asserted: this machine is shared."""
 

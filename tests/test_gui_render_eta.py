@@ -1,4 +1,4 @@
-"""Issue 27, section 4: a render's time left comes from what its tiles cost (measured by the
+"""A render's time left comes from what its tiles cost (measured by the
 preview of the same picture), not from how many there are."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Issue 27, defect 1: keying and saving never loses what the user wrote. Every example is
+"""Keying and saving never loses what the user wrote. Every example is
 opened, an object clicked in the picture, I pressed, Ctrl+S pressed: the file changes only by
 its new keys (comments, layout and every setting of the animation, ``cyclic`` included, stay).
 When the edit cannot be written into the file as it is, the user is asked first."""

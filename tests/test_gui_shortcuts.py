@@ -1,4 +1,4 @@
-"""Issue 27, defects 2 and 3, sections 3 and 4: the editing shortcuts act on the selection
+"""The editing shortcuts act on the selection
 wherever the focus is and never change it; every menu shortcut works in every focus state
 (a text field being typed in keeps its own keys); the menus and Help > Controls come from one
 actions table; multi-select with one undo step; Delete leaves nothing selected."""

@@ -1,4 +1,4 @@
-"""The editor's timeline (issue 15, section 4), driven as a person drives it: clicks on the frame
+"""The editor's timeline, driven as a person drives it: clicks on the frame
 slider and the Play button, the I key wherever the focus is, Ctrl+Z, Ctrl+S; offscreen."""
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
-"""Saving keeps a hand-written TOML scene as it was except for what was edited (issue 14,
-defect 6): byte for byte when nothing changed, one value when one value changed, new items
+"""Saving keeps a hand-written TOML scene as it was except for what was edited:
+byte for byte when nothing changed, one value when one value changed, new items
 compact; and in the editor, through real key presses."""
 
 from __future__ import annotations
@@ -153,7 +153,7 @@ def test_the_editor_saves_only_what_was_typed(make_window, hand_written, qtbot):
 
 
 def test_a_named_material_made_the_objects_own_stays_inline_and_new_blocks_are_apart():
-    """Issue 27, section 4: ``material = "glass"`` becoming an object's own material is
+    """``material = "glass"`` becoming an object's own material is
     written on its line (not as a sub-table), and new ``[[objects]]`` blocks are separated
     by a blank line, as people write them."""
     text = ('[materials.glass]\npreset = "glass"\n\n[[objects]]\ntype = "sphere"\n'

@@ -1,4 +1,4 @@
-"""Issue 27, section 2 and defect 4: the viewport has its own view. Looking around never
+"""The viewport has its own view. Looking around never
 changes the scene's camera; numpad 0 looks through the camera; Ctrl+Alt+numpad 0 moves the
 camera to the view as one undoable edit. The preview's size follows the picture's size on
 screen once the window is laid out and whenever it is resized."""

@@ -1,4 +1,4 @@
-"""The viewport as a 3-D view (issue 14, section 2), driven by real clicks and keys: picking
+"""The viewport as a 3-D view, driven by real clicks and keys: picking
 through the object-id image, the outline, Esc, moving with G, turntable orbit, framing and
 the numpad views."""
 

@@ -548,3 +548,15 @@ def test_render_async_outside_a_notebook_is_the_plain_render(scene, shown):
     image = asyncio.run(whitted.render_async(scene, live=False))
     assert shown == []
     np.testing.assert_array_equal(image.pixels, whitted.render(scene, live=False).pixels)
+
+
+def test_the_view_turns_the_compile_bar_off_while_it_runs(scene, shown):
+    from whitted.jit.progress import compile_bar_setting
+
+    before = compile_bar_setting()
+    during = []
+    whitted.render(scene, live=True, progress=lambda p: during.append(compile_bar_setting()))
+    assert during and set(during) == {False}  # the view shows a first compile itself
+    assert compile_bar_setting() == before
+    whitted.render(scene, live=False, progress=lambda p: during.append(compile_bar_setting()))
+    assert during[-1] == before

@@ -1,6 +1,6 @@
-"""Issue 13: nothing a user types destroys a file, hangs, eats memory or prints a traceback.
+"""Nothing a user types destroys a file, hangs, eats memory or prints a traceback.
 
-One test (or a few) per defect of the issue, section by section (A: data, B: hangs and
+One test (or a few) per hazard, section by section (A: data, B: hangs and
 memory, C: one line, D: exact messages, E: the Python API). The command is run in-process
 through its real entry point :func:`whitted.cli.main.main` (fast, and it includes the last
 line of defence against tracebacks); a few cases need a real process (signals, FIFOs)."""

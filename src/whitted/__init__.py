@@ -38,6 +38,7 @@ _LAZY = {
     "run_stefan": ".notebook",
     "Film": ".output.inline_film", "ContactSheet": ".animation.sheet",
     "default_scene": ".scene.default",
+    "framed": ".studio", "model_scene": ".studio", "turntable": ".studio",
     **dict.fromkeys((
         "CSG", "PRESETS", "AmbientLight", "AxisAngle", "Background", "Box", "Camera",
         "CheckerTexture", "Cone", "Cylinder", "DirectionalLight", "Disk", "DiskLight",
@@ -53,9 +54,9 @@ __all__ = [
     "DiskLight", "Film", "Gradient", "GradientTexture", "Image", "ImageTexture", "JobState",
     "Material", "Mesh", "Plane", "PointLight", "Progress", "Rectangle", "RenderJob",
     "RenderSettings", "RenderStats", "Scene", "SceneError", "Sphere", "Torus", "Transform",
-    "Triangle", "WhittedError", "__version__", "default_scene", "film_from_frames",
-    "load_scene", "render", "render_aovs", "render_async", "render_film", "run_stefan",
-    "save_scene", "sweep", "viewer",
+    "Triangle", "WhittedError", "__version__", "default_scene", "film_from_frames", "framed",
+    "load_scene", "model_scene", "render", "render_aovs", "render_async", "render_film",
+    "run_stefan", "save_scene", "sweep", "turntable", "viewer",
 ]
 
 

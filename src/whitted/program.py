@@ -18,10 +18,14 @@ from .errors import WhittedError
 @app.command()
 def gui(
     scene_path: Annotated[
-        Path | None, typer.Argument(metavar="[SCENE]", help="Scene file; a new one if missing")
+        Path | None, typer.Argument(
+            metavar="[SCENE]", help="Scene file (a new one if missing), model file (.obj, .ply, "
+            ".stl, .off, .glb, .gltf) or example name")
     ] = None,
 ) -> None:
-    """Open the scene editor (a desktop window) on SCENE, or on the built-in default scene."""
+    """Open the scene editor (a desktop window) on SCENE, or on the built-in default scene. A
+    model file opens as a new scene (the model on a lit ground, framed), to save as a scene
+    file."""
     from .scene import load_scene
 
     scene = None
@@ -29,20 +33,33 @@ def gui(
         exists = scene_path is not None and scene_path.exists()
     except (OSError, ValueError) as exc:
         raise fail(f"{scene_path}: {getattr(exc, 'strerror', None) or exc}") from None
-    if exists:
-        try:
-            scene = load_scene(scene_path)
+    from .files.shipped import example_path
+    from .studio import is_model_file, model_scene
+
+    example = None if exists or scene_path is None else example_path(str(scene_path))
+    if scene_path is not None and is_model_file(scene_path):
+        try:  # the model on a lit ground, framed: an untitled scene, saved where the user says
+            scene, scene_path = model_scene(scene_path), None
         except WhittedError as exc:
             raise fail(str(exc)) from None
+    elif exists or example is not None:
+        try:
+            scene = load_scene(example or scene_path)
+        except WhittedError as exc:
+            raise fail(str(exc)) from None
+        if example is not None:  # untitled: a save never writes into whitted's own examples
+            scene_path = None
     elif scene_path is not None and scene_path.suffix.lower() not in (".toml", ".json"):
         raise fail(f"{scene_path}: unknown scene format {scene_path.suffix!r} (use .toml or .json)")
     # Qt is imported by the editor only, after its check of the system libraries Qt needs
     if importlib.util.find_spec("PySide6") is None:
-        raise fail("the editor needs PySide6, which is not installed: pip install 'whitted[gui]'")
+        raise fail("the editor needs PySide6, which is not installed: install whitted[gui] "
+                   "(pip install 'whitted[gui]')")
     try:
         from .gui.app import run_editor
     except ImportError as exc:
-        raise fail(f"the editor needs PySide6 ({exc}): pip install 'whitted[gui]'") from None
+        raise fail(f"the editor needs PySide6 ({exc}): install whitted[gui] "
+                   "(pip install 'whitted[gui]')") from None
     raise typer.Exit(run_editor(scene, scene_path))
 
 

@@ -207,7 +207,7 @@ def prepare_film(
     frames' way was written by anyone but whitted. One-line :class:`~whitted.WhittedError`
     otherwise."""
     from ..output.safety import check_memory, check_outputs, input_files
-    from ..output.video import DEFAULT_CRF, check_crf, check_fps, video_format
+    from ..output.video import DEFAULT_CRF, check_crf, check_fps, ffmpeg_exe, video_format
 
     paths = output if isinstance(output, FilmPaths) else film_paths(output)
     count = scene.frame_count
@@ -231,6 +231,8 @@ def prepare_film(
     inputs = input_files(scene, scene_path)
     if paths.film is not None:
         check_outputs([paths.film], inputs=inputs)
+        if video_format(paths.film) == "mp4":
+            ffmpeg_exe()  # before the first frame: an encoder is there (whitted[film])
     files = [paths.frame(k, count) for k in chosen]
     check_frame_files(paths.frames, files, inputs)
     r = scene.render

@@ -157,7 +157,7 @@ def startup_main(*, scenes: list[str] | None, runs: int, threads: str | None,
                  err: Console) -> None:
     """``whitted bench --startup``: the budget of a whole ``whitted render`` process for each
     scene (a benchmark's name or a scene file), beside POV-Ray with ``--compare povray``."""
-    from .startup import budget_table, scene_file_of, startup_budget
+    from .startup import budget_table, cpu_name, scene_file_of, startup_budget
 
     if compare not in (None, "povray"):
         raise BenchUsageError(f"--compare: --startup compares with povray only (got {compare!r})")
@@ -181,7 +181,7 @@ def startup_main(*, scenes: list[str] | None, runs: int, threads: str | None,
     def log(line: str) -> None:
         err.print(f"[dim]{line}[/]", highlight=False)
 
-    err.print(f"[dim]whitted bench --startup on {platform.processor() or platform.machine()}, "
+    err.print(f"[dim]whitted bench --startup on {cpu_name()}, "
               f"{available_threads()} usable core(s); median of {runs} run(s) after a "
               "warm-up[/]")
     results = []

@@ -71,13 +71,11 @@ SCENES: dict[str, BenchScene] = {
 
 
 def benchmarks_dir() -> Path:
-    """The ``benchmarks/`` folder: the checkout's (found from this file in an editable install
-    or a source tree), else ``./benchmarks``."""
-    for parent in Path(__file__).resolve().parents:
-        candidate = parent / "benchmarks"
-        if (candidate / "seed000.toml").is_file():
-            return candidate
-    return Path.cwd() / "benchmarks"
+    """The ``benchmarks/`` folder: the installed package's, or the checkout's (found from
+    this file in an editable install or a source tree), else ``./benchmarks``."""
+    from ..files.shipped import shipped_dir
+
+    return shipped_dir("benchmarks") or Path.cwd() / "benchmarks"
 
 
 def pick_scenes(names: list[str] | None, quick: bool = False) -> list[BenchScene]:
@@ -97,8 +95,8 @@ def load_bench_scene(name: str, folder: Path | None = None, quick: bool = False)
     spec = SCENES[name]
     path = (folder or benchmarks_dir()) / spec.file
     if not path.is_file():
-        raise SceneError("no such benchmark scene file (is this a whitted checkout?)",
-                         file=str(path))
+        raise SceneError("no such benchmark scene file (whitted's benchmark scenes are not "
+                         "installed here)", file=str(path))
     text = path.read_text(encoding="utf-8")
     scene = scene_from_dict(parse_scene_text(text, ".toml", str(path)), file=str(path),
                             text=text).with_base_dir(path.parent)

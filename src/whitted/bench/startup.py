@@ -64,7 +64,7 @@ class StartupBudget:
         return rows
 
     def as_dict(self) -> dict:
-        data = {"scene": self.scene, "runs": self.runs,
+        data = {"scene": self.scene, "cpu": cpu_name(), "runs": self.runs,
                 "median": {phase: seconds for phase, seconds, _ in self.rows()}}
         if self.povray_wall:
             pov = statistics.median(self.povray_wall)
@@ -107,6 +107,20 @@ def phases(marks: dict[str, float], launched: float, ended: float) -> dict[str, 
         "exit": ended - marks["written"],
         "whole process": ended - launched,
     }
+
+
+def cpu_name() -> str:
+    """The CPU's model name (``lscpu``'s "Model name": /proc/cpuinfo on Linux), to print
+    beside every figure; the architecture elsewhere."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    import platform
+
+    return platform.processor() or platform.machine() or "unknown CPU"
 
 
 def read_marks(path: Path) -> dict[str, float]:

@@ -51,6 +51,9 @@ def animate(
     crf: Annotated[int, typer.Option("--crf", help="MP4 quality: 0 best .. 51 worst")] = 18,
     force: Annotated[bool, typer.Option("--force", help="Render frames already on disk")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress output")] = False,
+    turntable: Annotated[int | None, typer.Option(
+        "--turntable", help="N frames of the camera going once around (a model's quick look)",
+        min=1, max=1_000_000)] = None,
     cluster: ClusterOption = None,
     scheduler: SchedulerOption = None,
 ) -> None:
@@ -65,7 +68,8 @@ def animate(
 
     started = time.perf_counter()
     try:
-        scene, name = load_scene_argument(scene_path)
+        scene, name = load_scene_argument(scene_path, width=width, height=height,
+                                          turntable=turntable)
         scene = apply_set_options(scene, set_values)
         scene = with_options(scene, width=width, height=height, samples=samples,
                              max_depth=max_depth, threads=threads, seed=seed)

@@ -34,7 +34,9 @@ app = typer.Typer(
 
 #: The optional scene-file argument of render, export, animate and sweep.
 SceneArgument = Annotated[
-    Path | None, typer.Argument(metavar="[SCENE]", help="Scene file; default: built-in scene")
+    Path | None, typer.Argument(
+        metavar="[SCENE]", help="Scene file (.toml, .json), model file (.obj, .ply, .stl, .off, "
+        ".glb, .gltf) or example name (glass_cube); default: the built-in scene")
 ]
 
 EXIT_USER_ERROR = 2
@@ -79,13 +81,42 @@ def main_options(
     """whitted: a fast Whitted ray tracer."""
 
 
-def load_scene_argument(scene_path: Path | None) -> tuple[Scene, str]:
+def load_scene_argument(scene_path: Path | None, *, width: int | None = None,
+                        height: int | None = None,
+                        turntable: int | None = None) -> tuple[Scene, str]:
+    """The scene the SCENE argument names: a scene file; a model file (OBJ, PLY, STL, OFF,
+    glTF), shown on a lit ground by a framed camera (for a picture ``width`` x ``height``);
+    an example's short name (``glass_cube``); nothing: the built-in default scene. With
+    ``turntable``, a film of that many frames with the camera going once around."""
+    from ..files.shipped import example_path
     from ..scene import load_scene
     from ..scene.default import default_scene
+    from ..studio import is_model_file, model_scene
+    from ..studio import turntable as turntable_of
 
     if scene_path is None:
-        return default_scene(), "<default scene>"
-    return load_scene(scene_path), str(scene_path)
+        scene, name = default_scene(), "<default scene>"
+    elif is_model_file(scene_path):
+        size = {k: v for k, v in (("width", width), ("height", height)) if v is not None}
+        if len(size) == 1:  # keep the default picture's shape
+            size.setdefault("width", max(1, round(size["height"] * 4 / 3)))
+            size.setdefault("height", max(1, round(size["width"] * 3 / 4)))
+        scene = model_scene(scene_path, **size, all_around=turntable is not None)
+        name = str(scene_path)
+    else:
+        example = None if _exists(scene_path) else example_path(str(scene_path))
+        scene = load_scene(example or scene_path)
+        name = str(example or scene_path)
+    if turntable is not None:
+        scene = turntable_of(scene, turntable)
+    return scene, name
+
+
+def _exists(path: Path) -> bool:
+    try:
+        return path.exists()
+    except (OSError, ValueError):
+        return False
 
 
 def apply_set_options(scene: Scene, set_values: list[str] | None) -> Scene:

@@ -22,6 +22,7 @@ from ..errors import WhittedError
 from ..jit.progress import show_compile_bar
 from . import animate as _animate  # noqa: F401
 from . import bench as _bench  # noqa: F401
+from . import examples as _examples  # noqa: F401
 from . import export as _export  # noqa: F401
 from . import info as _info  # noqa: F401
 from . import render as _render  # noqa: F401

@@ -51,9 +51,8 @@ def _parse_aovs(text: str | None) -> list[str]:
 @app.command()
 def render(
     scene_path: SceneArgument = None,
-    output: Annotated[Path, typer.Option("-o", "--output", help="Image to write")] = Path(
-        "render.png"
-    ),
+    output: Annotated[Path | None, typer.Option(
+        "-o", "--output", help="Image to write [default: render.png]")] = None,
     width: Annotated[int | None, typer.Option("--width", "-W", help="Image width")] = None,
     height: Annotated[int | None, typer.Option("--height", "-H", help="Image height")] = None,
     samples: Annotated[int | None, typer.Option("--samples", "-s", help="Samples/pixel")] = None,
@@ -85,17 +84,36 @@ def render(
     )] = None,
     resume: Annotated[bool, typer.Option(
         "--continue", help="Finish an interrupted render from the tiles it kept")] = False,
+    turntable: Annotated[int | None, typer.Option(
+        "--turntable", help="A film instead: N frames of the camera going once around "
+        "(whitted animate --turntable; -o NAME.mp4 or .gif, default SCENE_turntable.mp4)",
+        min=1, max=1_000_000)] = None,
     cluster: ClusterOption = None,
     scheduler: SchedulerOption = None,
 ) -> None:
     """Render SCENE (or the built-in default scene) to an image: PNG, JPEG, TIFF, WebP,
     EXR, PFM or NPY, chosen by the name given to -o. An animated scene renders frame 0, or
     the frame --frame names; an interrupted render (Ctrl-C) keeps its finished tiles, and
-    --continue finishes it."""
+    --continue finishes it. A model file is shown on a lit ground by a camera that frames
+    it."""
     from .. import marks
 
     marks.mark("command")  # the imports and the command line's parsing are done
     from pydantic import ValidationError
+
+    if turntable is not None:
+        stills_only = [name for name, given in (
+            ("--aov", aov), ("--frame", frame is not None), ("--bit-depth", bit_depth != 8),
+            ("--transfer", transfer), ("--region", region), ("--alpha", alpha),
+            ("--exposure", exposure != 0.0), ("--quality", quality is not None),
+            ("--continue", resume)) if given]
+        if stills_only:
+            raise fail(f"--turntable makes a film: {', '.join(stills_only)} only apply to a "
+                       "still")
+        _turntable_film(scene_path, output, turntable, width, height, samples, max_depth,
+                        threads, seed, set_values, quiet, cluster, scheduler)
+        return
+    output = output or Path("render.png")
 
     from ..output.formats import check_bit_depth, check_image_options, image_format
     from ..render.api import DEFAULT_TILE, RenderJob
@@ -119,7 +137,7 @@ def render(
     if transfer not in (None, "srgb", "linear"):
         raise fail(f"--transfer: unknown transfer {shorten(transfer)!r} (use srgb or linear)")
     try:
-        scene, name = load_scene_argument(scene_path)
+        scene, name = load_scene_argument(scene_path, width=width, height=height)
         scene = apply_set_options(scene, set_values)
     except WhittedError as exc:
         raise fail(str(exc)) from None
@@ -210,6 +228,24 @@ def _kept_tiles(path: Path, digest: str, scene):
         raise fail(f"--continue: {path} holds tiles of another scene, settings or region "
                    "(render without --continue to start over)")
     return state.finished, state.framebuffer
+
+
+def _turntable_film(scene_path, output, frames, width, height, samples, max_depth, threads,
+                    seed, set_values, quiet, cluster, scheduler) -> None:
+    """``render --turntable N``: the film ``whitted animate --turntable N`` makes."""
+    from .animate import animate
+
+    if output is None:
+        stem = scene_path.stem if scene_path is not None else "render"
+        output = Path(f"{stem}_turntable.mp4")
+    elif output.suffix.lower() in (".png", ".exr", ".pfm", ".npy", ".jpg", ".jpeg", ".tif",
+                                   ".tiff", ".webp"):
+        raise fail(f"{output}: --turntable makes a film: name an .mp4 or .gif file, or a "
+                   "folder for the frames alone")
+    animate(scene_path=scene_path, output=output, frames=None, fps=None, width=width,
+            height=height, samples=samples, max_depth=max_depth, threads=threads, seed=seed,
+            set_values=set_values, crf=18, force=False, quiet=quiet, turntable=frames,
+            cluster=cluster, scheduler=scheduler)
 
 
 def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,

@@ -30,6 +30,20 @@ def _fail(message: str) -> typer.Exit:
     return fail(message)
 
 
+@app.callback()
+def _needs_the_solver() -> None:
+    """The Stefan problem: a hollow piece of ice with water inside, melting."""
+    import importlib.util
+
+    missing = [name for module, name in (("scipy", "SciPy"), ("skimage", "scikit-image"),
+                                         ("matplotlib", "Matplotlib"))
+               if importlib.util.find_spec(module) is None]
+    if missing:
+        names = ", ".join(missing[:-1]) + " and " * (len(missing) > 1) + missing[-1]
+        raise _fail(f"whitted stefan needs {names}, which are not installed: "
+                    "install whitted[stefan] (pip install 'whitted[stefan]')")
+
+
 def load_scene_argument(case_path: Path):
     from ..stefan.case import load_case
 

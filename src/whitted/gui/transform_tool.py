@@ -17,6 +17,7 @@ from PySide6.QtCore import QPointF, Qt
 from PySide6.QtGui import QKeyEvent
 
 from ..scene import Scene, Transform
+from ..studio.bounds import item_bounds
 from . import camera_ops
 
 AXES = {"x": np.array([1.0, 0, 0]), "y": np.array([0, 1.0, 0]), "z": np.array([0, 0, 1.0])}
@@ -28,80 +29,9 @@ _serials = itertools.count(1)
 # ---------------------------------------------------------------------- geometry
 
 
-def _local_points(obj) -> np.ndarray | None:
-    """Points spanning the object before its transform (None: unbounded or unknown)."""
-    t = obj.type
-    if t == "sphere":
-        c, r = np.asarray(obj.center), obj.radius
-        return np.array([c - r, c + r])
-    if t == "box":
-        if obj.min is not None:
-            return np.array([obj.min, obj.max], np.float64)
-        c, e = np.asarray(obj.corner, np.float64), np.asarray(obj.edges, np.float64)
-        return np.array([c + i * e[0] + j * e[1] + k * e[2]
-                         for i in (0, 1) for j in (0, 1) for k in (0, 1)])
-    if t == "rectangle":
-        c, a, b = (np.asarray(v, np.float64) for v in (obj.corner, obj.edge1, obj.edge2))
-        return np.array([c, c + a, c + b, c + a + b])
-    if t == "triangle":
-        return np.asarray(obj.vertices, np.float64)
-    if t in ("disk",):
-        c, r = np.asarray(obj.center, np.float64), obj.radius
-        return np.array([c - r, c + r])
-    if t in ("cylinder", "cone"):
-        r = obj.radius if t == "cylinder" else max(obj.radius, obj.top_radius or 0.0)
-        b, top = np.asarray(obj.base, np.float64), np.asarray(obj.top, np.float64)
-        return np.array([b - r, b + r, top - r, top + r])
-    if t == "torus":
-        a = obj.major_radius + obj.minor_radius
-        return np.array([(-a, -obj.minor_radius, -a), (a, obj.minor_radius, a)])
-    if t == "csg":  # from the children's boxes, in the CSG object's space
-        children = obj.objects[:1] if obj.operation == "difference" else obj.objects
-        boxes = [b for c in children if (b := item_bounds(c, None)) is not None]
-        if not boxes:
-            return None
-        if obj.operation == "intersection" and len(boxes) == len(children):
-            lo = np.max([b[0] for b in boxes], axis=0)
-            hi = np.min([b[1] for b in boxes], axis=0)
-            hi = np.maximum(hi, lo)
-        else:
-            lo = np.min([b[0] for b in boxes], axis=0)
-            hi = np.max([b[1] for b in boxes], axis=0)
-        return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
-                         for z in (lo[2], hi[2])])
-    return None
-
-
 def object_bounds(scene: Scene, index: int) -> tuple[np.ndarray, np.ndarray] | None:
     """World-space box (lo, hi) around object ``index``; None for an unbounded plane."""
     return item_bounds(scene.objects[index], scene)
-
-
-def item_bounds(obj, scene: Scene | None) -> tuple[np.ndarray, np.ndarray] | None:
-    """World-space box (lo, hi) around ``obj`` (its files found from ``scene``'s folder)."""
-    pts = _local_points(obj)
-    if pts is None and obj.type == "mesh":
-        try:
-            if scene is None and obj.file is not None:
-                return None
-            if obj.file is not None:
-                from ..assets import load_mesh
-
-                v = load_mesh(scene.resolve_path(obj.file)).vertices
-            else:
-                v = np.asarray(obj.vertices, np.float64)
-            pts = np.array([v.min(axis=0), v.max(axis=0)])
-            lo, hi = pts
-            pts = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
-                            for z in (lo[2], hi[2])])
-        except Exception:  # noqa: BLE001 - an unreadable model: no bounds
-            return None
-    if pts is None:
-        return None
-    if obj.transform is not None:
-        m = obj.transform.matrix()
-        pts = pts @ m[:3, :3].T + m[:3, 3]
-    return pts.min(axis=0), pts.max(axis=0)
 
 
 def object_centre(scene: Scene, index: int) -> np.ndarray:

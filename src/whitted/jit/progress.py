@@ -46,6 +46,11 @@ def show_compile_bar(on: bool | str) -> None:
     _bar = on
 
 
+def compile_bar_setting() -> bool | str:
+    """What :func:`show_compile_bar` was last given (to put it back after a while)."""
+    return _bar
+
+
 def _times_file():
     from .cache import cache_root
 

@@ -95,7 +95,9 @@ class LiveRender:
         self._next = 0.0  # perf_counter() of the next allowed picture update
         self.started = time.perf_counter()
         self.stop_requested = False
+        self.compile_bar: bool | str = "auto"  # the compile bar's setting before this render
         self._eta: float | None = None  # the render's estimate of the time left
+        self._expected: dict[str, float] = {}  # a first compile's expected seconds, by kind
         name = f"{title}: " if title else ""
         self.bar = w.FloatProgress(value=0.0, min=0.0, max=100.0, description="preparing",
                                    bar_style="info",
@@ -149,10 +151,16 @@ class LiveRender:
 
             fraction = compile_progress()
             if fraction is not None:
+                label = compile_label()
+                if label not in self._expected:
+                    from ..jit.progress import expected_seconds
+
+                    self._expected[label] = expected_seconds(label)
                 self.bar.description = "compiling"
                 self.bar.value = 100.0 * fraction
-                self.status.value = (f"{self.title}compiling {compile_label()} (the first "
-                                     f"render only, kept for later ones): {_seconds(elapsed)}")
+                self.status.value = (f"{self.title}compiling {label} (the first render only, "
+                                     f"kept for later ones; about "
+                                     f"{_seconds(self._expected[label])}): {_seconds(elapsed)}")
             else:
                 self.status.value = f"{self.title}preparing the scene: {_seconds(elapsed)}"
         else:
@@ -240,6 +248,12 @@ class _Box:
 
 
 def _start(job: RenderJob, view: LiveRender) -> None:
+    """Start ``job`` with ``view`` noting its tiles; the view shows a first compile, so the
+    compile's own bar (jit/progress.py) is off until :func:`_end`."""
+    from ..jit.progress import compile_bar_setting, show_compile_bar
+
+    view.compile_bar = compile_bar_setting()
+    show_compile_bar(False)
     user = job.progress
 
     def both(p: Progress) -> None:
@@ -252,6 +266,9 @@ def _start(job: RenderJob, view: LiveRender) -> None:
 
 
 def _end(job: RenderJob, view: LiveRender, keep_picture: bool) -> Image:
+    from ..jit.progress import show_compile_bar
+
+    show_compile_bar(view.compile_bar)
     view.finish(keep_picture=keep_picture)
     if job.failed:
         raise job.error  # type: ignore[misc]
@@ -282,6 +299,9 @@ async def watch_async(job: RenderJob, view: LiveRender, *, keep_picture: bool = 
             await asyncio.sleep(view.wait_seconds())
             view.update()
     except asyncio.CancelledError:
+        from ..jit.progress import show_compile_bar
+
         job.cancel()
+        show_compile_bar(view.compile_bar)
         raise
     return _end(job, view, keep_picture)

@@ -21,6 +21,7 @@ import contextlib
 import itertools
 import math
 import os
+import shutil
 import subprocess
 import tempfile
 from collections.abc import Iterable, Iterator
@@ -30,7 +31,7 @@ from typing import Protocol
 
 import numpy as np
 
-from ..errors import RenderCancelled
+from ..errors import ArgumentError, RenderCancelled
 from ..files import atomic_write
 
 __all__ = ["DEFAULT_CRF", "FPS_MAX", "FPS_MIN", "VIDEO_FORMATS", "check_crf", "check_fps",
@@ -154,11 +155,24 @@ def _check(cancel: Cancel | None) -> None:
         raise RenderCancelled("the encode was cancelled")
 
 
-def _ffmpeg_command(tmp: str, width: int, height: int, fps: float, crf: int) -> list[str]:
-    import imageio_ffmpeg
+def ffmpeg_exe() -> str:
+    """The ffmpeg that encodes MP4 films: imageio-ffmpeg's (``pip install 'whitted[film]'``),
+    else an ``ffmpeg`` on the PATH. ArgumentError (one line) when there is neither."""
+    try:
+        import imageio_ffmpeg
+    except ImportError:
+        found = shutil.which("ffmpeg")
+        if found is None:
+            raise ArgumentError("MP4 films need ffmpeg, which is not installed: install "
+                                "whitted[film] (pip install 'whitted[film]'), or write a .gif"
+                                ) from None
+        return found
+    return imageio_ffmpeg.get_ffmpeg_exe()
 
+
+def _ffmpeg_command(tmp: str, width: int, height: int, fps: float, crf: int) -> list[str]:
     rate = Fraction(fps).limit_denominator(100_000)  # exact for 24000/1001 and the like
-    return [imageio_ffmpeg.get_ffmpeg_exe(), "-y", "-hide_banner", "-loglevel", "error",
+    return [ffmpeg_exe(), "-y", "-hide_banner", "-loglevel", "error",
             "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{width}x{height}", "-r", str(rate),
             "-i", "-", "-an", "-vcodec", "libx264", "-pix_fmt", "yuv420p",
             "-crf", str(int(crf)), "-preset", "medium", "-movflags", "+faststart",
