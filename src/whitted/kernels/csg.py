@@ -51,7 +51,6 @@ from .intersect import (
     frustum_crossings,
     intersect_triangle,
     normal_local,
-    sphere_span,
 )
 from .layout import (
     CSG_DIFFERENCE,
@@ -69,6 +68,7 @@ from .layout import (
     SHAPE_TORUS,
 )
 from .mesh import mesh_closest_hit
+from .shapes.sphere import sphere_span
 from .shapes.torus import torus_crossings, torus_normal
 from .traverse import inverse_direction, slab_entry
 from .vec import dot, madd

@@ -1,4 +1,5 @@
-"""Exact ray/shape intersection and surface normals, one function per shape.
+"""Exact ray/shape intersection and surface normals, one function per shape (the sphere's and
+the torus's are in their own files under ``shapes/``), and the dispatch on the shape code.
 
 Every ``intersect_*`` takes the parameter table ``P`` and a row ``i`` (see :mod:`.layout`), a ray
 origin ``o`` and direction ``d`` (tuples; ``d`` need not be unit length) and the open interval
@@ -21,61 +22,14 @@ from .layout import (
     SHAPE_SPHERE,
     SHAPE_TRIANGLE,
 )
+from .shapes.quadric import nearest_root, quadratic_roots
+from .shapes.sphere import intersect_sphere
 from .vec import cross, dot, normalize, sub, vload
 
 INF = math.inf
 # Flat shapes accept hits a hair outside their edges (in parametric units): rays through a
 # shared edge of two rectangles or triangles never slip between them.
 EDGE_TOL = 1e-9
-
-
-@kernel
-def _roots(a, b, c):
-    """Both roots (t0 <= t1) of a·t² + 2b·t + c = 0, a != 0 (numerically stable form);
-    (inf, inf) when there are none."""
-    disc = b * b - a * c
-    if disc < 0.0:
-        return INF, INF
-    sq = math.sqrt(disc)
-    q = -(b + sq) if b >= 0.0 else -(b - sq)
-    if q == 0.0:
-        return -b / a, -b / a
-    t0 = q / a
-    t1 = c / q
-    return (t0, t1) if t0 <= t1 else (t1, t0)
-
-
-@kernel
-def _nearest_root(a, b, c, tmin, tmax):
-    """Nearest root in (tmin, tmax) of a·t² + 2b·t + c = 0."""
-    if a == 0.0:
-        if b == 0.0:
-            return INF
-        t = -c / (2.0 * b)
-        return t if tmin < t < tmax else INF
-    t0, t1 = _roots(a, b, c)
-    if tmin < t0 < tmax:
-        return t0
-    if tmin < t1 < tmax:
-        return t1
-    return INF
-
-
-@kernel
-def sphere_span(P, i, o, d):
-    """(enter, leave): where the ray's line crosses sphere row ``i`` ((inf, inf): nowhere)."""
-    c = vload(P, i, 0)
-    r = P[i, 3]
-    oc = sub(o, c)
-    return _roots(dot(d, d), dot(oc, d), dot(oc, oc) - r * r)
-
-
-@kernel
-def intersect_sphere(P, i, o, d, tmin, tmax):
-    c = vload(P, i, 0)
-    r = P[i, 3]
-    oc = sub(o, c)
-    return _nearest_root(dot(d, d), dot(oc, d), dot(oc, oc) - r * r, tmin, tmax)
 
 
 @kernel
@@ -255,7 +209,7 @@ def frustum_crossings(P, i, o, d):
         s0 = -c / (2.0 * b) if b != 0.0 else INF
         s1 = INF
     else:
-        s0, s1 = _roots(a, b, c)
+        s0, s1 = quadratic_roots(a, b, c)
     z = oz + s0 * dz
     if not (0.0 <= z <= h and r0 + k * z >= 0.0):
         s0 = INF
@@ -288,7 +242,7 @@ def intersect_frustum(P, i, o, d, tmin, tmax):
     # side: up to two roots, keep the nearest whose height lies on the body
     lo = tmin
     for _ in range(2):
-        t = _nearest_root(a, b, c, lo, tmax)
+        t = nearest_root(a, b, c, lo, tmax)
         if t == INF:
             break
         z = oz + t * dz

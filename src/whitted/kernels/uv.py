@@ -36,24 +36,13 @@ from .layout import (
     SHAPE_RECTANGLE,
     SHAPE_SPHERE,
     SHAPE_TRIANGLE,
-    SPHERE_FRAME,
     TRIANGLE_UV,
 )
 from .mesh import mesh_uv
+from .shapes.sphere import sphere_uv
 from .vec import cross, dot, sub, vload
 
 INV_TWO_PI = 0.5 / math.pi
-
-
-@kernel
-def _sphere_uv(P, i, p):
-    r = P[i, 3]
-    q = sub(p, vload(P, i, 0))
-    x = dot(q, vload(P, i, SPHERE_FRAME)) / r
-    y = dot(q, vload(P, i, SPHERE_FRAME + 3)) / r
-    z = dot(q, vload(P, i, SPHERE_FRAME + 6)) / r
-    y = min(1.0, max(-1.0, y))
-    return 0.5 + math.atan2(x, z) * INV_TWO_PI, 0.5 + math.asin(y) / math.pi
 
 
 @kernel
@@ -119,7 +108,7 @@ def surface_uv(geo, prim, tri, b1, b2, p):
         p, _ = to_object(geo.xforms, xf, p, p)
     P = geo.prim_params
     if typ == SHAPE_SPHERE:
-        return _sphere_uv(P, prim, p)
+        return sphere_uv(P, prim, p)
     if typ == SHAPE_RECTANGLE:
         q = sub(p, vload(P, prim, 0))
         return dot(q, vload(P, prim, 12)), dot(q, vload(P, prim, 15))

@@ -23,8 +23,10 @@ The dispatch on the ``SHAPE_*`` code is in one place per query: ``intersect.py``
 objects), ``csg.py`` ``leaf_crossings`` / ``leaf_normal`` for CSG leaves.
 
 One file per shape is the aim: ``torus.py`` here is the template (its hit, crossings, normal
-and uv together). :data:`PIECES` names, for every kind, the function of each piece (one named
-hop), wherever it lives now.
+and uv together); ``sphere.py`` holds the sphere's (its normal stays written in place in
+``normal_local``, the hottest path); ``quadric.py`` the quadratics the quadrics share.
+:data:`PIECES` names, for every kind, the function of each piece (one named hop), wherever
+it lives now.
 """
 
 from __future__ import annotations
@@ -33,9 +35,9 @@ from __future__ import annotations
 #: such piece (a flat or open shape bounds no volume, so CSG refuses it: no crossings)
 PIECES: dict[str, dict[str, str | None]] = {
     "sphere": {
-        "rows": "compile.shapes:add_shape", "hit": "kernels.intersect:intersect_sphere",
-        "crossings": "kernels.intersect:sphere_span", "normal": "kernels.intersect:normal_local",
-        "uv": "kernels.uv:_sphere_uv",
+        "rows": "compile.shapes:add_shape", "hit": "kernels.shapes.sphere:intersect_sphere",
+        "crossings": "kernels.shapes.sphere:sphere_span",
+        "normal": "kernels.intersect:normal_local", "uv": "kernels.shapes.sphere:sphere_uv",
     },
     "plane": {
         "rows": "compile.shapes:add_shape", "hit": "kernels.intersect:intersect_plane",
