@@ -47,7 +47,6 @@ from ..jit import kernel, numba_object
 from .hit_list import keep_nearest
 from .intersect import (
     INF,
-    box_span,
     frustum_crossings,
     intersect_triangle,
     normal_local,
@@ -68,6 +67,7 @@ from .layout import (
     SHAPE_TORUS,
 )
 from .mesh import mesh_closest_hit
+from .shapes.box import box_span
 from .shapes.sphere import sphere_span
 from .shapes.torus import torus_crossings, torus_normal
 from .traverse import inverse_direction, slab_entry

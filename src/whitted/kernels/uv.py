@@ -20,7 +20,7 @@ from ..jit import kernel, overload
 from .accel import to_object
 from .extras import extra_uv_if_extras
 from .features import has_extras, instances_possible
-from .intersect import _box_local, triangle_barycentric
+from .intersect import triangle_barycentric
 from .layout import (
     DISK_TANGENT,
     FIRST_EXTRA_SHAPE,
@@ -39,6 +39,7 @@ from .layout import (
     TRIANGLE_UV,
 )
 from .mesh import mesh_uv
+from .shapes.box import box_uv
 from .shapes.sphere import sphere_uv
 from .vec import cross, dot, sub, vload
 
@@ -54,23 +55,6 @@ def _triangle_uv(P, i, p):
         b0 * P[i, c] + b1 * P[i, c + 2] + b2 * P[i, c + 4],
         b0 * P[i, c + 1] + b1 * P[i, c + 3] + b2 * P[i, c + 5],
     )
-
-
-@kernel
-def _box_uv(P, i, p):
-    lp = _box_local(P, i, sub(p, vload(P, i, 0)))
-    best_k = 0
-    best_dist = math.inf
-    for k in range(3):
-        gap = min(abs(lp[k]), abs(1.0 - lp[k]))
-        if gap < best_dist:
-            best_dist = gap
-            best_k = k
-    if best_k == 0:  # faces across x: u along z, v along y
-        return lp[2], lp[1]
-    if best_k == 1:  # faces across y: u along x, v along z
-        return lp[0], lp[2]
-    return lp[0], lp[1]
 
 
 @kernel
@@ -124,7 +108,7 @@ def surface_uv(geo, prim, tri, b1, b2, p):
     if typ == SHAPE_TRIANGLE:
         return _triangle_uv(P, prim, p)
     if typ == SHAPE_BOX:
-        return _box_uv(P, prim, p)
+        return box_uv(P, prim, p)
     if typ == SHAPE_FRUSTUM:
         return _frustum_uv(P, prim, p)
     if has_extras(geo) and typ >= FIRST_EXTRA_SHAPE:  # the torus (kernels/shapes/torus.py)

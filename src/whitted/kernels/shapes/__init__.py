@@ -23,10 +23,10 @@ The dispatch on the ``SHAPE_*`` code is in one place per query: ``intersect.py``
 objects), ``csg.py`` ``leaf_crossings`` / ``leaf_normal`` for CSG leaves.
 
 One file per shape is the aim: ``torus.py`` here is the template (its hit, crossings, normal
-and uv together); ``sphere.py`` holds the sphere's (its normal stays written in place in
-``normal_local``, the hottest path); ``quadric.py`` the quadratics the quadrics share.
-:data:`PIECES` names, for every kind, the function of each piece (one named hop), wherever
-it lives now.
+and uv together); ``sphere.py`` and ``box.py`` hold theirs (the sphere's normal stays
+written in place in ``normal_local``, the hottest path); ``quadric.py`` the quadratics the
+quadrics share. :data:`PIECES` names, for every kind, the function of each piece (one named
+hop), wherever it lives now.
 """
 
 from __future__ import annotations
@@ -60,9 +60,9 @@ PIECES: dict[str, dict[str, str | None]] = {
         "uv": "kernels.uv:_triangle_uv",
     },
     "box": {
-        "rows": "compile.shapes:add_shape", "hit": "kernels.intersect:intersect_box",
-        "crossings": "kernels.intersect:box_span", "normal": "kernels.intersect:_solid_normal",
-        "uv": "kernels.uv:_box_uv",
+        "rows": "compile.shapes:add_shape", "hit": "kernels.shapes.box:intersect_box",
+        "crossings": "kernels.shapes.box:box_span", "normal": "kernels.shapes.box:box_normal",
+        "uv": "kernels.shapes.box:box_uv",
     },
     "cylinder": {  # a frustum with equal radii
         "rows": "compile.shapes:add_shape", "hit": "kernels.intersect:intersect_frustum",
