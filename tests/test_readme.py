@@ -103,7 +103,7 @@ def test_the_readme_shows_the_commands_this_test_runs():
     names = [a[1] for a in commands if a[0] == "whitted" and len(a) > 1]
     for name in ("render", "info", "export", "animate", "sweep", "stefan", "examples"):
         assert name in names
-    # the Quick start's second line is what `make demo` prints
+    # the activation line the README shows is what `make demo` prints
     makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
     assert "VENV ?= .venv\n" in makefile and '@echo "    . $(VENV)/bin/activate"' in makefile
 

@@ -13,7 +13,6 @@ import base64
 import html
 import os
 import re
-import shutil
 import tempfile
 from pathlib import Path
 
@@ -28,13 +27,15 @@ _NUMBERED = re.compile(r"(\d+)\.png$", re.IGNORECASE)
 
 
 def mp4_encoder() -> bool:
-    """An MP4 encoder is there: imageio-ffmpeg's ffmpeg, or an ``ffmpeg`` on the PATH."""
-    try:
-        import imageio_ffmpeg
+    """An MP4 encoder is there: imageio-ffmpeg's ffmpeg (``whitted[film]``), or an
+    ``ffmpeg`` on the PATH (:func:`whitted.output.video.ffmpeg_exe`)."""
+    from ..errors import WhittedError
+    from .video import ffmpeg_exe
 
-        return bool(imageio_ffmpeg.get_ffmpeg_exe())
-    except (ImportError, RuntimeError, OSError):
-        return shutil.which("ffmpeg") is not None
+    try:
+        return bool(ffmpeg_exe())
+    except (WhittedError, RuntimeError, OSError):
+        return False
 
 
 def frame_files(folder: str | os.PathLike[str]) -> list[Path]:
