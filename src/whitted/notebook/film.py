@@ -102,16 +102,9 @@ def render_film(
         return library_render_film(scene, plan, force=force, threads=threads,
                                    progress=progress, cancel=cancel)
 
-    if view is None:
-        result = work()
-    else:
-        from .task import run_watched
+    from .task import run_in_view
 
-        try:
-            result = run_watched(work, view, cancel)
-        except BaseException as exc:
-            view.fail(exc)
-            raise
+    result = run_in_view(work, view, cancel)
     if result is None or not result.files:
         from ..errors import RenderCancelled
 
@@ -171,7 +164,7 @@ def sweep(
     if not live:
         return render_sweep(scene, values, columns=columns, title=title, threads=threads,
                             cancel=cancel)
-    from .task import TaskView, run_watched
+    from .task import TaskView, run_in_view
 
     view = TaskView("sweep")
 
@@ -180,13 +173,9 @@ def sweep(
         view.text = f"{p.cell.label} ({p.done + 1}/{p.total})"
 
     _show(view.widget)
-    try:
-        sheet = run_watched(lambda: render_sweep(scene, values, columns=columns, title=title,
-                                                 threads=threads, progress=progress,
-                                                 cancel=cancel), view, cancel)
-    except BaseException as exc:
-        view.fail(exc)
-        raise
+    sheet = run_in_view(lambda: render_sweep(scene, values, columns=columns, title=title,
+                                             threads=threads, progress=progress,
+                                             cancel=cancel), view, cancel)
     if sheet is None:
         from ..errors import RenderCancelled
 

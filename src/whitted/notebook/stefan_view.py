@@ -99,16 +99,9 @@ def run_stefan(
                         should_stop=lambda: cancel.cancelled, allow_large=allow_large,
                         case_path=path)
 
-    if view is None:
-        result = work()
-    else:
-        from .task import run_watched
+    from .task import run_in_view
 
-        try:
-            result = run_watched(work, view, cancel)
-        except BaseException as exc:
-            view.fail(exc)
-            raise
+    result = run_in_view(work, view, cancel)
     results = load_results(out)
     results.run = result
     if view is not None:

@@ -11,7 +11,7 @@ from typing import Any
 
 from ..errors import WhittedError, shorten
 
-__all__ = ["TaskView", "run_watched"]
+__all__ = ["TaskView", "run_in_view", "run_watched"]
 
 #: Seconds between two updates of a task's view.
 INTERVAL = 0.25
@@ -102,3 +102,15 @@ def run_watched(work: Callable[[], Any], view: TaskView | None, cancel: Any) -> 
     if "error" in box:
         raise box["error"]
     return box.get("value")
+
+
+def run_in_view(work: Callable[[], Any], view: TaskView | None, cancel: Any) -> Any:
+    """``work()`` here when there is no view; else watched by ``view`` (:func:`run_watched`),
+    which is told of a failure before it is raised."""
+    if view is None:
+        return work()
+    try:
+        return run_watched(work, view, cancel)
+    except BaseException as exc:
+        view.fail(exc)
+        raise
