@@ -57,6 +57,18 @@ def parse_size(text: str | None) -> tuple[int, int] | None:
     return w, h
 
 
+def _check_runs_and_povray(runs: int, compare: str | None) -> None:
+    """--runs is at least 1, and POV-Ray is installed when it is to be compared with."""
+    if runs < 1:
+        raise BenchUsageError("--runs: must be at least 1")
+    if compare == "povray":
+        from .povray import povray_executable
+
+        if povray_executable() is None:
+            raise BenchUsageError("--compare povray: povray is not installed "
+                                  "(Debian: apt-get install povray)")
+
+
 def bench_main(
     *, scenes: list[str] | None, runs: int, threads: str | None, quick: bool,
     compare: str | None, study: str | None, json_path: Path | None, plot_path: Path | None,
@@ -72,14 +84,7 @@ def bench_main(
             raise BenchUsageError("--compare embree needs embreex: pip install 'whitted[bench]'")
     if study not in (None, "threads", "size"):
         raise BenchUsageError(f"--study: unknown study {study!r} (threads or size)")
-    if runs < 1:
-        raise BenchUsageError("--runs: must be at least 1")
-    if compare == "povray":
-        from .povray import povray_executable
-
-        if povray_executable() is None:
-            raise BenchUsageError("--compare povray: povray is not installed "
-                                  "(Debian: apt-get install povray)")
+    _check_runs_and_povray(runs, compare)
     if study:
         import importlib.util
 
@@ -161,14 +166,7 @@ def startup_main(*, scenes: list[str] | None, runs: int, threads: str | None,
 
     if compare not in (None, "povray"):
         raise BenchUsageError(f"--compare: --startup compares with povray only (got {compare!r})")
-    if runs < 1:
-        raise BenchUsageError("--runs: must be at least 1")
-    if compare == "povray":
-        from .povray import povray_executable
-
-        if povray_executable() is None:
-            raise BenchUsageError("--compare povray: povray is not installed "
-                                  "(Debian: apt-get install povray)")
+    _check_runs_and_povray(runs, compare)
     counts = parse_threads(threads)
     if counts is not None and len(counts) > 1:
         raise BenchUsageError("--threads: --startup takes one thread count")
