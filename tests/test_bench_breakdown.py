@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from whitted.bench.breakdown import KINDS, split_time, variants
@@ -27,6 +29,22 @@ def test_split_time_worked_numbers():
     out = split_time({"full": 1.0, "dark": 1.1, "primary": 0.4}, 0.0, rays)
     assert out["seconds"]["shadow"] == 0.0 and out["noise_s"] == pytest.approx(0.1)
     assert sum(out["seconds"].values()) - out["noise_s"] == pytest.approx(1.0)
+
+
+times = st.floats(min_value=0.0, max_value=1e4, allow_nan=False)
+counts = st.integers(min_value=0, max_value=10**12)
+
+
+@given(times, times, times, times, counts, counts)
+def test_split_time_always_adds_up(full, dark, primary, photon, reflection, refraction):
+    """Whatever the machine's noise does to the variants' times, the kinds are never negative
+    and add up to the render time plus the noise kept aside."""
+    rays = {"full": {"primary": 1, "shadow": 1, "reflection": reflection,
+                     "refraction": refraction}}
+    out = split_time({"full": full, "dark": dark, "primary": primary}, photon, rays)
+    seconds = out["seconds"]
+    assert all(v >= 0.0 for v in seconds.values()) and out["noise_s"] >= 0.0
+    assert sum(seconds.values()) - out["noise_s"] == pytest.approx(full, abs=1e-6)
 
 
 def test_variants_drop_direct_light_and_depth():
