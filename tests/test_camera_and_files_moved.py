@@ -84,7 +84,9 @@ def test_benchmark_scene_checks(tmp_path):
 
 def test_benchmarks_folder_outside_a_checkout(monkeypatch, tmp_path):
     from whitted.bench import scenes
+    from whitted.files import shipped
 
-    monkeypatch.setattr(scenes, "__file__", str(tmp_path / "x" / "scenes.py"))
+    # neither an installed package's nor a checkout's benchmarks/ above this source
+    monkeypatch.setattr(shipped, "__file__", str(tmp_path / "x" / "shipped.py"))
     monkeypatch.chdir(tmp_path)
     assert scenes.benchmarks_dir() == Path(tmp_path) / "benchmarks"

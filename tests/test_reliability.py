@@ -151,7 +151,7 @@ def _slow_compile(monkeypatch, signum: int, release: threading.Event) -> threadi
 
     ended = threading.Event()
 
-    def warm_up(compiled=None) -> float:
+    def warm_up(compiled=None, render_kernel=True) -> float:
         if compiled is None:
             os.kill(os.getpid(), signum)
             release.wait(30)
@@ -160,6 +160,7 @@ def _slow_compile(monkeypatch, signum: int, release: threading.Event) -> threadi
         return 0.0
 
     monkeypatch.setattr(api, "warm_up_kernels", warm_up)
+    monkeypatch.setattr(api, "kernels_cached", lambda *key: False)  # a first run
     return ended
 
 
@@ -185,12 +186,13 @@ def test_a3_a4_signal_during_the_first_compile_stops_at_once_and_writes_nothing(
 LONG_COMPILE = """
 import os, signal, sys, time
 from whitted.render import api
-def warm_up(compiled=None):
+def warm_up(compiled=None, render_kernel=True):
     if compiled is None:
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(120)  # a first compile that takes long and cannot be cut short
     return 0.0
 api.warm_up_kernels = warm_up
+api.kernels_cached = lambda *key: False  # a first run
 from whitted.cli.main import main
 sys.argv = ["whitted", "render", "scene.toml", "-o", "out.png"]
 main()

@@ -83,10 +83,14 @@ def test_warm_render_to_a_pipe_imports_no_rich(tmp_path):
     assert "rich" not in loaded
 
 
-def test_plain_line_is_what_rich_prints_and_needs_no_rich(tmp_path):
+def test_plain_line_is_what_rich_prints_and_needs_no_rich(tmp_path, monkeypatch):
     """cli/console.py writes a plain line to a file that is not a terminal itself: the same
     bytes rich writes for it (markup and emoji codes stay literal)."""
     import io
+
+    # as in a command's process (a Jupyter kernel started by another test imports ipykernel
+    # here, and in a kernel the answer is left to rich)
+    monkeypatch.delitem(sys.modules, "ipykernel", raising=False)
 
     from rich.console import Console
     from rich.text import Text
@@ -433,6 +437,8 @@ def test_terminal_check_without_rich_agrees_with_rich(monkeypatch):
     that is or is not a terminal."""
     import io
     import pty
+
+    monkeypatch.delitem(sys.modules, "ipykernel", raising=False)  # as in a command's process
 
     from rich.console import Console
 

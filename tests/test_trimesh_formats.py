@@ -146,7 +146,7 @@ def test_an_embedded_texture_that_cannot_be_stored_is_a_warning(tmp_path, monkey
     path.write_bytes(trimesh.Scene(box).export(file_type="glb"))
     blocker = tmp_path / "a file"
     blocker.write_text("")
-    monkeypatch.setattr(tf, "cache_dir", lambda: blocker / "kernels")  # textures/ under a file
+    monkeypatch.setattr(tf, "cache_root", lambda: blocker)  # textures/ under a file
     mesh = load_mesh(path)
     assert mesh.materials[0].texture is None
     assert mesh.warnings == [f"{path}: material 'red': its texture image cannot be stored "
