@@ -22,12 +22,14 @@ install: $(BIN)/whitted
 
 install-test: $(VENV)/.test-deps
 
-## Install, compile every kernel into the per-user cache (whitted warm), render the built-in
-## default scene to render.png, and say how to use the `whitted` command from here on (it lives
-## in $(VENV)/bin)
+## Install, render the built-in default scene to render.png (the picture first: it compiles
+## only the kernels it needs), then compile every other kernel variant into the per-user cache
+## (whitted warm), and say how to use the `whitted` command from here on (it lives in $(VENV)/bin)
 demo: install
-	$(BIN)/whitted warm
 	$(BIN)/whitted render -o render.png
+	@echo "render.png is ready; now compiling the other kernel variants (CSG, caustics, ...) once,"
+	@echo "so that no later command waits for them:"
+	$(BIN)/whitted warm
 	@echo "whitted is installed in $(VENV)/; to use the whitted command in this shell, type:"
 	@echo "    . $(VENV)/bin/activate"
 

@@ -16,6 +16,7 @@ from whitted import scene as S
 from whitted.export.pov import scene_to_pov
 from whitted.gui import catalog
 from whitted.gui.fields import NOT_SHAPE_FIELDS, object_specs
+from whitted.kernels.shapes import PIECES
 
 ROOT = Path(__file__).resolve().parents[1]
 KINDS = catalog.shape_kinds()
@@ -152,3 +153,51 @@ def test_the_renderer_sees_it_alone_and_in_csg(kind):
         if not _seen(cut):
             missing.append("CSG crossings (no pixel shows it inside a CSG intersection)")
     assert not missing, f"{kind}: " + "; ".join(missing)
+
+
+def _refused_by_csg(obj) -> bool:
+    try:
+        S.CSG(operation="union", objects=[obj])
+    except ValueError as exc:
+        assert "cannot take part in CSG" in str(exc)
+        return True
+    return False
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_its_kernel_pieces_are_named_and_exist(kind):
+    """kernels/shapes/ names the function of each piece of every kind (one named hop)."""
+    import importlib
+
+    pieces = PIECES.get(kind)
+    assert pieces is not None, f"{kind}: no entry in kernels/shapes/__init__.py PIECES"
+    missing = [p for p in ("rows", "hit", "crossings", "normal", "uv") if p not in pieces]
+    for piece, where in pieces.items():
+        if where is None:
+            if piece != "crossings" or not _refused_by_csg(sample(kind)):
+                missing.append(f"{piece} (none named)")
+            continue
+        module, _, name = where.partition(":")
+        if not hasattr(importlib.import_module(f"whitted.{module}"), name):
+            missing.append(f"{piece} ({where} does not exist)")
+    if pieces.get("crossings") is not None and kind != "csg" and _refused_by_csg(sample(kind)):
+        missing.append("crossings named for a kind CSG refuses")
+    assert not missing, f"{kind}: " + "; ".join(missing)
+
+
+def test_the_kernel_cache_key_covers_the_shapes_package(tmp_path):
+    """A change to a shape's file (in kernels/shapes/) compiles the kernels again."""
+    import shutil
+
+    from whitted.jit import cache
+
+    root = Path(cache.__file__).parents[1]
+    copy = tmp_path / "whitted"
+    for folder in (*cache.KERNEL_DIRS, "jit"):
+        shutil.copytree(root / folder, copy / folder,
+                        ignore=shutil.ignore_patterns("__pycache__"))
+    before = cache.kernel_source_hash(copy)
+    assert before == cache.kernel_source_hash(root)
+    torus = copy / "kernels" / "shapes" / "torus.py"
+    torus.write_text(torus.read_text() + "\n# changed\n")
+    assert cache.kernel_source_hash(copy) != before

@@ -150,9 +150,9 @@ def test_bad_radii_are_refused(field, value):
 
 
 def _assert_root_finders_agree(o, d, minor):
-    """The two root finders of kernels/torus.py give the same roots for the ray (o, d) at a
+    """The two root finders of kernels/shapes/torus.py give the same roots for the ray (o, d) at a
     torus of major radius 1 (where the fast one takes the ray)."""
-    from whitted.kernels.torus import _roots_by_cubic, _roots_by_curvature, torus_quartic
+    from whitted.kernels.shapes.torus import _roots_by_cubic, _roots_by_curvature, torus_quartic
 
     near, _, _, a, b, c, e, lo, hi, q0, q1 = torus_quartic(o, d, 1.0, minor)
     if not near:

@@ -63,8 +63,9 @@ import tempfile
 import threading
 from pathlib import Path
 
-#: the sources that decide the kernels' machine code: every file of these packages, and the
-#: two modules of this one that choose how kernels are compiled
+#: the sources that decide the kernels' machine code: every file of these packages (their
+#: subpackages too: kernels/shapes/), and the two modules of this one that choose how
+#: kernels are compiled
 KERNEL_DIRS = ("kernels", "compile", "assets")
 KERNEL_FILES = ("jit/decorators.py", "jit/dispatcher.py")
 #: the list of sums in the cache folder
@@ -80,10 +81,12 @@ HELPER_ENV = "WHITTED_KERNEL_CACHE_HELPER"
 LOCK_WAIT_SECONDS = 900.0  # a process holding the lock longer than this is not waited for
 
 
-def kernel_source_hash() -> str:
-    root = Path(__file__).parents[1]
+def kernel_source_hash(root: Path | None = None) -> str:
+    """A hash of the sources that decide the kernels' machine code, under ``root`` (whitted's
+    package folder unless given)."""
+    root = root if root is not None else Path(__file__).parents[1]
     h = hashlib.sha256()
-    paths = [path for folder in KERNEL_DIRS for path in sorted((root / folder).glob("*.py"))]
+    paths = [path for folder in KERNEL_DIRS for path in sorted((root / folder).rglob("*.py"))]
     for path in paths + [root / name for name in KERNEL_FILES]:
         h.update(path.relative_to(root).as_posix().encode())
         h.update(path.read_bytes())

@@ -47,11 +47,9 @@ from ..jit import kernel, numba_object
 from .hit_list import keep_nearest
 from .intersect import (
     INF,
-    box_span,
     frustum_crossings,
     intersect_triangle,
     normal_local,
-    sphere_span,
 )
 from .layout import (
     CSG_DIFFERENCE,
@@ -69,7 +67,9 @@ from .layout import (
     SHAPE_TORUS,
 )
 from .mesh import mesh_closest_hit
-from .torus import torus_crossings, torus_normal
+from .shapes.box import box_span
+from .shapes.sphere import sphere_span
+from .shapes.torus import torus_crossings, torus_normal
 from .traverse import inverse_direction, slab_entry
 from .vec import dot, madd
 from .xform import normal_to_world, to_object

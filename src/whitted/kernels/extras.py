@@ -14,7 +14,7 @@ from .csg import csg_hit
 from .features import extras_possible
 from .intersect import INF
 from .layout import PRIM_FLIP, PRIM_MEDIUM, PRIM_TYPE, SHAPE_CSG, SHAPE_TORUS
-from .torus import intersect_torus, torus_normal, torus_uv
+from .shapes.torus import intersect_torus, torus_normal, torus_uv
 from .traverse import inverse_direction
 
 

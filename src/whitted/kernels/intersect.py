@@ -1,4 +1,6 @@
-"""Exact ray/shape intersection and surface normals, one function per shape.
+"""Exact ray/shape intersection and surface normals, one function per shape (the sphere's,
+the box's and the torus's are in their own files under ``shapes/``), and the dispatch on the
+shape code.
 
 Every ``intersect_*`` takes the parameter table ``P`` and a row ``i`` (see :mod:`.layout`), a ray
 origin ``o`` and direction ``d`` (tuples; ``d`` need not be unit length) and the open interval
@@ -21,61 +23,15 @@ from .layout import (
     SHAPE_SPHERE,
     SHAPE_TRIANGLE,
 )
+from .shapes.box import box_normal, intersect_box
+from .shapes.quadric import nearest_root, quadratic_roots
+from .shapes.sphere import intersect_sphere
 from .vec import cross, dot, normalize, sub, vload
 
 INF = math.inf
 # Flat shapes accept hits a hair outside their edges (in parametric units): rays through a
 # shared edge of two rectangles or triangles never slip between them.
 EDGE_TOL = 1e-9
-
-
-@kernel
-def _roots(a, b, c):
-    """Both roots (t0 <= t1) of a·t² + 2b·t + c = 0, a != 0 (numerically stable form);
-    (inf, inf) when there are none."""
-    disc = b * b - a * c
-    if disc < 0.0:
-        return INF, INF
-    sq = math.sqrt(disc)
-    q = -(b + sq) if b >= 0.0 else -(b - sq)
-    if q == 0.0:
-        return -b / a, -b / a
-    t0 = q / a
-    t1 = c / q
-    return (t0, t1) if t0 <= t1 else (t1, t0)
-
-
-@kernel
-def _nearest_root(a, b, c, tmin, tmax):
-    """Nearest root in (tmin, tmax) of a·t² + 2b·t + c = 0."""
-    if a == 0.0:
-        if b == 0.0:
-            return INF
-        t = -c / (2.0 * b)
-        return t if tmin < t < tmax else INF
-    t0, t1 = _roots(a, b, c)
-    if tmin < t0 < tmax:
-        return t0
-    if tmin < t1 < tmax:
-        return t1
-    return INF
-
-
-@kernel
-def sphere_span(P, i, o, d):
-    """(enter, leave): where the ray's line crosses sphere row ``i`` ((inf, inf): nowhere)."""
-    c = vload(P, i, 0)
-    r = P[i, 3]
-    oc = sub(o, c)
-    return _roots(dot(d, d), dot(oc, d), dot(oc, oc) - r * r)
-
-
-@kernel
-def intersect_sphere(P, i, o, d, tmin, tmax):
-    c = vload(P, i, 0)
-    r = P[i, 3]
-    oc = sub(o, c)
-    return _nearest_root(dot(d, d), dot(oc, d), dot(oc, oc) - r * r, tmin, tmax)
 
 
 @kernel
@@ -156,51 +112,6 @@ def triangle_barycentric(P, i, p):
     return (d11 * d20 - d01 * d21) / denom, (d00 * d21 - d01 * d20) / denom
 
 
-@kernel
-def _box_local(P, i, x):
-    """Row-vector product M^-1 x with the inverse edge matrix stored row-major at 3:12."""
-    return (
-        P[i, 3] * x[0] + P[i, 4] * x[1] + P[i, 5] * x[2],
-        P[i, 6] * x[0] + P[i, 7] * x[1] + P[i, 8] * x[2],
-        P[i, 9] * x[0] + P[i, 10] * x[1] + P[i, 11] * x[2],
-    )
-
-
-@kernel
-def box_span(P, i, o, d):
-    """(enter, leave): where the ray's line crosses box row ``i`` ((inf, inf): nowhere)."""
-    lo = _box_local(P, i, sub(o, vload(P, i, 0)))
-    ld = _box_local(P, i, d)
-    t_near = -INF
-    t_far = INF
-    for k in range(3):
-        if ld[k] == 0.0:
-            if lo[k] < 0.0 or lo[k] > 1.0:
-                return INF, INF
-            continue
-        inv = 1.0 / ld[k]
-        t0 = -lo[k] * inv
-        t1 = (1.0 - lo[k]) * inv
-        if t0 > t1:
-            t0, t1 = t1, t0
-        t_near = max(t_near, t0)
-        t_far = min(t_far, t1)
-        if t_near > t_far:
-            return INF, INF
-    return t_near, t_far
-
-
-@kernel
-def intersect_box(P, i, o, d, tmin, tmax):
-    """Slab test in the box's own coordinates, where it is the unit cube [0, 1]^3."""
-    t_near, t_far = box_span(P, i, o, d)
-    if tmin < t_near < tmax:
-        return t_near
-    if tmin < t_far < tmax:
-        return t_far
-    return INF
-
-
 @kernel(inline="always")
 def _sorted4(a, b, c, d):
     """(a, b, c, d) in increasing order (five compare-exchanges)."""
@@ -255,7 +166,7 @@ def frustum_crossings(P, i, o, d):
         s0 = -c / (2.0 * b) if b != 0.0 else INF
         s1 = INF
     else:
-        s0, s1 = _roots(a, b, c)
+        s0, s1 = quadratic_roots(a, b, c)
     z = oz + s0 * dz
     if not (0.0 <= z <= h and r0 + k * z >= 0.0):
         s0 = INF
@@ -288,7 +199,7 @@ def intersect_frustum(P, i, o, d, tmin, tmax):
     # side: up to two roots, keep the nearest whose height lies on the body
     lo = tmin
     for _ in range(2):
-        t = _nearest_root(a, b, c, lo, tmax)
+        t = nearest_root(a, b, c, lo, tmax)
         if t == INF:
             break
         z = oz + t * dz
@@ -347,23 +258,7 @@ def normal_local(typ, P, i, p):
 def _solid_normal(typ, P, i, p):
     """:func:`normal_local` of a box or a frustum."""
     if typ == SHAPE_BOX:
-        lp = _box_local(P, i, sub(p, vload(P, i, 0)))
-        best_k = 0
-        best_side = -1.0
-        best_dist = INF
-        for k in range(3):
-            if abs(lp[k]) < best_dist:
-                best_dist = abs(lp[k])
-                best_k = k
-                best_side = -1.0
-            if abs(1.0 - lp[k]) < best_dist:
-                best_dist = abs(1.0 - lp[k])
-                best_k = k
-                best_side = 1.0
-        row = 3 + 3 * best_k
-        return normalize(
-            (best_side * P[i, row], best_side * P[i, row + 1], best_side * P[i, row + 2])
-        )
+        return box_normal(P, i, p)
     if typ == SHAPE_FRUSTUM:
         base = vload(P, i, 0)
         axis = vload(P, i, 3)

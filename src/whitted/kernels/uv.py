@@ -20,7 +20,7 @@ from ..jit import kernel, overload
 from .accel import to_object
 from .extras import extra_uv_if_extras
 from .features import has_extras, instances_possible
-from .intersect import _box_local, triangle_barycentric
+from .intersect import triangle_barycentric
 from .layout import (
     DISK_TANGENT,
     FIRST_EXTRA_SHAPE,
@@ -36,24 +36,14 @@ from .layout import (
     SHAPE_RECTANGLE,
     SHAPE_SPHERE,
     SHAPE_TRIANGLE,
-    SPHERE_FRAME,
     TRIANGLE_UV,
 )
 from .mesh import mesh_uv
+from .shapes.box import box_uv
+from .shapes.sphere import sphere_uv
 from .vec import cross, dot, sub, vload
 
 INV_TWO_PI = 0.5 / math.pi
-
-
-@kernel
-def _sphere_uv(P, i, p):
-    r = P[i, 3]
-    q = sub(p, vload(P, i, 0))
-    x = dot(q, vload(P, i, SPHERE_FRAME)) / r
-    y = dot(q, vload(P, i, SPHERE_FRAME + 3)) / r
-    z = dot(q, vload(P, i, SPHERE_FRAME + 6)) / r
-    y = min(1.0, max(-1.0, y))
-    return 0.5 + math.atan2(x, z) * INV_TWO_PI, 0.5 + math.asin(y) / math.pi
 
 
 @kernel
@@ -65,23 +55,6 @@ def _triangle_uv(P, i, p):
         b0 * P[i, c] + b1 * P[i, c + 2] + b2 * P[i, c + 4],
         b0 * P[i, c + 1] + b1 * P[i, c + 3] + b2 * P[i, c + 5],
     )
-
-
-@kernel
-def _box_uv(P, i, p):
-    lp = _box_local(P, i, sub(p, vload(P, i, 0)))
-    best_k = 0
-    best_dist = math.inf
-    for k in range(3):
-        gap = min(abs(lp[k]), abs(1.0 - lp[k]))
-        if gap < best_dist:
-            best_dist = gap
-            best_k = k
-    if best_k == 0:  # faces across x: u along z, v along y
-        return lp[2], lp[1]
-    if best_k == 1:  # faces across y: u along x, v along z
-        return lp[0], lp[2]
-    return lp[0], lp[1]
 
 
 @kernel
@@ -119,7 +92,7 @@ def surface_uv(geo, prim, tri, b1, b2, p):
         p, _ = to_object(geo.xforms, xf, p, p)
     P = geo.prim_params
     if typ == SHAPE_SPHERE:
-        return _sphere_uv(P, prim, p)
+        return sphere_uv(P, prim, p)
     if typ == SHAPE_RECTANGLE:
         q = sub(p, vload(P, prim, 0))
         return dot(q, vload(P, prim, 12)), dot(q, vload(P, prim, 15))
@@ -135,9 +108,9 @@ def surface_uv(geo, prim, tri, b1, b2, p):
     if typ == SHAPE_TRIANGLE:
         return _triangle_uv(P, prim, p)
     if typ == SHAPE_BOX:
-        return _box_uv(P, prim, p)
+        return box_uv(P, prim, p)
     if typ == SHAPE_FRUSTUM:
         return _frustum_uv(P, prim, p)
-    if has_extras(geo) and typ >= FIRST_EXTRA_SHAPE:  # the torus (kernels/torus.py)
+    if has_extras(geo) and typ >= FIRST_EXTRA_SHAPE:  # the torus (kernels/shapes/torus.py)
         return extra_uv_if_extras(geo, prim, p)
     return 0.0, 0.0

@@ -34,8 +34,8 @@ from __future__ import annotations
 
 import math
 
-from ..jit import kernel
-from .vec import dot, normalize, sub, vload
+from ...jit import kernel
+from ..vec import dot, normalize, sub, vload
 
 INF = math.inf
 NEWTON_STEPS = 60  # at most, per root (monotone convergence: five or six in practice)
