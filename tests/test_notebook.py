@@ -21,6 +21,15 @@ from whitted.errors import OutputError, SceneError  # noqa: E402
 from whitted.notebook import detect, live  # noqa: E402
 
 
+@pytest.fixture(autouse=True)
+def kernel_interrupt():
+    """Ctrl-C as a Jupyter kernel has it (Python's own handler: KeyboardInterrupt in the main
+    thread), whatever handler an earlier test of the whitted program left installed."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
 @pytest.fixture
 def shown(monkeypatch):
     """What the code under test displayed."""
