@@ -73,7 +73,7 @@ def bench_main(
     *, scenes: list[str] | None, runs: int, threads: str | None, quick: bool,
     compare: str | None, study: str | None, json_path: Path | None, plot_path: Path | None,
     markdown_path: Path | None, size: str | None, in_process: bool,
-    out: Console, err: Console,
+    out: Console, err: Console, rays: bool = False,
 ) -> None:
     if compare not in (None, "povray", "embree"):
         raise BenchUsageError(f"--compare: unknown renderer {compare!r} (known: povray, embree)")
@@ -93,7 +93,9 @@ def bench_main(
                                   "pip install 'whitted[plots]'")
     options = BenchOptions(scenes=scenes or None, runs=runs, threads=parse_threads(threads),
                            quick=quick, compare=compare, in_process=in_process,
-                           size=parse_size(size))
+                           size=parse_size(size), rays=rays)
+    if rays and study:
+        raise BenchUsageError("--rays: not with --study (it times the scenes themselves)")
 
     def log(line: str) -> None:
         err.print(f"[dim]{line}[/]", highlight=False)
@@ -115,13 +117,11 @@ def bench_main(
     if not result.rows:
         raise BenchUsageError("no scene could be rendered")
     title = f"whitted bench{' --study ' + study if study else ''}"
-    table = rich_table(result.rows, title=title)
-    # wide enough for every column, also when the output is a file or a pipe
-    needed = Console(width=1000).measure(table).maximum
-    if needed > out.width and not out.is_terminal:
-        Console(file=out.file, width=needed, highlight=False).print(table)
-    else:
-        out.print(table)
+    _print_wide(out, rich_table(result.rows, title=title))
+    if rays:
+        from .breakdown import breakdown_table
+
+        _print_wide(out, breakdown_table(result.rows))
     if json_path is not None:
         write_json(result.rows, json_path)
         out.print(f"wrote {json_path}")
@@ -137,6 +137,15 @@ def bench_main(
 
         markdown_path.write_text(markdown_table(result.rows) + "\n", encoding="utf-8")
         out.print(f"wrote {markdown_path}")
+
+
+def _print_wide(out: Console, table) -> None:
+    """A table wide enough for every column, also when the output is a file or a pipe."""
+    needed = Console(width=1000).measure(table).maximum
+    if needed > out.width and not out.is_terminal:
+        Console(file=out.file, width=needed, highlight=False).print(table)
+    else:
+        out.print(table)
 
 
 def _say_compile_time(options: BenchOptions, err: Console) -> None:

@@ -59,13 +59,14 @@ class BenchOptions:
     in_process: bool = False
     size: tuple[int, int] | None = None  # override every scene's image size
     warmup: bool = True
+    rays: bool = False  # also the render time by kind of ray (bench/breakdown.py)
 
     def effective(self) -> BenchOptions:
         if not self.quick:
             return self
         return BenchOptions(scenes=self.scenes, runs=1, threads=self.threads or [1],
                             quick=True, compare=self.compare, in_process=True,
-                            size=self.size, warmup=self.warmup)
+                            size=self.size, warmup=self.warmup, rays=self.rays)
 
 
 @dataclass
@@ -115,6 +116,13 @@ def run_bench(options: BenchOptions, log: Callable[[str], None] = print) -> Benc
                     result.skipped.append((spec.name, f"its meshes do not render: {exc}"))
                     log(f"  skipped {spec.name}: {exc}")
                     break
+                if options.rays:
+                    from .breakdown import time_by_kind
+
+                    measure = _in_process_run if options.in_process else _process_run
+                    log(f"{spec.name}: time by kind of ray, {threads} thread(s)")
+                    row["time_by_kind"] = time_by_kind(scene, threads, options.runs, folder,
+                                                       measure)
                 result.rows.append(row)
         if options.compare == "embree" and spec.meshes and result.rows \
                 and result.rows[-1]["scene"] == spec.name:
@@ -199,6 +207,7 @@ def _in_process_run(scene: Scene, threads: int, folder: Path) -> dict[str, Any]:
     return {
         "rays": dict(s.rays), "compile_s": s.compile_seconds, "build_s": s.build_seconds,
         "render_s": s.render_seconds, "wall_s": wall,
+        "photon_s": s.photons.seconds if s.photons is not None else 0.0,
         "startup_s": max(0.0, wall - s.compile_seconds - s.build_seconds - s.render_seconds),
         "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
     }
@@ -219,6 +228,7 @@ def _process_run(scene: Scene, threads: int, folder: Path) -> dict[str, Any]:
     return {
         "rays": stats["rays"], "compile_s": stats["compile_s"], "build_s": stats["build_s"],
         "render_s": stats["render_s"], "wall_s": run.wall_s,
+        "photon_s": stats.get("photon_s", 0.0),
         "startup_s": max(0.0, run.wall_s - work), "peak_mib": run.peak_mib,
     }
 

@@ -38,6 +38,7 @@ def main(argv: list[str] | None = None) -> None:
         "rays": stats.rays, "load_s": loaded - start, "compile_s": stats.compile_seconds,
         "build_s": stats.build_seconds, "render_s": stats.render_seconds,
         "job_s": rendered - loaded, "output_s": written - rendered,
+        "photon_s": stats.photons.seconds if stats.photons is not None else 0.0,
     }))
 
 

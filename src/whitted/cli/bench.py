@@ -38,6 +38,10 @@ def bench(
     in_process: Annotated[
         bool, typer.Option("--in-process", help="Render in this process, not a fresh one")
     ] = False,
+    rays: Annotated[bool, typer.Option(
+        "--rays", help="Also the render time by kind of ray (primary, shadow, reflection, "
+                       "refraction, photon), from variants of each scene timed alternately")
+    ] = False,
     startup: Annotated[bool, typer.Option(
         "--startup", help="Where a whole `whitted render` process spends its time, for "
                           "--scene (a benchmark or a scene file; default seed000)")] = False,
@@ -73,7 +77,7 @@ def bench(
     try:
         bench_main(scenes=scene, runs=runs, threads=threads, quick=quick, compare=compare,
                    study=study, json_path=json_path, plot_path=plot, markdown_path=markdown,
-                   size=size, in_process=in_process, out=out, err=err)
+                   size=size, in_process=in_process, out=out, err=err, rays=rays)
     except WhittedError as exc:
         raise fail(str(exc)) from None
 
