@@ -35,7 +35,7 @@ demo: install
 
 ## Install the test dependencies, lint, then run the whole test suite
 test: install-test
-	$(BIN)/ruff check src tests
+	$(BIN)/ruff check .
 	$(BIN)/python -m pytest -q
 
 ## The render smoke tests again with the oldest Numba pyproject.toml allows (stock Numba:
@@ -97,7 +97,7 @@ bench: install
 	$(BIN)/whitted bench
 
 lint: install-test
-	$(BIN)/ruff check src tests
+	$(BIN)/ruff check .
 
 clean:
 	rm -rf $(VENV) $(OLDEST_VENV) $(WHEEL_VENV) .cache .cache-oldest-numba build dist *.egg-info \

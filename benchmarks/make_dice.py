@@ -6,7 +6,6 @@ each die is a rounded cube (the intersection of a cube and a ball) minus 21 pips
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
