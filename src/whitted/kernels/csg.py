@@ -45,12 +45,7 @@ import numpy as np
 
 from ..jit import kernel, numba_object
 from .hit_list import keep_nearest
-from .intersect import (
-    INF,
-    frustum_crossings,
-    intersect_triangle,
-    normal_local,
-)
+from .intersect import INF, frustum_crossings, normal_local
 from .layout import (
     CSG_DIFFERENCE,
     CSG_INTERSECTION,
@@ -70,6 +65,7 @@ from .mesh import mesh_closest_hit
 from .shapes.box import box_span
 from .shapes.sphere import sphere_span
 from .shapes.torus import torus_crossings, torus_normal
+from .shapes.triangle import intersect_triangle
 from .traverse import inverse_direction, slab_entry
 from .vec import dot, madd
 from .xform import normal_to_world, to_object

@@ -24,14 +24,13 @@ from .layout import (
     SHAPE_TRIANGLE,
 )
 from .shapes.box import box_normal, intersect_box
+from .shapes.flat import EDGE_TOL
 from .shapes.quadric import nearest_root, quadratic_roots
 from .shapes.sphere import intersect_sphere
-from .vec import cross, dot, normalize, sub, vload
+from .shapes.triangle import intersect_triangle
+from .vec import dot, normalize, sub, vload
 
 INF = math.inf
-# Flat shapes accept hits a hair outside their edges (in parametric units): rays through a
-# shared edge of two rectangles or triangles never slip between them.
-EDGE_TOL = 1e-9
 
 
 @kernel
@@ -73,43 +72,6 @@ def intersect_disk(P, i, o, d, tmin, tmax):
     q = (o[0] + t * d[0] - c[0], o[1] + t * d[1] - c[1], o[2] + t * d[2] - c[2])
     r = P[i, 6]
     return t if dot(q, q) <= r * r * (1.0 + EDGE_TOL) else INF
-
-
-@kernel
-def intersect_triangle(P, i, o, d, tmin, tmax):
-    """Möller–Trumbore with the edges precomputed."""
-    e1 = vload(P, i, 3)
-    e2 = vload(P, i, 6)
-    pv = cross(d, e2)
-    det = dot(e1, pv)
-    if det == 0.0:
-        return INF
-    inv = 1.0 / det
-    tv = sub(o, vload(P, i, 0))
-    u = dot(tv, pv) * inv
-    if u < -EDGE_TOL or u > 1.0 + EDGE_TOL:
-        return INF
-    qv = cross(tv, e1)
-    v = dot(d, qv) * inv
-    if v < -EDGE_TOL or u + v > 1.0 + EDGE_TOL:
-        return INF
-    t = dot(e2, qv) * inv
-    return t if tmin < t < tmax else INF
-
-
-@kernel
-def triangle_barycentric(P, i, p):
-    """(b1, b2) of point ``p`` on triangle primitive ``i``: p = v0 + b1·edge1 + b2·edge2."""
-    q = sub(p, vload(P, i, 0))
-    e1 = vload(P, i, 3)
-    e2 = vload(P, i, 6)
-    d00 = dot(e1, e1)
-    d01 = dot(e1, e2)
-    d11 = dot(e2, e2)
-    d20 = dot(q, e1)
-    d21 = dot(q, e2)
-    denom = d00 * d11 - d01 * d01
-    return (d11 * d20 - d01 * d21) / denom, (d00 * d21 - d01 * d20) / denom
 
 
 @kernel(inline="always")

@@ -20,7 +20,6 @@ from ..jit import kernel, overload
 from .accel import to_object
 from .extras import extra_uv_if_extras
 from .features import has_extras, instances_possible
-from .intersect import triangle_barycentric
 from .layout import (
     DISK_TANGENT,
     FIRST_EXTRA_SHAPE,
@@ -36,25 +35,14 @@ from .layout import (
     SHAPE_RECTANGLE,
     SHAPE_SPHERE,
     SHAPE_TRIANGLE,
-    TRIANGLE_UV,
 )
-from .mesh import mesh_uv
 from .shapes.box import box_uv
+from .shapes.mesh import mesh_uv
 from .shapes.sphere import sphere_uv
+from .shapes.triangle import triangle_uv
 from .vec import cross, dot, sub, vload
 
 INV_TWO_PI = 0.5 / math.pi
-
-
-@kernel
-def _triangle_uv(P, i, p):
-    b1, b2 = triangle_barycentric(P, i, p)
-    b0 = 1.0 - b1 - b2
-    c = TRIANGLE_UV
-    return (
-        b0 * P[i, c] + b1 * P[i, c + 2] + b2 * P[i, c + 4],
-        b0 * P[i, c + 1] + b1 * P[i, c + 3] + b2 * P[i, c + 5],
-    )
 
 
 @kernel
@@ -106,7 +94,7 @@ def surface_uv(geo, prim, tri, b1, b2, p):
         s = 0.5 / P[prim, 6]
         return 0.5 + dot(q, t) * s, 0.5 + dot(q, cross(vload(P, prim, 3), t)) * s
     if typ == SHAPE_TRIANGLE:
-        return _triangle_uv(P, prim, p)
+        return triangle_uv(P, prim, p)
     if typ == SHAPE_BOX:
         return box_uv(P, prim, p)
     if typ == SHAPE_FRUSTUM:

@@ -55,9 +55,9 @@ PIECES: dict[str, dict[str, str | None]] = {
         "uv": "kernels.uv:surface_uv",
     },
     "triangle": {
-        "rows": "compile.shapes:add_shape", "hit": "kernels.intersect:intersect_triangle",
+        "rows": "compile.shapes:add_shape", "hit": "kernels.shapes.triangle:intersect_triangle",
         "crossings": None, "normal": "kernels.intersect:normal_local",
-        "uv": "kernels.uv:_triangle_uv",
+        "uv": "kernels.shapes.triangle:triangle_uv",
     },
     "box": {
         "rows": "compile.shapes:add_shape", "hit": "kernels.shapes.box:intersect_box",
@@ -80,9 +80,10 @@ PIECES: dict[str, dict[str, str | None]] = {
         "normal": "kernels.shapes.torus:torus_normal", "uv": "kernels.shapes.torus:torus_uv",
     },
     "mesh": {  # flattened triangles (small meshes) or instances of a stored mesh (big ones)
-        "rows": "compile.mesh_objects:add_flat_mesh", "hit": "kernels.mesh:mesh_closest_hit",
-        "crossings": "kernels.csg:mesh_leaf_t", "normal": "kernels.mesh:mesh_normals",
-        "uv": "kernels.uv:surface_uv",
+        "rows": "compile.mesh_objects:add_flat_mesh",
+        "hit": "kernels.shapes.mesh:intersect_mesh_triangle",
+        "crossings": "kernels.csg:mesh_leaf_t", "normal": "kernels.shapes.mesh:mesh_normals",
+        "uv": "kernels.shapes.mesh:mesh_uv",
     },
     "csg": {  # its leaves are the solids above; the object walks them
         "rows": "compile.csg:add_csg", "hit": "kernels.csg:csg_hit",
