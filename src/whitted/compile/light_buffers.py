@@ -14,6 +14,7 @@ import numpy as np
 
 from ..jit import kernel
 from ..kernels.layout import (
+    BVH_STACK,
     CELL_COUNT,
     CELL_FIRST,
     CELL_OPAQUE,
@@ -39,6 +40,7 @@ from ..kernels.light_buffer import (
 )
 from ..kernels.lighting import list_cone_leaves
 from ..kernels.mesh import OPAQUE_KT
+from .wide_bvh import wide_bounds
 
 CONE_SLACK = 1e-6  # relative widening of each cell's cone (rounding of the ray directions)
 CELLS_PER_PRIMITIVE = 256  # cells per light for each primitive, at most: finer cells would
@@ -115,7 +117,7 @@ def _reach(geo: GeometryArrays, light: np.ndarray) -> float:
     """Distance from ``light`` to the farthest corner of the scene BVH's root box, widened."""
     if geo.node_box.shape[0] == 0:
         return 1.0
-    lo, hi = geo.node_box[0]
+    lo, hi = wide_bounds(geo.node_box, geo.node_link)
     far = np.maximum(np.abs(lo - light), np.abs(hi - light))
     return float(np.linalg.norm(far)) * (1.0 + 1e-6) + 1e-9
 
@@ -163,7 +165,7 @@ def build_light_buffers(geo: GeometryArrays, materials: np.ndarray, table: np.nd
         position, reach, first, last, row = part
         block = slice(row, row + n_cells)  # the light's own rows: cells count from 0 in it
         list_cell_occluders(geo, materials, position, reach, res, lists[block], counts[block],
-                            opaque[block], np.empty(128, np.int32), first, last)
+                            opaque[block], np.empty(BVH_STACK, np.int32), first, last)
 
     if threads > 1 and len(work) > 1:
         from concurrent.futures import ThreadPoolExecutor

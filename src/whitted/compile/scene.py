@@ -43,6 +43,7 @@ from .primitives import PrimitiveRows
 from .reuse import cached_build_bvh
 from .shapes import add_shape
 from .textures import compile_textures
+from .wide_bvh import wide_nodes
 
 
 @dataclass
@@ -197,7 +198,7 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
     prim_info[:, PRIM_OBJECT] = prim_object
     prim_info[:, PRIM_FLIP] = prim_flip
     prim_info[:, PRIM_MEDIUM] = prim_medium
-    node_box, node_link = packed_nodes(bvh, np.float64)
+    node_box, node_link = wide_nodes(bvh)
     # float32 marks a scene without instances: kernels specialised for it (features.py)
     inst_box, inst_link = packed_nodes(
         inst_bvh, np.float64 if len(instances) else NO_INSTANCES_DTYPE)

@@ -9,11 +9,11 @@ import math
 from ..jit import kernel, overload
 from .accel import (
     closest_hit,
+    geometric_normal,
     hit_analytic,
     hit_material,
     instance_occludes,
     occludes,
-    surface_normals,
 )
 from .csg import csg_surfaces
 from .extras import body_medium
@@ -55,6 +55,7 @@ from .layout import (
     SHAPE_CSG,
     SHAPE_PLANE,
     SHAPE_TRIANGLE,
+    WIDE,
 )
 from .light_buffer import cube_cell
 from .media import absorbed, media_enter, media_leave
@@ -193,31 +194,32 @@ def list_cone_leaves(geo, mats, apex, axis, radius, stack, out, n, cap, opaque):
     cone from ``apex`` to the ball of ``radius`` around ``apex + axis`` (see
     :func:`cone_meets_box`). ``opaque`` says whether those already listed are all opaque.
     Returns (the new count, whether all listed are opaque); the count is -1 when they would
-    be more than ``cap``."""
+    be more than ``cap``. (The leaves come in the order of the wide nodes' lanes.)"""
     if geo.node_box.shape[0] == 0:
         return n, opaque
+    box = geo.node_box
+    link = geo.node_link
     top = 0
     stack[0] = 0
     while top >= 0:
-        node = stack[top]
+        w = stack[top]
         top -= 1
-        if not cone_meets_box(geo.node_box, node, apex, axis, radius):
-            continue
-        count = geo.node_link[node, 1]
-        if count == 0:
-            top += 1
-            stack[top] = node + 1
-            top += 1
-            stack[top] = geo.node_link[node, 0]
-            continue
-        if n + count > cap:
-            return -1, False
-        first = geo.node_link[node, 0]
-        for leaf in range(first, first + count):
-            i = geo.node_prims[leaf]
-            out[n] = i
-            n += 1
-            opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
+        for c in range(WIDE):
+            count = link[w, 1, c]
+            if count < 0 or not cone_meets_box(box, w, c, apex, axis, radius):
+                continue
+            if count == 0:
+                top += 1
+                stack[top] = link[w, 0, c]
+                continue
+            if n + count > cap:
+                return -1, False
+            first = link[w, 0, c]
+            for leaf in range(first, first + count):
+                i = geo.node_prims[leaf]
+                out[n] = i
+                n += 1
+                opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
     return n, opaque
 
 
@@ -306,7 +308,7 @@ def _pass_surface(geo, mats, prim, tri, b1, b2, o, d, t, scratch, count, trans):
     kt = mats[m, MAT_KT]
     entering = True
     if geo.prim_info[prim, PRIM_SOLID]:
-        n, _ = surface_normals(geo, prim, tri, b1, b2, madd(o, d, t))
+        n = geometric_normal(geo, prim, tri, b1, b2, madd(o, d, t))
         entering = dot(d, n) < 0.0
         body = body_medium(geo, prim, m)  # a CSG object is one body (extras.py)
         if entering:
