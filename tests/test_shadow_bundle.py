@@ -128,15 +128,6 @@ def test_planes_the_light_and_the_point_are_clear_of_are_left_out():
 coords = st.floats(-3.0, 3.0, allow_nan=False)
 
 
-def _lane_box(lo, hi):
-    """One box as lane 0 of wide node 0 (the scene BVH's layout: rows lo x, y, z, hi x, y,
-    z)."""
-    box = np.zeros((1, 6, 1))
-    box[0, 0:3, 0] = lo
-    box[0, 3:6, 0] = hi
-    return box
-
-
 @settings(max_examples=300, deadline=None)
 @given(p=st.tuples(coords, coords, coords), axis=st.tuples(coords, coords, coords),
        radius=st.floats(0.0, 2.0), lo=st.tuples(coords, coords, coords),
@@ -149,17 +140,17 @@ def test_cone_box_test_never_misses_a_box_the_cone_enters(p, axis, radius, lo, s
     if norm > 1.0:
         u = tuple(c / norm for c in u)
     x = tuple(p[k] + t * (axis[k] + radius * u[k]) for k in range(3))
-    box = _lane_box(lo, tuple(lo[k] + size[k] for k in range(3)))
-    inside = all(box[0, k, 0] <= x[k] <= box[0, 3 + k, 0] for k in range(3))
+    box = np.array([[lo, tuple(lo[k] + size[k] for k in range(3))]])
+    inside = all(box[0, 0, k] <= x[k] <= box[0, 1, k] for k in range(3))
     if inside:
-        assert cone_meets_box(box, 0, 0, p, axis, radius)
+        assert cone_meets_box(box, 0, p, axis, radius)
 
 
 def test_cone_box_test_rejects_boxes_off_the_cone():
-    box = _lane_box((4.0, 8.0, -1.0), (5.0, 10.0, 1.0))
+    box = np.array([[(4.0, 8.0, -1.0), (5.0, 10.0, 1.0)]])
     # a thin cone along +y from the origin passes far from a box at x = 4..5, y = 8..10
-    assert not cone_meets_box(box, 0, 0, (0.0, 0.0, 0.0), (0.0, 10.0, 0.0), 1.0)
+    assert not cone_meets_box(box, 0, (0.0, 0.0, 0.0), (0.0, 10.0, 0.0), 1.0)
     # widened to radius 5 at its base (4.5 at y = 9), it reaches it
-    assert cone_meets_box(box, 0, 0, (0.0, 0.0, 0.0), (0.0, 10.0, 0.0), 5.0)
+    assert cone_meets_box(box, 0, (0.0, 0.0, 0.0), (0.0, 10.0, 0.0), 5.0)
     # behind the apex there is nothing
-    assert not cone_meets_box(box, 0, 0, (6.0, 0.0, 0.0), (10.0, 0.0, 0.0), 1.0)
+    assert not cone_meets_box(box, 0, (6.0, 0.0, 0.0), (10.0, 0.0, 0.0), 1.0)

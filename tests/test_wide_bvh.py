@@ -13,32 +13,38 @@ from hypothesis import strategies as st
 import whitted
 from whitted.compile.bvh import MAX_DEPTH, build_bvh
 from whitted.compile.scene import compile_scene
-from whitted.compile.wide_bvh import wide_bounds, wide_nodes
+from whitted.compile.wide_bvh import wide_nodes
 from whitted.kernels.accel import closest_hit, hit_analytic
 from whitted.kernels.intersect import INF
-from whitted.kernels.layout import BVH_STACK, MESH_STACK_BASE, WIDE
+from whitted.kernels.layout import (
+    BVH_STACK,
+    MESH_STACK_BASE,
+    WIDE,
+    WIDE_COUNT,
+    WIDE_LINK,
+    WIDE_ROWS,
+)
 from whitted.kernels.lighting import any_occluder
 
 
-def _walk(box, link):
+def _walk(wide):
     """(leaves as (first, count), the deepest stack a walk that pushes every child needs)."""
     leaves = []
     deepest = 0
     todo = [(0, 1)]  # (wide node, stack entries in use when it is popped)
     while todo:
         w, used = todo.pop()
-        children = int(np.sum(link[w, 1] >= 0))
+        children = int(np.sum(wide[w, WIDE_COUNT] >= 0))
         deepest = max(deepest, used - 1 + children)
         for c in range(WIDE):
-            count = link[w, 1, c]
+            count = wide[w, WIDE_COUNT, c]
             if count < 0:
                 continue
-            # every box holds the float32 box it was rounded from
-            assert np.all(box[w, 0:3, c] <= box[w, 3:6, c])
+            assert np.all(wide[w, 0:3, c] <= wide[w, 3:6, c])
             if count == 0:
-                todo.append((int(link[w, 0, c]), used - 1 + children))
+                todo.append((int(wide[w, WIDE_LINK, c]), used - 1 + children))
             else:
-                leaves.append((int(link[w, 0, c]), int(count)))
+                leaves.append((int(wide[w, WIDE_LINK, c]), int(count)))
     return leaves, deepest
 
 
@@ -52,10 +58,9 @@ def test_every_leaf_once_and_boxes_hold_their_primitives(n, seed, flat):
         size[:, 1] = 0.0  # rectangles in planes: flat boxes
     hi = lo + size
     bvh = build_bvh(lo, hi)
-    box, link = wide_nodes(bvh)
-    assert box.dtype == np.float32 and box.shape[1:] == (6, WIDE)
-    assert link.dtype == np.int32 and link.shape[1:] == (2, WIDE)
-    leaves, deepest = _walk(box, link)
+    wide = wide_nodes(bvh)
+    assert wide.dtype == np.float32 and wide.shape[1:] == (WIDE_ROWS, WIDE)
+    leaves, deepest = _walk(wide)
     binary = [(int(o), int(c)) for o, c in zip(bvh.node_offset, bvh.node_count, strict=True)
               if c > 0]
     assert sorted(leaves) == sorted(binary)
@@ -63,29 +68,31 @@ def test_every_leaf_once_and_boxes_hold_their_primitives(n, seed, flat):
     assert deepest <= MESH_STACK_BASE and (WIDE - 1) * MAX_DEPTH + 1 <= MESH_STACK_BASE
     assert MESH_STACK_BASE + MAX_DEPTH + 1 <= BVH_STACK
     # a leaf's float32 box holds each of its primitives' float64 boxes
-    for w in range(len(box)):
+    for w in range(len(wide)):
         for c in range(WIDE):
-            count = link[w, 1, c]
+            count = int(wide[w, WIDE_COUNT, c])
             if count <= 0:
                 continue
-            prims = bvh.prim_order[link[w, 0, c]:link[w, 0, c] + count]
-            assert np.all(box[w, 0:3, c].astype(np.float64) <= lo[prims])
-            assert np.all(box[w, 3:6, c].astype(np.float64) >= hi[prims])
-    root_lo, root_hi = wide_bounds(box, link)
-    assert np.all(root_lo <= lo.min(axis=0)) and np.all(root_hi >= hi.max(axis=0))
-    np.testing.assert_allclose(root_lo, lo.min(axis=0), rtol=1e-6, atol=1e-6)
+            first = int(wide[w, WIDE_LINK, c])
+            prims = bvh.prim_order[first:first + count]
+            assert np.all(wide[w, 0:3, c].astype(np.float64) <= lo[prims])
+            assert np.all(wide[w, 3:6, c].astype(np.float64) >= hi[prims])
+    # the root's children together hold everything, and no more than float32 rounding adds
+    used = wide[0][:, wide[0, WIDE_COUNT] >= 0]
+    np.testing.assert_allclose(used[0:3].min(axis=1), lo.min(axis=0), rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(used[3:6].max(axis=1), hi.max(axis=0), rtol=1e-6, atol=1e-6)
 
 
 def test_no_primitives_no_nodes():
-    box, link = wide_nodes(build_bvh(np.zeros((0, 3)), np.zeros((0, 3))))
-    assert box.shape == (0, 6, WIDE) and link.shape == (0, 2, WIDE)
+    wide = wide_nodes(build_bvh(np.zeros((0, 3)), np.zeros((0, 3))))
+    assert wide.shape == (0, WIDE_ROWS, WIDE)
 
 
 def test_a_lone_leaf_is_one_node_of_one_child():
-    box, link = wide_nodes(build_bvh(np.zeros((1, 3)), np.ones((1, 3))))
-    assert box.shape[0] == 1
-    assert link[0, 1].tolist() == [1, -1, -1, -1, -1, -1, -1, -1]
-    assert box[0, 0:3, 0].tolist() == [0.0, 0.0, 0.0] and box[0, 3:6, 0].tolist() == [1, 1, 1]
+    wide = wide_nodes(build_bvh(np.zeros((1, 3)), np.ones((1, 3))))
+    assert wide.shape[0] == 1
+    assert wide[0, WIDE_COUNT].tolist() == [1, -1, -1, -1, -1, -1, -1, -1]
+    assert wide[0, 0:3, 0].tolist() == [0, 0, 0] and wide[0, 3:6, 0].tolist() == [1, 1, 1]
 
 
 def _spheres(n, seed, kt):
@@ -100,8 +107,8 @@ def _spheres(n, seed, kt):
 @settings(max_examples=15, deadline=None)
 @given(seed=st.integers(0, 2**31 - 1))
 def test_walks_find_what_brute_force_finds(seed):
-    """closest_hit (the ordered wide walk) gives the nearest hit of all primitives tested one
-    by one, and any_occluder (the unordered one) says whether any lies on the segment."""
+    """any_occluder (the any-hit walk of the wide nodes) says whether anything lies on the
+    segment, as testing every primitive does; closest_hit (the binary nodes) agrees."""
     compiled = _spheres(120, seed, 0.0)
     geo = compiled.geometry
     stack = np.empty(BVH_STACK, np.int32)

@@ -110,7 +110,7 @@ def info(
         out.print(f"bounds: ({lo}) .. ({hi}) (infinite planes: {len(compiled.geometry.unbounded)})")
     else:
         out.print("bounds: no bounded objects")
-    out.print(f"bvh: {len(compiled.geometry.node_link)} eight-wide nodes over "
+    out.print(f"bvh: {len(compiled.geometry.node_link)} nodes over "
               f"{len(compiled.geometry.node_prims)} primitives")
     if compiled.triangles:
         geo = compiled.geometry

@@ -40,7 +40,6 @@ from ..kernels.light_buffer import (
 )
 from ..kernels.lighting import list_cone_leaves
 from ..kernels.mesh import OPAQUE_KT
-from .wide_bvh import wide_bounds
 
 CONE_SLACK = 1e-6  # relative widening of each cell's cone (rounding of the ray directions)
 CELLS_PER_PRIMITIVE = 256  # cells per light for each primitive, at most: finer cells would
@@ -117,7 +116,7 @@ def _reach(geo: GeometryArrays, light: np.ndarray) -> float:
     """Distance from ``light`` to the farthest corner of the scene BVH's root box, widened."""
     if geo.node_box.shape[0] == 0:
         return 1.0
-    lo, hi = wide_bounds(geo.node_box, geo.node_link)
+    lo, hi = geo.node_box[0]
     far = np.maximum(np.abs(lo - light), np.abs(hi - light))
     return float(np.linalg.norm(far)) * (1.0 + 1e-6) + 1e-9
 

@@ -198,7 +198,7 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
     prim_info[:, PRIM_OBJECT] = prim_object
     prim_info[:, PRIM_FLIP] = prim_flip
     prim_info[:, PRIM_MEDIUM] = prim_medium
-    node_box, node_link = wide_nodes(bvh)
+    node_box, node_link = packed_nodes(bvh, np.float64)
     # float32 marks a scene without instances: kernels specialised for it (features.py)
     inst_box, inst_link = packed_nodes(
         inst_bvh, np.float64 if len(instances) else NO_INSTANCES_DTYPE)
@@ -214,6 +214,7 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
         xforms=np.array(b.xforms, dtype=np.float64).reshape(len(b.xforms), 3, 4),
         node_box=node_box,
         node_link=node_link,
+        node_wide=wide_nodes(bvh),
         node_prims=np.ascontiguousarray(bounded[bvh.prim_order], dtype=np.int32),
         # int64 selects the kernels compiled with tori and CSG (features.py)
         unbounded=unbounded.astype(

@@ -55,7 +55,6 @@ from .layout import (
     SHAPE_CSG,
     SHAPE_PLANE,
     SHAPE_TRIANGLE,
-    WIDE,
 )
 from .light_buffer import cube_cell
 from .media import absorbed, media_enter, media_leave
@@ -194,32 +193,31 @@ def list_cone_leaves(geo, mats, apex, axis, radius, stack, out, n, cap, opaque):
     cone from ``apex`` to the ball of ``radius`` around ``apex + axis`` (see
     :func:`cone_meets_box`). ``opaque`` says whether those already listed are all opaque.
     Returns (the new count, whether all listed are opaque); the count is -1 when they would
-    be more than ``cap``. (The leaves come in the order of the wide nodes' lanes.)"""
+    be more than ``cap``."""
     if geo.node_box.shape[0] == 0:
         return n, opaque
-    box = geo.node_box
-    link = geo.node_link
     top = 0
     stack[0] = 0
     while top >= 0:
-        w = stack[top]
+        node = stack[top]
         top -= 1
-        for c in range(WIDE):
-            count = link[w, 1, c]
-            if count < 0 or not cone_meets_box(box, w, c, apex, axis, radius):
-                continue
-            if count == 0:
-                top += 1
-                stack[top] = link[w, 0, c]
-                continue
-            if n + count > cap:
-                return -1, False
-            first = link[w, 0, c]
-            for leaf in range(first, first + count):
-                i = geo.node_prims[leaf]
-                out[n] = i
-                n += 1
-                opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
+        if not cone_meets_box(geo.node_box, node, apex, axis, radius):
+            continue
+        count = geo.node_link[node, 1]
+        if count == 0:
+            top += 1
+            stack[top] = node + 1
+            top += 1
+            stack[top] = geo.node_link[node, 0]
+            continue
+        if n + count > cap:
+            return -1, False
+        first = geo.node_link[node, 0]
+        for leaf in range(first, first + count):
+            i = geo.node_prims[leaf]
+            out[n] = i
+            n += 1
+            opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
     return n, opaque
 
 
