@@ -248,16 +248,17 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
                                                              j, leaf, leaf_end, top, False)
             if i < 0:
                 break
-        clear = mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] >= OPAQUE_KT
-        if clear and has_extras(geo) and geo.prim_info[i, PRIM_TYPE] >= FIRST_EXTRA_SHAPE:
-            # a torus or a CSG object: every crossing (a CSG object's as its leaves)
+        if (has_extras(geo) and geo.prim_info[i, PRIM_TYPE] >= FIRST_EXTRA_SHAPE
+                and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] >= OPAQUE_KT):
+            # a clear torus or CSG object: every crossing (a CSG object's as its leaves)
             n, full = gather_extra_hits_if_extras(geo, i, o, d, inv, tmin, tmax, step, hits,
                                                   n, full)
             continue
         t = hit_analytic(geo, i, o, d, tmin, tmax)
         if t == INF:
             continue
-        if not clear:
+        # the material is looked up only for the surfaces hit (most candidates miss)
+        if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT:
             hits[1] = i
             return -1, False
         n, full = keep_nearest(hits, n, t, i, full)
