@@ -153,7 +153,8 @@ def validate(
     """Check the solver against exact answers and print the tables: Neumann's lambda, front
     error against cell size, the axes, the cavity's convection, the flow solver on de Vahl
     Davis's square cavity (32², with --full 32² to 128²) and on the heated cube (24³, with
-    --full 32³ to 64³), the convective slab, the sphere,
+    --full 32³ to 64³), gallium melting beside Gau & Viskanta's measured front, the convective
+    slab, the sphere,
     the energy balance."""
     from rich.table import Table
 
@@ -238,6 +239,19 @@ def validate(
     out.print("cube reference: Tric et al. (2000) and Wakashima & Saitoh (2004) as a secondary "
               "source quotes them (docs/stefan.md); velocity maxima at z = 1/2 in units of "
               "alpha/L, no reference read")
+
+    table = Table(title="Gallium melting from a heated wall (Gau & Viskanta 1986), 2-D: the "
+                  "melted length over the width (measured, whitted)")
+    for col in ("cells", "t (min)", "top ref", "top", "middle ref", "middle", "bottom ref",
+                "bottom", "melted", "energy (rel.)"):
+        table.add_column(col, justify="right")
+    for mm, last in (((4.0, None), (2.0, None)) if full else ((4.0, 3),)):
+        for r in v.gallium_rows(mm, last=last):
+            table.add_row(r["cells"], f"{r['minutes']:.1f}", f"{r['top_ref']:.3f}",
+                          f"{r['top']:.3f}", f"{r['middle_ref']:.3f}", f"{r['middle']:.3f}",
+                          f"{r['bottom_ref']:.3f}", f"{r['bottom']:.3f}", f"{r['melted']:.3f}",
+                          f"{r['energy_rel']:.1e}")
+    out.print(table)
 
     slab = v.convective_slab()
     out.print(f"convective slab (h = 20 W/m²K, air 20 °C, 3000 s): receded "

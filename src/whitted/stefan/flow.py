@@ -342,13 +342,19 @@ class MeltFlow:
     G = 9.80665
 
     def __init__(self, box: tuple[slice, slice, slice], dx: float, props,
-                 t_viscosity: float = 2.0) -> None:
+                 t_viscosity: float = 2.0, viscosity: float | None = None,
+                 expansion: float | None = None) -> None:
+        """``viscosity`` (kinematic, m²/s) and ``expansion`` (beta, 1/K: the Boussinesq
+        buoyancy g beta (T - T_melt)) replace water's (Vogel's viscosity at ``t_viscosity``,
+        Kell's density) for another liquid (the gallium benchmark)."""
         from .convection import water_density, water_viscosity
 
         self.box = box
         shape = tuple(s.stop - s.start for s in box)
         self.rho0 = water_density(0.0)
-        self.nu = water_viscosity(t_viscosity) / water_density(t_viscosity)
+        self.expansion = expansion
+        self.nu = (water_viscosity(t_viscosity) / water_density(t_viscosity)
+                   if viscosity is None else float(viscosity))
         self.flow = Flow(shape, dx, self.nu)
         self.props = props
         self.dx = float(dx)
@@ -378,7 +384,10 @@ class MeltFlow:
     def step(self, Hp: np.ndarray, kindp: np.ndarray, dt: float) -> None:
         """One step of the flow with the field of now, then its heat carried into ``Hp``."""
         f, T, heat = self.fields(Hp, kindp)
-        buoy = self.G * (self.rho0 - water_density_array(T)) / self.rho0 * f
+        if self.expansion is None:
+            buoy = self.G * (self.rho0 - water_density_array(T)) / self.rho0 * f
+        else:
+            buoy = self.G * self.expansion * T * f
         sink = self.sink_c * (1.0 - f) ** 2 / (f ** 3 + 1.0e-3)
         self.flow.step(dt, buoy, sink, fluid=f >= 0.5)
         # the heat goes with the new velocity: in as many parts as keep each under half a cell
