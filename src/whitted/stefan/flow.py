@@ -195,14 +195,14 @@ class Flow:
         sink = self._zero if sink is None else sink
         dx, nu, flat = self.dx, self.nu, self.flat
         t = (1, 0, 2)
-        fk.predict(self.u, self.v, self.w, nu, dt, dx, self._zero, sink, self._u, flat)
+        fk.predict(self.u, self.v, self.w, nu, dt, dx, self._zero, sink, self._u, flat, False)
         fk.predict(self.v.transpose(t), self.u.transpose(t), self.w.transpose(t), nu, dt, dx,
-                   buoyancy.transpose(t), sink.transpose(t), self._v.transpose(t), flat)
+                   buoyancy.transpose(t), sink.transpose(t), self._v.transpose(t), flat, False)
         if not flat:
             t = (2, 1, 0)
             fk.predict(self.w.transpose(t), self.v.transpose(t), self.u.transpose(t), nu, dt,
                        dx, self._zero.transpose(t), sink.transpose(t), self._w.transpose(t),
-                       False)
+                       False, True)
         self.u, self._u = self._u, self.u
         self.v, self._v = self._v, self.v
         self.w, self._w = self._w, self.w
