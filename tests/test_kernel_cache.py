@@ -203,6 +203,27 @@ def test_a_file_numba_rewrote_in_this_process_is_sealed_anew(tmp_path):
     assert "kernels_1/a-1.py311.nbi" in _names(again)
 
 
+def test_a_file_rewritten_before_its_kernel_is_looked_up_is_no_damage(tmp_path, capsys):
+    # a process checks lazily (verify(lazy=True)), then Numba writes a new index for a kernel
+    # this process has not looked up yet (a compile helper, or another variant's compile),
+    # and the process seals it: the kernel's first look-up then finds it as sealed
+    state = _fake_cache(tmp_path)
+    again = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert again.verify(lazy=True) == 0
+    index = Path(state.folder, "kernels_1/a-1.py311.nbi")
+    tmp = index.with_suffix(".tmp")
+    tmp.write_bytes(b"a new signature added")
+    os.replace(tmp, index)
+    again.seal()
+    assert again.check_function("kernels_1", "a-1.py311") == 0
+    assert index.read_bytes() == b"a new signature added"
+    assert capsys.readouterr().err == ""
+    # a file damaged after the seal is still found at the look-up
+    _flip(Path(state.folder, "compile_2/b-2.py311.0.nbc"), 9)
+    assert again.check_function("compile_2", "b-2.py311") == 1
+    assert "damaged kernel cache file" in capsys.readouterr().err
+
+
 def test_a_damaged_list_of_sums_drops_everything_with_one_warning(tmp_path, capsys):
     state = _fake_cache(tmp_path)
     sums = Path(state.folder, _cache.SUMS)

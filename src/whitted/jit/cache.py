@@ -455,6 +455,10 @@ class KernelCache:
                     continue
                 sums[name] = [digest, st.st_size, st.st_ino]
                 self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
+                # a file verify() left for later and Numba (here or in the compile helper)
+                # has since written anew: sealed with its new content, so its kernel's first
+                # look-up must not take it for damage and compile it a second time
+                self._deferred.pop(name, None)
                 changed = True
             if changed or damaged_list:
                 self._write_sums(sums)
