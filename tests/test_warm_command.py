@@ -15,6 +15,7 @@ import pytest
 from whitted.compile.scene import compile_scene
 from whitted.kernels.features import EXTRAS_DTYPE
 from whitted.render.variants import GEOMETRY, KINDS, tiny_scene, variant_names
+from whitted.scene import Scene
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -27,7 +28,28 @@ def _whitted(*args: str) -> subprocess.CompletedProcess:
 
 def test_every_variant_is_named_once():
     names = variant_names()
-    assert len(names) == len(set(names)) == len(GEOMETRY) * len(KINDS) == 16
+    assert len(names) == len(set(names)) == len(GEOMETRY) * len(KINDS) == 8
+
+
+def test_instances_and_extras_share_the_general_kernels():
+    """A scene with mesh instances, one with a torus and one with both run the same
+    specialisation (the general kernels); a scene with neither the plain one."""
+    from numba import typeof
+
+    from whitted.scene import Sphere
+
+    instanced = compile_scene(tiny_scene(False, "render"), flatten_limit=0)
+    torus = compile_scene(tiny_scene(True, "render"))
+    both = compile_scene(tiny_scene(True, "render"), flatten_limit=0)
+    plain = compile_scene(tiny_scene(False, "render"))
+    assert len(instanced.geometry.inst_prims) == 1 and len(torus.geometry.inst_prims) == 0
+    general = typeof(both.geometry)
+    assert typeof(instanced.geometry) == typeof(torus.geometry) == general
+    assert typeof(plain.geometry) != general
+    assert plain.geometry.inst_box.dtype == np.float32
+    assert plain.geometry.unbounded.dtype == np.int32
+    sphere = compile_scene(Scene(objects=[Sphere(radius=1.0)]))
+    assert typeof(sphere.geometry) == typeof(plain.geometry)
 
 
 @pytest.mark.parametrize("geometry", list(GEOMETRY))
