@@ -243,13 +243,14 @@ def validate(
     table = Table(title="Gallium melting from a heated wall (Gau & Viskanta 1986), 2-D: the "
                   "melted length over the width (measured, whitted)")
     for col in ("cells", "t (min)", "top ref", "top", "middle ref", "middle", "bottom ref",
-                "bottom", "melted", "energy (rel.)"):
+                "bottom", "melted ref", "melted", "energy (rel.)"):
         table.add_column(col, justify="right")
     for mm, last in (((4.0, None), (2.0, None)) if full else ((4.0, 3),)):
         for r in v.gallium_rows(mm, last=last):
             table.add_row(r["cells"], f"{r['minutes']:.1f}", f"{r['top_ref']:.3f}",
                           f"{r['top']:.3f}", f"{r['middle_ref']:.3f}", f"{r['middle']:.3f}",
-                          f"{r['bottom_ref']:.3f}", f"{r['bottom']:.3f}", f"{r['melted']:.3f}",
+                          f"{r['bottom_ref']:.3f}", f"{r['bottom']:.3f}",
+                          f"{r['melted_ref']:.3f}", f"{r['melted']:.3f}",
                           f"{r['energy_rel']:.1e}")
     out.print(table)
 

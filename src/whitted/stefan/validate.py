@@ -371,6 +371,11 @@ GAU_VISKANTA = {
     "top": (0.11508, 0.18212, 0.28603, 0.31508, 0.38994, 0.50391, 0.61117, 0.72514),
     "middle": (0.11508, 0.16313, 0.20894, 0.23911, 0.29609, 0.36089, 0.45475, 0.52961),
     "bottom": (0.1095, 0.12849, 0.14078, 0.16425, 0.21117, 0.22346, 0.26592, 0.26592),
+    # the melted fraction of the cavity, measured (the same file, its own tau values)
+    "melted_tau": (0.00946, 0.01433, 0.02113, 0.02877, 0.03774, 0.04739, 0.05956, 0.07164,
+                   0.08104, 0.09069),
+    "melted": (0.11972, 0.16112, 0.20476, 0.22713, 0.2786, 0.34014, 0.43077, 0.5035, 0.56392,
+               0.61664),
     "stefan": 0.041,
 }
 #: Gallium as the MOOSE framework's gallium-melting input gives it (idaholab/moose; the same
@@ -386,7 +391,8 @@ def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None) -> 
     """Gau & Viskanta's gallium melting in 2-D (the flow solver coupled to the enthalpy
     method, the enthalpy-porosity sink): the melted length along the top, middle and bottom
     rows of cells (liquid fraction summed, over the width) at the experiment's times, beside
-    the measured front. ``last``: only the first ``last`` times."""
+    the measured front, and the melted fraction of the cavity beside the measured one
+    (interpolated linearly to the same time). ``last``: only the first ``last`` times."""
     from .flow import MeltFlow
     from .properties import Phase
 
@@ -416,7 +422,9 @@ def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None) -> 
         f = solver.liquid_fraction()[:, :, 0]
         row = {"minutes": t / 60.0, "tau": tau, "cells": f"{nx}x{ny}", "dx_mm": dx * 1e3,
                "melted": float(f.mean()), "speed_mm_s": flow.speed() * 1e3,
-               "energy_rel": solver.energy_error() / solver.heat_in}
+               "energy_rel": solver.energy_error() / solver.heat_in,
+               "melted_ref": float(np.interp(tau, ref["melted_tau"], ref["melted"],
+                                               left=math.nan))}
         for name, j in (("top", ny - 1), ("middle", ny // 2), ("bottom", 0)):
             row[name] = float(f[:, j].sum()) / nx
             row[name + "_ref"] = ref[name][i]
