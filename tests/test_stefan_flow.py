@@ -69,7 +69,7 @@ def test_gallium_melts_from_the_hot_wall_fastest_at_the_top():
     # Gau & Viskanta's gallium cavity on 4 mm cells (22 x 16), 2 and 3 minutes: measured
     # here top/middle/bottom 0.153/0.128/0.115 and 0.210/0.170/0.146 of the width against the
     # experiment's 0.115/0.115/0.110 and 0.182/0.163/0.128 (a 2-D model melts faster than
-    # the experiment's cell: conduction alone, Neumann's front, gives 0.128 at 2 minutes)
+    # the experiment's cell: conduction alone, Neumann's front, gives 0.125 at 2 minutes)
     from whitted.stefan.validate import gallium_rows
 
     first, second = gallium_rows(4.0, last=2)

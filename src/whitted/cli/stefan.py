@@ -5,6 +5,7 @@ A thin client: the physics is :mod:`whitted.stefan`, the rendering the render AP
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import time
@@ -250,7 +251,8 @@ def validate(
             table.add_row(r["cells"], f"{r['minutes']:.1f}", f"{r['top_ref']:.3f}",
                           f"{r['top']:.3f}", f"{r['middle_ref']:.3f}", f"{r['middle']:.3f}",
                           f"{r['bottom_ref']:.3f}", f"{r['bottom']:.3f}",
-                          f"{r['melted_ref']:.3f}", f"{r['melted']:.3f}",
+                          "-" if math.isnan(r["melted_ref"]) else f"{r['melted_ref']:.3f}",
+                          f"{r['melted']:.3f}",
                           f"{r['energy_rel']:.1e}")
     out.print(table)
 
