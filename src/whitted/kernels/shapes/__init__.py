@@ -14,8 +14,10 @@ whole when it has:
   (tmin, tmax) of the ray ``o + t d`` in the row's own space (:data:`INF` for a miss);
 - **crossings** (solids only: what CSG needs): ``<shape>_span`` / ``<shape>_crossings(P, i,
   o, d)``, every crossing of the whole line in order, entering and leaving, computed from
-  the ray alone so that asking again from past one gives the next; a flat or open shape
-  bounds no volume, has none, and CSG refuses it (``scene/shapes.py``);
+  the ray alone so that asking again from past one gives the next (``dispatch.py``
+  ``solid_crossings`` counts them for the CSG walk; the frustum, convex, gives its first and
+  last: ``frustum_solid_crossings``); a flat or open shape bounds no volume, has none, and
+  CSG refuses it (``scene/shapes.py``);
 - **normal**: ``<shape>_normal(P, i, p)``, the outward unit normal at a point on it;
 - **uv**: ``<shape>_uv(P, i, p)``, its texture coordinates at a point on it, the mapping said
   in its docstring and in docs/scene-format.md's table;
