@@ -20,7 +20,6 @@ from .extras import (
     flipped_if_extras,
 )
 from .features import has_extras, has_instances, instances_possible
-from .intersect import INF, intersect_local, normal_local, triangle_barycentric
 from .layout import (
     FIRST_EXTRA_SHAPE,
     MAT_KT,
@@ -31,7 +30,11 @@ from .layout import (
     SHAPE_TRIANGLE,
     TRIANGLE_NORMALS,
 )
-from .mesh import OPAQUE_KT, mesh_closest_hit, mesh_normals, mesh_occlusion
+from .mesh import OPAQUE_KT, mesh_closest_hit, mesh_occlusion
+from .shapes import INF
+from .shapes.dispatch import intersect_local, normal_local
+from .shapes.mesh import mesh_normals
+from .shapes.triangle import triangle_shading_normal
 from .traverse import (
     box_entry,
     inverse_direction,
@@ -39,7 +42,6 @@ from .traverse import (
     push_children,
     start_scene_walk,
 )
-from .vec import normalize
 from .xform import normal_to_world as _normal_to_world
 from .xform import to_object
 
@@ -131,26 +133,8 @@ def world_normal(geo, i, p):
     return _normal_to_world(geo.xforms, xf, n)
 
 
-@kernel
-def _triangle_shading_normal(geo, i, p, fallback):
-    """The corner normals of a smooth-shaded triangle primitive blended at ``p``."""
-    P = geo.prim_params
-    b1, b2 = triangle_barycentric(P, i, p)
-    b0 = 1.0 - b1 - b2
-    r = int(P[i, TRIANGLE_NORMALS])
-    n = geo.tri_normals
-    ns = (
-        b0 * n[r, 0, 0] + b1 * n[r, 1, 0] + b2 * n[r, 2, 0],
-        b0 * n[r, 0, 1] + b1 * n[r, 1, 1] + b2 * n[r, 2, 1],
-        b0 * n[r, 0, 2] + b1 * n[r, 1, 2] + b2 * n[r, 2, 2],
-    )
-    if ns[0] == 0.0 and ns[1] == 0.0 and ns[2] == 0.0:
-        return fallback
-    return normalize(ns)
-
-
 def mesh_normals_if_instances(geo, mesh, tri, b1, b2):
-    """:func:`.mesh.mesh_normals`, never compiled for scenes without instances (see
+    """:func:`.shapes.mesh.mesh_normals`, never compiled for scenes without instances (see
     features.py)."""
     return mesh_normals(geo, mesh, tri, b1, b2)
 
@@ -170,7 +154,7 @@ def surface_normals(geo, prim, tri, b1, b2, p):
         n = world_normal(geo, prim, p)
         smooth = geo.prim_params[prim, TRIANGLE_NORMALS] >= 0
         if geo.prim_info[prim, PRIM_TYPE] == SHAPE_TRIANGLE and smooth:
-            ns = _triangle_shading_normal(geo, prim, p, n)
+            ns = triangle_shading_normal(geo, prim, p, n)
             if has_extras(geo):  # a smooth mesh cutting a CSG difference: turned too
                 ns = flipped_if_extras(geo, prim, ns)
             return n, ns

@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from ..jit import kernel
-from .intersect import INF
+from .shapes import INF
 
 TINY_DIRECTION = 1e-30  # stands in for a zero direction component in the slab test
 

@@ -22,43 +22,60 @@ from ..jit import builder, numba_object
 prange = numba_object("numba", "prange")
 
 
+@builder(entry=False, error_model="numpy", numba_inline=True)
+def _predict_at(q, p, r, visc, inv, dt, force, sink, out, flat, i, j, k):
+    """The predictor at face (i, j, k) of the views (:func:`predict`)."""
+    n1 = q.shape[1]
+    n2 = q.shape[2]
+    qc = q[i, j, k]
+    qe = q[i + 1, j, k]
+    qw = q[i - 1, j, k]
+    ce = 0.5 * (qc + qe)
+    cw = 0.5 * (qw + qc)
+    adv = (ce * ce - cw * cw) * inv
+    lap = qe + qw - 2.0 * qc
+    qn = q[i, j + 1, k] if j < n1 - 1 else -qc
+    qs = q[i, j - 1, k] if j > 0 else -qc
+    pn = 0.5 * (p[i - 1, j + 1, k] + p[i, j + 1, k])
+    ps = 0.5 * (p[i - 1, j, k] + p[i, j, k])
+    adv += (0.5 * (qc + qn) * pn - 0.5 * (qc + qs) * ps) * inv
+    lap += qn + qs - 2.0 * qc
+    if not flat:
+        qt = q[i, j, k + 1] if k < n2 - 1 else -qc
+        qb = q[i, j, k - 1] if k > 0 else -qc
+        rt = 0.5 * (r[i - 1, j, k + 1] + r[i, j, k + 1])
+        rb = 0.5 * (r[i - 1, j, k] + r[i, j, k])
+        adv += (0.5 * (qc + qt) * rt - 0.5 * (qc + qb) * rb) * inv
+        lap += qt + qb - 2.0 * qc
+    f = 0.5 * (force[i - 1, j, k] + force[i, j, k])
+    a = 0.5 * (sink[i - 1, j, k] + sink[i, j, k])
+    out[i, j, k] = (qc + dt * (visc * lap - adv + f)) / (1.0 + dt * a)
+
+
 @builder(parallel=True, error_model="numpy")
-def predict(q, p, r, nu, dt, dx, force, sink, out, flat):
+def predict(q, p, r, nu, dt, dx, force, sink, out, flat, along_inner):
     """``out`` = the predicted component ``q`` (along axis 0 of these views; ``p`` and ``r``
     the components along axes 1 and 2) after one explicit step of advection, diffusion,
     ``force`` (per cell, along axis 0; the face takes the mean of its two cells) and the
-    implicit ``sink`` (1/s per cell). Wall faces (first and last along axis 0) are 0."""
+    implicit ``sink`` (1/s per cell). Wall faces (first and last along axis 0) are 0.
+    ``along_inner``: the loop along axis 0 innermost, parallel over axis 2 (for the views
+    whose axis 0 is the arrays' contiguous one: the last component, 13 times faster at 48³
+    than striding across planes); the same operations per face either way."""
     n0 = q.shape[0] - 1
     n1 = q.shape[1]
     n2 = q.shape[2]
     inv = 1.0 / dx
     visc = nu / (dx * dx)
-    for i in prange(1, n0):
-        for j in range(n1):
-            for k in range(n2):
-                qc = q[i, j, k]
-                qe = q[i + 1, j, k]
-                qw = q[i - 1, j, k]
-                ce = 0.5 * (qc + qe)
-                cw = 0.5 * (qw + qc)
-                adv = (ce * ce - cw * cw) * inv
-                lap = qe + qw - 2.0 * qc
-                qn = q[i, j + 1, k] if j < n1 - 1 else -qc
-                qs = q[i, j - 1, k] if j > 0 else -qc
-                pn = 0.5 * (p[i - 1, j + 1, k] + p[i, j + 1, k])
-                ps = 0.5 * (p[i - 1, j, k] + p[i, j, k])
-                adv += (0.5 * (qc + qn) * pn - 0.5 * (qc + qs) * ps) * inv
-                lap += qn + qs - 2.0 * qc
-                if not flat:
-                    qt = q[i, j, k + 1] if k < n2 - 1 else -qc
-                    qb = q[i, j, k - 1] if k > 0 else -qc
-                    rt = 0.5 * (r[i - 1, j, k + 1] + r[i, j, k + 1])
-                    rb = 0.5 * (r[i - 1, j, k] + r[i, j, k])
-                    adv += (0.5 * (qc + qt) * rt - 0.5 * (qc + qb) * rb) * inv
-                    lap += qt + qb - 2.0 * qc
-                f = 0.5 * (force[i - 1, j, k] + force[i, j, k])
-                a = 0.5 * (sink[i - 1, j, k] + sink[i, j, k])
-                out[i, j, k] = (qc + dt * (visc * lap - adv + f)) / (1.0 + dt * a)
+    if along_inner:
+        for k in prange(n2):
+            for j in range(n1):
+                for i in range(1, n0):
+                    _predict_at(q, p, r, visc, inv, dt, force, sink, out, flat, i, j, k)
+    else:
+        for i in prange(1, n0):
+            for j in range(n1):
+                for k in range(n2):
+                    _predict_at(q, p, r, visc, inv, dt, force, sink, out, flat, i, j, k)
     for j in range(n1):
         for k in range(n2):
             out[0, j, k] = 0.0
