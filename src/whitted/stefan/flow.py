@@ -47,8 +47,9 @@ DE_VAHL_DAVIS = {
 
 #: The differentially heated cube (Pr 0.71, hot and cold opposite vertical walls, the other
 #: four adiabatic, no slip everywhere): the mean Nusselt number of the hot wall. The values of
-#: Tric, Labrosse & Betrouni (2000), Int. J. Heat Mass Transfer 43, 4043-4056 (pseudo-spectral,
-#: 81³ and finer) and Wakashima & Saitoh (2004), Int. J. Heat Mass Transfer 47, 853-864, as a
+#: Tric, Labrosse & Betrouni (2000, "A first incursion into the 3D structure of natural
+#: convection of air in a differentially heated cubic cavity") and Wakashima & Saitoh (2004),
+#: Int. J. Heat Mass Transfer 47, 853-864, as a
 #: public GitHub file quotes them (``utils_3D_convection.py``, its dictionary
 #: ``WAKASHIMA_SAITOH_2004_GROUND_TRUTH``, read through a code search whose index does not name
 #: the repository): Nu 2.054 at Ra 10⁴ and 4.337 at 10⁵. A secondary source, rounded to
