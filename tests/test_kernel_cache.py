@@ -10,6 +10,7 @@ import shutil
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 from pathlib import Path
 
@@ -201,6 +202,52 @@ def test_a_file_numba_rewrote_in_this_process_is_sealed_anew(tmp_path):
     again = _cache.KernelCache(state.folder, own=True, helper=False)
     assert again.verify() == 1  # the flipped one only
     assert "kernels_1/a-1.py311.nbi" in _names(again)
+
+
+def test_a_file_rewritten_before_its_kernel_is_looked_up_is_no_damage(tmp_path, capsys):
+    # a process checks lazily (verify(lazy=True)), then Numba writes a new index for a kernel
+    # this process has not looked up yet (a compile helper, or another variant's compile),
+    # and the process seals it: the kernel's first look-up then finds it as sealed
+    state = _fake_cache(tmp_path)
+    again = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert again.verify(lazy=True) == 0
+    index = Path(state.folder, "kernels_1/a-1.py311.nbi")
+    tmp = index.with_suffix(".tmp")
+    tmp.write_bytes(b"a new signature added")
+    os.replace(tmp, index)
+    again.seal()
+    assert again.check_function("kernels_1", "a-1.py311") == 0
+    assert index.read_bytes() == b"a new signature added"
+    assert capsys.readouterr().err == ""
+    # a file damaged after the seal is still found at the look-up
+    _flip(Path(state.folder, "compile_2/b-2.py311.0.nbc"), 9)
+    assert again.check_function("compile_2", "b-2.py311") == 1
+    assert "damaged kernel cache file" in capsys.readouterr().err
+
+
+def test_a_cold_compile_of_one_variant_lets_other_processes_seal(tmp_path):
+    # whitted warm: one process compiles the general kernels cold (holding that variant's
+    # lock for the whole compile) while another compiles and seals other kernels
+    state = _fake_cache(tmp_path)
+    other = _cache.KernelCache(state.folder, own=True, helper=False)
+    sealed, second = threading.Event(), threading.Event()
+
+    def seal_and_compile_the_same():
+        Path(state.folder, "kernels_1/c-3.py311.nbi").write_bytes(b"another kernel")
+        other.seal()
+        sealed.set()
+        with other.compile_lock("general"):  # the same variant: waits for the first
+            second.set()
+
+    with state.compile_lock("general"):
+        thread = threading.Thread(target=seal_and_compile_the_same, daemon=True)
+        thread.start()
+        assert sealed.wait(30)
+        assert not second.wait(0.3)
+    assert second.wait(30)
+    thread.join(30)
+    assert "kernels_1/c-3.py311.nbi" in _cache.KernelCache(state.folder, own=True,
+                                                            helper=False)._read_sums()[0]
 
 
 def test_a_damaged_list_of_sums_drops_everything_with_one_warning(tmp_path, capsys):

@@ -18,7 +18,6 @@ from whitted.compile.light_buffers import buffer_side
 from whitted.compile.params import render_params
 from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import hit_analytic
-from whitted.kernels.intersect import INF
 from whitted.kernels.layout import (
     CELL_COUNT,
     CELL_FIRST,
@@ -28,6 +27,7 @@ from whitted.kernels.layout import (
     N_RAY_KINDS,
 )
 from whitted.kernels.light_buffer import LIGHT_BUFFER_CELLS, cell_cone, cube_cell
+from whitted.kernels.shapes import INF
 from whitted.kernels.tiles import lane_workspace, render_tiles
 from whitted.render.api import tile_grid
 

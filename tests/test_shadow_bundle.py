@@ -15,9 +15,9 @@ import whitted
 from meshgen import uv_sphere
 from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import hit_analytic
-from whitted.kernels.intersect import INF
 from whitted.kernels.layout import BVH_STACK
 from whitted.kernels.lighting import SHADOW_LIST_CAP, list_bundle_occluders
+from whitted.kernels.shapes import INF
 from whitted.kernels.traverse import cone_meets_box
 
 EPS = 1e-6  # the shadow rays' tmin

@@ -164,14 +164,38 @@ def _refused_by_csg(obj) -> bool:
     return False
 
 
-@pytest.mark.parametrize("kind", KINDS)
-def test_its_kernel_pieces_are_named_and_exist(kind):
-    """kernels/shapes/ names the function of each piece of every kind (one named hop)."""
+#: the kinds whose objects are walked by code of their own rather than asked for through
+#: kernels/shapes/dispatch.py, and what walks them
+COMPOSITES = {
+    "mesh": "kernels/mesh.py walks an instance's BVH; a small mesh is flattened to triangles",
+    "csg": "kernels/csg.py walks the object's leaves, each asked through dispatch.py",
+}
+KERNEL_PIECES = ("hit", "crossings", "normal", "uv")
+
+
+def dispatched_names() -> set[str]:
+    """The functions kernels/shapes/dispatch.py calls: what the integrator can reach."""
+    import ast
+
+    tree = ast.parse((ROOT / "src" / "whitted" / "kernels" / "shapes" / "dispatch.py")
+                     .read_text(encoding="utf-8"))
+    return {node.func.id for node in ast.walk(tree)
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name)}
+
+
+def piece_problems(kind: str, pieces: dict | None, dispatched: set[str]) -> list[str]:
+    """What ``kind`` lacks of the pieces kernels/shapes/__init__.py asks of every shape:
+    each piece named and existing; for an analytic shape, its kernel pieces in one file of
+    its own under kernels/shapes/, each asked for in kernels/shapes/dispatch.py, and its
+    rows the function compile/shapes.py's ``ROWS`` gives its scene class."""
     import importlib
 
-    pieces = PIECES.get(kind)
-    assert pieces is not None, f"{kind}: no entry in kernels/shapes/__init__.py PIECES"
-    missing = [p for p in ("rows", "hit", "crossings", "normal", "uv") if p not in pieces]
+    from whitted.compile.shapes import ROWS
+
+    if pieces is None:
+        return ["no entry in kernels/shapes/__init__.py PIECES"]
+    missing = [f"{p} (none named)" for p in ("rows", *KERNEL_PIECES) if p not in pieces]
+    modules = set()
     for piece, where in pieces.items():
         if where is None:
             if piece != "crossings" or not _refused_by_csg(sample(kind)):
@@ -180,9 +204,82 @@ def test_its_kernel_pieces_are_named_and_exist(kind):
         module, _, name = where.partition(":")
         if not hasattr(importlib.import_module(f"whitted.{module}"), name):
             missing.append(f"{piece} ({where} does not exist)")
+            continue
+        if kind in COMPOSITES:
+            continue
+        if piece == "rows":
+            rows = ROWS.get(type(sample(kind)))
+            if rows is None or f"compile.shapes:{rows.__name__}" != where:
+                missing.append(f"rows ({where} is not compile/shapes.py ROWS's entry for "
+                               f"{type(sample(kind)).__name__})")
+            continue
+        modules.add(module)
+        if name not in dispatched:
+            missing.append(f"{piece} ({name} is not asked for in kernels/shapes/dispatch.py)")
+    if len(modules) > 1 or any(not m.startswith("kernels.shapes.") for m in modules):
+        missing.append(f"its kernel pieces in one file under kernels/shapes/ (they are in "
+                       f"{', '.join(sorted(modules))})")
     if pieces.get("crossings") is not None and kind != "csg" and _refused_by_csg(sample(kind)):
         missing.append("crossings named for a kind CSG refuses")
+    return missing
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_its_pieces_are_in_its_file_and_dispatched(kind):
+    """kernels/shapes/ names the function of each piece of every kind (one named hop), the
+    analytic kinds' all in the kind's own file and reached through dispatch.py."""
+    missing = piece_problems(kind, PIECES.get(kind), dispatched_names())
     assert not missing, f"{kind}: " + "; ".join(missing)
+
+
+def test_the_piece_check_names_what_is_missing():
+    """A torus whose uv is not named, whose normal lives elsewhere and is not dispatched, and
+    whose rows are not compile/shapes.py's: each named."""
+    broken = dict(PIECES["torus"])
+    del broken["uv"]
+    broken["normal"] = "kernels.shapes.box:box_local"
+    broken["rows"] = "compile.shapes:sphere_rows"
+    assert piece_problems("torus", broken, dispatched_names()) == [
+        "uv (none named)",
+        "rows (compile.shapes:sphere_rows is not compile/shapes.py ROWS's entry for Torus)",
+        "normal (box_local is not asked for in kernels/shapes/dispatch.py)",
+        "its kernel pieces in one file under kernels/shapes/ (they are in "
+        "kernels.shapes.box, kernels.shapes.torus)",
+    ]
+    assert piece_problems("torus", None, set()) == [
+        "no entry in kernels/shapes/__init__.py PIECES"]
+    assert piece_problems("torus", PIECES["torus"], dispatched_names() - {"torus_uv"}) == [
+        "uv (torus_uv is not asked for in kernels/shapes/dispatch.py)"]
+
+
+def test_every_analytic_scene_shape_has_rows_and_a_dispatch():
+    """compile/shapes.py ``ROWS`` covers every analytic scene class, and dispatch.py asks for
+    a hit, a normal and a uv of every shape code the rows write."""
+    import ast
+    import inspect
+
+    from whitted.compile import shapes as compile_shapes
+
+    analytic = {type(sample(k)) for k in KINDS if k not in COMPOSITES}
+    assert set(compile_shapes.ROWS) == analytic
+    written = {node.id for fn in set(compile_shapes.ROWS.values())
+               for node in ast.walk(ast.parse(inspect.getsource(fn)))
+               if isinstance(node, ast.Name) and node.id.startswith("SHAPE_")}
+    assert len(written) == len(analytic) - 1  # the cylinder and the cone: frustum rows
+    for core, extra in (("intersect_local", "extra_shape_t"),
+                        ("normal_local", "extra_shape_normal"), ("uv_local", "extra_shape_uv")):
+        asked = dispatch_body(core) + dispatch_body(extra)
+        if core == "normal_local":  # the box's and the frustum's behind a call
+            asked += dispatch_body("_solid_normal")
+        assert not {c for c in written if c not in asked}, f"{core} misses a shape code"
+
+
+def dispatch_body(name: str) -> str:
+    """The source of function ``name`` of kernels/shapes/dispatch.py."""
+    source = (ROOT / "src" / "whitted" / "kernels" / "shapes" / "dispatch.py").read_text(
+        encoding="utf-8")
+    body = source[source.index(f"def {name}("):]
+    return body[: body.index("\n@kernel")] if "\n@kernel" in body else body
 
 
 def test_the_kernel_cache_key_covers_the_shapes_package(tmp_path):

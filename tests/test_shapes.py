@@ -1350,8 +1350,8 @@ def test_all_crossings_of_a_frustum_are_the_nearest_asked_again(which, origin, a
     """``frustum_crossings`` (every crossing of the line at once, for CSG walks) lists what
     ``intersect_frustum`` returns when asked again from past each crossing: the same values
     in the same order, each once, including rays aimed exactly at a cap's rim."""
-    from whitted.kernels.intersect import frustum_crossings, intersect_frustum
     from whitted.kernels.layout import PRIM_TYPE, SHAPE_FRUSTUM
+    from whitted.kernels.shapes.frustum import frustum_crossings, intersect_frustum
 
     shape = _FRUSTA[which]
     geo = compile_scene(Scene(objects=[shape])).geometry

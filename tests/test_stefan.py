@@ -110,7 +110,8 @@ def _reference_step(H, kind, dt, dx):
     ki, kw = p.ice.k, p.water.k
     body = kind == 1
     T = np.where(body, p.temperature(H), 0.0)
-    K = np.where(body, np.where(H <= 0.0, ki, np.where(hl <= H, kw, ki + H / hl * (kw - ki))), 0.0)
+    K = np.where(body, np.where(H <= 0.0, ki, np.where(hl <= H, kw, ki + H * ((kw - ki) / hl))),
+                 0.0)
     Tp = np.pad(T, 1)
     Kp = np.pad(K, 1)
     c = (slice(1, -1),) * 3

@@ -15,6 +15,7 @@ import pytest
 from whitted.compile.scene import compile_scene
 from whitted.kernels.features import EXTRAS_DTYPE
 from whitted.render.variants import GEOMETRY, KINDS, tiny_scene, variant_names
+from whitted.scene import Scene
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -27,7 +28,28 @@ def _whitted(*args: str) -> subprocess.CompletedProcess:
 
 def test_every_variant_is_named_once():
     names = variant_names()
-    assert len(names) == len(set(names)) == len(GEOMETRY) * len(KINDS) == 16
+    assert len(names) == len(set(names)) == len(GEOMETRY) * len(KINDS) == 8
+
+
+def test_instances_and_extras_share_the_general_kernels():
+    """A scene with mesh instances, one with a torus and one with both run the same
+    specialisation (the general kernels); a scene with neither the plain one."""
+    from numba import typeof
+
+    from whitted.scene import Sphere
+
+    instanced = compile_scene(tiny_scene(False, "render"), flatten_limit=0)
+    torus = compile_scene(tiny_scene(True, "render"))
+    both = compile_scene(tiny_scene(True, "render"), flatten_limit=0)
+    plain = compile_scene(tiny_scene(False, "render"))
+    assert len(instanced.geometry.inst_prims) == 1 and len(torus.geometry.inst_prims) == 0
+    general = typeof(both.geometry)
+    assert typeof(instanced.geometry) == typeof(torus.geometry) == general
+    assert typeof(plain.geometry) != general
+    assert plain.geometry.inst_box.dtype == np.float32
+    assert plain.geometry.unbounded.dtype == np.int32
+    sphere = compile_scene(Scene(objects=[Sphere(radius=1.0)]))
+    assert typeof(sphere.geometry) == typeof(plain.geometry)
 
 
 @pytest.mark.parametrize("geometry", list(GEOMETRY))
@@ -59,3 +81,43 @@ def test_mistakes_are_one_line(args, message):
     result = _whitted("warm", *args)
     assert result.returncode == 2
     assert result.stderr.strip().count("\n") == 0 and message in result.stderr
+
+
+def test_the_queue_hands_a_general_kind_out_only_after_the_general_render_kernel():
+    from whitted.cli.warm import _all_names, _Queue
+
+    queue = _Queue(_all_names())
+    assert queue.take() == "general/render"  # the longest chain first
+    taken = []
+    while True:  # what another worker gets meanwhile: never a general kind
+        name = queue.todo and next((n for n in queue.todo if not n.startswith("general/")),
+                                   None)
+        if not name:
+            break
+        assert queue.take() == name
+        taken.append(name)
+    assert sorted(taken) == ["plain/adaptive", "plain/aovs", "plain/caustics", "stefan"]
+    queue.finish("general/render", 12.5)
+    assert queue.take() == "general/caustics"
+
+
+def test_a_failed_general_render_kernel_fails_its_kinds_without_compiling_them():
+    from whitted.cli.warm import _Queue
+
+    queue = _Queue(["general/render", "general/aovs", "plain/aovs"])
+    assert queue.take() == "general/render"
+    assert queue.take() == "plain/aovs"
+    queue.finish("general/render", None, "boom")
+    assert queue.take() is None
+    assert queue.failed == {"general/render", "general/aovs"} and queue.errors == ["boom"]
+
+
+def test_a_worker_answers_each_name_it_reads_with_one_line():
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
+    result = subprocess.run([sys.executable, "-m", "whitted", "warm", "--serve"],
+                            input="plain/render\n\nplain/render\n", capture_output=True,
+                            text=True, timeout=900, env=env)
+    assert result.returncode == 0, result.stderr
+    lines = [json.loads(line) for line in result.stdout.splitlines()]
+    assert [entry["name"] for entry in lines] == ["plain/render", "plain/render"]
+    assert all(entry["seconds"] >= 0 for entry in lines)

@@ -15,7 +15,6 @@ from whitted.compile.bvh import MAX_DEPTH, build_bvh
 from whitted.compile.scene import compile_scene
 from whitted.compile.wide_bvh import wide_nodes
 from whitted.kernels.accel import closest_hit, hit_analytic
-from whitted.kernels.intersect import INF
 from whitted.kernels.layout import (
     BVH_STACK,
     MESH_STACK_BASE,
@@ -25,6 +24,7 @@ from whitted.kernels.layout import (
     WIDE_ROWS,
 )
 from whitted.kernels.lighting import any_occluder
+from whitted.kernels.shapes import INF
 
 
 def _walk(wide):

@@ -5,6 +5,8 @@ A thin client: the physics is :mod:`whitted.stefan`, the rendering the render AP
 
 from __future__ import annotations
 
+import math
+import os
 import sys
 import time
 from pathlib import Path
@@ -151,7 +153,9 @@ def validate(
 ) -> None:
     """Check the solver against exact answers and print the tables: Neumann's lambda, front
     error against cell size, the axes, the cavity's convection, the flow solver on de Vahl
-    Davis's square cavity (32², with --full 32² to 128²), the convective slab, the sphere,
+    Davis's square cavity (32², with --full 32² to 128²) and on the heated cube (24³, with
+    --full 32³ to 64³), gallium melting beside Gau & Viskanta's measured front, the convective
+    slab, the sphere,
     the energy balance."""
     from rich.table import Table
 
@@ -220,6 +224,38 @@ def validate(
                       f"{r['v_error_pct']:+.2f} %")
     out.print(table)
 
+    cubes = (32, 48, 64) if full else (24,)
+    table = Table(title="The flow solver on the differentially heated cube (3-D, Pr 0.71; "
+                  "reference, whitted, error)")
+    for col in ("Ra", "grid", "Nu ref", "Nu (hot wall)", "error", "u_max", "v_max", "steps",
+                "M cell updates/s"):
+        table.add_column(col, justify="right")
+    for r in v.cube_rows(cubes):
+        table.add_row(f"{r['ra']:.0e}", r["grid"], f"{r['nu_ref']:.3f}", f"{r['nu']:.4f}",
+                      f"{r['nu_error_pct']:+.2f} %", f"{r['u_max']:.3f}", f"{r['v_max']:.3f}",
+                      "" if r["steps"] is None else str(r["steps"]),
+                      "" if r["cell_updates_per_s"] is None
+                      else f"{r['cell_updates_per_s'] / 1e6:.1f}")
+    out.print(table)
+    out.print("cube reference: Tric et al. (2000) and Wakashima & Saitoh (2004) as a secondary "
+              "source quotes them (docs/stefan.md); velocity maxima at z = 1/2 in units of "
+              "alpha/L, no reference read")
+
+    table = Table(title="Gallium melting from a heated wall (Gau & Viskanta 1986), 2-D: the "
+                  "melted length over the width (measured, whitted)")
+    for col in ("cells", "t (min)", "top ref", "top", "middle ref", "middle", "bottom ref",
+                "bottom", "melted ref", "melted", "energy (rel.)"):
+        table.add_column(col, justify="right")
+    for mm, last in (((4.0, None), (2.0, None)) if full else ((4.0, 3),)):
+        for r in v.gallium_rows(mm, last=last):
+            table.add_row(r["cells"], f"{r['minutes']:.1f}", f"{r['top_ref']:.3f}",
+                          f"{r['top']:.3f}", f"{r['middle_ref']:.3f}", f"{r['middle']:.3f}",
+                          f"{r['bottom_ref']:.3f}", f"{r['bottom']:.3f}",
+                          "-" if math.isnan(r["melted_ref"]) else f"{r['melted_ref']:.3f}",
+                          f"{r['melted']:.3f}",
+                          f"{r['energy_rel']:.1e}")
+    out.print(table)
+
     slab = v.convective_slab()
     out.print(f"convective slab (h = 20 W/m²K, air 20 °C, 3000 s): receded "
               f"{slab['receded_mm']:.4f} mm, h dT t / (rho_i L) = {slab['expected_mm']:.4f} mm, "
@@ -238,6 +274,86 @@ def validate(
         v.plot_front(plot)
         out.print(f"plot -> {plot}")
     out.print(f"({time.perf_counter() - t0:.1f} s)")
+
+
+def _thread_counts(text: str) -> tuple[int, ...]:
+    try:
+        counts = tuple(int(t) for t in text.split(",") if t.strip())
+    except ValueError:
+        counts = ()
+    if not counts or any(c < 1 or c > 1024 for c in counts):
+        raise _fail(f"--threads: {text!r} is not a list of thread counts (e.g. 1,2)")
+    return counts
+
+
+@app.command()
+def bench(
+    cells: Annotated[int, typer.Option("--cells", help="The enthalpy step's grid: the default "
+                                       "case at this many cells a side")] = 64,
+    flow_cells: Annotated[int, typer.Option("--flow-cells", help="The flow solver's cube: "
+                                            "this many cells a side")] = 48,
+    threads: Annotated[str, typer.Option("--threads", "-t",
+                                         help="Thread counts, alternating run by run")] = "1,2",
+    runs: Annotated[int, typer.Option("--runs", "-n", help="Timed runs per thread count")] = 5,
+    steps: Annotated[int, typer.Option("--steps", help="Enthalpy steps a run")] = 200,
+    json_path: Annotated[Path | None, typer.Option("--json", "-o",
+                                                   help="Write the runs (JSON)")] = None,
+) -> None:
+    """The solvers' throughput in cell updates a second (median and best run, per thread,
+    speed-up over one thread): the enthalpy step on the default case without the cavity's
+    convection, and the flow solver on the heated cube. Run it on a quiet machine; the
+    processor and the load average are printed beside the figures."""
+    from rich.table import Table
+
+    from ..stefan import bench as b
+
+    counts = _thread_counts(threads)
+    for option, value, low, high in (("--cells", cells, 8, 400), ("--flow-cells", flow_cells, 8,
+                                                                   256),
+                                     ("--runs", runs, 1, 1000), ("--steps", steps, 1, 100000)):
+        if not low <= value <= high:
+            raise _fail(f"{option}: {value} is outside {low}..{high}")
+    if json_path is not None:
+        from ..output.safety import check_output_place
+
+        try:
+            check_output_place(json_path)
+        except WhittedError as exc:
+            raise _fail(f"--json: {exc}") from None
+    load = b.load_average()
+    usable = (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+              else os.cpu_count())
+    out.print(f"CPU: {b.cpu_name()}; {usable} cores usable; load average "
+              f"{'unknown' if load is None else f'{load:.2f}'}")
+    guard = InterruptGuard(at_once=True)
+    try:
+        with guard:
+            rows = b.measure(cells=cells, flow_cells=flow_cells, threads=counts, runs=runs,
+                             steps=steps)
+    except KeyboardInterrupt:
+        raise guard.exit("the benchmark stopped before its table; nothing written") from None
+    table = Table(title="Cell updates a second (M), the thread counts alternating run by run")
+    for col in ("solver", "cells", "threads", "median", "best", "per thread", "speed-up"):
+        table.add_column(col, justify="right")
+    one = {r.solver: r.median for r in rows if r.threads == 1}
+    for r in rows:
+        base = one.get(r.solver)
+        table.add_row(r.solver, f"{r.cells:,}", str(r.threads), f"{r.median / 1e6:.1f}",
+                      f"{r.best / 1e6:.1f}", f"{r.per_thread / 1e6:.1f}",
+                      "" if base is None else f"{r.median / base:.2f}x")
+    out.print(table)
+    load = b.load_average()
+    out.print(f"load average after: {'unknown' if load is None else f'{load:.2f}'}")
+    if json_path is not None:
+        import json
+
+        from ..files.atomic import atomic_write
+
+        data = {"cpu": b.cpu_name(), "rows": [
+            {"solver": r.solver, "cells": r.cells, "threads": r.threads, "steps": r.steps,
+             "cell_updates_per_s": r.runs} for r in rows]}
+        atomic_write(json_path, lambda tmp: Path(tmp).write_text(json.dumps(data, indent=1)))
+        out.print(f"wrote {json_path}")
 
 
 def _check_film_options(case_path: Path, output: Path, gif: Path | None, width: int,

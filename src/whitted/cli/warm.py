@@ -4,9 +4,12 @@ compile.
 
 The default scene's kernels (with the scene builders and the OBJ reader) come first, in this
 process and its compile helper (both cores); then the other variants (render/variants.py) and
-the Stefan solver's kernels are shared among ``--jobs`` processes (one per core), each
-compiling its share into the same cache (jit/cache.py keeps them consistent). A variant
-already in the cache loads in a fraction of a second, so a second ``whitted warm`` is quick.
+the Stefan solver's kernels are handed out, one at a time, to ``--jobs`` worker processes (one
+per core), each compiling into the same cache (jit/cache.py keeps it consistent). A kind of
+the general kernels (caustics, adaptive anti-aliasing, AOVs) is handed out only once the
+general render kernel is in the cache: it shares that kernel's callees, which it then loads
+instead of compiling them a second time in another process. A variant already in the cache
+loads in a fraction of a second, so a second ``whitted warm`` is quick.
 """
 
 from __future__ import annotations
@@ -14,6 +17,8 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import tempfile
+import threading
 import time
 from typing import Annotated
 
@@ -31,18 +36,124 @@ def _all_names() -> list[str]:
     return [n for n in variant_names() if n != "plain/render"] + [STEFAN]
 
 
-def _warm_here(names: list[str]) -> None:
-    """Warm ``names`` in this process, one JSON line per name on stdout."""
+def _first(name: str) -> str | None:
+    """The variant that must be in the cache before ``name`` is compiled: the render kernel
+    of its geometry, whose callees it shares (plain/render is compiled before any)."""
+    geometry, _, kind = name.partition("/")
+    return None if name == STEFAN or kind == "render" or geometry == "plain" else \
+        f"{geometry}/render"
+
+
+def _order(names: list[str]) -> list[str]:
+    """The order variants are handed out in: the longest chain (the general render kernel,
+    then its kinds, caustics the biggest) first, the rest filling the other cores."""
+    def rank(name: str) -> tuple[int, int]:
+        geometry, _, kind = name.partition("/")
+        kinds = ("render", "caustics", "adaptive", "aovs")
+        return (0 if geometry not in ("plain", STEFAN) else 1,
+                kinds.index(kind) if kind in kinds else len(kinds))
+    return sorted(names, key=rank)
+
+
+def _warm_one(name: str) -> float:
+    if name == STEFAN:
+        from ..stefan.warm import warm_stefan_kernels
+
+        return warm_stefan_kernels()
     from ..render.variants import warm_variant
 
-    for name in names:
-        if name == STEFAN:
-            from ..stefan.warm import warm_stefan_kernels
+    return warm_variant(name)
 
-            seconds = warm_stefan_kernels()
-        else:
-            seconds = warm_variant(name)
-        print(json.dumps({"name": name, "seconds": seconds}), flush=True)
+
+def _warm_here(names: list[str]) -> None:
+    """Warm ``names`` in this process, one JSON line per name on stdout."""
+    for name in names:
+        print(json.dumps({"name": name, "seconds": _warm_one(name)}), flush=True)
+
+
+def _serve() -> None:
+    """A worker of ``whitted warm``: warm each name read from stdin (one a line), answering
+    each with its JSON line, until stdin ends."""
+    for line in sys.stdin:
+        name = line.strip()
+        if name:
+            print(json.dumps({"name": name, "seconds": _warm_one(name)}), flush=True)
+
+
+class _Queue:
+    """The variants left, handed out in order, each once the variant it needs is done."""
+
+    def __init__(self, names: list[str]) -> None:
+        self.todo = _order(names)
+        self.done: set[str] = {"plain/render"}
+        self.failed: set[str] = set()
+        self.times: dict[str, float] = {}
+        self.errors: list[str] = []
+        self._changed = threading.Condition()
+
+    def take(self) -> str | None:
+        """The next variant ready to compile, waiting while every one left waits for another
+        in progress; None when none is left (or what is left cannot be done)."""
+        with self._changed:
+            while self.todo:
+                for name in self.todo:
+                    first = _first(name)
+                    if first in self.failed:  # what it needs failed: it fails with it
+                        self.todo.remove(name)
+                        self.failed.add(name)
+                        break
+                    if first is None or first in self.done:
+                        self.todo.remove(name)
+                        return name
+                else:
+                    self._changed.wait()
+            return None
+
+    def finish(self, name: str, seconds: float | None, error: str = "") -> None:
+        with self._changed:
+            if seconds is None:
+                self.failed.add(name)
+                if error:
+                    self.errors.append(error)
+            else:
+                self.done.add(name)
+                self.times[name] = seconds
+            self._changed.notify_all()
+
+
+def _work(queue: _Queue, procs: list[subprocess.Popen]) -> None:
+    """Feed one worker process from the queue until nothing is left or it fails."""
+    # its stderr read only if it fails (a pipe could fill up while nobody reads it)
+    with tempfile.TemporaryFile("w+") as stderr:
+        proc = subprocess.Popen([sys.executable, "-m", "whitted", "warm", "--serve"],
+                                stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=stderr,
+                                text=True)
+        procs.append(proc)
+        assert proc.stdin is not None and proc.stdout is not None
+        try:
+            while (name := queue.take()) is not None:
+                try:
+                    proc.stdin.write(name + "\n")
+                    proc.stdin.flush()
+                except OSError:
+                    line = ""
+                else:
+                    line = proc.stdout.readline()
+                try:
+                    entry = json.loads(line)
+                    queue.finish(name, float(entry["seconds"]))
+                except (ValueError, KeyError, TypeError):  # the worker failed on it
+                    proc.kill()
+                    proc.wait()
+                    stderr.seek(0)
+                    lines = stderr.read().strip().splitlines()
+                    queue.finish(name, None, lines[-1] if lines else
+                                 f"{name}: exit status {proc.returncode}")
+                    return
+        finally:
+            if proc.poll() is None:
+                proc.stdin.close()
+                proc.wait()
 
 
 @app.command()
@@ -51,10 +162,15 @@ def warm(
         "--jobs", "-j", help="Processes compiling at once (0: one per core)")] = 0,
     variants: Annotated[list[str] | None, typer.Option(
         "--variant", hidden=True, help="Only these (a process of the command's own)")] = None,
+    serve: Annotated[bool, typer.Option(
+        "--serve", hidden=True, help="A worker of the command: names on stdin")] = False,
 ) -> None:
     """Compile every kernel variant (CSG and tori, mesh instances, caustics, adaptive
     anti-aliasing, AOVs, the Stefan solver, the OBJ reader) into the kernel cache, so that
     no later command waits for a first compile."""
+    if serve:
+        _serve()
+        return
     if variants:
         known = set(_all_names()) | {"plain/render"}
         unknown = [v for v in variants if v not in known]
@@ -70,36 +186,32 @@ def warm(
     jobs = jobs or available_threads()
     start = time.perf_counter()
     err.line("compiling the default scene's kernels (the first time: both cores)")
-    times = {"plain/render": warm_up_kernels()}
+    first = warm_up_kernels()
     names = _all_names()
-    shares = [names[i::jobs] for i in range(min(jobs, len(names)))]
-    err.line(f"compiling {len(names)} more variants in {len(shares)} process"
-             f"{'es' * (len(shares) > 1)}")
-    procs = [subprocess.Popen(
-        [sys.executable, "-m", "whitted", "warm", *sum((["--variant", n] for n in share), [])],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for share in shares]
-    failed = []
+    queue = _Queue(names)
+    queue.times["plain/render"] = first
+    workers = min(jobs, len(names))
+    err.line(f"compiling {len(names)} more variants in {workers} process"
+             f"{'es' * (workers > 1)}")
+    procs: list[subprocess.Popen] = []
+    threads = [threading.Thread(target=_work, args=(queue, procs), daemon=True,
+                                name=f"whitted-warm-{i}") for i in range(workers)]
     try:
-        for proc in procs:
-            stdout, stderr = proc.communicate()
-            for line in stdout.splitlines():
-                try:
-                    entry = json.loads(line)
-                except ValueError:
-                    continue
-                times[entry["name"]] = entry["seconds"]
-            if proc.returncode != 0:
-                failed.append(stderr.strip().splitlines()[-1] if stderr.strip() else
-                              f"exit status {proc.returncode}")
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            while thread.is_alive():
+                thread.join(0.2)  # a timeout: Ctrl-C reaches this thread
     finally:
-        for proc in procs:
+        for proc in list(procs):
             if proc.poll() is None:
                 proc.kill()
                 proc.wait()
     for name in ["plain/render", *names]:
-        if name in times:
-            out.line(f"{name:28} {times[name]:7.2f} s")
+        if name in queue.times:
+            out.line(f"{name:28} {queue.times[name]:7.2f} s")
     total = time.perf_counter() - start
-    if failed:
-        raise fail(f"a compile failed: {failed[0]}")
+    if queue.failed:
+        reason = queue.errors[0] if queue.errors else sorted(queue.failed)[0]
+        raise fail(f"a compile failed: {reason}")
     out.line(f"every kernel is in the cache: {total:.1f} s")

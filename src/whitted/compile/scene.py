@@ -199,9 +199,10 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
     prim_info[:, PRIM_FLIP] = prim_flip
     prim_info[:, PRIM_MEDIUM] = prim_medium
     node_box, node_link = packed_nodes(bvh, np.float64)
-    # float32 marks a scene without instances: kernels specialised for it (features.py)
-    inst_box, inst_link = packed_nodes(
-        inst_bvh, np.float64 if len(instances) else NO_INSTANCES_DTYPE)
+    # a scene with mesh instances or with tori or CSG objects runs the general kernels
+    # (float64 inst_box, int64 unbounded); one with neither the plain ones (features.py)
+    general = len(instances) > 0 or bool((prim_type >= FIRST_EXTRA_SHAPE).any())
+    inst_box, inst_link = packed_nodes(inst_bvh, np.float64 if general else NO_INSTANCES_DTYPE)
     mat_table = np.array(materials.rows, dtype=np.float64).reshape(len(materials.rows),
                                                                     N_MAT_PARAMS)
     tracer = meshes.tracer or "whitted"
@@ -216,9 +217,7 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
         node_link=node_link,
         node_wide=wide_nodes(bvh),
         node_prims=np.ascontiguousarray(bounded[bvh.prim_order], dtype=np.int32),
-        # int64 selects the kernels compiled with tori and CSG (features.py)
-        unbounded=unbounded.astype(
-            EXTRAS_DTYPE if (prim_type >= FIRST_EXTRA_SHAPE).any() else np.int32),
+        unbounded=unbounded.astype(EXTRAS_DTYPE if general else np.int32),
         inst_box=inst_box,
         inst_link=inst_link,
         inst_prims=np.ascontiguousarray(instances[inst_bvh.prim_order], dtype=np.int32),

@@ -71,6 +71,8 @@ KERNEL_FILES = ("jit/decorators.py", "jit/dispatcher.py")
 #: the list of sums in the cache folder
 SUMS = "whitted-sums.json"
 LOCK = "whitted.lock"
+#: the lock a process holds while it compiles a variant of the render kernels cold
+COMPILE_LOCK = "whitted-compile-"
 #: the marker a process holds while it has compiled files not yet in the list
 COMPILING = "whitted-compiling-"
 #: what Numba writes into the cache folder
@@ -208,16 +210,38 @@ class KernelCache:
                     self._release()
 
     def _acquire(self) -> None:
+        self._file_lock = self._take(LOCK)
+
+    def _take(self, name: str):
+        """The lock file ``name`` in the folder, acquired (None: not waited for longer, or
+        it cannot be made)."""
         from filelock import Timeout
 
-        lock = _file_lock(os.path.join(self.folder, LOCK), LOCK_WAIT_SECONDS)
+        lock = _file_lock(os.path.join(self.folder, name), LOCK_WAIT_SECONDS)
         try:
             lock.acquire(poll_interval=0.05)
         except Timeout:
-            return  # a process holding it this long is not waited for
+            return None  # a process holding it this long is not waited for
         except (OSError, NotImplementedError):
-            return  # it cannot be made, or a file system without locks
-        self._file_lock = lock
+            return None  # it cannot be made, or a file system without locks
+        return lock
+
+    @contextlib.contextmanager
+    def compile_lock(self, variant: str):
+        """Held by one process at a time while it compiles the kernels of ``variant`` cold
+        (render/warm_up.py): a second process that needs them waits, then loads them.
+        Apart from :meth:`locked` (held only to check and seal), so that processes
+        compiling other variants at the same time (``whitted warm``) seal theirs
+        meanwhile."""
+        if self.folder is None or self.helper or self.read_only:
+            yield
+            return
+        lock = self._take(f"{COMPILE_LOCK}{variant}")
+        try:
+            yield
+        finally:
+            if lock is not None:
+                lock.release()
 
     def _release(self) -> None:
         lock, self._file_lock = self._file_lock, None
@@ -355,6 +379,8 @@ class KernelCache:
                     continue
                 if entry is None and not damaged_list and not self.own:
                     continue  # another program's file in the user's NUMBA_CACHE_DIR
+                if entry is None and not damaged_list and rewriting:
+                    continue  # new, from a process compiling now: it seals it
                 if entry is not None and (entry[2:] == [st.st_ino] or not rewriting):
                     damaged += 1  # changed in place, or by no process compiling: damage
                 # else a new file under a sealed name while another process compiles (its
@@ -455,6 +481,10 @@ class KernelCache:
                     continue
                 sums[name] = [digest, st.st_size, st.st_ino]
                 self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
+                # a file verify() left for later and Numba (here or in the compile helper)
+                # has since written anew: sealed with its new content, so its kernel's first
+                # look-up must not take it for damage and compile it a second time
+                self._deferred.pop(name, None)
                 changed = True
             if changed or damaged_list:
                 self._write_sums(sums)

@@ -61,6 +61,9 @@ _swapped = False  # dispatchers put in the kernels' globals (before the first co
 _swapping = False
 _deferred: list = []  # registrations waiting for Numba: callables, run in order
 _defining_modules: set[str] = set()  # modules that defined kernels (swapped by load_numba)
+#: globals of functions made outside a module (kernels/strict.py's twins), swapped like a
+#: module's before the first compile
+_namespaces: list[dict] = []
 #: every kernel made, by its Python function, and every overload registered, by the function
 #: it implements: (implementation, options) (kernels/strict.py makes IEEE twins from them)
 kernels_by_function: dict = {}
@@ -172,14 +175,29 @@ def _whitted_modules() -> set[str]:
 def _swap_in_globals(names: set[str]) -> None:
     for name in names:
         module = sys.modules.get(name)
-        if module is None:
-            continue
-        namespace = vars(module)
-        for key, value in list(namespace.items()):
-            if isinstance(value, Kernel) and not value.entry:
-                namespace[key] = value.dispatcher
-            elif isinstance(value, NumbaObject):
-                namespace[key] = value.resolve()
+        if module is not None:
+            _swap_in_namespace(vars(module))
+    while _namespaces:
+        _swap_in_namespace(_namespaces.pop())
+
+
+def _swap_in_namespace(namespace: dict) -> None:
+    for key, value in list(namespace.items()):
+        if isinstance(value, Kernel) and not value.entry:
+            namespace[key] = value.dispatcher
+        elif isinstance(value, NumbaObject):
+            namespace[key] = value.resolve()
+
+
+def kernels_in_globals(namespace: dict) -> None:
+    """Have the kernels in ``namespace`` (the globals of a function made outside a module,
+    which calls them) swapped for their dispatchers as a module's are: before Numba's first
+    compile in the process, or now if that has begun."""
+    with _lock:
+        if _swapped:
+            _swap_in_namespace(namespace)
+        else:
+            _namespaces.append(namespace)
 
 
 class Kernel:

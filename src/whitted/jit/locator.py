@@ -17,8 +17,13 @@ versions (the folder's name too) and the CPU (Numba's index keys each entry by t
 and features). Other functions are left to Numba's own locators, in Numba's order.
 
 It is chosen through Numba's ``NUMBA_CACHE_LOCATOR_CLASSES`` setting (a list of locator
-classes, tried in order; jit/cache.py sets it), subclassing Numba's public
-``UserProvidedCacheLocator``: no undocumented name. It also checks that a folder can be
+classes, tried in order; jit/cache.py sets it), documented in Numba's reference of
+environment variables since 0.62, which allows "custom locator classes ... using their full
+module path". It subclasses ``numba.core.caching.UserProvidedCacheLocator`` (the locator
+Numba uses for ``NUMBA_CACHE_DIR``, a public name since 0.62) and overrides only the methods
+of the locator interface (``from_function``, ``get_cache_path``, ``ensure_cache_path``),
+which Numba describes in its source rather than its user manual; it reads none of Numba's
+private attributes. It also checks that a folder can be
 written once per process rather than once per dispatcher (Numba writes a temporary file each
 time), and takes a read-only warm folder (jit/cache.py ``KernelCache.read_only``) without
 that check, for loading only.
@@ -63,8 +68,12 @@ class KernelLocator(UserProvidedCacheLocator):
     def __init__(self, py_func, py_file):
         super().__init__(py_func, py_file)
         # one level, as jit/cache.py checks the folder's files one level down
-        self._cache_path = os.path.join(config.CACHE_DIR,
-                                        package_folder(py_file).replace("/", "."))
+        self._whitted_path = os.path.join(config.CACHE_DIR,
+                                          package_folder(py_file).replace("/", "."))
+
+    def get_cache_path(self):
+        """The folder of the function's cache files (the locator interface's method)."""
+        return self._whitted_path
 
     @classmethod
     def from_function(cls, py_func, py_file):

@@ -20,7 +20,6 @@ from .extras import (
     flipped_if_extras,
 )
 from .features import has_extras, has_instances, instances_possible
-from .intersect import INF, intersect_local, normal_local
 from .layout import (
     FIRST_EXTRA_SHAPE,
     MAT_KT,
@@ -33,6 +32,8 @@ from .layout import (
     TRIANGLE_NORMALS,
 )
 from .mesh import OPAQUE_KT, mesh_closest_hit, mesh_occlusion
+from .shapes import INF
+from .shapes.dispatch import intersect_local, normal_local
 from .shapes.mesh import mesh_normals
 from .shapes.triangle import triangle_shading_normal
 from .traverse import (
@@ -132,7 +133,7 @@ def world_normal(geo, i, p):
 
 
 def mesh_normals_if_instances(geo, mesh, tri, b1, b2):
-    """:func:`.mesh.mesh_normals`, never compiled for scenes without instances (see
+    """:func:`.shapes.mesh.mesh_normals`, never compiled for scenes without instances (see
     features.py)."""
     return mesh_normals(geo, mesh, tri, b1, b2)
 

@@ -45,7 +45,6 @@ import numpy as np
 
 from ..jit import kernel, numba_object
 from .hit_list import keep_nearest
-from .intersect import INF, frustum_crossings, normal_local
 from .layout import (
     CSG_DIFFERENCE,
     CSG_INTERSECTION,
@@ -54,17 +53,12 @@ from .layout import (
     MESH_TRI_OFFSET,
     PRIM_TYPE,
     PRIM_XFORM,
-    SHAPE_BOX,
     SHAPE_CSG_MESH,
     SHAPE_CSG_OP,
-    SHAPE_FRUSTUM,
-    SHAPE_SPHERE,
-    SHAPE_TORUS,
 )
 from .mesh import mesh_closest_hit
-from .shapes.box import box_span
-from .shapes.sphere import sphere_span
-from .shapes.torus import torus_crossings, torus_normal
+from .shapes import INF
+from .shapes.dispatch import has_crossings, solid_crossings, solid_normal
 from .shapes.triangle import intersect_triangle
 from .traverse import inverse_direction, slab_entry
 from .vec import dot, madd
@@ -116,27 +110,7 @@ def leaf_crossings(geo, j, o, d):
     xf = geo.prim_info[j, PRIM_XFORM]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
-    typ = geo.prim_info[j, PRIM_TYPE]
-    P = geo.prim_params
-    t2 = INF
-    t3 = INF
-    if typ == SHAPE_TORUS:
-        t0, t1, t2, t3 = torus_crossings(P, j, o, d)
-    elif typ == SHAPE_SPHERE:
-        t0, t1 = sphere_span(P, j, o, d)
-    elif typ == SHAPE_BOX:
-        t0, t1 = box_span(P, j, o, d)
-    else:  # the frustum: convex, so the line enters at its first crossing and leaves at its
-        # last; those between are a rim met twice (cap and side, a rounding apart). One
-        # crossing alone (a touch, or one lost to rounding) goes to the walk by normals
-        t0, t1, t2, t3 = frustum_crossings(P, j, o, d)
-        if t1 == INF:
-            return (0 if t0 == INF else 1), t0, INF, INF, INF
-        return 2, t0, (t1 if t2 == INF else (t2 if t3 == INF else t3)), INF, INF
-    if t0 == t1:
-        t0, t1, t2, t3 = t2, t3, INF, INF
-    n = 0 if t0 == INF else (1 if t1 == INF else (2 if t2 == INF else (3 if t3 == INF else 4)))
-    return n, t0, t1, t2, t3
+    return solid_crossings(geo.prim_info[j, PRIM_TYPE], geo.prim_params, j, o, d)
 
 
 @kernel
@@ -146,11 +120,7 @@ def leaf_normal(geo, j, p):
     lp = p
     if xf >= 0:
         lp, _ = to_object(geo.xforms, xf, p, p)
-    typ = geo.prim_info[j, PRIM_TYPE]
-    if typ == SHAPE_TORUS:
-        n = torus_normal(geo.prim_params, j, lp)
-    else:
-        n = normal_local(typ, geo.prim_params, j, lp)
+    n = solid_normal(geo.prim_info[j, PRIM_TYPE], geo.prim_params, j, lp)
     if xf >= 0:
         return normal_to_world(geo.xforms, xf, n)
     return n
@@ -361,15 +331,6 @@ def _crossing(r0, r1, r2, r3, k, c):
 
 
 @kernel(inline="always")
-def _parity_leaf(typ):
-    """Whether a leaf of this shape is walked by the parity of its crossings (a sphere, a
-    box, a torus, a frustum: :func:`leaf_crossings` gives them in entering and leaving
-    pairs, or an odd count that the general walk takes by normals)."""
-    return (typ == SHAPE_SPHERE or typ == SHAPE_BOX or typ == SHAPE_TORUS
-            or typ == SHAPE_FRUSTUM)
-
-
-@kernel(inline="always")
 def _pick(c, x0, x1, x2, x3):
     """``x<c>``, INF past the fourth."""
     if c == 0:
@@ -440,8 +401,8 @@ def _is_pair(geo, root):
     of cuts (:func:`_pair_walk`)?"""
     P = geo.prim_params
     return (P[root, 0] == 3.0 and P[root, 1] == 2.0 and P[root, 10] <= 0.0
-            and _parity_leaf(geo.prim_info[root + 1, PRIM_TYPE])
-            and _parity_leaf(geo.prim_info[root + 2, PRIM_TYPE]))
+            and has_crossings(geo.prim_info[root + 1, PRIM_TYPE])
+            and has_crossings(geo.prim_info[root + 2, PRIM_TYPE]))
 
 
 @kernel

@@ -1,5 +1,6 @@
 """The shapes beyond the core ones (tori, CSG objects), reached from the scene-level queries
-only in kernels compiled for scenes that have them (features.py ``has_extras``).
+only in kernels compiled for scenes that have them (features.py ``has_extras``). A CSG object
+is walked by csg.py; the shapes are asked through shapes/dispatch.py's ``extra_shape_*``.
 
 Each ``*_if_extras`` function is an overload that resolves, while its caller is typed, to the
 real kernel or to a stand-in of the same types, so the kernels of the default scene never
@@ -12,9 +13,9 @@ import numpy as np
 from ..jit import kernel, overload
 from .csg import csg_hit
 from .features import extras_possible
-from .intersect import INF
-from .layout import PRIM_FLIP, PRIM_MEDIUM, PRIM_TYPE, SHAPE_CSG, SHAPE_TORUS
-from .shapes.torus import intersect_torus, torus_normal, torus_uv
+from .layout import PRIM_FLIP, PRIM_MEDIUM, PRIM_TYPE, SHAPE_CSG
+from .shapes import INF
+from .shapes.dispatch import extra_shape_normal, extra_shape_t, extra_shape_uv
 from .traverse import inverse_direction
 
 
@@ -23,12 +24,10 @@ def extra_t(geo, i, o, d, tmin, tmax):
     """Nearest visible crossing in (tmin, tmax) of extra shape ``i`` (``o``, ``d`` in its
     row's space)."""
     typ = geo.prim_info[i, PRIM_TYPE]
-    if typ == SHAPE_TORUS:
-        return intersect_torus(geo.prim_params, i, o, d, tmin, tmax)
     if typ == SHAPE_CSG:
         t, _ = csg_hit(geo, i, o, d, inverse_direction(d), tmin, tmax)
         return t
-    return INF
+    return extra_shape_t(typ, geo.prim_params, i, o, d, tmin, tmax)
 
 
 def extra_t_if_extras(geo, i, o, d, tmin, tmax):
@@ -57,9 +56,7 @@ def _csg_hit_if_extras(geo, i, o, d, inv, tmin, tmax):
 def extra_normal(geo, i, p, n):
     """Outward normal of extra shape ``i`` at ``p`` (its row's space); ``n``: the core
     shapes' answer, kept for the others."""
-    if geo.prim_info[i, PRIM_TYPE] == SHAPE_TORUS:
-        return torus_normal(geo.prim_params, i, p)
-    return n
+    return extra_shape_normal(geo.prim_info[i, PRIM_TYPE], geo.prim_params, i, p, n)
 
 
 def extra_normal_if_extras(geo, i, p, n):
@@ -113,9 +110,7 @@ def _body_medium(geo, i, m):
 
 @kernel
 def extra_uv(geo, i, p):
-    if geo.prim_info[i, PRIM_TYPE] == SHAPE_TORUS:
-        return torus_uv(geo.prim_params, i, p)
-    return 0.0, 0.0
+    return extra_shape_uv(geo.prim_info[i, PRIM_TYPE], geo.prim_params, i, p)
 
 
 def extra_uv_if_extras(geo, i, p):

@@ -13,9 +13,18 @@ the ``*_if_instances`` functions (in accel.py, lighting.py and uv.py): overloads
 while the caller is typed, to the real kernel or to a stand-in returning the same types. The
 default scene's cold compile then never compiles the mesh kernels (2 s of it).
 
-The same way, scenes with tori or CSG objects get ``unbounded`` as int64 (int32 otherwise),
-and :func:`has_extras` is the constant False in the kinds without: the torus's quartic and
-the CSG walk (kernels/extras.py) stay out of the default scene's kernels and cold compile.
+The same way, ``unbounded`` as int64 (int32 otherwise) makes :func:`has_extras` the
+constant True, and int32 the constant False: the torus's quartic and the CSG walk
+(kernels/extras.py) stay out of the default scene's kernels and cold compile.
+
+There are two kinds, not four: compile/scene.py gives a scene with mesh instances, with tori
+or CSG objects, or with both the *general* kernels (float64 ``inst_box``, int64
+``unbounded``: the instance walks behind a run-time test of the instance count, the extra
+shapes behind their primitive types), and a scene with neither the *plain* ones. Measured
+side by side (docs/performance.md, the variant table): the kernels specialised for instances
+only or for extras only were within 3 % of the general ones on the scenes they served, and
+each cost a full compile of the render kernels; the plain ones are 4-12 % faster than the
+others on the scenes without either, so they stay.
 """
 
 from __future__ import annotations

@@ -19,7 +19,6 @@ from .csg import csg_surfaces
 from .extras import body_medium
 from .features import extras_possible, has_extras, has_instances, instances_possible
 from .hit_list import keep_nearest
-from .intersect import INF
 from .layout import (
     CELL_COUNT,
     CELL_FIRST,
@@ -60,6 +59,7 @@ from .light_buffer import cube_cell
 from .media import absorbed, media_enter, media_leave
 from .mesh import OPAQUE_KT
 from .sampling import concentric_disk, random_pair, stratum
+from .shapes import INF
 from .traverse import (
     box_entry,
     cone_meets_box,

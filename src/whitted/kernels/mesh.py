@@ -20,7 +20,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import kernel, numba_object
-from .intersect import INF
 from .layout import (
     EMBREE_ALL,
     EMBREE_CLEAR,
@@ -36,6 +35,7 @@ from .layout import (
     MESH_ROOT,
     MESH_TRI_OFFSET,
 )
+from .shapes import INF
 from .shapes.mesh import intersect_mesh_triangle, shear_setup
 from .traverse import slab_entry
 

@@ -16,7 +16,10 @@ left: the same on one machine; docs/caustics.md.)
 
 A twin is a copy of the kernel's Python function with its own globals, where each kernel it
 calls is that kernel's twin and each function with an overload (jit/decorators.py ``overload``)
-a copy whose overload builds its lambdas with twinned globals. A twin's name ends in
+a copy whose overload builds its lambdas with twinned globals. The twins in those globals get
+their Numba dispatchers as a module's kernels do, before Numba's first compile in the process
+(jit/decorators.py ``kernels_in_globals``): loading the tracer from the cache makes one
+dispatcher, not one per kernel it calls (each with its cache files looked up). A twin's name ends in
 ``__ieee`` (its cache files are its own) and its options are the kernel's with
 ``fastmath=False``.
 """
@@ -86,10 +89,12 @@ def _twin_globals(f, copy) -> None:
             g[name] = value = value.resolve()
         kern = _kernel_of(value)
         if kern is not None:
-            twin = _twin_kernel(kern)
-            g[name] = twin if twin.entry else twin.dispatcher
+            g[name] = _twin_kernel(kern)
         elif callable(value) and value in jit.overloads_by_function:
             g[name] = _twin_overloaded(value)
+    # the twins' dispatchers are made only if Numba compiles (jit/decorators.py): a process
+    # that loads the tracer from the cache never makes the 120-odd of its callees
+    jit.kernels_in_globals(g)
 
 
 def _twin_kernel(kern):

@@ -12,8 +12,8 @@ import math
 import numpy as np
 
 from ..jit import kernel
-from .intersect import INF
 from .layout import WIDE, WIDE_COUNT, WIDE_LINK
+from .shapes import INF
 
 TINY_DIRECTION = 1e-30  # stands in for a zero direction component in the slab test
 

@@ -1,9 +1,9 @@
 """Every variant of the render kernels a scene can reach, each compiled (or loaded) by
 rendering a tiny scene that needs it: what ``whitted warm`` compiles ahead of use.
 
-The render kernels are specialised on a scene's arrays (kernels/features.py): with or
-without mesh *instances*, with or without *extras* (tori, CSG objects), and the render kernel
-has three kinds: plain, with *caustics* (a photon map in the lights) and with *adaptive*
+The render kernels are specialised on a scene's arrays (kernels/features.py): *plain* (no mesh
+instances, no tori or CSG objects) or *general* (either or both), and the render kernel has
+three kinds: plain, with *caustics* (a photon map in the lights) and with *adaptive*
 anti-aliasing; the AOV kernel (depth, normal, id) is one more. Focal blur, area lights,
 textures and media are run-time choices inside these kernels, compiled with them.
 """
@@ -13,9 +13,9 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-#: (instances, extras) x kind, in the order ``whitted warm`` compiles them
-GEOMETRY = {"plain": (False, False), "extras": (False, True), "instances": (True, False),
-            "instances+extras": (True, True)}
+#: the tiny scene of each kind of geometry: (with a mesh instance, with a torus); compile/
+#: scene.py gives either or both the general kernels
+GEOMETRY = {"plain": (False, False), "general": (True, True)}
 KINDS = ("render", "caustics", "adaptive", "aovs")
 
 

@@ -14,7 +14,7 @@ loads what it made. Whatever the
 helper did not finish is compiled here, so the result never depends on the helper: it only
 saves time. The AOV kernel (depth, normal and object-id images) is compiled when first used.
 
-A marker file in the cache folder (``whitted-ready-plain`` / ``whitted-ready-instances``)
+A marker file in the cache folder (``whitted-ready-plain`` / ``whitted-ready-general``)
 records that a variant is complete there, so a warm start starts no helper.
 
 While a cold compile runs, :func:`compile_progress` says how far along it is (functions
@@ -58,12 +58,13 @@ _ready: set[tuple[bool, bool]] = set()
 _builders_ready = False
 HELPER_WAIT_SECONDS = 120.0  # a helper still busy after this is stopped (never expected)
 #: functions Numba compiles in a cold compile of each variant, this process and the helper
-#: together (counted on the 2-core VM: 88 + 73 for the plain variant; 26 + 26 for the
-#: instance variant once the plain one is cached, as the render API compiles the plain
-#: variant first; each kernel other kernels call counts once, as its twin). Only the
-#: progress shown depends on it: a count that drifted (kernels changed, a different split
-#: between the processes) makes the fraction approximate.
-EXPECTED_COMPILES = {False: 161, True: 52}
+#: together (counted on the 2-core VM: 88 + 73 for the plain variant; for the general one
+#: once the plain one is cached, as the render API compiles the plain variant first, about
+#: 150: 119 counted for the kernels with tori and CSG, 33 more for those with instances,
+#: when they were variants of their own; each kernel other kernels call counts once, as its
+#: twin). Only the progress shown depends on it: a count that drifted (kernels changed, a
+#: different split between the processes) makes the fraction approximate.
+EXPECTED_COMPILES = {False: 161, True: 150}
 TINY_OBJ = b"""v 0 0 0
 v 1 0 0
 v 0 1 0
@@ -76,26 +77,29 @@ f 1/1/1 2/2/1 3/3/1
 
 
 def kernel_variant(compiled: CompiledScene) -> bool:
-    """True for the variant of the kernels compiled for scenes with mesh instances."""
+    """True for the general variant of the kernels (scenes with mesh instances, tori or CSG
+    objects: kernels/features.py), False for the plain one."""
     return compiled.geometry.inst_box.dtype == np.float64
 
 
 def _loaded_key(compiled: CompiledScene | None) -> tuple[bool, bool]:
-    """Which render kernel a scene like ``compiled`` runs: (with mesh instances, with tori or
-    CSG objects). Each is its own specialisation, loaded (or compiled) by the warm-up, not by
-    the render's first call, whose time would then include it."""
+    """Which render kernel a scene like ``compiled`` runs: (with mesh instances possible,
+    with tori or CSG objects possible): (False, False) plain, (True, True) general. Each is
+    its own specialisation, loaded (or compiled) by the warm-up, not by the render's first
+    call, whose time would then include it."""
     if compiled is None:
         return False, False
     return kernel_variant(compiled), compiled.geometry.unbounded.dtype == np.dtype(EXTRAS_DTYPE)
 
 
 def stand_in_scene(instances: bool) -> CompiledScene:
-    """Arrays with no geometry but the types of a compiled scene of the given variant: enough
-    to compile the render kernels without running any builder."""
+    """Arrays with no geometry but the types of a compiled scene of the given variant (True:
+    the general one): enough to compile the render kernels without running any builder."""
     compiled = compile_scene(Scene())
     if instances:
         geometry = compiled.geometry._replace(
-            inst_box=compiled.geometry.inst_box.astype(np.float64))
+            inst_box=compiled.geometry.inst_box.astype(np.float64),
+            unbounded=compiled.geometry.unbounded.astype(EXTRAS_DTYPE))
         compiled = dataclasses.replace(compiled, geometry=geometry)
     return compiled
 
@@ -146,7 +150,7 @@ def _marker(instances: bool) -> Path | None:
     folder = prepare().folder
     if folder is None:
         return None
-    return Path(folder) / ("whitted-ready-instances" if instances else "whitted-ready-plain")
+    return Path(folder) / ("whitted-ready-general" if instances else "whitted-ready-plain")
 
 
 def kernels_cached(instances: bool = False) -> bool:
@@ -388,7 +392,8 @@ def warm_up_kernels(compiled: CompiledScene | None = None,
             _compile_render_kernels(compiled if compiled is not None
                                     else stand_in_scene(instances), aovs=False)
         else:
-            with cache.locked():  # a second cold render waits here, then loads
+            # a second cold render of the variant waits here, then loads
+            with cache.compile_lock("general" if instances else "plain"):
                 if marker is not None and marker.exists():  # another process compiled it
                     _compile_render_kernels(compiled if compiled is not None
                                             else stand_in_scene(instances), aovs=False)
@@ -461,7 +466,8 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
     if delegated and KernelCache is not None:
         KernelCache.wait_for_helper = count.wait_for_helper
     _progress = count
-    report = CompileReport("the instance kernels" if instances else "the kernels",
+    report = CompileReport("the kernels for instances, tori and CSG" if instances
+                           else "the kernels",
                            compile_progress)
     try:
         with report, _CountCompiles(count), _interrupt_at_safe_points(count):

@@ -54,9 +54,9 @@ TINY = 1e-300  # keeps 0/0 out of the harmonic mean of two zero conductivities
 @builder(entry=False, error_model="numpy", numba_inline=True)
 def _temperature(h, p):
     if h < 0.0:
-        return h / p[P_CI]
+        return h * (1.0 / p[P_CI])
     if h > p[P_HL]:
-        return (h - p[P_HL]) / p[P_CW]
+        return (h - p[P_HL]) * (1.0 / p[P_CW])
     return 0.0
 
 
@@ -66,7 +66,7 @@ def _conductivity(h, p):
         return p[P_KI]
     if h >= p[P_HL]:
         return p[P_KW]
-    return p[P_KI] + h / p[P_HL] * (p[P_KW] - p[P_KI])
+    return p[P_KI] + h * ((p[P_KW] - p[P_KI]) / p[P_HL])
 
 
 @builder(entry=False, error_model="numpy", numba_inline=True)
@@ -75,30 +75,41 @@ def _face(kc, kn, tn, tc):
 
 
 @builder(entry=False, error_model="numpy", numba_inline=True)
-def _state(h, p):
+def _state(h, hl, inv_ci, inv_cw, ki, kw, slope):
     """Temperature and conductivity of a body cell of enthalpy ``h``: ``_temperature`` and
     ``_conductivity`` with every branch computed and selected (the same operations, so the
-    same bits), which lets the compiler vectorise the loops that call it."""
-    hl = p[P_HL]
-    t_ice = h / p[P_CI]
-    t_water = (h - hl) / p[P_CW]
-    k_mushy = p[P_KI] + h / hl * (p[P_KW] - p[P_KI])
+    same bits), which lets the compiler vectorise the loops that call it. The properties
+    come as scalars (:func:`_state_constants`), the divisions as products by reciprocals
+    computed once a plane: a division costs several multiplications' time, and a loop over
+    a plane holds nothing else as slow (the faces' harmonic means aside)."""
+    t_ice = h * inv_ci
+    t_water = (h - hl) * inv_cw
+    k_mushy = ki + h * slope
     t = t_ice if h < 0.0 else (t_water if h > hl else 0.0)
-    k = p[P_KI] if h <= 0.0 else (p[P_KW] if h >= hl else k_mushy)
+    k = ki if h <= 0.0 else (kw if h >= hl else k_mushy)
     return t, k
+
+
+@builder(entry=False, error_model="numpy", numba_inline=True)
+def _state_constants(p):
+    """L per volume, 1/c_i, 1/c_w, k_i, k_w and the mushy slope (k_w - k_i)/L of the property
+    vector, computed as ``_temperature`` and ``_conductivity`` compute them (same bits)."""
+    return (p[P_HL], 1.0 / p[P_CI], 1.0 / p[P_CW], p[P_KI], p[P_KW],
+            (p[P_KW] - p[P_KI]) / p[P_HL])
 
 
 @builder(entry=False, error_model="numpy")
 def _state_plane(H, kind, p, i, T, K):
     """Temperature and conductivity of the cells of plane i, ghosts included (air and ghost
     cells 0): computed from H as a step needs them, never stored for the grid."""
+    hl, inv_ci, inv_cw, ki, kw, slope = _state_constants(p)  # locals: T, K may alias p
     for j in range(H.shape[1]):
         h = H[i, j]
         c = kind[i, j]
         t = T[j]
         kk = K[j]
         for k in range(H.shape[2]):
-            tv, kv = _state(h[k], p)
+            tv, kv = _state(h[k], hl, inv_ci, inv_cw, ki, kw, slope)
             body = c[k] == BODY
             t[k] = tv if body else 0.0
             kk[k] = kv if body else 0.0

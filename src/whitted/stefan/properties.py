@@ -82,11 +82,12 @@ class Properties:
         return self.ice.capacity * min(temperature, 0.0)
 
     def temperature(self, enthalpy: np.ndarray) -> np.ndarray:
-        """Temperature (°C) from enthalpy per volume (vectorised, for analysis and tests)."""
+        """Temperature (°C) from enthalpy per volume (vectorised, for analysis and tests), the
+        kernels' arithmetic to the last bit (a product by the reciprocal capacity)."""
         h = np.asarray(enthalpy, dtype=np.float64)
         hl = self.latent_per_volume
-        return np.where(h < 0.0, h / self.ice.capacity,
-                        np.where(h > hl, (h - hl) / self.water.capacity, 0.0))
+        return np.where(h < 0.0, h * (1.0 / self.ice.capacity),
+                        np.where(h > hl, (h - hl) * (1.0 / self.water.capacity), 0.0))
 
     def liquid_fraction(self, enthalpy: np.ndarray) -> np.ndarray:
         return np.clip(np.asarray(enthalpy, dtype=np.float64) / self.latent_per_volume, 0.0, 1.0)

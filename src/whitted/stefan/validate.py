@@ -259,6 +259,42 @@ def flow_cavity_rows(grids: tuple[int, ...] = (32,), ras: tuple[float, ...] = (1
     return rows
 
 
+def cube_rows(grids: tuple[int, ...] = (24,), ras: tuple[float, ...] = (1e4, 1e5),
+              progress=None) -> list[dict]:
+    """The flow solver on the differentially heated cube (3-D, :data:`flow.CUBE_NU`): the
+    hot wall's mean Nusselt number against the reference, its error, and the velocity
+    maxima on the mid-plane z = 1/2 (no reference: see ``CUBE_NU``); with two grids or more
+    the Richardson extrapolation of the last two (second order, when the cell halves; for
+    another ratio r, f_fine + (f_fine - f_coarse) / (r² - 1))."""
+    from .flow import CUBE_NU, heated_cavity
+
+    rows = []
+    for ra in ras:
+        ref = CUBE_NU[ra]
+        found = []
+        for n in grids:
+            r = heated_cavity(ra, n, dims=3)
+            if progress is not None:
+                progress(ra, n, r)
+            found.append(r)
+            rows.append(_cube_row(ra, f"{n}³", r.nu_wall, r.u_max, r.v_max, ref, r.steps,
+                                  r.seconds, r.cell_updates_per_s))
+        if len(found) >= 2:
+            a, b = found[-2], found[-1]
+            k = (b.cells / a.cells) ** 2 - 1.0
+            ext = [getattr(b, q) + (getattr(b, q) - getattr(a, q)) / k
+                   for q in ("nu_wall", "u_max", "v_max")]
+            rows.append(_cube_row(ra, f"{a.cells}³/{b.cells}³ extrapolated", *ext, ref,
+                                  None, None, None))
+    return rows
+
+
+def _cube_row(ra, grid, nu, u_max, v_max, ref, steps, seconds, rate) -> dict:
+    return {"ra": ra, "grid": grid, "nu": nu, "nu_ref": ref,
+            "nu_error_pct": 100.0 * (nu / ref - 1.0), "u_max": u_max, "v_max": v_max,
+            "steps": steps, "seconds": seconds, "cell_updates_per_s": rate}
+
+
 def _cavity_row(ra, grid, nu, u_max, v_max, ref, steps, seconds) -> dict:
     return {"ra": ra, "grid": grid, "nu": nu, "nu_ref": ref["nu"],
             "nu_error_pct": 100.0 * (nu / ref["nu"] - 1.0), "u_max": u_max,
@@ -320,3 +356,79 @@ def plot_front(path, props: Properties | None = None, dx: float = 0.25e-3,
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
+
+
+#: Gau & Viskanta (1986), "Melting and solidification of a pure metal on a vertical wall",
+#: J. Heat Transfer 108, 174-181: gallium melting from a heated side wall of a cavity 8.89 cm
+#: wide and 6.35 cm high. The measured melt front (distance from the hot wall over the width)
+#: at the top, the middle and the bottom of the cavity against tau = Ste alpha t / W², as the
+#: Lethe project digitised the paper's figure (github.com/chaos-polymtl/lethe,
+#: examples/multiphysics/melting-cavity/melting-cavity.py, with Ste = 0.041 in its
+#: dimensionless_number_calculator.py); tau maps to 2, 3, 4.5, 6, 8, 10, 12.5 and 15 minutes
+#: with gallium's alpha below, which is how the experiment's photographs were timed.
+GAU_VISKANTA = {
+    "tau": (0.00853, 0.01279, 0.01931, 0.02575, 0.03428, 0.04298, 0.0536, 0.06438),
+    "top": (0.11508, 0.18212, 0.28603, 0.31508, 0.38994, 0.50391, 0.61117, 0.72514),
+    "middle": (0.11508, 0.16313, 0.20894, 0.23911, 0.29609, 0.36089, 0.45475, 0.52961),
+    "bottom": (0.1095, 0.12849, 0.14078, 0.16425, 0.21117, 0.22346, 0.26592, 0.26592),
+    # the melted fraction of the cavity, measured (the same file, its own tau values)
+    "melted_tau": (0.00946, 0.01433, 0.02113, 0.02877, 0.03774, 0.04739, 0.05956, 0.07164,
+                   0.08104, 0.09069),
+    "melted": (0.11972, 0.16112, 0.20476, 0.22713, 0.2786, 0.34014, 0.43077, 0.5035, 0.56392,
+               0.61664),
+    "stefan": 0.041,
+}
+#: Gallium as the MOOSE framework's gallium-melting input gives it (idaholab/moose, read
+#: through a code search whose index does not name the file's path): rho 6093 kg/m³,
+#: c 381.5 J/kgK, k 32 W/mK, L 80160 J/kg, mu 1.81 mPa s, beta 1.2e-4 1/K; melting at
+#: 302.93 K, the hot wall at 311.15 K, the cold wall and the initial solid at 301.15 K.
+GALLIUM = {"rho": 6093.0, "c": 381.5, "k": 32.0, "latent": 80160.0, "mu": 1.81e-3,
+           "beta": 1.2e-4, "t_melt": 302.93, "t_hot": 311.15, "t_cold": 301.15,
+           "width": 0.0889, "height": 0.0635}
+
+
+def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None) -> list[dict]:
+    """Gau & Viskanta's gallium melting in 2-D (the flow solver coupled to the enthalpy
+    method, the enthalpy-porosity sink): the melted length along the top, middle and bottom
+    rows of cells (liquid fraction summed, over the width) at the experiment's times, beside
+    the measured front, and the melted fraction of the cavity beside the measured one
+    (interpolated linearly to the same time). ``last``: only the first ``last`` times."""
+    from .flow import MeltFlow
+    from .properties import Phase
+
+    g = GALLIUM
+    phase = Phase(rho=g["rho"], c=g["c"], k=g["k"])
+    props = Properties(ice=phase, water=phase, latent_heat=g["latent"])
+    dx = dx_mm * 1e-3
+    nx = int(round(g["width"] / dx))
+    ny = int(round(g["height"] / dx))
+    dx = g["width"] / nx  # the width exact; the height within half a cell
+    shape = (nx, ny, 1)
+    t_cold = g["t_cold"] - g["t_melt"]
+    H = np.full(shape, props.enthalpy(t_cold, liquid=False))
+    kind = np.ones(shape, dtype=np.uint8)
+    faces = (Faces.adiabatic().set("x-", math.inf, g["t_hot"] - g["t_melt"])
+             .set("x+", math.inf, t_cold))
+    flow = MeltFlow((slice(0, nx), slice(0, ny), slice(0, 1)), dx, props,
+                    viscosity=g["mu"] / g["rho"], expansion=g["beta"])
+    solver = EnthalpySolver(H, kind, dx, props, faces=faces, flow=flow)
+    alpha = phase.diffusivity
+    ref = GAU_VISKANTA
+    taus = ref["tau"][:last]
+    rows = []
+    for i, tau in enumerate(taus):
+        t = tau * g["width"] ** 2 / (ref["stefan"] * alpha)
+        solver.advance(t)
+        f = solver.liquid_fraction()[:, :, 0]
+        row = {"minutes": t / 60.0, "tau": tau, "cells": f"{nx}x{ny}", "dx_mm": dx * 1e3,
+               "melted": float(f.mean()), "speed_mm_s": flow.speed() * 1e3,
+               "energy_rel": solver.energy_error() / solver.heat_in,
+               "melted_ref": float(np.interp(tau, ref["melted_tau"], ref["melted"],
+                                               left=math.nan))}
+        for name, j in (("top", ny - 1), ("middle", ny // 2), ("bottom", 0)):
+            row[name] = float(f[:, j].sum()) / nx
+            row[name + "_ref"] = ref[name][i]
+        rows.append(row)
+        if progress is not None:
+            progress(row)
+    return rows

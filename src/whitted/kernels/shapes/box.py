@@ -83,6 +83,8 @@ def box_normal(P, i, p):
 
 @kernel
 def box_uv(P, i, p):
+    """Per face, the two in-face box coordinates in 0..1 (faces across x: u along z, v along
+    y; across y: u along x, v along z; across z: u along x, v along y)."""
     lp = box_local(P, i, sub(p, vload(P, i, 0)))
     best_k = 0
     best_dist = math.inf

@@ -1,8 +1,8 @@
-"""The sphere: its crossings, its nearest hit and its texture coordinates.
+"""The sphere: its crossings, its nearest hit, its normal and its texture coordinates.
 
 A sphere row (layout.SHAPE_SPHERE) holds its centre 0:3 and radius 3, then the object's x, y,
-z axes in world space (``SPHERE_FRAME``) for its spherical uv. Its normal, (p - c) / r, is
-written in place in ``intersect.normal_local`` (the hottest path: no call).
+z axes in world space (``SPHERE_FRAME``) for its spherical uv: the transform baked in under a
+similarity, else the row is in the object's own space (``PRIM_XFORM``).
 """
 
 from __future__ import annotations
@@ -34,8 +34,19 @@ def intersect_sphere(P, i, o, d, tmin, tmax):
     return nearest_root(dot(d, d), dot(oc, d), dot(oc, oc) - r * r, tmin, tmax)
 
 
+@kernel(inline="always")
+def sphere_normal(P, i, p):
+    """(p - c) / r: ``p`` lies on it, so |p - c| is the radius (no square root). Inlined
+    where the normals are dispatched (the hottest path: no call)."""
+    q = sub(p, vload(P, i, 0))
+    s = 1.0 / P[i, 3]
+    return (q[0] * s, q[1] * s, q[2] * s)
+
+
 @kernel
 def sphere_uv(P, i, p):
+    """Spherical, in the sphere's own frame: u = 0.5 + atan2(x, z)/2π (u = 0.5 faces +z, and
+    grows to the right seen from there), v = 0.5 + asin(y)/π (v = 1 at the +y pole)."""
     r = P[i, 3]
     q = sub(p, vload(P, i, 0))
     x = dot(q, vload(P, i, SPHERE_FRAME)) / r

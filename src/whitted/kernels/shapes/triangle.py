@@ -54,6 +54,13 @@ def triangle_barycentric(P, i, p):
     return (d11 * d20 - d01 * d21) / denom, (d00 * d21 - d01 * d20) / denom
 
 
+@kernel(inline="always")
+def triangle_normal(P, i, p):
+    """The geometric normal (the winding's); a smooth-shaded one's shading normal is
+    :func:`triangle_shading_normal`."""
+    return vload(P, i, 9)
+
+
 @kernel
 def triangle_uv(P, i, p):
     """The corners' uvs (default (0,0), (1,0), (0,1)) blended by barycentric weight."""
