@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from whitted.cli.main import app
@@ -47,3 +49,25 @@ def test_the_bench_json_is_not_written_into_a_missing_folder(tmp_path):
     result = CliRunner().invoke(app, ["stefan", "bench", "--json",
                                       str(tmp_path / "nope" / "b.json")])
     assert result.exit_code == 2 and "--json" in result.output
+
+
+def test_the_bench_json_is_not_written_over_a_folder(tmp_path):
+    result = CliRunner().invoke(app, ["stefan", "bench", "--json", str(tmp_path)])
+    assert result.exit_code == 2 and "--json" in result.output
+    assert list(tmp_path.iterdir()) == []
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.text(max_size=12))
+def test_any_thread_list_is_read_or_refused_in_one_line(text):
+    import typer
+
+    from whitted.cli.stefan import _thread_counts
+
+    try:
+        counts = _thread_counts(text)
+    except typer.Exit as exc:
+        assert exc.exit_code == 2
+        return
+    assert counts and all(1 <= c <= 1024 for c in counts)
+    assert counts == tuple(int(t) for t in text.split(",") if t.strip())

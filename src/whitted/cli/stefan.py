@@ -296,7 +296,8 @@ def bench(
                                          help="Thread counts, alternating run by run")] = "1,2",
     runs: Annotated[int, typer.Option("--runs", "-n", help="Timed runs per thread count")] = 5,
     steps: Annotated[int, typer.Option("--steps", help="Enthalpy steps a run")] = 200,
-    json_path: Annotated[Path | None, typer.Option("--json", help="Write the runs (JSON)")] = None,
+    json_path: Annotated[Path | None, typer.Option("--json", "-o",
+                                                   help="Write the runs (JSON)")] = None,
 ) -> None:
     """The solvers' throughput in cell updates a second (median and best run, per thread,
     speed-up over one thread): the enthalpy step on the default case without the cavity's
@@ -324,7 +325,13 @@ def bench(
               else os.cpu_count())
     out.print(f"CPU: {b.cpu_name()}; {usable} cores usable; load average "
               f"{'unknown' if load is None else f'{load:.2f}'}")
-    rows = b.measure(cells=cells, flow_cells=flow_cells, threads=counts, runs=runs, steps=steps)
+    guard = InterruptGuard(at_once=True)
+    try:
+        with guard:
+            rows = b.measure(cells=cells, flow_cells=flow_cells, threads=counts, runs=runs,
+                             steps=steps)
+    except KeyboardInterrupt:
+        raise guard.exit("the benchmark stopped before its table; nothing written") from None
     table = Table(title="Cell updates a second (M), the thread counts alternating run by run")
     for col in ("solver", "cells", "threads", "median", "best", "per thread", "speed-up"):
         table.add_column(col, justify="right")

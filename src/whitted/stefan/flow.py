@@ -47,8 +47,9 @@ DE_VAHL_DAVIS = {
 
 #: The differentially heated cube (Pr 0.71, hot and cold opposite vertical walls, the other
 #: four adiabatic, no slip everywhere): the mean Nusselt number of the hot wall. The values of
-#: Tric, Labrosse & Betrouni (2000), Int. J. Heat Mass Transfer 43, 4043-4056 (pseudo-spectral,
-#: 81³ and finer) and Wakashima & Saitoh (2004), Int. J. Heat Mass Transfer 47, 853-864, as a
+#: Tric, Labrosse & Betrouni (2000, "A first incursion into the 3D structure of natural
+#: convection of air in a differentially heated cubic cavity") and Wakashima & Saitoh (2004),
+#: Int. J. Heat Mass Transfer 47, 853-864, as a
 #: public GitHub file quotes them (``utils_3D_convection.py``, its dictionary
 #: ``WAKASHIMA_SAITOH_2004_GROUND_TRUTH``, read through a code search whose index does not name
 #: the repository): Nu 2.054 at Ra 10⁴ and 4.337 at 10⁵. A secondary source, rounded to
@@ -88,7 +89,8 @@ class Poisson:
 
 class MaskedPoisson:
     """div(grad phi) = rhs on the fluid cells of a box, no flux through the faces to other
-    cells or the walls: conjugate gradients (SciPy) on the cells' graph Laplacian, started
+    cells or the walls: conjugate gradients (:func:`flow_kernels.jacobi_cg`, on SciPy's
+    sparse matrix) on the cells' graph Laplacian, started
     from the last solution, Jacobi-preconditioned; the matrix is rebuilt when the fluid
     changes. Each connected body of fluid is singular (phi up to a constant): a 10⁻¹⁰ shift of
     the diagonal fixes the constant without moving the gradient measurably."""
@@ -125,8 +127,10 @@ class MaskedPoisson:
         degree = np.asarray(off.sum(axis=1)).ravel()
         h2 = 1.0 / (self.dx * self.dx)
         self.matrix = ((off - sp.diags(degree + 1e-10 * np.maximum(degree, 1.0))) * h2).tocsr()
-        self.jacobi = sp.diags(1.0 / (-(degree + 1e-10 * np.maximum(degree, 1.0)) * h2
-                                      - 1e-300))
+        self.matrix.sort_indices()
+        self._csr = (self.matrix.indptr.astype(np.int64), self.matrix.indices.astype(np.int64),
+                     self.matrix.data.astype(np.float64))
+        self._inv_diag = 1.0 / (-(degree + 1e-10 * np.maximum(degree, 1.0)) * h2 - 1e-300)
         self.cells = cells
         self._mask = fluid.copy()
 
@@ -138,19 +142,17 @@ class MaskedPoisson:
             w[:, :, 1:-1][~(fluid[:, :, 1:] & fluid[:, :, :-1])] = 0.0
 
     def solve(self, fluid: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-        from scipy.sparse.linalg import cg
-
         if self._mask is None or not np.array_equal(self._mask, fluid):
             self._build(fluid)
         phi = np.zeros(self.shape)
         if len(self.cells) == 0:
             return phi
-        b = rhs.flat[self.cells]
-        x0 = self._phi.flat[self.cells]
+        b = np.ascontiguousarray(rhs.flat[self.cells], dtype=np.float64)
+        x = np.ascontiguousarray(self._phi.flat[self.cells], dtype=np.float64)
         scale = float(np.abs(b).max())
         if scale == 0.0:
             return phi
-        x, _ = cg(self.matrix, b, x0=x0, rtol=1e-9, atol=0.0, maxiter=2000, M=self.jacobi)
+        fk.jacobi_cg(*self._csr, self._inv_diag, b, x, 1e-9, 2000)
         phi.flat[self.cells] = x
         self._phi = phi
         return phi
@@ -359,6 +361,7 @@ class MeltFlow:
         self.props = props
         self.dx = float(dx)
         self._out = np.zeros(shape)
+        self._buoy = np.zeros(shape)
         self._open = np.ones(shape)  # the faces' weights: the velocity is 0 off the fluid
         self.box0 = np.array([s.start + 1 for s in box], dtype=np.int64)  # padded indices
         self.sink_c = MUSHY_CONSTANT / props.water.rho
@@ -385,7 +388,8 @@ class MeltFlow:
         """One step of the flow with the field of now, then its heat carried into ``Hp``."""
         f, T, heat = self.fields(Hp, kindp)
         if self.expansion is None:
-            buoy = self.G * (self.rho0 - water_density_array(T)) / self.rho0 * f
+            buoy = self._buoy
+            fk.kell_buoyancy(T, f, self.G, self.rho0, buoy)
         else:
             buoy = self.G * self.expansion * T * f
         sink = self.sink_c * (1.0 - f) ** 2 / (f ** 3 + 1.0e-3)

@@ -16,6 +16,8 @@ cell; its face value the mean of the two cells') taken implicitly: u* = (u + dt 
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..jit import builder, numba_object
 
 #: Numba's parallel range, in the kernels' globals once Numba is loaded (jit/decorators.py)
@@ -187,3 +189,76 @@ def advect_enthalpy(H, box0, u, v, w, frac, heat, dt, dx, flat, out):
         for j in range(n1):
             for k in range(n2):
                 H[box0[0] + i, box0[1] + j, box0[2] + k] += out[i, j, k]
+
+
+@builder(error_model="numpy")
+def jacobi_cg(indptr, indices, data, inv_diag, b, x, rtol, maxiter):
+    """Conjugate gradients, Jacobi-preconditioned, on the symmetric definite matrix in CSR
+    form (``indptr``, ``indices``, ``data``; ``inv_diag`` its diagonal's inverse): ``x``
+    (the start, overwritten by the solution) until the residual's norm is at most ``rtol``
+    times b's (SciPy's ``cg`` test with ``atol=0``), at most ``maxiter`` iterations. One
+    thread, each iteration's loops fused: SciPy's own ``cg`` spends most of its time in
+    Python between the matrix products at the melt's sizes. Returns the iterations done."""
+    n = b.shape[0]
+    r = np.empty(n)
+    z = np.empty(n)
+    p = np.empty(n)
+    ap = np.empty(n)
+    bb = 0.0
+    rr = 0.0
+    rz = 0.0
+    for i in range(n):
+        s = 0.0
+        for e in range(indptr[i], indptr[i + 1]):
+            s += data[e] * x[indices[e]]
+        ri = b[i] - s
+        r[i] = ri
+        zi = inv_diag[i] * ri
+        z[i] = zi
+        p[i] = zi
+        bb += b[i] * b[i]
+        rr += ri * ri
+        rz += ri * zi
+    tol2 = rtol * rtol * bb
+    it = 0
+    while it < maxiter and rr > tol2:
+        pap = 0.0
+        for i in range(n):
+            s = 0.0
+            for e in range(indptr[i], indptr[i + 1]):
+                s += data[e] * p[indices[e]]
+            ap[i] = s
+            pap += p[i] * s
+        alpha = rz / pap
+        rr = 0.0
+        rz_new = 0.0
+        for i in range(n):
+            x[i] += alpha * p[i]
+            ri = r[i] - alpha * ap[i]
+            r[i] = ri
+            zi = inv_diag[i] * ri
+            z[i] = zi
+            rr += ri * ri
+            rz_new += ri * zi
+        beta = rz_new / rz
+        rz = rz_new
+        for i in range(n):
+            p[i] = z[i] + beta * p[i]
+        it += 1
+    return it
+
+
+@builder(parallel=True, error_model="numpy")
+def kell_buoyancy(T, f, g, rho0, out):
+    """``out`` = g (rho0 - rho(T)) / rho0 f per cell, rho Kell's (1975) density of water
+    (:func:`whitted.stefan.flow.water_density_array`, the same operations in one pass)."""
+    n0, n1, n2 = T.shape
+    for i in prange(n0):
+        for j in range(n1):
+            for k in range(n2):
+                t = T[i, j, k]
+                num = (999.83952 + 16.945176 * t - 7.9870401e-3 * t ** 2
+                       - 46.170461e-6 * t ** 3 + 105.56302e-9 * t ** 4
+                       - 280.54253e-12 * t ** 5)
+                rho = num / (1.0 + 16.879850e-3 * t)
+                out[i, j, k] = g * (rho0 - rho) / rho0 * f[i, j, k]

@@ -378,10 +378,10 @@ GAU_VISKANTA = {
                0.61664),
     "stefan": 0.041,
 }
-#: Gallium as the MOOSE framework's gallium-melting input gives it (idaholab/moose; the same
-#: values as Brent, Voller & Reid 1988): rho 6093 kg/m³, c 381.5 J/kgK, k 32 W/mK, L 80160
-#: J/kg, mu 1.81 mPa s, beta 1.2e-4 1/K; melting at 302.93 K, the hot wall at 311.15 K, the
-#: cold wall and the initial solid at 301.15 K.
+#: Gallium as the MOOSE framework's gallium-melting input gives it (idaholab/moose, read
+#: through a code search whose index does not name the file's path): rho 6093 kg/m³,
+#: c 381.5 J/kgK, k 32 W/mK, L 80160 J/kg, mu 1.81 mPa s, beta 1.2e-4 1/K; melting at
+#: 302.93 K, the hot wall at 311.15 K, the cold wall and the initial solid at 301.15 K.
 GALLIUM = {"rho": 6093.0, "c": 381.5, "k": 32.0, "latent": 80160.0, "mu": 1.81e-3,
            "beta": 1.2e-4, "t_melt": 302.93, "t_hot": 311.15, "t_cold": 301.15,
            "width": 0.0889, "height": 0.0635}
