@@ -81,3 +81,43 @@ def test_mistakes_are_one_line(args, message):
     result = _whitted("warm", *args)
     assert result.returncode == 2
     assert result.stderr.strip().count("\n") == 0 and message in result.stderr
+
+
+def test_the_queue_hands_a_general_kind_out_only_after_the_general_render_kernel():
+    from whitted.cli.warm import _all_names, _Queue
+
+    queue = _Queue(_all_names())
+    assert queue.take() == "general/render"  # the longest chain first
+    taken = []
+    while True:  # what another worker gets meanwhile: never a general kind
+        name = queue.todo and next((n for n in queue.todo if not n.startswith("general/")),
+                                   None)
+        if not name:
+            break
+        assert queue.take() == name
+        taken.append(name)
+    assert sorted(taken) == ["plain/adaptive", "plain/aovs", "plain/caustics", "stefan"]
+    queue.finish("general/render", 12.5)
+    assert queue.take() == "general/caustics"
+
+
+def test_a_failed_general_render_kernel_fails_its_kinds_without_compiling_them():
+    from whitted.cli.warm import _Queue
+
+    queue = _Queue(["general/render", "general/aovs", "plain/aovs"])
+    assert queue.take() == "general/render"
+    assert queue.take() == "plain/aovs"
+    queue.finish("general/render", None, "boom")
+    assert queue.take() is None
+    assert queue.failed == {"general/render", "general/aovs"} and queue.errors == ["boom"]
+
+
+def test_a_worker_answers_each_name_it_reads_with_one_line():
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
+    result = subprocess.run([sys.executable, "-m", "whitted", "warm", "--serve"],
+                            input="plain/render\n\nplain/render\n", capture_output=True,
+                            text=True, timeout=900, env=env)
+    assert result.returncode == 0, result.stderr
+    lines = [json.loads(line) for line in result.stdout.splitlines()]
+    assert [entry["name"] for entry in lines] == ["plain/render", "plain/render"]
+    assert all(entry["seconds"] >= 0 for entry in lines)
