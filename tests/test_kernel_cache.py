@@ -225,6 +225,93 @@ def test_a_file_rewritten_before_its_kernel_is_looked_up_is_no_damage(tmp_path, 
     assert "damaged kernel cache file" in capsys.readouterr().err
 
 
+def test_a_file_another_process_rewrote_and_sealed_after_the_check_is_no_damage(
+        tmp_path, capsys):
+    """Two processes on one folder: the first checks lazily at start-up; the second then
+    compiles a new signature of a kernel (Numba renames a new index over the sealed one)
+    and seals it; the first's look-up of that kernel finds the second's sealed file: kept,
+    loaded, no warning."""
+    state = _fake_cache(tmp_path)
+    first = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert first.verify(lazy=True) == 0
+    second = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert second.verify(lazy=True) == 0
+    index = Path(state.folder, "kernels_1/a-1.py311.nbi")
+    second.compiling()
+    _rewrite(index, b"a new signature added by the second process")
+    second.seal()
+    assert first.check_function("kernels_1", "a-1.py311") == 0
+    assert index.read_bytes() == b"a new signature added by the second process"
+    assert capsys.readouterr().err == ""
+    # real damage after that is still found, with one warning
+    _flip(Path(state.folder, "compile_2/b-2.py311.0.nbc"), 9)
+    assert first.check_function("compile_2", "b-2.py311") == 1
+    assert capsys.readouterr().err.count("damaged kernel cache file") == 1
+    assert _cache.KernelCache(state.folder, own=True, helper=False).verify() == 0
+
+
+def test_a_file_a_live_process_rewrote_after_the_check_is_kept_at_the_look_up(
+        tmp_path, capsys):
+    """The first process checks lazily; another, still compiling (its marker held), has
+    its Numba rename a new index over a sealed one and has not sealed it yet when the first
+    looks that kernel up: the file is that process's work, kept and not called damage.
+    Damage in place is still found meanwhile; once the writer has ended without sealing,
+    such a file is damage."""
+    state = _fake_cache(tmp_path)
+    first = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert first.verify(lazy=True) == 0
+    started, release = tmp_path / "started", tmp_path / "release"
+    other = _hold_compiling_marker(state.folder, started, release)
+    index = Path(state.folder, "kernels_1/a-1.py311.nbi")
+    try:
+        while not started.exists():  # an event, not a time: it exits on any failure
+            assert other.poll() is None, "the other process ended before compiling"
+            time.sleep(0.02)
+        _rewrite(index, b"another signature, not sealed yet")
+        assert first.check_function("kernels_1", "a-1.py311") == 0
+        assert index.read_bytes() == b"another signature, not sealed yet"
+        assert capsys.readouterr().err == ""
+        _flip(Path(state.folder, "compile_2/b-2.py311.0.nbc"), 3)  # in place: damage still
+        assert first.check_function("compile_2", "b-2.py311") == 1
+        assert capsys.readouterr().err.count("damaged kernel cache file") == 1
+    finally:
+        release.touch()
+        other.wait(timeout=60)
+    # its writer ended without sealing it: not trusted by the next process
+    third = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert third.verify() == 1 and not index.exists()
+
+
+def test_a_file_renamed_in_while_the_start_up_check_reads_the_folder_is_no_damage(
+        tmp_path, capsys, monkeypatch):
+    """Another process, compiling, has its Numba rename a new index over a sealed one after
+    the start-up check listed the folder and before it hashed that file: the check judges
+    the file it hashed (another inode: that process's work), never the listed one's inode
+    against the new content (which reads as damage in place)."""
+    state = _fake_cache(tmp_path)
+    started, release = tmp_path / "started", tmp_path / "release"
+    other = _hold_compiling_marker(state.folder, started, release)
+    index = Path(state.folder, "kernels_1/a-1.py311.nbi")
+    first = _cache.KernelCache(state.folder, own=True, helper=False)
+    listed = first._files
+
+    def list_then_rewrite():
+        files = listed()
+        _rewrite(index, b"another signature from the compiling process")
+        return files
+
+    monkeypatch.setattr(first, "_files", list_then_rewrite)
+    try:
+        while not started.exists():  # an event, not a time: it exits on any failure
+            assert other.poll() is None, "the other process ended before compiling"
+            time.sleep(0.02)
+        assert first.verify() == 0
+        assert "damaged" not in capsys.readouterr().err
+    finally:
+        release.touch()
+        other.wait(timeout=60)
+
+
 def test_a_cold_compile_of_one_variant_lets_other_processes_seal(tmp_path):
     # whitted warm: one process compiles the general kernels cold (holding that variant's
     # lock for the whole compile) while another compiles and seals other kernels

@@ -341,11 +341,26 @@ class KernelCache:
 
     @staticmethod
     def _digest(path: str) -> str | None:
+        return KernelCache._read_file(path)[0]
+
+    @staticmethod
+    def _read_file(path: str) -> tuple[str | None, os.stat_result | None]:
+        """The SHA-256 sum of the file at ``path`` and the status of that same file (one
+        open file: another process's Numba may rename a new file over ``path`` at any
+        moment, and a sum must never be judged against another file's inode)."""
         try:
             with open(path, "rb") as f:
-                return hashlib.sha256(f.read()).hexdigest()
+                return hashlib.sha256(f.read()).hexdigest(), os.fstat(f.fileno())
         except OSError:
-            return None
+            return None, None
+
+    @staticmethod
+    def _drop(path: str, judged: os.stat_result) -> None:
+        """Delete the file at ``path`` when it is still the one judged (``judged``, its
+        status), not a new one another process's Numba has renamed in since."""
+        with contextlib.suppress(OSError):
+            if os.stat(path).st_ino == judged.st_ino:
+                os.unlink(path)
 
     def verify(self, lazy: bool = False) -> int:
         """Check every cache file against the list (module docstring); delete what fails.
@@ -369,8 +384,10 @@ class KernelCache:
                     self._deferred[name] = entry[0]
                     self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
                     continue
-                good = entry is not None and entry[1] == st.st_size \
-                    and self._digest(path) == entry[0]
+                digest, now = self._read_file(path) if entry is not None else (None, None)
+                if now is not None:
+                    st = now  # the file hashed (Numba may have renamed a new one in since)
+                good = entry is not None and entry[1] == st.st_size and digest == entry[0]
                 if good:
                     self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
                     if entry[2:] != [st.st_ino]:  # a copied folder: new inodes, same content
@@ -386,8 +403,7 @@ class KernelCache:
                 # else a new file under a sealed name while another process compiles (its
                 # Numba rewrote it and it has not sealed it yet): dropped without a word
                 if entry is not None or self.own or damaged_list:
-                    with contextlib.suppress(OSError):
-                        os.unlink(path)
+                    self._drop(path, st)
                     deleted = True
                 sums.pop(name, None)
             stale = [name for name in sums if name not in files]
@@ -422,15 +438,36 @@ class KernelCache:
             if not names:
                 return 0
             wanted = {n: self._deferred.pop(n) for n in names}
-        bad = [n for n, digest in wanted.items()
-               if self._digest(os.path.join(self.folder, n)) != digest]
-        if not bad:
+        if all(self._digest(os.path.join(self.folder, n)) == d for n, d in wanted.items()):
             return 0
-        with self.locked():
+        with self.locked():  # another process seals (and drops its marker) under this lock
             sums, _ = self._read_sums()
-            for name in bad:
-                with contextlib.suppress(OSError):
-                    os.unlink(os.path.join(self.folder, name))
+            rewriting = None
+            bad = []
+            for name, digest in wanted.items():
+                path = os.path.join(self.folder, name)
+                now, st = self._read_file(path)
+                if now is None or now == digest:
+                    continue  # gone (another process's check), or as verify() saw it
+                entry = sums.get(name)
+                seen = self._seen.get(name)
+                if entry is not None and entry[0] == now and entry[1] == st.st_size:
+                    # written anew by another process since verify() and sealed by it
+                    self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
+                    continue
+                if seen is not None and seen[0] != st.st_ino and not self.read_only:
+                    # a new file renamed in since verify() (as Numba writes) and not sealed
+                    # yet: while its writer is still compiling, it is that process's work
+                    # (whole, and sealed by it): kept, never taken for damage
+                    if rewriting is None:
+                        rewriting = self.others_compiling()
+                    if rewriting:
+                        continue
+                bad.append((name, st))
+            if not bad:
+                return 0
+            for name, st in bad:
+                self._drop(os.path.join(self.folder, name), st)
                 sums.pop(name, None)
                 self._seen.pop(name, None)
             if not self.read_only:
@@ -476,10 +513,10 @@ class KernelCache:
                 entry = sums.get(name)
                 if seen is not None and seen[0] == st.st_ino and entry is not None:
                     continue  # as checked (or changed in place: not sealed)
-                digest = self._digest(os.path.join(self.folder, name))
+                digest, st = self._read_file(os.path.join(self.folder, name))
                 if digest is None:
                     continue
-                sums[name] = [digest, st.st_size, st.st_ino]
+                sums[name] = [digest, st.st_size, st.st_ino]  # the file hashed
                 self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
                 # a file verify() left for later and Numba (here or in the compile helper)
                 # has since written anew: sealed with its new content, so its kernel's first
