@@ -41,6 +41,16 @@ cache file against it:
   process compiling, it is damage like any other;
 - a damaged list is a list of nothing: every file is then compiled again, with one warning.
 
+A file as sealed (its entry's size and inode) has its content checked only when its kernel is
+first looked up (:meth:`KernelCache.check_function`). Other processes keep writing meanwhile:
+a file that no longer has the sum the start-up check saw is judged under the lock, against
+the list and the markers as they are then: sealed since by another process, it is loaded;
+a new file (another inode) while another process is compiling is that process's work, kept
+for it to seal; only a file changed in place, or replaced by no live process, is damage.
+Every check judges the file it hashed (its status read from the same open file, never the
+inode listed before another process's Numba renamed a new file in), and deletes a file only
+while it is still the one judged.
+
 After Numba wrote files (a compile of a kernel called from Python, the warm-up), whitted
 :func:`seal` s them: the files that are new since this process last looked, or were replaced
 by a new file (a new inode: Numba writes a file whole and renames it into place), get their
