@@ -25,6 +25,26 @@ def cpu_seconds() -> float:
     return ru.ru_utime + ru.ru_stime
 
 
+def compile_times(buffer) -> list[tuple[str, str, float, float]]:
+    """(function, signature, inclusive s, exclusive s) of each compile in a recorder's buffer
+    of ``"numba:compile"`` events, in the order the compiles ended. Events nest: a callee is
+    compiled inside its caller's compile, and its time is the caller's inclusive time, not
+    its exclusive time."""
+    stack: list[list] = []
+    rows = []
+    for ts, ev in buffer:
+        if ev.is_start:
+            stack.append([ev.data["dispatcher"], ev.data["args"], ts, 0.0])
+        else:
+            disp, sig, start, children = stack.pop()
+            inclusive = ts - start
+            rows.append((disp.py_func.__module__ + "." + disp.py_func.__qualname__, str(sig),
+                         inclusive, inclusive - children))
+            if stack:
+                stack[-1][3] += inclusive
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("scene", nargs="?", help="a scene file (default: the default scene)")
@@ -49,20 +69,7 @@ def main() -> None:
     cpu = cpu_seconds() - cpu0
     wall = time.perf_counter() - wall0
 
-    # inclusive and exclusive time per compile (events nest: a callee compiles inside its
-    # caller's compile)
-    stack: list[list] = []
-    rows = []
-    for ts, ev in rec.buffer:
-        if ev.is_start:
-            stack.append([ev.data["dispatcher"], ev.data["args"], ts, 0.0])
-        else:
-            disp, sig, start, children = stack.pop()
-            inclusive = ts - start
-            rows.append((disp.py_func.__module__ + "." + disp.py_func.__qualname__, str(sig),
-                         inclusive, inclusive - children))
-            if stack:
-                stack[-1][3] += inclusive
+    rows = compile_times(rec.buffer)
     by_name = collections.defaultdict(list)
     for name, sig, inc, exc in rows:
         by_name[name].append((sig, inc, exc))
