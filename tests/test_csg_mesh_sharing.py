@@ -13,7 +13,7 @@ import pytest
 from whitted.compile.csg import CSG_MESH_SCAN
 from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import closest_hit, surface_normals
-from whitted.kernels.layout import PRIM_XFORM, SHAPE_CSG_MESH
+from whitted.kernels.layout import BVH_STACK, PRIM_XFORM, SHAPE_CSG_MESH
 from whitted.scene import CSG, Box, Material, Mesh, Scene, Transform
 
 SUBDIVISIONS = 3  # 1,280 triangles, 642 vertices: over CSG_MESH_SCAN, so stored with a BVH
@@ -59,7 +59,7 @@ def _compile(objects):
 
 def _hits(compiled, rays):
     geo = compiled.geometry
-    stack = np.empty(128, np.int32)
+    stack = np.empty(BVH_STACK, np.int32)
     out = []
     for o, d in rays:
         t, prim, tri, b1, b2 = closest_hit(geo, o, d, 0.0, math.inf, stack)

@@ -22,6 +22,7 @@ from whitted.compile.embree import embree_addresses, embree_library, resolve_mes
 from whitted.compile.scene import compile_scene
 from whitted.errors import SceneError
 from whitted.kernels.accel import closest_hit
+from whitted.kernels.layout import BVH_STACK
 from whitted.kernels.lighting import any_occluder
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -43,7 +44,7 @@ def _traced(compiled, origins, directions):
     n = len(origins)
     t, tri, shadow = np.empty(n), np.empty(n, np.int64), np.empty(n, np.int64)
     _trace(compiled.geometry, compiled.materials, np.ascontiguousarray(origins),
-           np.ascontiguousarray(directions), t, tri, shadow, np.empty(128, np.int32))
+           np.ascontiguousarray(directions), t, tri, shadow, np.empty(BVH_STACK, np.int32))
     return t, tri, shadow
 
 

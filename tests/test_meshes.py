@@ -14,7 +14,7 @@ from meshgen import cube, uv_sphere
 from whitted.compile.embree import embree_library
 from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import closest_hit, surface_normals
-from whitted.kernels.layout import PRIM_MATERIAL
+from whitted.kernels.layout import BVH_STACK, PRIM_MATERIAL
 from whitted.kernels.uv import surface_uv
 
 
@@ -36,7 +36,7 @@ def _hits(compiled, origins, directions, tmin=None):
     if tmin is None:
         tmin = np.zeros(len(origins))
     return _first_hits(compiled.geometry, origins, directions,
-                       np.ascontiguousarray(tmin, np.float64), np.empty(128, np.int32))
+                       np.ascontiguousarray(tmin, np.float64), np.empty(BVH_STACK, np.int32))
 
 
 def _targets(verts, faces):
@@ -167,7 +167,8 @@ def test_same_model_file_is_instanced(tmp_path):
 def _one_triangle_hit(mesh, ray_o, ray_d, layout):
     compiled = compile_as(whitted.Scene(objects=[mesh]), layout)
     geo = compiled.geometry
-    t, prim, tri, b1, b2 = closest_hit(geo, ray_o, ray_d, 0.0, math.inf, np.empty(128, np.int32))
+    t, prim, tri, b1, b2 = closest_hit(geo, ray_o, ray_d, 0.0, math.inf,
+                                       np.empty(BVH_STACK, np.int32))
     assert prim == 0 and tri == (-1 if layout is None else 0)
     p = tuple(o + t * d for o, d in zip(ray_o, ray_d, strict=True))
     return geo, prim, tri, b1, b2, p

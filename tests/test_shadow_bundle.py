@@ -15,6 +15,7 @@ import whitted
 from meshgen import uv_sphere
 from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import hit_analytic
+from whitted.kernels.layout import BVH_STACK
 from whitted.kernels.lighting import SHADOW_LIST_CAP, list_bundle_occluders
 from whitted.kernels.shapes import INF
 from whitted.kernels.traverse import cone_meets_box
@@ -28,7 +29,7 @@ def _audit_bundles(geo, mats, points, centre, u_axis, v_axis, radius, n_rays, se
     opaque, and how many primitives one of its shadow rays to a random point of the disk hits
     (beyond EPS) without their being listed."""
     np.random.seed(seed)
-    stack = np.empty(128, np.int32)
+    stack = np.empty(BVH_STACK, np.int32)
     listed = np.empty(SHADOW_LIST_CAP, np.int32)
     n_prims = geo.prim_info.shape[0]
     counts = np.empty(points.shape[0], np.int64)

@@ -14,6 +14,7 @@ import whitted
 from whitted.cli.main import app
 from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import closest_hit
+from whitted.kernels.layout import BVH_STACK
 from whitted.kernels.uv import surface_uv
 
 CHECKER = whitted.CheckerTexture(color1=(1, 1, 1), color2=(0, 0, 0), checks=1.0)
@@ -22,7 +23,7 @@ CHECKER = whitted.CheckerTexture(color1=(1, 1, 1), color2=(0, 0, 0), checks=1.0)
 def _uv(shape, o, d):
     compiled = compile_scene(whitted.Scene(objects=[shape]))
     geo = compiled.geometry
-    t, prim, tri, b1, b2 = closest_hit(geo, o, d, 0.0, math.inf, np.empty(128, np.int32))
+    t, prim, tri, b1, b2 = closest_hit(geo, o, d, 0.0, math.inf, np.empty(BVH_STACK, np.int32))
     assert prim >= 0
     p = tuple(a + t * b for a, b in zip(o, d, strict=True))
     return surface_uv(geo, prim, tri, b1, b2, p)

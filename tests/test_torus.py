@@ -13,6 +13,7 @@ from pydantic import ValidationError
 
 from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import closest_hit, surface_normals
+from whitted.kernels.layout import BVH_STACK
 from whitted.kernels.uv import surface_uv
 from whitted.scene import Scene, Torus, Transform
 
@@ -22,7 +23,7 @@ REL = 1e-12
 class Compiled:
     def __init__(self, *shapes):
         self.geo = compile_scene(Scene(objects=list(shapes))).geometry
-        self.stack = np.empty(128, np.int32)
+        self.stack = np.empty(BVH_STACK, np.int32)
 
     def hit(self, o, d, tmin=0.0):
         o = tuple(map(float, o))

@@ -14,6 +14,7 @@ import numpy as np
 
 from ..jit import kernel
 from ..kernels.layout import (
+    BVH_STACK,
     CELL_COUNT,
     CELL_FIRST,
     CELL_OPAQUE,
@@ -163,7 +164,7 @@ def build_light_buffers(geo: GeometryArrays, materials: np.ndarray, table: np.nd
         position, reach, first, last, row = part
         block = slice(row, row + n_cells)  # the light's own rows: cells count from 0 in it
         list_cell_occluders(geo, materials, position, reach, res, lists[block], counts[block],
-                            opaque[block], np.empty(128, np.int32), first, last)
+                            opaque[block], np.empty(BVH_STACK, np.int32), first, last)
 
     if threads > 1 and len(work) > 1:
         from concurrent.futures import ThreadPoolExecutor

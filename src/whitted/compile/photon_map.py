@@ -22,6 +22,7 @@ from ..errors import SceneError
 from ..jit import builder
 from ..kernels.caustics import cell_hash, cell_of
 from ..kernels.layout import (
+    BVH_STACK,
     GRID_BITS,
     GRID_INV_CELL,
     GRID_PASS,
@@ -74,7 +75,6 @@ GRID_SHIFT = np.array([0.5, 0.5, 0.5])
 DEFAULT_NEIGHBOURS = 256  # photons the default radius gathers where light is not focused
 MAX_TARGETS = 64  # more bodies than this are aimed at as one bounding sphere
 PHOTON_BYTES = PHOTON_WIDTH * 4
-BVH_STACK = 128  # as kernels/tiles.py
 MEMORY_SHARE = 0.5  # of the memory available, what a photon map may take
 CHUNK_MIN = 2048  # photons per kernel call: at least this many (calls cost little)...
 CHUNK_MAX = 1 << 18  # ...at most this many (a cancel waits for the calls under way)

@@ -43,6 +43,7 @@ from .primitives import PrimitiveRows
 from .reuse import cached_build_bvh
 from .shapes import add_shape
 from .textures import compile_textures
+from .wide_bvh import wide_nodes
 
 
 @dataclass
@@ -214,6 +215,7 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
         xforms=np.array(b.xforms, dtype=np.float64).reshape(len(b.xforms), 3, 4),
         node_box=node_box,
         node_link=node_link,
+        node_wide=wide_nodes(bvh),
         node_prims=np.ascontiguousarray(bounded[bvh.prim_order], dtype=np.int32),
         unbounded=unbounded.astype(EXTRAS_DTYPE if general else np.int32),
         inst_box=inst_box,

@@ -23,6 +23,7 @@ from .features import has_extras, has_instances, instances_possible
 from .layout import (
     FIRST_EXTRA_SHAPE,
     MAT_KT,
+    MESH_STACK_BASE,
     PRIM_MATERIAL,
     PRIM_TYPE,
     PRIM_XFORM,
@@ -44,8 +45,6 @@ from .traverse import (
 )
 from .xform import normal_to_world as _normal_to_world
 from .xform import to_object
-
-MESH_STACK_BASE = 64  # traversal stack entries [0, 64) for the scene BVH, the rest for meshes
 
 
 @kernel(inline="always")
@@ -166,6 +165,17 @@ def surface_normals(geo, prim, tri, b1, b2, p):
     return _normal_to_world(geo.xforms, xf, ng), _normal_to_world(geo.xforms, xf, ns)
 
 
+@kernel(inline="always")
+def geometric_normal(geo, prim, tri, b1, b2, p):
+    """The geometric unit normal of :func:`surface_normals`, without the shading one: what
+    decides whether a ray enters or leaves a body (a smooth triangle's blended normal is not
+    computed)."""
+    if tri < 0:
+        return world_normal(geo, prim, p)
+    n, _ = surface_normals(geo, prim, tri, b1, b2, p)
+    return n
+
+
 @kernel
 def closest_instance_hit(geo, o, d, inv, tmin, tmax, stack):
     """Nearest mesh-instance hit in (tmin, tmax), as :func:`closest_hit` returns it
@@ -217,7 +227,7 @@ def _closest_instance_hit_if_instances(geo, o, d, inv, tmin, tmax, stack):
 @kernel(inline="always")
 def closest_hit(geo, o, d, tmin, tmax, stack):
     """Nearest hit in (tmin, tmax): (t, primitive, triangle, b1, b2), or (tmax, -1, -1, 0, 0).
-    ``stack`` is caller-owned int32 scratch space (128 entries: two levels of 64).
+    ``stack`` is caller-owned int32 scratch space (BVH_STACK entries: layout.py).
 
     First the analytic shapes (the unbounded ones, then the BVH's leaves, through one call
     site of the intersection routines), then, only when the scene has meshes, the mesh

@@ -140,11 +140,27 @@ PRIM_FLIP = 5
 PRIM_MEDIUM = 6
 N_PRIM_INFO = 7
 
-# BVH layout (every level): node_box[n] = (lower corner, upper corner); node_link[n] = (offset,
-# count): a leaf (count > 0) holds entries offset .. offset + count - 1 of its index list; an
-# interior node (count 0) has its left child at n + 1 and its right child at offset.
+# BVH layout (every level): node_box[n] = (lower corner, upper
+# corner); node_link[n] = (offset, count): a leaf (count > 0) holds entries offset .. offset +
+# count - 1 of its index list; an interior node (count 0) has its left child at n + 1 and its
+# right child at offset.
 LINK_OFFSET = 0
 LINK_COUNT = 1
+# the scene BVH's eight-wide nodes (compile/wide_bvh.py), which any-hit walks take:
+# node_wide[w, 0:3, c] and node_wide[w, 3:6, c] the corners of child c (rounded outward),
+# node_wide[w, WIDE_LINK, c] an interior child's wide node or a leaf's first entry in
+# node_prims, node_wide[w, WIDE_COUNT, c] 0 (interior), the leaf's primitive count, or -1 (no
+# child in that lane); whole numbers held exactly in float32 (below 2**24; a scene BVH
+# with more leaf entries has no wide nodes and its any-hit walks take the binary nodes)
+WIDE = 8
+WIDE_LINK = 6
+WIDE_COUNT = 7
+WIDE_ROWS = 8
+# a ray's BVH-walk stack (int32 entries, caller-owned scratch): [0, MESH_STACK_BASE) for the
+# scene BVH (a wide walk pushes at most (WIDE - 1) * bvh.MAX_DEPTH + 1 = 421 entries), the
+# rest for a mesh's own binary BVH (at most MAX_DEPTH + 1)
+MESH_STACK_BASE = 448
+BVH_STACK = 512
 # mesh BVH node rows (GeometryArrays.mesh_nodes): lower corner 0:3, upper corner 3:6, link 6:8
 MESH_NODE_LO = 0
 MESH_NODE_HI = 3
@@ -172,6 +188,7 @@ class GeometryArrays(NamedTuple):
     xforms: np.ndarray  # (X, 3, 4) float64 world-to-object affine matrices
     node_box: np.ndarray  # (M, 2, 3) float64 scene BVH over the bounded analytic primitives
     node_link: np.ndarray  # (M, 2) int32
+    node_wide: np.ndarray  # (W, WIDE_ROWS, WIDE) float32 the same BVH in eight-wide nodes
     node_prims: np.ndarray  # (N,) int32 primitive indices in leaf order
     # (U,) primitives outside the BVH (infinite planes): int32, or int64 in scenes with tori
     # or CSG objects, which selects kernels compiled with those shapes (features.py)

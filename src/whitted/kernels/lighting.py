@@ -9,11 +9,11 @@ import math
 from ..jit import kernel, overload
 from .accel import (
     closest_hit,
+    geometric_normal,
     hit_analytic,
     hit_material,
     instance_occludes,
     occludes,
-    surface_normals,
 )
 from .csg import csg_surfaces
 from .extras import body_medium
@@ -248,16 +248,17 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
                                                              j, leaf, leaf_end, top, False)
             if i < 0:
                 break
-        clear = mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] >= OPAQUE_KT
-        if clear and has_extras(geo) and geo.prim_info[i, PRIM_TYPE] >= FIRST_EXTRA_SHAPE:
-            # a torus or a CSG object: every crossing (a CSG object's as its leaves)
+        if (has_extras(geo) and geo.prim_info[i, PRIM_TYPE] >= FIRST_EXTRA_SHAPE
+                and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] >= OPAQUE_KT):
+            # a clear torus or CSG object: every crossing (a CSG object's as its leaves)
             n, full = gather_extra_hits_if_extras(geo, i, o, d, inv, tmin, tmax, step, hits,
                                                   n, full)
             continue
         t = hit_analytic(geo, i, o, d, tmin, tmax)
         if t == INF:
             continue
-        if not clear:
+        # the material is looked up only for the surfaces hit (most candidates miss)
+        if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT:
             hits[1] = i
             return -1, False
         n, full = keep_nearest(hits, n, t, i, full)
@@ -306,7 +307,7 @@ def _pass_surface(geo, mats, prim, tri, b1, b2, o, d, t, scratch, count, trans):
     kt = mats[m, MAT_KT]
     entering = True
     if geo.prim_info[prim, PRIM_SOLID]:
-        n, _ = surface_normals(geo, prim, tri, b1, b2, madd(o, d, t))
+        n = geometric_normal(geo, prim, tri, b1, b2, madd(o, d, t))
         entering = dot(d, n) < 0.0
         body = body_medium(geo, prim, m)  # a CSG object is one body (extras.py)
         if entering:

@@ -18,6 +18,7 @@ from .accel import closest_hit, surface_normals
 from .hit_list import MAX_SHADOW_HITS
 from .integrator import N_STACK_F, N_STACK_I, trace_path
 from .layout import (
+    BVH_STACK,
     MAX_MEDIA,
     N_RAY_KINDS,
     PRIM_OBJECT,
@@ -26,8 +27,6 @@ from .layout import (
 from .lighting import SHADOW_LIST_CAP
 from .sampling import concentric_disk, random_pair, stratum
 from .vec import dot, madd, normalize, sub
-
-BVH_STACK = 128
 
 # kernels/geometry_ref.py is a Numba extension: imported with Numba (jit/decorators.py)
 geometry_ref_if_instances = numba_object(f"{__package__}.geometry_ref",

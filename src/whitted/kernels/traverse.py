@@ -1,7 +1,9 @@
 """Helpers every BVH walk shares (the scene's, the instances' and each mesh's own): the slab
 test of a node box, a ray's safe inverse direction, pushing a node's children nearest
-last, and the test of a node box against a cone of rays (shadow bundles, light buffers). The
-boxes may be float64 (scene level) or float32 rounded outward (meshes)."""
+last, the any-hit walk of the scene BVH's eight-wide nodes (all eight boxes of a node tested
+in one loop), and the test of a node box against a cone of rays (shadow bundles, light
+buffers). The boxes may be float64 (scene level), float32 rounded outward (meshes, the scene's
+wide nodes)."""
 
 from __future__ import annotations
 
@@ -10,6 +12,7 @@ import math
 import numpy as np
 
 from ..jit import kernel
+from .layout import WIDE, WIDE_COUNT, WIDE_LINK
 from .shapes import INF
 
 TINY_DIRECTION = 1e-30  # stands in for a zero direction component in the slab test
@@ -140,12 +143,82 @@ def start_scene_walk(geo, stack):
 
 
 @kernel(inline="always")
+def wide_hits(wide, w, o, inv, tmin, tmax):
+    """Bit c set for each child c of wide scene node ``w`` (``GeometryArrays.node_wide``)
+    whose box the ray meets on (tmin, tmax): :func:`slab_entry`'s test on all eight lanes in
+    one loop (vector instructions), the lanes without a child left out."""
+    w = np.uint64(w)
+    mask = np.int64(0)
+    for c in range(WIDE):
+        t0 = (wide[w, 0, c] - o[0]) * inv[0]
+        t1 = (wide[w, 3, c] - o[0]) * inv[0]
+        tn = min(t0, t1)
+        tf = max(t0, t1)
+        t0 = (wide[w, 1, c] - o[1]) * inv[1]
+        t1 = (wide[w, 4, c] - o[1]) * inv[1]
+        tn = max(tn, min(t0, t1))
+        tf = min(tf, max(t0, t1))
+        t0 = (wide[w, 2, c] - o[2]) * inv[2]
+        t1 = (wide[w, 5, c] - o[2]) * inv[2]
+        tn = max(tn, min(t0, t1))
+        tf = min(tf, max(t0, t1))
+        miss = (tf * (1.0 + 1e-9) + 1e-12 < max(tn, tmin)) | (tn > tmax)
+        hit = (wide[w, WIDE_COUNT, c] >= 0.0) & ~miss
+        mask |= np.int64(hit) << np.int64(c)
+    return mask
+
+
+@kernel(inline="always")
+def lowest_bit(mask):
+    """Index of the lowest set bit of ``mask`` (nonzero)."""
+    c = 0
+    while (mask >> np.int64(c)) & np.int64(1) == 0:
+        c += 1
+    return c
+
+
+@kernel(inline="always")
+def _next_wide_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top):
+    """:func:`next_scene_candidate` of an any-hit walk, through the wide nodes."""
+    wide = geo.node_wide
+    while True:
+        if j < geo.unbounded.shape[0]:
+            return geo.unbounded[np.uint64(j)], j + 1, leaf, leaf_end, top
+        if leaf < leaf_end:
+            return geo.node_prims[np.uint64(leaf)], j, leaf + 1, leaf_end, top
+        if top < 0:
+            return -1, j, leaf, leaf_end, top
+        w = stack[top]
+        top -= 1
+        if w < 0:  # a leaf (its box was tested in its parent)
+            g = np.uint64(-1 - w)
+            lw = g // np.uint64(WIDE)
+            lc = g % np.uint64(WIDE)
+            leaf = int(wide[lw, WIDE_LINK, lc])
+            leaf_end = leaf + int(wide[lw, WIDE_COUNT, lc])
+            continue
+        mask = wide_hits(wide, w, o, inv, tmin, tmax)
+        while mask != 0:
+            c = lowest_bit(mask)
+            mask &= mask - 1
+            top += 1
+            if wide[np.uint64(w), WIDE_COUNT, np.uint64(c)] == 0.0:
+                stack[top] = int(wide[np.uint64(w), WIDE_LINK, np.uint64(c)])
+            else:
+                stack[top] = -1 - (WIDE * w + c)
+
+
+@kernel(inline="always")
 def next_scene_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top, ordered):
     """The next analytic primitive a ray on (tmin, tmax) may hit: first the unbounded ones,
     then those of the scene BVH's leaves whose boxes it meets. The walk's state is the cursor
     (j, leaf, leaf_end, top), passed in and returned with the primitive (-1 when the walk is
     over). ``ordered`` pushes the nearer child last (closest-hit walks, which pass the nearest
-    hit so far as ``tmax``); any-hit walks skip the ordering."""
+    hit so far as ``tmax``) in the binary BVH; any-hit walks skip the ordering and go through
+    the eight-wide nodes (``node_wide``), where a stack entry is a wide node (>= 0) or a
+    leaf, -1 - (8·node + lane)."""
+    if not ordered and geo.node_wide.shape[0] > 0:
+        return _next_wide_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top)
     box = geo.node_box
     while True:
         if j < geo.unbounded.shape[0]:
