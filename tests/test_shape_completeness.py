@@ -298,3 +298,51 @@ def test_the_kernel_cache_key_covers_the_shapes_package(tmp_path):
     torus = copy / "kernels" / "shapes" / "torus.py"
     torus.write_text(torus.read_text() + "\n# changed\n")
     assert cache.kernel_source_hash(copy) != before
+
+
+#: the names of shape codes a kernel outside kernels/shapes/ may not compare a row's type with
+SHAPE_CODE = re.compile(r"^(SHAPE_\w+|FIRST_EXTRA_SHAPE)$")
+
+
+def kind_comparisons(source: str, where: str) -> list[str]:
+    """``where:line`` of every comparison in ``source`` with a ``SHAPE_*`` code (or
+    ``FIRST_EXTRA_SHAPE``) as an operand, however it is spelt (``layout.SHAPE_CSG`` too)."""
+    import ast
+
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if not isinstance(node, ast.Compare):
+            continue
+        for operand in (node.left, *node.comparators):
+            name = (operand.id if isinstance(operand, ast.Name)
+                    else operand.attr if isinstance(operand, ast.Attribute) else "")
+            if SHAPE_CODE.match(name):
+                found.append((node.lineno, f"{where}:{node.lineno} compares with {name}"))
+                break
+    return [text for _, text in sorted(found)]
+
+
+def test_kernels_ask_dispatch_to_tell_kinds_apart():
+    """No kernel module outside kernels/shapes/ compares a row's type with a shape code: each
+    such decision is a named predicate of kernels/shapes/dispatch.py."""
+    kernels = ROOT / "src" / "whitted" / "kernels"
+    found = []
+    for path in sorted(kernels.rglob("*.py")):
+        if kernels / "shapes" in path.parents:
+            continue
+        found += kind_comparisons(path.read_text(encoding="utf-8"),
+                                  str(path.relative_to(ROOT)))
+    assert not found, "ask kernels/shapes/dispatch.py instead: " + "; ".join(found)
+
+
+def test_the_kind_comparison_check_names_file_and_line():
+    source = ("x = SHAPE_CSG\n"
+              "if geo.prim_info[i, PRIM_TYPE] == SHAPE_TRIANGLE and smooth:\n"
+              "    pass\n"
+              "ok = typ >= layout.FIRST_EXTRA_SHAPE\n"
+              "mesh = is_extra(typ) or layout.SHAPE_MESH != typ\n")
+    assert kind_comparisons(source, "kernels/x.py") == [
+        "kernels/x.py:2 compares with SHAPE_TRIANGLE",
+        "kernels/x.py:4 compares with FIRST_EXTRA_SHAPE",
+        "kernels/x.py:5 compares with SHAPE_MESH",
+    ]

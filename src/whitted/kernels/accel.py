@@ -21,19 +21,21 @@ from .extras import (
 )
 from .features import has_extras, has_instances, instances_possible
 from .layout import (
-    FIRST_EXTRA_SHAPE,
     MAT_KT,
     MESH_STACK_BASE,
     PRIM_MATERIAL,
     PRIM_TYPE,
     PRIM_XFORM,
-    SHAPE_CSG,
-    SHAPE_TRIANGLE,
-    TRIANGLE_NORMALS,
 )
 from .mesh import OPAQUE_KT, mesh_closest_hit, mesh_occlusion
 from .shapes import INF
-from .shapes.dispatch import intersect_local, normal_local
+from .shapes.dispatch import (
+    has_shading_normal,
+    intersect_local,
+    is_csg_object,
+    is_extra,
+    normal_local,
+)
 from .shapes.mesh import mesh_normals
 from .shapes.triangle import triangle_shading_normal
 from .traverse import (
@@ -56,7 +58,7 @@ def hit_analytic(geo, i, o, d, tmin, tmax):
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
     typ = geo.prim_info[i, PRIM_TYPE]
-    if has_extras(geo) and typ >= FIRST_EXTRA_SHAPE:  # tori, CSG (compiled only where used)
+    if has_extras(geo) and is_extra(typ):  # tori, CSG (compiled only where used)
         return extra_t_if_extras(geo, i, o, d, tmin, tmax)
     return intersect_local(typ, geo.prim_params, i, o, d, tmin, tmax)
 
@@ -65,7 +67,7 @@ def hit_analytic(geo, i, o, d, tmin, tmax):
 def hit_part(geo, i, o, d, inv, tmin, tmax):
     """(t, the primitive whose surface it is) for analytic primitive ``i``: ``i`` itself, or
     for a CSG object the leaf whose surface shows (``inv``: the ray's inverse direction)."""
-    if has_extras(geo) and geo.prim_info[i, PRIM_TYPE] == SHAPE_CSG:
+    if has_extras(geo) and is_csg_object(geo.prim_info[i, PRIM_TYPE]):
         return csg_hit_if_extras(geo, i, o, d, inv, tmin, tmax)
     return hit_analytic(geo, i, o, d, tmin, tmax), np.int64(i)
 
@@ -122,7 +124,7 @@ def world_normal(geo, i, p):
         lp, _ = to_object(geo.xforms, xf, p, p)
     n = normal_local(typ, geo.prim_params, i, lp)
     if has_extras(geo):  # tori; CSG cuts turned inside out
-        if typ >= FIRST_EXTRA_SHAPE:
+        if is_extra(typ):
             n = extra_normal_if_extras(geo, i, lp, n)
         if xf >= 0:
             n = _normal_to_world(geo.xforms, xf, n)
@@ -151,8 +153,7 @@ def surface_normals(geo, prim, tri, b1, b2, p):
     smooth-shaded meshes; the geometric one decides which side a ray is on."""
     if tri < 0:
         n = world_normal(geo, prim, p)
-        smooth = geo.prim_params[prim, TRIANGLE_NORMALS] >= 0
-        if geo.prim_info[prim, PRIM_TYPE] == SHAPE_TRIANGLE and smooth:
+        if has_shading_normal(geo.prim_info[prim, PRIM_TYPE], geo.prim_params, prim):
             ns = triangle_shading_normal(geo, prim, p, n)
             if has_extras(geo):  # a smooth mesh cutting a CSG difference: turned too
                 ns = flipped_if_extras(geo, prim, ns)

@@ -53,12 +53,16 @@ from .layout import (
     MESH_TRI_OFFSET,
     PRIM_TYPE,
     PRIM_XFORM,
-    SHAPE_CSG_MESH,
-    SHAPE_CSG_OP,
 )
 from .mesh import mesh_closest_hit
 from .shapes import INF
-from .shapes.dispatch import has_crossings, solid_crossings, solid_normal
+from .shapes.dispatch import (
+    has_crossings,
+    is_csg_mesh_leaf,
+    is_csg_operation,
+    solid_crossings,
+    solid_normal,
+)
 from .shapes.triangle import intersect_triangle
 from .traverse import inverse_direction, slab_entry
 from .vec import dot, madd
@@ -150,7 +154,7 @@ def _shows_in(geo, start, n_rows, hit_leaf, inside):
     sp = 0
     leaf = 0
     for r in range(start, start + n_rows):
-        if geo.prim_info[r, PRIM_TYPE] != SHAPE_CSG_OP:
+        if not is_csg_operation(geo.prim_info[r, PRIM_TYPE]):
             ins = _with_bit(ins, sp, _bit(inside, leaf) if leaf != hit_leaf else 0)
             vis = _with_bit(vis, sp, 1 if leaf == hit_leaf else 0)
             sp += 1
@@ -238,7 +242,7 @@ def may_show(geo, root, possible, cuts):
     sp = 0
     leaf = 0
     for r in range(root + 1, root + 1 + n_rows):
-        if geo.prim_info[r, PRIM_TYPE] != SHAPE_CSG_OP:
+        if not is_csg_operation(geo.prim_info[r, PRIM_TYPE]):
             st = _with_bit(st, sp, _bit(possible, leaf))
             sp += 1
             leaf += 1
@@ -491,13 +495,13 @@ def _walk(geo, root, o, d, inv, tmin, tmax, collect, hits, n_hits, full):
     odd = np.int64(0)  # analytic leaves walked by their normals (see below)
     leaf = 0
     for r in range(root + 1, root + 1 + n_rows):
-        if geo.prim_info[r, PRIM_TYPE] == SHAPE_CSG_OP:
+        if is_csg_operation(geo.prim_info[r, PRIM_TYPE]):
             continue
         rows[leaf] = r
         cur[leaf] = 0
         if _bit(skip, leaf):
             count[leaf] = 0
-        elif geo.prim_info[r, PRIM_TYPE] == SHAPE_CSG_MESH:
+        elif is_csg_mesh_leaf(geo.prim_info[r, PRIM_TYPE]):
             t, tri = mesh_leaf_t(geo, r, o, d, tmin, INF)
             count[leaf] = -1
             r0[leaf] = t

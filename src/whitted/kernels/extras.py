@@ -13,9 +13,9 @@ import numpy as np
 from ..jit import kernel, overload
 from .csg import csg_hit
 from .features import extras_possible
-from .layout import PRIM_FLIP, PRIM_MEDIUM, PRIM_TYPE, SHAPE_CSG
+from .layout import PRIM_FLIP, PRIM_MEDIUM, PRIM_TYPE
 from .shapes import INF
-from .shapes.dispatch import extra_shape_normal, extra_shape_t, extra_shape_uv
+from .shapes.dispatch import extra_shape_normal, extra_shape_t, extra_shape_uv, is_csg_object
 from .traverse import inverse_direction
 
 
@@ -24,7 +24,7 @@ def extra_t(geo, i, o, d, tmin, tmax):
     """Nearest visible crossing in (tmin, tmax) of extra shape ``i`` (``o``, ``d`` in its
     row's space)."""
     typ = geo.prim_info[i, PRIM_TYPE]
-    if typ == SHAPE_CSG:
+    if is_csg_object(typ):
         t, _ = csg_hit(geo, i, o, d, inverse_direction(d), tmin, tmax)
         return t
     return extra_shape_t(typ, geo.prim_params, i, o, d, tmin, tmax)

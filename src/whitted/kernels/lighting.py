@@ -23,7 +23,6 @@ from .layout import (
     CELL_COUNT,
     CELL_FIRST,
     CELL_OPAQUE,
-    FIRST_EXTRA_SHAPE,
     LIGHT_BUFFER,
     LIGHT_BUFFER_SIDE,
     LIGHT_DIRECTION,
@@ -51,15 +50,13 @@ from .layout import (
     PRIM_TYPE,
     PRIM_XFORM,
     RAY_SHADOW,
-    SHAPE_CSG,
-    SHAPE_PLANE,
-    SHAPE_TRIANGLE,
 )
 from .light_buffer import cube_cell
 from .media import absorbed, media_enter, media_leave
 from .mesh import OPAQUE_KT
 from .sampling import concentric_disk, random_pair, stratum
 from .shapes import INF
+from .shapes.dispatch import crossed_twice, is_csg_object, is_extra, is_world_plane
 from .traverse import (
     box_entry,
     cone_meets_box,
@@ -175,7 +172,7 @@ def list_bundle_occluders(geo, mats, p, centre, radius, tmin, stack, listed):
     opaque = True
     for j in range(geo.unbounded.shape[0]):
         i = geo.unbounded[j]
-        if (geo.prim_info[i, PRIM_TYPE] == SHAPE_PLANE and geo.prim_info[i, PRIM_XFORM] < 0
+        if (is_world_plane(geo.prim_info[i, PRIM_TYPE], geo.prim_info[i, PRIM_XFORM])
                 and _plane_clear_of_bundle(geo.prim_params, i, p, centre, radius, tmin)):
             continue
         if n == SHADOW_LIST_CAP:
@@ -248,7 +245,7 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
                                                              j, leaf, leaf_end, top, False)
             if i < 0:
                 break
-        if (has_extras(geo) and geo.prim_info[i, PRIM_TYPE] >= FIRST_EXTRA_SHAPE
+        if (has_extras(geo) and is_extra(geo.prim_info[i, PRIM_TYPE])
                 and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] >= OPAQUE_KT):
             # a clear torus or CSG object: every crossing (a CSG object's as its leaves)
             n, full = gather_extra_hits_if_extras(geo, i, o, d, inv, tmin, tmax, step, hits,
@@ -264,7 +261,7 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
         n, full = keep_nearest(hits, n, t, i, full)
         # a closed analytic body is crossed twice (the triangles of a flattened solid mesh
         # are each crossed once: their body's other side is other triangles)
-        if geo.prim_info[i, PRIM_SOLID] and geo.prim_info[i, PRIM_TYPE] != SHAPE_TRIANGLE:
+        if crossed_twice(geo.prim_info[i, PRIM_TYPE], geo.prim_info[i, PRIM_SOLID]):
             t = hit_analytic(geo, i, o, d, t * (1.0 + 1e-12) + step, tmax)
             if t < INF:
                 n, full = keep_nearest(hits, n, t, i, full)
@@ -276,7 +273,7 @@ def gather_extra_hits(geo, i, o, d, inv, tmin, tmax, step, hits, n, full):
     """:func:`gather_transparent_hits` for a torus or CSG object ``i``: its crossings in
     (tmin, tmax), a CSG object's as (t, leaf) pairs from one walk (:func:`.csg.csg_surfaces`),
     a torus's each found from past the one before (up to four)."""
-    if geo.prim_info[i, PRIM_TYPE] == SHAPE_CSG:
+    if is_csg_object(geo.prim_info[i, PRIM_TYPE]):
         return csg_surfaces(geo, i, o, d, inv, tmin, tmax, hits, n, full)
     t = hit_analytic(geo, i, o, d, tmin, tmax)
     for _ in range(4):

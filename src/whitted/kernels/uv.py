@@ -9,8 +9,8 @@ from ..jit import kernel, overload
 from .accel import to_object
 from .extras import extra_uv_if_extras
 from .features import has_extras, instances_possible
-from .layout import FIRST_EXTRA_SHAPE, PRIM_TYPE, PRIM_XFORM, SHAPE_MESH
-from .shapes.dispatch import uv_local
+from .layout import PRIM_TYPE, PRIM_XFORM
+from .shapes.dispatch import is_extra, is_mesh_instance, uv_local
 from .shapes.mesh import mesh_uv
 
 
@@ -31,11 +31,11 @@ def _mesh_uv_if_instances(geo, mesh, tri, b1, b2):
 def surface_uv(geo, prim, tri, b1, b2, p):
     """Texture coordinates of the hit at world point ``p`` (see the module docstring)."""
     typ = geo.prim_info[prim, PRIM_TYPE]
-    if typ == SHAPE_MESH:
+    if is_mesh_instance(typ):
         return mesh_uv_if_instances(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
     xf = geo.prim_info[prim, PRIM_XFORM]
     if xf >= 0:
         p, _ = to_object(geo.xforms, xf, p, p)
-    if has_extras(geo) and typ >= FIRST_EXTRA_SHAPE:  # the torus
+    if has_extras(geo) and is_extra(typ):  # the torus
         return extra_uv_if_extras(geo, prim, p)
     return uv_local(typ, geo.prim_params, prim, p)

@@ -26,7 +26,10 @@ whole when it has:
 
 ``dispatch.py`` is the one place the shape code picks these functions (hit, normal, uv,
 crossings): the walks (accel.py), the uv of a hit (uv.py), the kernels of the shapes only
-some scenes have (extras.py) and the CSG walk (csg.py) all ask there. Two kinds are
+some scenes have (extras.py) and the CSG walk (csg.py) all ask there. It also holds the
+named predicates (``is_extra``, ``is_csg_object``, ``has_shading_normal``, ``crossed_twice``,
+...) through which every kernel outside this package tells kinds of rows apart; none of
+them compares a row's type with a ``SHAPE_*`` code. Two kinds are
 composites walked elsewhere: a mesh (its triangles flattened into triangle rows, or kept
 whole as an instance, whose BVH kernels/mesh.py walks with the triangle test of this
 package's ``mesh.py``) and a CSG object (kernels/csg.py walks its leaves, each an ordinary
@@ -34,7 +37,8 @@ solid row).
 
 :data:`PIECES` names, for every kind, the function of each piece (one named hop);
 tests/test_shape_completeness.py checks that each exists, lives in the kind's own file, is
-reached from ``dispatch.py`` (or the composite's walk), and that every kind has its export,
+reached from ``dispatch.py`` (or the composite's walk), that no kernel outside this package
+compares a row's type with a shape code, and that every kind has its export,
 editor entry, ``whitted info`` line and docs.
 """
 

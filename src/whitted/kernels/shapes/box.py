@@ -10,8 +10,7 @@ import math
 
 from ...jit import kernel
 from ..vec import normalize, sub, vload
-
-INF = math.inf
+from . import INF
 
 
 @kernel
@@ -65,7 +64,7 @@ def box_normal(P, i, p):
     lp = box_local(P, i, sub(p, vload(P, i, 0)))
     best_k = 0
     best_side = -1.0
-    best_dist = INF
+    best_dist = math.inf
     for k in range(3):
         if abs(lp[k]) < best_dist:
             best_dist = abs(lp[k])

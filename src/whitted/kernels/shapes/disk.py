@@ -11,7 +11,8 @@ from __future__ import annotations
 from ...jit import kernel
 from ..layout import DISK_TANGENT
 from ..vec import cross, dot, sub, vload
-from .flat import EDGE_TOL, INF, plane_t
+from . import INF
+from .flat import EDGE_TOL, plane_t
 
 
 @kernel

@@ -1,8 +1,10 @@
 """The one place a primitive's shape code picks its shape's function: for each query (hit,
 normal, uv, crossings), one function here switches on the ``SHAPE_*`` code and calls the
-shape's own file. The scene-level queries (accel.py, uv.py), the kernels of the shapes only
-some scenes have (extras.py) and the CSG walk (csg.py) all ask here; none of them names a
-shape. A new shape adds its branch to each function here, and its entry in ``PIECES``.
+shape's own file. The scene-level queries (accel.py, uv.py, lighting.py), the kernels of
+the shapes only some scenes have (extras.py) and the CSG walk (csg.py) all ask here; none of
+them names a shape. Where they must tell kinds apart (a composite walked by code of its own,
+a smooth-shaded triangle, a body crossed twice) they ask one of the predicates at the end of
+this file. A new shape adds its branch to each function here, and its entry in ``PIECES``.
 
 The switches are chains of comparisons on the code, not tables of functions: a Numba
 function value is an indirect call that cannot be inlined, and the hit is asked once per
@@ -21,14 +23,20 @@ import numpy as np
 
 from ...jit import kernel
 from ..layout import (
+    FIRST_EXTRA_SHAPE,
     SHAPE_BOX,
+    SHAPE_CSG,
+    SHAPE_CSG_MESH,
+    SHAPE_CSG_OP,
     SHAPE_DISK,
     SHAPE_FRUSTUM,
+    SHAPE_MESH,
     SHAPE_PLANE,
     SHAPE_RECTANGLE,
     SHAPE_SPHERE,
     SHAPE_TORUS,
     SHAPE_TRIANGLE,
+    TRIANGLE_NORMALS,
 )
 from . import INF
 from .box import box_normal, box_span, box_uv, intersect_box
@@ -178,3 +186,57 @@ def solid_normal(typ, P, j, p):
     if typ == SHAPE_TORUS:
         return torus_normal(P, j, p)
     return normal_local(typ, P, j, p)
+
+
+# The kinds of rows, for the code outside this package that must tell them apart (each
+# inlined: a comparison or two, as fast as writing it at the caller).
+
+
+@kernel(inline="always")
+def is_extra(typ):
+    """Whether ``typ`` is a shape only some scenes have (a torus, a CSG object): asked
+    through extras.py, compiled only for scenes that have one."""
+    return typ >= FIRST_EXTRA_SHAPE
+
+
+@kernel(inline="always")
+def is_csg_object(typ):
+    """Whether ``typ`` is a CSG object's root row, whose leaves kernels/csg.py walks."""
+    return typ == SHAPE_CSG
+
+
+@kernel(inline="always")
+def is_csg_operation(typ):
+    """Whether ``typ`` is an operation row of a CSG tree (not a leaf)."""
+    return typ == SHAPE_CSG_OP
+
+
+@kernel(inline="always")
+def is_csg_mesh_leaf(typ):
+    """Whether ``typ`` is a CSG leaf that is a closed mesh (walked by kernels/mesh.py)."""
+    return typ == SHAPE_CSG_MESH
+
+
+@kernel(inline="always")
+def is_mesh_instance(typ):
+    """Whether ``typ`` is a mesh instance, whose triangles' BVH kernels/mesh.py walks."""
+    return typ == SHAPE_MESH
+
+
+@kernel(inline="always")
+def has_shading_normal(typ, P, i):
+    """Whether row ``i`` of shape ``typ`` is a smooth-shaded triangle (of a flattened mesh)."""
+    return typ == SHAPE_TRIANGLE and P[i, TRIANGLE_NORMALS] >= 0
+
+
+@kernel(inline="always")
+def is_world_plane(typ, xf):
+    """Whether a row of shape ``typ`` and transform ``xf`` is a plane given in world space."""
+    return typ == SHAPE_PLANE and xf < 0
+
+
+@kernel(inline="always")
+def crossed_twice(typ, solid):
+    """Whether a line through a row of shape ``typ`` (``solid``: its ``PRIM_SOLID``) crosses
+    its surface twice: a closed core body, not a triangle of a flattened solid mesh."""
+    return solid != 0 and typ != SHAPE_TRIANGLE

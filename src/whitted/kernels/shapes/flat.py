@@ -3,12 +3,10 @@ plane, and how far past their edges a hit still counts."""
 
 from __future__ import annotations
 
-import math
-
 from ...jit import kernel
 from ..vec import dot, sub
+from . import INF
 
-INF = math.inf
 # Flat shapes accept hits a hair outside their edges (in parametric units): rays through a
 # shared edge of two rectangles or triangles never slip between them.
 EDGE_TOL = 1e-9

@@ -15,9 +15,9 @@ import math
 from ...jit import kernel
 from ..layout import FRUSTUM_TANGENT
 from ..vec import cross, dot, normalize, sub, vload
+from . import INF
 from .quadric import nearest_root, quadratic_roots
 
-INF = math.inf
 INV_TWO_PI = 0.5 / math.pi
 
 

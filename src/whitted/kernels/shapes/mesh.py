@@ -14,15 +14,12 @@ vertex) hits at least one of them: no cracks, whatever the floating-point roundi
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ...jit import kernel
 from ..layout import MESH_NORMALS, MESH_TRI_OFFSET, MESH_UVS
 from ..vec import cross, normalize
-
-INF = math.inf
+from . import INF
 
 
 @kernel(fastmath=False)

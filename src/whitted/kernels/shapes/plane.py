@@ -11,7 +11,8 @@ from __future__ import annotations
 from ...jit import kernel
 from ..layout import PLANE_TANGENT
 from ..vec import cross, dot, sub, vload
-from .flat import INF, plane_t
+from . import INF
+from .flat import plane_t
 
 
 @kernel

@@ -5,8 +5,7 @@ from __future__ import annotations
 import math
 
 from ...jit import kernel
-
-INF = math.inf
+from . import INF
 
 
 @kernel

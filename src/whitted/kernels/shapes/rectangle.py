@@ -10,7 +10,8 @@ from __future__ import annotations
 
 from ...jit import kernel
 from ..vec import dot, sub, vload
-from .flat import EDGE_TOL, INF, plane_t
+from . import INF
+from .flat import EDGE_TOL, plane_t
 
 
 @kernel

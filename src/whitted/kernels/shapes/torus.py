@@ -36,8 +36,8 @@ import math
 
 from ...jit import kernel
 from ..vec import dot, normalize, sub, vload
+from . import INF
 
-INF = math.inf
 NEWTON_STEPS = 60  # at most, per root (monotone convergence: five or six in practice)
 NEWTON_TOL = 1e-13  # a step this small (relative, on the unit-ball chord) ends the search
 

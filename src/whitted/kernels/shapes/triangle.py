@@ -14,7 +14,8 @@ from __future__ import annotations
 from ...jit import kernel
 from ..layout import TRIANGLE_NORMALS, TRIANGLE_UV
 from ..vec import cross, dot, normalize, sub, vload
-from .flat import EDGE_TOL, INF
+from . import INF
+from .flat import EDGE_TOL
 
 
 @kernel
