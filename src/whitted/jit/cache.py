@@ -397,6 +397,10 @@ class KernelCache:
                 digest, now = self._read_file(path) if entry is not None else (None, None)
                 if now is not None:
                     st = now  # the file hashed (Numba may have renamed a new one in since)
+                elif entry is not None and not os.path.lexists(path):
+                    sums.pop(name, None)  # gone since the folder was listed: nothing to judge
+                    refreshed = True
+                    continue
                 good = entry is not None and entry[1] == st.st_size and digest == entry[0]
                 if good:
                     self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
