@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 from PIL import Image
 
+from whitted import machine
 from whitted.farm import measure
 from whitted.scene import load_scene
 from whitted.scene.io import scene_from_dict
@@ -53,7 +54,8 @@ def test_layouts_medians_and_cpu_name():
     model = [line.split(":", 1)[1].strip()
              for line in Path("/proc/cpuinfo").read_text().splitlines()
              if line.startswith("model name")]
-    assert measure._cpu() == model[0]
+    assert machine.cpu_name() == model[0]
+    assert measure.cpu_name is machine.cpu_name  # the farm names the CPU as bench does
 
 
 def test_cpu_name_without_proc_cpuinfo(monkeypatch):
@@ -63,8 +65,8 @@ def test_cpu_name_without_proc_cpuinfo(monkeypatch):
         def read_text(self, *args, **kwargs):
             raise OSError("no /proc here")
 
-    monkeypatch.setattr(measure, "Path", NoProc)
-    assert measure._cpu() == (platform.processor() or "unknown")
+    monkeypatch.setattr(machine, "Path", NoProc)
+    assert machine.cpu_name() == (platform.processor() or platform.machine() or "unknown")
 
 
 def test_hd_frame_is_a_1080p_png(tmp_path):
@@ -93,7 +95,7 @@ def test_measure_reports_the_local_and_the_farm_film(tmp_path):
     report = json.loads(out.read_text())
     assert report["frames"] == 2 and report["size"] == [16, 12]
     assert report["scene"] == str(ROOT / "examples" / "textured.toml")
-    assert report["cpu"] == measure._cpu()
+    assert report["cpu"] == machine.cpu_name()
     assert report["scene_pickle_bytes"] > 0
     local = report["local"]
     assert local["threads"] == 2

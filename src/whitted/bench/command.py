@@ -171,7 +171,8 @@ def startup_main(*, scenes: list[str] | None, runs: int, threads: str | None,
                  err: Console) -> None:
     """``whitted bench --startup``: the budget of a whole ``whitted render`` process for each
     scene (a benchmark's name or a scene file), beside POV-Ray with ``--compare povray``."""
-    from .startup import budget_table, cpu_name, scene_file_of, startup_budget
+    from ..machine import cpu_name
+    from .startup import budget_table, scene_file_of, startup_budget
 
     if compare not in (None, "povray"):
         raise BenchUsageError(f"--compare: --startup compares with povray only (got {compare!r})")

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import WhittedError
+from ..machine import cpu_name
 from ..marks import ENV
 
 PHASES = ("interpreter", "imports", "scene", "kernels", "render", "other work", "encoding",
@@ -109,18 +110,6 @@ def phases(marks: dict[str, float], launched: float, ended: float) -> dict[str, 
     }
 
 
-def cpu_name() -> str:
-    """The CPU's model name (``lscpu``'s "Model name": /proc/cpuinfo on Linux), to print
-    beside every figure; the architecture elsewhere."""
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    import platform
-
-    return platform.processor() or platform.machine() or "unknown CPU"
 
 
 def read_marks(path: Path) -> dict[str, float]:

@@ -305,6 +305,7 @@ def bench(
     processor and the load average are printed beside the figures."""
     from rich.table import Table
 
+    from .. import machine
     from ..stefan import bench as b
 
     counts = _thread_counts(threads)
@@ -320,10 +321,10 @@ def bench(
             check_output_place(json_path)
         except WhittedError as exc:
             raise _fail(f"--json: {exc}") from None
-    load = b.load_average()
+    load = machine.load_average()
     usable = (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
               else os.cpu_count())
-    out.print(f"CPU: {b.cpu_name()}; {usable} cores usable; load average "
+    out.print(f"CPU: {machine.cpu_name()}; {usable} cores usable; load average "
               f"{'unknown' if load is None else f'{load:.2f}'}")
     guard = InterruptGuard(at_once=True)
     try:
@@ -342,14 +343,14 @@ def bench(
                       f"{r.best / 1e6:.1f}", f"{r.per_thread / 1e6:.1f}",
                       "" if base is None else f"{r.median / base:.2f}x")
     out.print(table)
-    load = b.load_average()
+    load = machine.load_average()
     out.print(f"load average after: {'unknown' if load is None else f'{load:.2f}'}")
     if json_path is not None:
         import json
 
         from ..files.atomic import atomic_write
 
-        data = {"cpu": b.cpu_name(), "rows": [
+        data = {"cpu": machine.cpu_name(), "rows": [
             {"solver": r.solver, "cells": r.cells, "threads": r.threads, "steps": r.steps,
              "cell_updates_per_s": r.runs} for r in rows]}
         atomic_write(json_path, lambda tmp: Path(tmp).write_text(json.dumps(data, indent=1)))

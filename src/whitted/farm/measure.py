@@ -24,6 +24,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from ..machine import cpu_name
+
 
 def _noop(x: int) -> int:
     return x
@@ -141,7 +143,7 @@ def main(argv: list[str] | None = None) -> dict:
 
     scene = film_scene(args.scene, args.frames).with_settings(width=args.width,
                                                                height=args.height)
-    report: dict = {"cpu": _cpu(), "load_before": os.getloadavg(), "frames": scene.frame_count,
+    report: dict = {"cpu": cpu_name(), "load_before": os.getloadavg(), "frames": scene.frame_count,
                     "size": [args.width, args.height], "scene": args.scene or "<default>",
                     "scene_pickle_bytes": len(pickle.dumps(scene))}
     with tempfile.TemporaryDirectory(prefix="whitted-measure-") as tmp:
@@ -200,16 +202,6 @@ def _fresh(folder: Path) -> Path:
     return folder
 
 
-def _cpu() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    import platform
-
-    return platform.processor() or "unknown"
 
 
 if __name__ == "__main__":

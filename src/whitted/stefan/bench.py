@@ -15,7 +15,6 @@ this process (``numba.set_num_threads``); SciPy's transforms take as many worker
 
 from __future__ import annotations
 
-import os
 import statistics
 import time
 from dataclasses import dataclass, field
@@ -42,28 +41,6 @@ class Rates:
     @property
     def per_thread(self) -> float:
         return self.median / self.threads
-
-
-def cpu_name() -> str:
-    """The processor's model name (Linux: /proc/cpuinfo, as lscpu reports it), else the
-    platform's word for it."""
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8") as f:
-            for line in f:
-                if line.lower().startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    import platform
-
-    return platform.processor() or platform.machine() or "unknown"
-
-
-def load_average() -> float | None:
-    try:
-        return os.getloadavg()[0]
-    except (AttributeError, OSError):
-        return None
 
 
 def _enthalpy_runner(cells: int):
@@ -144,4 +121,4 @@ def measure(cells: int = 64, flow_cells: int = 48, threads: tuple[int, ...] = (1
     return results
 
 
-__all__ = ["Rates", "cpu_name", "load_average", "measure"]
+__all__ = ["Rates", "measure"]
