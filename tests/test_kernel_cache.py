@@ -225,6 +225,26 @@ def test_a_file_rewritten_before_its_kernel_is_looked_up_is_no_damage(tmp_path, 
     assert "damaged kernel cache file" in capsys.readouterr().err
 
 
+def test_the_start_up_check_leaves_sealed_files_to_their_look_up(tmp_path, capsys):
+    """The start-up check (lazy) reads only the folder's listing: a sealed file truncated
+    in place (the same inode, another size) is not looked at then, and is found, deleted
+    and reported in one line when its kernel is looked up; the other kernel's files are
+    loaded as sealed, and a fresh check of every file agrees."""
+    state = _fake_cache(tmp_path)
+    index = Path(state.folder, "kernels_1/a-1.py311.nbi")
+    os.truncate(index, 100)
+    again = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert again.verify(lazy=True) == 0
+    assert index.exists() and capsys.readouterr().err == ""
+    assert again.check_function("compile_2", "b-2.py311") == 0
+    assert again.check_function("kernels_1", "a-1.py311") == 1
+    assert not index.exists()
+    assert capsys.readouterr().err == (f"warning: 1 damaged kernel cache file in "
+                                       f"{state.folder} deleted; compiling it again\n")
+    assert _cache.KernelCache(state.folder, own=True, helper=False).verify() == 0
+    assert _names(again) == _names(state) - {"kernels_1/a-1.py311.nbi"}
+
+
 def test_a_file_another_process_rewrote_and_sealed_after_the_check_is_no_damage(
         tmp_path, capsys):
     """Two processes on one folder: the first checks lazily at start-up; the second then
@@ -293,14 +313,14 @@ def test_a_file_renamed_in_while_the_start_up_check_reads_the_folder_is_no_damag
     other = _hold_compiling_marker(state.folder, started, release)
     index = Path(state.folder, "kernels_1/a-1.py311.nbi")
     first = _cache.KernelCache(state.folder, own=True, helper=False)
-    listed = first._files
+    listed = first._entries
 
     def list_then_rewrite():
         files = listed()
         _rewrite(index, b"another signature from the compiling process")
         return files
 
-    monkeypatch.setattr(first, "_files", list_then_rewrite)
+    monkeypatch.setattr(first, "_entries", list_then_rewrite)
     try:
         while not started.exists():  # an event, not a time: it exits on any failure
             assert other.poll() is None, "the other process ended before compiling"

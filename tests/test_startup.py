@@ -131,6 +131,31 @@ def test_numba_imported_through_whitted_skips_its_scipy_and_yaml_probes(tmp_path
     assert {"numba", "scipy", "yaml"} <= loaded
 
 
+def test_numba_imported_through_whitted_skips_its_coverage_probe(tmp_path):
+    """Numba imports coverage.py to report compiled lines to a running measurement: through
+    whitted it is skipped when coverage.py is not imported (no measurement can be running),
+    and still importable afterwards; with coverage.py imported first (``coverage run``,
+    pytest-cov), Numba sees it as without whitted."""
+    pytest.importorskip("coverage")
+    loaded = _modules_after("""
+        import whitted, sys
+        import numba
+        from numba.misc import coverage_support
+        assert "coverage" not in sys.modules, "probed"
+        assert coverage_support.coverage_available is False
+        import coverage
+        assert coverage.Coverage
+    """, tmp_path, COVERAGE_PROCESS_START="", COVERAGE_PROCESS_CONFIG="")  # not measured
+    assert {"numba", "coverage"} <= loaded
+    _modules_after("""
+        import coverage
+        import whitted
+        import numba
+        from numba.misc import coverage_support
+        assert coverage_support.coverage_available is True
+    """, tmp_path)
+
+
 def test_numba_config_file_still_read_through_whitted(tmp_path):
     """With a ``.numba_config.yaml`` in the working folder PyYAML is imported, so Numba reads
     the user's settings as it would without whitted."""

@@ -305,8 +305,12 @@ class KernelCache:
         return busy
 
     # ---------------------------------------------------------------- sums
-    def _files(self) -> dict[str, os.stat_result]:
-        found: dict[str, os.stat_result] = {}
+    def _entries(self) -> dict[str, os.DirEntry]:
+        """The cache files in the folder (one level down), by name, as listed: their inodes
+        come with the listing (``DirEntry.inode()``, no system call on POSIX); their status
+        costs a ``stat`` each, made only where needed (a cache of every variant holds about
+        a thousand files, and a process loads a few of them)."""
+        found: dict[str, os.DirEntry] = {}
         root = self.folder
         try:
             folders = [e for e in os.scandir(root) if e.is_dir(follow_symlinks=False)]
@@ -319,8 +323,14 @@ class KernelCache:
                 continue
             for entry in entries:
                 if entry.name.endswith(CACHE_SUFFIXES):
-                    with contextlib.suppress(OSError):
-                        found[f"{sub.name}/{entry.name}"] = entry.stat(follow_symlinks=False)
+                    found[f"{sub.name}/{entry.name}"] = entry
+        return found
+
+    def _files(self) -> dict[str, os.stat_result]:
+        found: dict[str, os.stat_result] = {}
+        for name, entry in self._entries().items():
+            with contextlib.suppress(OSError):
+                found[name] = entry.stat(follow_symlinks=False)
         return found
 
     def _read_sums(self) -> tuple[dict, bool]:
@@ -384,22 +394,28 @@ class KernelCache:
             sums, damaged_list = self._read_sums()
             damaged = 0
             deleted = refreshed = False
-            files = self._files()
+            files = self._entries()
             rewriting = self.others_compiling()
-            for name, st in files.items():
+            for name, listed in files.items():
                 path = os.path.join(self.folder, name)
                 entry = sums.get(name)
                 if lazy and not damaged_list and entry is not None \
-                        and entry[1] == st.st_size and entry[2:] == [st.st_ino]:
+                        and entry[2:] == [_inode(listed)]:
+                    # the file as sealed (the same inode): its content, and so its size, is
+                    # checked when its kernel is first looked up, without a stat now
                     self._deferred[name] = entry[0]
-                    self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
+                    self._seen[name] = (entry[2], entry[1], 0)
                     continue
-                digest, now = self._read_file(path) if entry is not None else (None, None)
-                if now is not None:
-                    st = now  # the file hashed (Numba may have renamed a new one in since)
-                elif entry is not None and not os.path.lexists(path):
-                    sums.pop(name, None)  # gone since the folder was listed: nothing to judge
-                    refreshed = True
+                digest, st = self._read_file(path) if entry is not None else (None, None)
+                if st is None:
+                    try:
+                        st = listed.stat(follow_symlinks=False)
+                    except OSError:
+                        st = None
+                if st is None:  # gone since the folder was listed: nothing to judge
+                    if entry is not None:
+                        sums.pop(name, None)
+                        refreshed = True
                     continue
                 good = entry is not None and entry[1] == st.st_size and digest == entry[0]
                 if good:
@@ -522,10 +538,10 @@ class KernelCache:
             self._done_compiling()
             sums, damaged_list = self._read_sums()
             changed = False
-            for name, st in self._files().items():
+            for name, listed in self._entries().items():
                 seen = self._seen.get(name)
                 entry = sums.get(name)
-                if seen is not None and seen[0] == st.st_ino and entry is not None:
+                if seen is not None and entry is not None and seen[0] == _inode(listed):
                     continue  # as checked (or changed in place: not sealed)
                 digest, st = self._read_file(os.path.join(self.folder, name))
                 if digest is None:
@@ -539,6 +555,14 @@ class KernelCache:
                 changed = True
             if changed or damaged_list:
                 self._write_sums(sums)
+
+
+def _inode(entry: os.DirEntry) -> int | None:
+    """A listed file's inode (None: gone since it was listed)."""
+    try:
+        return entry.inode()
+    except OSError:  # Windows stats the file for it
+        return None
 
 
 _state: KernelCache | None = None
