@@ -83,6 +83,42 @@ def test_warm_render_to_a_pipe_imports_no_rich(tmp_path):
     assert "rich" not in loaded
 
 
+def _run_main(argv: list[str]) -> str:
+    """``whitted ARGV`` run by the command's own entry point, in the checking process."""
+    return f"""
+        import sys
+        import whitted.cli.main as main
+        main.EXIT_AT_ONCE_WHEN_ABANDONED = False  # back here, to list what was imported
+        sys.argv = ["whitted", *{argv!r}]
+        try:
+            main.main()
+        except SystemExit as exc:
+            assert exc.code in (0, None), exc.code
+    """
+
+
+def test_a_render_looks_for_no_pydantic_plugins(tmp_path):
+    """``whitted render`` validates its scene without pydantic's search of every installed
+    distribution for plugins (cli/main.py); a user's own setting is kept."""
+    out = tmp_path / "x.png"
+    code = _run_main(["render", str(REPO_ROOT / "examples" / "glass_cube.toml"), "-W", "24",
+                      "-H", "16", "-q", "-o", str(out)]) + """
+        from pydantic.plugin import _loader
+        assert _loader._plugins is None, "searched for plugins"
+        import os
+        print("SETTING=" + os.environ["PYDANTIC_DISABLE_PLUGINS"])
+    """
+    loaded = _modules_after(code, tmp_path)
+    assert out.stat().st_size > 0 and "pydantic" in loaded
+    script = textwrap.dedent(code).replace('assert _loader._plugins is None, "searched for '
+                                           'plugins"', "")
+    env = {**os.environ, "PYTHONPATH": str(REPO_ROOT / "src"), "PYDANTIC_DISABLE_PLUGINS": ""}
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         cwd=tmp_path, env=env, timeout=600)
+    assert run.returncode == 0, run.stderr
+    assert "SETTING=\n" in run.stdout
+
+
 def test_plain_line_is_what_rich_prints_and_needs_no_rich(tmp_path, monkeypatch):
     """cli/console.py writes a plain line to a file that is not a terminal itself: the same
     bytes rich writes for it (markup and emoji codes stay literal)."""
