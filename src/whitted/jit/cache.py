@@ -65,6 +65,7 @@ render waits and then loads what the first compiled.
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import json
 import os
@@ -95,8 +96,19 @@ LOCK_WAIT_SECONDS = 900.0  # a process holding the lock longer than this is not 
 
 def kernel_source_hash(root: Path | None = None) -> str:
     """A hash of the sources that decide the kernels' machine code, under ``root`` (whitted's
-    package folder unless given)."""
-    root = root if root is not None else Path(__file__).parents[1]
+    package folder unless given: read once a process, which names its cache folder and
+    digests its jobs with it)."""
+    if root is None:
+        return _own_kernel_source_hash()
+    return _kernel_source_hash(root)
+
+
+@functools.cache
+def _own_kernel_source_hash() -> str:
+    return _kernel_source_hash(Path(__file__).parents[1])
+
+
+def _kernel_source_hash(root: Path) -> str:
     h = hashlib.sha256()
     paths = [path for folder in KERNEL_DIRS for path in sorted((root / folder).rglob("*.py"))]
     for path in paths + [root / name for name in KERNEL_FILES]:
