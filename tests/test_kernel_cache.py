@@ -245,6 +245,30 @@ def test_the_start_up_check_leaves_sealed_files_to_their_look_up(tmp_path, capsy
     assert _names(again) == _names(state) - {"kernels_1/a-1.py311.nbi"}
 
 
+def test_the_start_up_check_of_a_sealed_folder_takes_no_lock(tmp_path, monkeypatch):
+    """A warm folder whose files are all as sealed is checked at start-up without the lock
+    (nothing to delete or write); a file nobody sealed sends the check under the lock,
+    which deletes it."""
+    state = _fake_cache(tmp_path)
+    again = _cache.KernelCache(state.folder, own=True, helper=False)
+
+    def no_lock():
+        raise AssertionError("the lock was taken")
+
+    monkeypatch.setattr(again, "_acquire", no_lock)
+    assert again.verify(lazy=True) == 0
+    assert set(again._deferred) == _names(state)
+    monkeypatch.undo()
+    stray = Path(state.folder, "kernels_1/c-9.py311.nbi")
+    stray.write_bytes(b"unsealed")
+    taken = []
+    third = _cache.KernelCache(state.folder, own=True, helper=False)
+    monkeypatch.setattr(third, "_acquire", lambda: taken.append(True))
+    assert third.verify(lazy=True) == 0
+    assert taken and not stray.exists()
+    assert set(third._deferred) == _names(state)
+
+
 def test_a_file_another_process_rewrote_and_sealed_after_the_check_is_no_damage(
         tmp_path, capsys):
     """Two processes on one folder: the first checks lazily at start-up; the second then

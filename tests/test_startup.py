@@ -119,6 +119,28 @@ def test_a_render_looks_for_no_pydantic_plugins(tmp_path):
     assert "SETTING=\n" in run.stdout
 
 
+def test_a_warm_render_imports_no_file_lock_library(tmp_path):
+    """A render whose kernels are all in the cache, as sealed, checks the cache without its
+    lock (jit/cache.py): filelock is not imported (21 modules). The first run may compile;
+    a copy of the warm cache keeps other processes' compiles out of the check."""
+    import shutil
+
+    from whitted.jit.cache import prepare
+
+    warm = Path(prepare().folder)
+    cache = tmp_path / "cache"
+    if warm.is_dir():
+        shutil.copytree(warm, cache / warm.name, ignore=shutil.ignore_patterns("whitted.lock"))
+    out = tmp_path / "x.png"
+    code = _run_main(["render", str(REPO_ROOT / "benchmarks" / "seed000.toml"), "-W", "24",
+                      "-H", "16", "-q", "-o", str(out)])
+    settings = {"WHITTED_CACHE_DIR": str(cache), "NUMBA_CACHE_DIR": ""}
+    _modules_after(code, tmp_path, **settings)  # may compile
+    loaded = _modules_after(code, tmp_path, **settings)
+    assert out.stat().st_size > 0 and "numba" in loaded
+    assert "filelock" not in loaded
+
+
 def test_plain_line_is_what_rich_prints_and_needs_no_rich(tmp_path, monkeypatch):
     """cli/console.py writes a plain line to a file that is not a terminal itself: the same
     bytes rich writes for it (markup and emoji codes stay literal)."""

@@ -41,8 +41,12 @@ cache file against it:
   process compiling, it is damage like any other;
 - a damaged list is a list of nothing: every file is then compiled again, with one warning.
 
-A file as sealed (its entry's size and inode) has its content checked only when its kernel is
-first looked up (:meth:`KernelCache.check_function`). Other processes keep writing meanwhile:
+A file as sealed (its entry's inode, which the folder's listing gives without a ``stat``) has
+its content, and so its size, checked only when its kernel is first looked up
+(:meth:`KernelCache.check_function`): a process reads the listing and the list, and hashes
+the few files it loads. A warm folder whose files are all as sealed is checked so without
+the lock (there is nothing to delete or write); anything else is checked under it. Other
+processes keep writing meanwhile:
 a file that no longer has the sum the start-up check saw is judged under the lock, against
 the list and the markers as they are then: sealed since by another process, it is loaded;
 a new file (another inode) while another process is compiling is that process's work, kept
@@ -397,10 +401,12 @@ class KernelCache:
     def verify(self, lazy: bool = False) -> int:
         """Check every cache file against the list (module docstring); delete what fails.
         Returns how many damaged files were deleted. ``lazy``: a file that is as sealed (its
-        entry's size and inode) has its content checked only when a kernel of its is first
+        entry's inode) has its content checked only when a kernel of its is first
         looked up in this process (:meth:`check_function`, from jit/locator.py), so a process
         hashes the few files it loads, not the whole cache of every variant."""
         if self.folder is None or self.helper:
+            return 0
+        if lazy and self.own and self._all_as_sealed():
             return 0
         with self.locked():
             sums, damaged_list = self._read_sums()
@@ -469,6 +475,32 @@ class KernelCache:
                 self.unsealed = True
                 self.seal()
             return damaged
+
+    def _all_as_sealed(self) -> bool:
+        """The lazy start-up check of a warm folder, without the lock: True when every
+        cache file listed is as sealed (its entry's inode) and every entry names a listed
+        file. Then there is nothing to delete or to write, and each file's content is left
+        for its kernel's first look-up (:meth:`check_function`), as :meth:`verify` leaves
+        it. Anything else (a file not in the list, another inode, an entry without its file,
+        a damaged list) is for the check under the lock. The list is written whole or not
+        at all (a new file renamed over it), so it is read whole without the lock; a file
+        another process writes or deletes meanwhile is judged when it is looked up."""
+        sums, damaged_list = self._read_sums()
+        if damaged_list or not sums:
+            return False
+        files = self._entries()
+        if len(files) != len(sums):
+            return False
+        found = []
+        for name, listed in files.items():
+            entry = sums.get(name)
+            if entry is None or entry[2:] != [_inode(listed)]:
+                return False
+            found.append((name, entry))
+        for name, entry in found:
+            self._deferred[name] = entry[0]
+            self._seen[name] = (entry[2], entry[1], 0)
+        return True
 
     def check_function(self, subfolder: str, filename_base: str) -> int:
         """Before Numba looks up a kernel (its cache files ``<subfolder>/<filename_base>.*``):
