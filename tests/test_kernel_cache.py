@@ -394,6 +394,33 @@ def test_a_damaged_list_of_sums_drops_everything_with_one_warning(tmp_path, caps
     assert len(err) == 1 and "list of checksums" in err[0] and err[0].startswith("warning:")
 
 
+def test_a_whitted_process_started_by_another_chooses_its_folder_itself(tmp_path):
+    """A whitted process started by another (a bench run, a farm worker) inherits the
+    NUMBA_CACHE_DIR its parent set: it takes it as whitted's own and chooses its folder again
+    (for its own sources), not as a folder the user named; a folder the user named stays
+    the user's."""
+    code = ("import json; from whitted.jit import cache; s = cache.prepare(); "
+            "print(json.dumps([s.folder, s.own, str(cache.cache_dir())]))")
+
+    def chosen(**settings: str) -> list:
+        env = {k: v for k, v in os.environ.items()
+               if k not in ("NUMBA_CACHE_DIR", _cache.OWN_FOLDER_ENV)}
+        env.update(PYTHONPATH=str(REPO_ROOT / "src"), WHITTED_CACHE_DIR=str(tmp_path / "c"),
+                   **settings)
+        run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                             env=env, timeout=300, cwd=tmp_path)
+        assert run.returncode == 0, run.stderr
+        return json.loads(run.stdout.strip().splitlines()[-1])
+
+    parents = str(tmp_path / "parents")
+    folder, own, ours = chosen(NUMBA_CACHE_DIR=parents, **{_cache.OWN_FOLDER_ENV: parents})
+    assert (folder, own) == (ours, True) and Path(ours).parent == tmp_path / "c"
+    users = str(tmp_path / "users")
+    folder, own, _ = chosen(NUMBA_CACHE_DIR=users, **{_cache.OWN_FOLDER_ENV: parents})
+    assert (folder, own) == (users, False)
+    assert chosen(NUMBA_CACHE_DIR=users)[:2] == [users, False]
+
+
 def test_other_programs_files_in_a_users_numba_cache_dir_are_kept(tmp_path):
     state = _fake_cache(tmp_path, own=False)
     other = Path(state.folder, "elsewhere_3/theirs-4.py311.nbi")

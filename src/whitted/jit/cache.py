@@ -5,7 +5,10 @@ so a change in a helper it calls would leave a stale machine-code copy behind. w
 therefore puts its cache in a folder named after a hash of all kernel sources: any change to
 any kernel starts a fresh cache, and different whitted versions never share one. The folder
 is ``$WHITTED_CACHE_DIR/numba-<hash>`` (default ``~/.cache/whitted``; ``numba-<hash>-stock``
-with ``WHITTED_NUMBA_TUNING=0``); an explicit ``NUMBA_CACHE_DIR`` set by the user wins.
+with ``WHITTED_NUMBA_TUNING=0``); an explicit ``NUMBA_CACHE_DIR`` set by the user wins. whitted
+points Numba at the folder through ``NUMBA_CACHE_DIR`` too, and says so in
+``WHITTED_OWN_NUMBA_CACHE_DIR``: a whitted process started by another (a bench run, a farm
+worker) inherits both and chooses its own folder again, as a process started by the user does.
 
 **A folder that cannot be used** (read-only, a file, ``/proc``, ``/dev/null``): whitted says so
 in one ``warning:`` line and uses the per-user folder instead, or, when that cannot be used
@@ -634,8 +637,20 @@ def read_only(path: str) -> bool:
             and os.path.abspath(path).startswith(os.path.abspath(state.folder)))
 
 
-def _set_numba_cache_dir(folder: str) -> None:
+#: set beside ``NUMBA_CACHE_DIR`` when whitted chose that folder itself (not the user): a
+#: whitted process this one starts (a bench run, a farm worker, ``whitted warm``'s workers)
+#: inherits the environment, and must take the folder as whitted's own, chosen again for its
+#: own sources, not as a folder the user named (which is checked under the lock and sealed
+#: by every process, and may hold other programs' files)
+OWN_FOLDER_ENV = "WHITTED_OWN_NUMBA_CACHE_DIR"
+
+
+def _set_numba_cache_dir(folder: str, own: bool = True) -> None:
     os.environ["NUMBA_CACHE_DIR"] = folder
+    if own:
+        os.environ[OWN_FOLDER_ENV] = folder
+    else:
+        os.environ.pop(OWN_FOLDER_ENV, None)
     # whitted's functions filed by their folder inside whitted, not by the install path
     locators = locator_setting(os.environ.get("NUMBA_CACHE_LOCATOR_CLASSES", ""))
     os.environ["NUMBA_CACHE_LOCATOR_CLASSES"] = locators
@@ -657,6 +672,8 @@ def prepare() -> KernelCache:
             return _state
         helper = os.environ.get(HELPER_ENV) == "1"
         chosen = os.environ.get("NUMBA_CACHE_DIR")
+        if chosen and not helper and chosen == os.environ.get(OWN_FOLDER_ENV):
+            chosen = None  # whitted's own choice, inherited from the process that started this
         own = not chosen or helper
         if not chosen:
             chosen = str(cache_dir())
@@ -665,7 +682,7 @@ def prepare() -> KernelCache:
         if problem is not None and not helper and _warm_to_read(chosen):
             state = KernelCache(chosen, own, helper, read_only=True)
             if state.intact():  # a warm folder this process cannot write: loaded from only
-                _set_numba_cache_dir(chosen)
+                _set_numba_cache_dir(chosen, own)
                 _state = state
                 return state
             problem = f"{problem}; its files do not match its list of checksums"
@@ -681,12 +698,13 @@ def prepare() -> KernelCache:
                 folder = None
         if folder is None:
             os.environ.pop("NUMBA_CACHE_DIR", None)
+            os.environ.pop(OWN_FOLDER_ENV, None)
             if "numba" in sys.modules:
                 import numba
 
                 numba.config.CACHE_DIR = ""
         else:
-            _set_numba_cache_dir(folder)
+            _set_numba_cache_dir(folder, own)
         state = KernelCache(folder, own, helper)
         state.verify(lazy=_locator_checks())
         _state = state
