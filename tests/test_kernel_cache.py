@@ -455,7 +455,7 @@ def test_an_unusable_folder_falls_back_with_one_warning(tmp_path, monkeypatch, c
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "user"))
     monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
     monkeypatch.setattr(_cache, "_state", None)
-    monkeypatch.setattr(_cache, "_set_numba_cache_dir", lambda folder: None)
+    monkeypatch.setattr(_cache, "_set_numba_cache_dir", lambda folder, own=True: None)
     state = _cache.prepare()
     assert state.folder == str(tmp_path / "user" / "whitted" / _cache._folder_name())
     err = capsys.readouterr().err.splitlines()
@@ -492,7 +492,7 @@ def test_a_warm_folder_that_cannot_be_written_is_loaded_from_as_it_is(tmp_path, 
     monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
     monkeypatch.delenv(_cache.HELPER_ENV, raising=False)
     monkeypatch.setattr(_cache, "_state", None)
-    monkeypatch.setattr(_cache, "_set_numba_cache_dir", lambda folder: None)
+    monkeypatch.setattr(_cache, "_set_numba_cache_dir", lambda folder, own=True: None)
     state = _cache.prepare()
     err = capsys.readouterr().err.splitlines()
     if damaged:

@@ -409,7 +409,7 @@ class KernelCache:
         hashes the few files it loads, not the whole cache of every variant."""
         if self.folder is None or self.helper:
             return 0
-        if lazy and self.own and self._all_as_sealed():
+        if lazy and self._all_as_sealed():
             return 0
         with self.locked():
             sums, damaged_list = self._read_sums()
