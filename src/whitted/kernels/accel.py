@@ -236,7 +236,7 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
     best_t = tmax
     best = -1
     inv = inverse_direction(d)
-    j, leaf, leaf_end, top = start_scene_walk(geo, stack)
+    j, leaf, leaf_end, top = start_scene_walk(geo, stack, True)
     while True:
         i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, best_t, stack, j,
                                                          leaf, leaf_end, top, True)

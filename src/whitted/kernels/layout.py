@@ -157,7 +157,8 @@ WIDE_LINK = 6
 WIDE_COUNT = 7
 WIDE_ROWS = 8
 # a ray's BVH-walk stack (int32 entries, caller-owned scratch): [0, MESH_STACK_BASE) for the
-# scene BVH (a wide walk pushes at most (WIDE - 1) * bvh.MAX_DEPTH + 1 = 421 entries), the
+# scene BVH (a wide walk pushes at most (WIDE - 1) * bvh.MAX_DEPTH + 1 = 421 entries, the
+# ordered binary walk two per waiting node, 2 * (bvh.MAX_DEPTH + 1) = 122), the
 # rest for a mesh's own binary BVH (at most MAX_DEPTH + 1)
 MESH_STACK_BASE = 448
 BVH_STACK = 512

@@ -116,7 +116,7 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
     of the intersection routines), then the mesh instances when there are any."""
     seen_transparent = 0
     inv = inverse_direction(d)
-    j, leaf, leaf_end, top = start_scene_walk(geo, stack)
+    j, leaf, leaf_end, top = start_scene_walk(geo, stack, False)
     while True:
         i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, tmax, stack, j,
                                                          leaf, leaf_end, top, False)
@@ -236,7 +236,7 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
     n = 0
     full = False
     inv = inverse_direction(d)
-    j, leaf, leaf_end, top = start_scene_walk(geo, stack)
+    j, leaf, leaf_end, top = start_scene_walk(geo, stack, False)
     k = 0
     while True:
         if n_listed >= 0:

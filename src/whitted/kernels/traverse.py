@@ -132,13 +132,37 @@ def cone_meets_box(box, node, p, axis, radius):
     return t_lo <= t_hi * (1.0 + 1e-9) + 1e-12
 
 
+# an ordered walk's waiting node carries floor(entry distance · ENTRY_SCALE) - 1, clamped to
+# int32: never above the true distance (so it only skips boxes a nearer hit has closed off)
+ENTRY_SCALE = 65536.0
+_ENTRY_MAX = 2147483647.0
+_ENTRY_NONE = -2147483648  # entered before the segment's start, or no bound (NaN)
+
+
+@kernel(inline="always")
+def entry_bound(t):
+    """An int32 lower bound on ``t`` · ENTRY_SCALE for ``t`` >= 0 (clamped at the int32
+    maximum), and the int32 minimum for a negative or NaN ``t`` (the walks' ``tmax`` is
+    never negative, so such a box is never skipped)."""
+    x = t * ENTRY_SCALE
+    if x > 0.0:
+        if x < _ENTRY_MAX:
+            return np.int32(np.floor(x) - 1.0)
+        return np.int32(_ENTRY_MAX)
+    return np.int32(_ENTRY_NONE)
+
+
 @kernel
-def start_scene_walk(geo, stack):
-    """Begin a walk of the scene BVH: its root on the stack. Returns the cursor
+def start_scene_walk(geo, stack, ordered):
+    """Begin a walk of the scene BVH: its root on the stack (an ordered walk's entries are
+    (node, entry bound) pairs, the root's bound the lowest). Returns the cursor
     (j, leaf, leaf_end, top) that :func:`next_scene_candidate` takes."""
     if geo.node_box.shape[0] == 0:
         return 0, 0, 0, -1
     stack[0] = 0
+    if ordered:
+        stack[1] = _ENTRY_NONE
+        return 0, 0, 0, 1
     return 0, 0, 0, 0
 
 
@@ -213,10 +237,12 @@ def next_scene_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top,
     """The next analytic primitive a ray on (tmin, tmax) may hit: first the unbounded ones,
     then those of the scene BVH's leaves whose boxes it meets. The walk's state is the cursor
     (j, leaf, leaf_end, top), passed in and returned with the primitive (-1 when the walk is
-    over). ``ordered`` pushes the nearer child last (closest-hit walks, which pass the nearest
-    hit so far as ``tmax``) in the binary BVH; any-hit walks skip the ordering and go through
-    the eight-wide nodes (``node_wide``), where a stack entry is a wide node (>= 0) or a
-    leaf, -1 - (8·node + lane)."""
+    over). ``ordered`` goes down the nearer child first (closest-hit walks, which pass the
+    nearest hit so far as ``tmax``) in the binary BVH, the farther one waiting on the stack
+    as (node, :func:`entry_bound` of its entry distance) so that it is dropped without a
+    second box test once a hit is nearer (start the walk with ``ordered`` too); any-hit
+    walks skip the ordering and go through the eight-wide nodes (``node_wide``), where a
+    stack entry is a wide node (>= 0) or a leaf, -1 - (8·node + lane)."""
     if not ordered and geo.node_wide.shape[0] > 0:
         return _next_wide_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top)
     box = geo.node_box
@@ -227,10 +253,20 @@ def next_scene_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top,
             return geo.node_prims[np.uint64(leaf)], j, leaf + 1, leaf_end, top
         if top < 0:
             return -1, j, leaf, leaf_end, top
-        node = stack[top]
-        top -= 1
-        if box_entry(box, node, o, inv, tmin, tmax) == INF:
-            continue
+        if ordered:
+            # a farther child waiting with a lower bound on its entry distance (its box was
+            # tested when its parent was entered): skipped once a nearer hit is closer,
+            # entered without a second box test otherwise
+            node = stack[top - 1]
+            entry = stack[top]
+            top -= 2
+            if entry > tmax * ENTRY_SCALE:
+                continue
+        else:
+            node = stack[top]
+            top -= 1
+            if box_entry(box, node, o, inv, tmin, tmax) == INF:
+                continue
         count = geo.node_link[np.uint64(node), 1]
         if count == 0 and not ordered:
             top += 1
@@ -239,13 +275,14 @@ def next_scene_candidate(geo, o, inv, tmin, tmax, stack, j, leaf, leaf_end, top,
             stack[top] = geo.node_link[node, 0]
             continue
         # down the nearer child directly (its box was just tested against this tmax); the
-        # farther one waits on the stack and is tested again when popped
+        # farther one waits on the stack with its entry distance (two entries)
         while count == 0:
             near, t_near, far, t_far = order_children(box, geo.node_link, node, o, inv, tmin,
                                                       tmax)
             if t_far != INF:
-                top += 1
-                stack[top] = far
+                stack[top + 1] = far
+                stack[top + 2] = entry_bound(t_far)
+                top += 2
             if t_near == INF:
                 break
             node = near
