@@ -131,7 +131,7 @@ def test_the_flow_keeps_the_energy_and_melts_where_it_goes():
 
 
 def test_the_estimate_counts_the_flow_and_refuses_what_cannot_finish(tmp_path):
-    from whitted.stefan.budget import FLOW_CELL_COST, check, estimate
+    from whitted.stefan.budget import FLOW_PREDICT_COST, FLOW_PROJECT_COST, check, estimate
 
     eff = estimate(case_from_dict({"grid": {"cells": 48}}))
     flow = estimate(case_from_dict({"grid": {"cells": 48}, "cavity": {"convection": "flow"}}))
@@ -139,9 +139,12 @@ def test_the_estimate_counts_the_flow_and_refuses_what_cannot_finish(tmp_path):
     # the box: the 24 mm cavity and two margins of half the 5 mm shell and two cells, inside
     # the 50-cell grid
     assert 30 ** 3 < flow.flow_cells < 50 ** 3
-    assert flow.flow_substeps >= 1
+    # the predictor in two parts (the enthalpy step 0.094 s, the viscous limit 0.9 x 0.070 s)
+    assert flow.flow_substeps == 2
     assert flow.cell_updates == pytest.approx(
-        (flow.cells + FLOW_CELL_COST * flow.flow_cells * flow.flow_substeps) * flow.steps)
+        (flow.cells + flow.flow_cells * (FLOW_PREDICT_COST * 2 + FLOW_PROJECT_COST))
+        * flow.steps)
+    assert eff.cell_updates == pytest.approx(eff.cells * eff.steps)
     huge = case_from_dict({"grid": {"cells": 400}, "cavity": {"convection": "flow"},
                            "time": {"end": 36000.0, "save_every": 3600.0}})
     with pytest.raises(CaseError) as err:
@@ -181,3 +184,21 @@ def test_a_flow_run_saves_its_flow_and_tracers_and_the_scene_shows_them(tmp_path
         np.testing.assert_array_equal(solver.flow.flow.v, z["flow_v"])
         np.testing.assert_array_equal(solver.flow.tracers, z["flow_tracers"])
 
+
+
+def test_a_run_says_its_estimate_before_it_starts_and_not_when_refused(tmp_path):
+    from cli_run import run_main
+
+    case = tmp_path / "case.toml"
+    case.write_text('[grid]\ncells = 8\n[cavity]\nradius = 0.008\nconvection = "flow"\n'
+                    '[time]\nend = 2.0\nsave_every = 2.0\n')
+    code, out, err = run_main("stefan", "run", case, "-o", "out", cwd=tmp_path)
+    assert code == 0, err
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("estimate: "), err
+    assert "flow box of" in lines[0] and "min on 2 cores to t = 2 s or the breach" in lines[0]
+    # refused (a folder of someone else's files): the one error line, no estimate
+    (tmp_path / "theirs").mkdir()
+    (tmp_path / "theirs" / "series.csv").write_text("mine\n")
+    code, out, err = run_main("stefan", "run", case, "-o", "theirs", cwd=tmp_path)
+    assert code == 2 and "estimate" not in err and len(err.strip().splitlines()) == 1, err

@@ -102,7 +102,9 @@ def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, guard: Inter
         try:
             result = run_case(case, text, output, resume=not fresh, progress=progress,
                               should_stop=guard.is_set, scene_size=size,
-                              allow_large=allow_large, case_path=case_path)
+                              allow_large=allow_large, case_path=case_path,
+                              on_estimate=None if quiet else
+                              lambda line: bar.console.print(line, highlight=False))
         except CaseError as exc:
             raise _fail(str(exc)) from None
     return case, result

@@ -387,16 +387,21 @@ GALLIUM = {"rho": 6093.0, "c": 381.5, "k": 32.0, "latent": 80160.0, "mu": 1.81e-
            "width": 0.0889, "height": 0.0635}
 
 
-def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None) -> list[dict]:
+def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None,
+                 changes: dict | None = None, mushy: float | None = None,
+                 taus: tuple[float, ...] | None = None) -> list[dict]:
     """Gau & Viskanta's gallium melting in 2-D (the flow solver coupled to the enthalpy
     method, the enthalpy-porosity sink): the melted length along the top, middle and bottom
     rows of cells (liquid fraction summed, over the width) at the experiment's times, beside
     the measured front, and the melted fraction of the cavity beside the measured one
-    (interpolated linearly to the same time). ``last``: only the first ``last`` times."""
+    (interpolated linearly to the same time). ``last``: only the first ``last`` times.
+    ``changes``: values that replace :data:`GALLIUM`'s (a study of what the answer depends
+    on); ``mushy``: the Carman-Kozeny constant (default Brent et al.'s); ``taus``: other
+    times (tau) than the measured ones (then no measured front beside them)."""
     from .flow import MeltFlow
     from .properties import Phase
 
-    g = GALLIUM
+    g = {**GALLIUM, **(changes or {})}
     phase = Phase(rho=g["rho"], c=g["c"], k=g["k"])
     props = Properties(ice=phase, water=phase, latent_heat=g["latent"])
     dx = dx_mm * 1e-3
@@ -410,11 +415,12 @@ def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None) -> 
     faces = (Faces.adiabatic().set("x-", math.inf, g["t_hot"] - g["t_melt"])
              .set("x+", math.inf, t_cold))
     flow = MeltFlow((slice(0, nx), slice(0, ny), slice(0, 1)), dx, props,
-                    viscosity=g["mu"] / g["rho"], expansion=g["beta"])
+                    viscosity=g["mu"] / g["rho"], expansion=g["beta"], mushy=mushy)
     solver = EnthalpySolver(H, kind, dx, props, faces=faces, flow=flow)
     alpha = phase.diffusivity
     ref = GAU_VISKANTA
-    taus = ref["tau"][:last]
+    measured = taus is None
+    taus = ref["tau"][:last] if measured else tuple(taus)
     rows = []
     for i, tau in enumerate(taus):
         t = tau * g["width"] ** 2 / (ref["stefan"] * alpha)
@@ -427,7 +433,7 @@ def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None) -> 
                                                left=math.nan))}
         for name, j in (("top", ny - 1), ("middle", ny // 2), ("bottom", 0)):
             row[name] = float(f[:, j].sum()) / nx
-            row[name + "_ref"] = ref[name][i]
+            row[name + "_ref"] = ref[name][i] if measured else math.nan
         rows.append(row)
         if progress is not None:
             progress(row)
