@@ -139,10 +139,11 @@ def test_the_estimate_counts_the_flow_and_refuses_what_cannot_finish(tmp_path):
     # the box: the 24 mm cavity and two margins of half the 5 mm shell and two cells, inside
     # the 50-cell grid
     assert 30 ** 3 < flow.flow_cells < 50 ** 3
-    # the predictor in two parts (the enthalpy step 0.094 s, the viscous limit 0.9 x 0.070 s)
-    assert flow.flow_substeps == 2
+    # a flow step every two enthalpy steps (0.19 s), its predictor in three parts (the
+    # viscous limit 0.9 x 0.070 s)
+    assert flow.flow_every == 2 and flow.flow_substeps == 3
     assert flow.cell_updates == pytest.approx(
-        (flow.cells + flow.flow_cells * (FLOW_PREDICT_COST * 2 + FLOW_PROJECT_COST))
+        (flow.cells + flow.flow_cells * (FLOW_PREDICT_COST * 3 + FLOW_PROJECT_COST) / 2)
         * flow.steps)
     assert eff.cell_updates == pytest.approx(eff.cells * eff.steps)
     huge = case_from_dict({"grid": {"cells": 400}, "cavity": {"convection": "flow"},
@@ -202,3 +203,32 @@ def test_a_run_says_its_estimate_before_it_starts_and_not_when_refused(tmp_path)
     (tmp_path / "theirs" / "series.csv").write_text("mine\n")
     code, out, err = run_main("stefan", "run", case, "-o", "theirs", cwd=tmp_path)
     assert code == 2 and "estimate" not in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_the_flow_every_second_step_is_the_same_however_the_run_is_chunked():
+    # the flow is stepped every FLOW_EVERY enthalpy steps counted from the start: chunks of
+    # 3 and 7 steps give the same bits as one of 10, the flow after steps 2, 4, 6, 8 and 10
+    import whitted.stefan.flow as flow_module
+
+    assert flow_module.FLOW_EVERY == 2
+    case = case_from_dict({"grid": {"cells": 12}, "cavity": {"convection": "flow"}})
+    runs = []
+    for chunks in ((10,), (3, 7), (1, 1, 5, 3)):
+        H, kind, _, _ = initial_state(case)
+        solver = EnthalpySolver(H, kind, case.dx, case.solver_properties(),
+                                faces=case.solver_faces(), air=case.solver_air(),
+                                flow=case.solver_flow(H, kind))
+        calls = []
+        step = solver.flow.step
+        solver.flow.step = lambda Hp, kp, h, step=step, calls=calls, solver=solver: (
+            calls.append((solver.steps, h)), step(Hp, kp, h))
+        for n in chunks:
+            solver.run_steps(n)
+        runs.append((solver.H.copy(), solver.flow.flow.u.copy(), calls))
+    steps = [s for s, _ in runs[0][2]]
+    assert sorted(set(steps)) == [2, 4, 6, 8, 10]  # (more than one projection where it is fast)
+    for s in (2, 4, 6, 8, 10):
+        assert sum(h for t, h in runs[0][2] if t == s) == pytest.approx(2 * solver.dt)
+    for H, u, calls in runs[1:]:
+        assert np.array_equal(H, runs[0][0]) and np.array_equal(u, runs[0][1])
+        assert calls == runs[0][2]

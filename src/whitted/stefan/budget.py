@@ -35,7 +35,8 @@ CELL_UPDATES_PER_SECOND = 50e6
 #: with it (the multigrid-preconditioned pressure, the divergence and correction, the carried
 #: heat, the fields). Measured on the default case at 48 cells (docs/stefan.md: one thread,
 #: CPU seconds per phase over 200 steps): 2.1 and 19.5 with 13 700 fluid cells in the 41³
-#: box, rounded up for the cavity's growth.
+#: box, rounded up for the cavity's growth. The projection's cost is spread over the
+#: ``FLOW_EVERY`` enthalpy steps of a flow step.
 FLOW_PREDICT_COST = 2.5
 FLOW_PROJECT_COST = 24.0
 
@@ -56,16 +57,18 @@ class Estimate:
     saves: int
     memory_bytes: int
     disk_bytes: int
-    #: with ``cavity.convection = "flow"``: the flow box's cells and its predictor's parts
-    #: per step (one projection a step)
+    #: with ``cavity.convection = "flow"``: the flow box's cells, its predictor's parts a
+    #: flow step (one projection each) and the enthalpy steps a flow step spans
     flow_cells: int = 0
     flow_substeps: int = 0
+    flow_every: int = 1
 
     @property
     def cell_updates(self) -> float:
         """Enthalpy cell updates, the flow's counted in them (``FLOW_PREDICT_COST`` a box
         cell and predictor part, ``FLOW_PROJECT_COST`` a box cell and step)."""
-        flow = self.flow_cells * (FLOW_PREDICT_COST * self.flow_substeps + FLOW_PROJECT_COST)
+        flow = (self.flow_cells * (FLOW_PREDICT_COST * self.flow_substeps + FLOW_PROJECT_COST)
+                / max(1, self.flow_every))
         return (float(self.cells) + (flow if self.flow_cells else 0.0)) * self.steps
 
     @property
@@ -100,6 +103,7 @@ def estimate(case: Case) -> Estimate:
     memory = BASE_BYTES + BYTES_PER_CELL * cells
     disk = saves * (DISK_PER_CELL * cells + DISK_PER_SAVE)
     flow_cells = substeps = 0
+    every = 1
     if case.cavity.model == "flow":  # the box around the cavity (Case.solver_flow), at rest
         from .convection import water_density, water_viscosity
 
@@ -110,18 +114,22 @@ def estimate(case: Case) -> Estimate:
         flow_cells = 1
         for a in range(3):
             flow_cells *= min(shape[a], int(math.ceil(2 * ext[a] / case.dx)) + 2 * margin)
+        from .flow import FLOW_EVERY
+
+        every = FLOW_EVERY
         nu = water_viscosity(2.0) / water_density(2.0)
-        substeps = max(1, math.ceil(dt / (0.9 * case.dx ** 2 / (6.0 * nu)))) if dt > 0 else 1
+        substeps = (max(1, math.ceil(every * dt / (0.9 * case.dx ** 2 / (6.0 * nu))))
+                    if dt > 0 else 1)
         memory += 200 * flow_cells  # 3 velocities and their copies, scratch, the levels
     return Estimate(cells, shape, dt, int(min(steps, 2**62)), int(saves), int(memory), int(disk),
-                    flow_cells, substeps)
+                    flow_cells, substeps, every)
 
 
 def describe(e: Estimate, case: Case) -> str:
     """One line: the steps, the cells and the time the run should take (to ``time.end``; a
     breach that stops the run comes sooner)."""
-    flow = (f" and a flow box of {e.flow_cells:,} cells ({e.flow_substeps} predictor "
-            "part(s) a step)") if e.flow_cells else ""
+    flow = (f" and a flow box of {e.flow_cells:,} cells (a flow step every {e.flow_every} "
+            f"step(s), its predictor in {e.flow_substeps} part(s))") if e.flow_cells else ""
     stop = " or the breach" if case.breach.action == "stop" else ""
     return (f"estimate: {e.steps:,} steps of {e.dt:.3g} s on {e.cells:,} cells{flow}, about "
             f"{_hours(e.seconds)} on 2 cores to t = {case.time.end:g} s{stop}")

@@ -193,20 +193,26 @@ class Flow:
         return min(self.viscous_dt(), self.advective_dt(cfl))
 
     def step(self, dt: float, buoyancy: np.ndarray, sink: np.ndarray | None = None,
-             fluid: np.ndarray | None = None, substeps: int = 1) -> None:
+             fluid: np.ndarray | None = None, parts: bool = False) -> None:
         """One step: ``buoyancy`` (m/s², per cell, along +axis 1, which is up), the
         enthalpy-porosity ``sink`` (1/s per cell; None: none) and, with ``fluid``, the
-        projection on those cells only (:meth:`project`). ``substeps``: the predictor in
-        that many explicit parts of dt / substeps (each under the viscous limit), then one
-        projection for the whole step."""
+        projection on those cells only (:meth:`project`). ``parts``: the predictor in as
+        many explicit parts as keep each within 0.9 of the limits at the speed of the
+        moment (:meth:`stable_dt` with cfl 0.4), then one projection for the whole step."""
         sink = self._zero if sink is None else sink
-        parts = max(1, int(substeps))
-        for _ in range(parts):
-            self._predict(dt / parts, buoyancy, sink)
+        left = dt
+        while left > 1e-12 * dt:
+            h = left
+            if parts:
+                h = min(left, 0.9 * self.stable_dt(0.4))
+                if left - h < 0.05 * h:
+                    h = left
+            self._predict(h, buoyancy, sink)
             if self.incremental and fluid is not None:
-                fk.correct_damped(self.u, self.v, self.w, self.pressure, dt / parts, self.dx,
-                                  sink, self.flat)
+                fk.correct_damped(self.u, self.v, self.w, self.pressure, h, self.dx, sink,
+                                  self.flat)
                 self._masked.zero_closed(self.u, self.v, self.w, fluid)
+            left -= h
         self.project(dt, fluid)
 
     def _predict(self, dt: float, buoyancy: np.ndarray, sink: np.ndarray) -> None:
@@ -348,6 +354,10 @@ def _mean_nusselt(T: np.ndarray, flow: Flow, dx: float) -> float:
 #: the explicit limits in parts of its own). Gallium (4 mm cells, 2-4 cm/s) moves by under
 #: 0.01 of the width at 15 min between 0.4 and 0.9 (docs/stefan.md).
 PROJECTION_CFL = 0.9
+#: The flow in the melt is stepped every FLOW_EVERY enthalpy steps, for their time together
+#: (its predictor still in parts under its limits, its heat carried in parts of under half a
+#: cell): the conduction's step limit is far below the flow's time scales.
+FLOW_EVERY = 2
 #: the melt's projection incremental (:attr:`Flow.incremental`)
 INCREMENTAL = True
 
@@ -394,6 +404,8 @@ class MeltFlow:
         self.box0 = np.array([s.start + 1 for s in box], dtype=np.int64)  # padded indices
         #: the projection at least every time the fastest water crosses this much of a cell
         self.projection_cfl = PROJECTION_CFL
+        #: stepped after every ``every`` enthalpy steps, for their time together
+        self.every = FLOW_EVERY
         self.sink_c = (MUSHY_CONSTANT if mushy is None else float(mushy)) / props.water.rho
         self.time = 0.0
         #: tracer particles carried by the flow (for the film): positions in cell units of the
@@ -406,13 +418,8 @@ class MeltFlow:
     def projection_dt(self) -> float:
         """The longest step between two projections: the time the fastest water takes to
         cross ``projection_cfl`` of a cell (inf at rest). The predictor's stability limits
-        are met by its parts (:meth:`substeps`)."""
+        are met by its parts (:meth:`Flow.step`)."""
         return self.projection_cfl * self.flow.advective_dt(1.0)
-
-    def substeps(self, dt: float) -> int:
-        """The predictor's parts for a step of ``dt``: each within 0.9 of the explicit
-        limits at the speed of now (viscous dx²/6ν; advective 0.4 dx over the speed)."""
-        return max(1, int(math.ceil(dt / self.stable_dt() - 1e-9)))
 
     def fields(self, Hp: np.ndarray, kindp: np.ndarray):
         """Liquid fraction, temperature and sensible heat (J/m³) of the box's cells."""
@@ -434,7 +441,7 @@ class MeltFlow:
         else:
             buoy = self.G * self.expansion * T * f
         sink = self.sink_c * (1.0 - f) ** 2 / (f ** 3 + 1.0e-3)
-        self.flow.step(dt, buoy, sink, fluid=f >= 0.5, substeps=self.substeps(dt))
+        self.flow.step(dt, buoy, sink, fluid=f >= 0.5, parts=True)
         # the heat goes with the new velocity: in as many parts as keep each under half a cell
         parts = max(1, int(math.ceil(self.speed() * dt / (0.5 * self.dx))))
         for q in range(parts):

@@ -201,7 +201,12 @@ class EnthalpySolver:
                 if did == 0:
                     break
                 done += 1
-                left = self.dt  # projected once a step, or more often at the speed of now
+                every = max(1, int(self.flow.every))  # the flow every that many steps
+                if self.steps % every != 0:  # (counted from the start: chunks change nothing)
+                    if self.breached and self.stop_on_breach:
+                        break
+                    continue
+                left = every * self.dt  # projected once, or more often at the speed of now
                 while left > 1e-12 * self.dt:
                     h = min(left, self.flow.projection_dt())
                     if left - h < 0.05 * h:
