@@ -156,7 +156,8 @@ def validate(
     """Check the solver against exact answers and print the tables: Neumann's lambda, front
     error against cell size, the axes, the cavity's convection, the flow solver on de Vahl
     Davis's square cavity (32², with --full 32² to 128²) and on the heated cube (24³, with
-    --full 32³ to 64³), gallium melting beside Gau & Viskanta's measured front, the convective
+    --full 32³ to 64³), gallium melting beside Gau & Viskanta's measured front and at Blais
+    & Ilinca's Ra 1e5 beside their computation, the convective
     slab, the sphere,
     the energy balance."""
     from rich.table import Table
@@ -256,6 +257,18 @@ def validate(
                           "-" if math.isnan(r["melted_ref"]) else f"{r['melted_ref']:.3f}",
                           f"{r['melted']:.3f}",
                           f"{r['energy_rel']:.1e}")
+    out.print(table)
+    table = Table(title="Gallium at Blais & Ilinca's Ra 1e5 (their 2-D computation's case): "
+                  "the melted fraction (measured at Ra 6.1e5, Blais & Ilinca, whitted)")
+    for col in ("cells", "t (min)", "tau", "measured", "Blais & Ilinca", "whitted", "top",
+                "middle", "bottom"):
+        table.add_column(col, justify="right")
+    for mm in ((4.0, 2.0) if full else (4.0,)):
+        for r in v.gallium_ra_1e5_rows(mm):
+            table.add_row(r["cells"], f"{r['minutes']:.1f}", f"{r['tau']:.4f}",
+                          "-" if math.isnan(r["melted_ref"]) else f"{r['melted_ref']:.3f}",
+                          f"{r['melted_blais']:.3f}", f"{r['melted']:.3f}", f"{r['top']:.3f}",
+                          f"{r['middle']:.3f}", f"{r['bottom']:.3f}")
     out.print(table)
 
     slab = v.convective_slab()

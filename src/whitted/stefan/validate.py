@@ -438,3 +438,43 @@ def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None,
         if progress is not None:
             progress(row)
     return rows
+
+
+#: Blais & Ilinca (2018), Comput. Fluids 172, 564-581: their 2-D computation's melted fraction
+#: of the gallium cavity against tau, as the Lethe project tabulates it beside the experiment
+#: (github.com/chaos-polymtl/lethe, examples/multiphysics/melting-cavity/
+#: compare-melting-cavity.py; sorted by tau here). Their case, as Lethe's example of it sets
+#: it up (melting-cavity.rst, its parameter file): Ra 10⁵ on the height, Pr 0.01818, Ste
+#: 0.041, the walls at 38 and 28 °C, melting at 29.8 °C: a sixth of the experiment's Ra.
+BLAIS_ILINCA = {
+    "tau": (0.00094, 0.00262, 0.00457, 0.00685, 0.01116, 0.01801, 0.02473, 0.02964, 0.03401,
+            0.03891, 0.04368, 0.04812, 0.05323, 0.05759, 0.06452, 0.07433, 0.08266, 0.08931,
+            0.09597, 0.09899),
+    "melted": (0.0372, 0.0670, 0.0856, 0.1079, 0.1423, 0.1898, 0.2344, 0.2614, 0.2874, 0.3163,
+               0.3442, 0.3721, 0.4000, 0.4242, 0.4651, 0.5153, 0.5600, 0.5935, 0.6279,
+               0.6437),
+}
+
+
+def gallium_ra_1e5_changes() -> dict:
+    """:data:`GALLIUM` changed to Blais & Ilinca's case (:data:`BLAIS_ILINCA`): gallium's
+    conductivity, density and heat capacity (so the same diffusivity and times), its
+    viscosity and expansion set for Pr 0.01818 and Ra 10⁵ on the height, the latent heat for
+    Ste 0.041, melting at 29.8 °C between walls at 38 and 28 °C."""
+    g = GALLIUM
+    alpha = g["k"] / (g["rho"] * g["c"])
+    nu = 0.01818 * alpha
+    d_t = 38.0 - 29.8
+    beta = 1.0e5 * nu * alpha / (9.80665 * d_t * g["height"] ** 3)
+    return {"mu": nu * g["rho"], "beta": beta, "t_melt": 273.15 + 29.8,
+            "t_hot": 273.15 + 38.0, "t_cold": 273.15 + 28.0, "latent": g["c"] * d_t / 0.041}
+
+
+def gallium_ra_1e5_rows(dx_mm: float = 4.0, progress=None) -> list[dict]:
+    """Gallium at Blais & Ilinca's Ra 10⁵ (:func:`gallium_ra_1e5_changes`) at the measured
+    times: the melted fraction beside their computation and the experiment's."""
+    rows = gallium_rows(dx_mm, progress=progress, changes=gallium_ra_1e5_changes())
+    for r in rows:
+        r["melted_blais"] = float(np.interp(r["tau"], BLAIS_ILINCA["tau"],
+                                            BLAIS_ILINCA["melted"]))
+    return rows
