@@ -247,7 +247,7 @@ def validate(
     table = Table(title="Gallium melting from a heated wall (Gau & Viskanta 1986), 2-D: the "
                   "melted length over the width (measured, whitted)")
     for col in ("cells", "t (min)", "top ref", "top", "middle ref", "middle", "bottom ref",
-                "bottom", "melted ref", "melted", "energy (rel.)"):
+                "bottom", "melted ref", "melted", "error", "energy (rel.)"):
         table.add_column(col, justify="right")
     for mm, last in (((4.0, None), (2.0, None)) if full else ((4.0, 3),)):
         for r in v.gallium_rows(mm, last=last):
@@ -256,18 +256,22 @@ def validate(
                           f"{r['bottom_ref']:.3f}", f"{r['bottom']:.3f}",
                           "-" if math.isnan(r["melted_ref"]) else f"{r['melted_ref']:.3f}",
                           f"{r['melted']:.3f}",
+                          "-" if math.isnan(r["melted_ref"]) else
+                          f"{100 * (r['melted'] / r['melted_ref'] - 1):+.1f} %",
                           f"{r['energy_rel']:.1e}")
     out.print(table)
     table = Table(title="Gallium at Blais & Ilinca's Ra 1e5 (their 2-D computation's case): "
                   "the melted fraction (measured at Ra 6.1e5, Blais & Ilinca, whitted)")
-    for col in ("cells", "t (min)", "tau", "measured", "Blais & Ilinca", "whitted", "top",
-                "middle", "bottom"):
+    for col in ("cells", "t (min)", "tau", "measured", "Blais & Ilinca", "whitted", "error",
+                "top", "middle", "bottom"):
         table.add_column(col, justify="right")
     for mm in ((4.0, 2.0) if full else (4.0,)):
         for r in v.gallium_ra_1e5_rows(mm):
             table.add_row(r["cells"], f"{r['minutes']:.1f}", f"{r['tau']:.4f}",
                           "-" if math.isnan(r["melted_ref"]) else f"{r['melted_ref']:.3f}",
-                          f"{r['melted_blais']:.3f}", f"{r['melted']:.3f}", f"{r['top']:.3f}",
+                          f"{r['melted_blais']:.3f}", f"{r['melted']:.3f}",
+                          f"{100 * (r['melted'] / r['melted_blais'] - 1):+.1f} %",
+                          f"{r['top']:.3f}",
                           f"{r['middle']:.3f}", f"{r['bottom']:.3f}")
     out.print(table)
 
