@@ -251,3 +251,26 @@ def test_gallium_at_blais_and_ilincas_rayleigh_number_follows_their_computation(
         assert abs(r["melted"] / r["melted_blais"] - 1.0) < 0.12, r
         assert r["top"] > r["middle"] > r["bottom"]
         assert abs(r["energy_rel"]) < 1e-9
+
+
+def test_the_coupled_flow_has_the_same_bits_on_one_thread_and_two():
+    import numba
+
+    case = case_from_dict({"grid": {"cells": 16}, "cavity": {"convection": "flow"}})
+    found = []
+    before = numba.get_num_threads()
+    try:
+        for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+            numba.set_num_threads(threads)
+            H, kind, _, _ = initial_state(case)
+            solver = EnthalpySolver(H, kind, case.dx, case.solver_properties(),
+                                    faces=case.solver_faces(), air=case.solver_air(),
+                                    flow=case.solver_flow(H, kind))
+            solver.run_steps(8)
+            found.append((solver.H.copy(), solver.flow.flow.u.copy(),
+                          solver.flow.flow.pressure.copy()))
+    finally:
+        numba.set_num_threads(before)
+    assert solver.flow.speed() > 0.0
+    for a, b in zip(found[0], found[1], strict=True):
+        assert np.array_equal(a, b)

@@ -17,7 +17,10 @@ g (ρ(0 °C) − ρ(T)) / ρ(0 °C) per liquid cell (times f), ρ from Kell's eq
 its 3.98 °C maximum (:func:`whitted.stefan.convection.water_density`): warm water above
 4 °C rises, water below 4 °C sinks, the two cells of a bulk between 0 and 8 °C included. The
 liquid carries its sensible heat ρ_w c_w T across the faces (upwind), which melts the wall
-where the flow brings it.
+where the flow brings it. There the pressure is solved on the fluid cells only, by
+multigrid-preconditioned conjugate gradients (:mod:`whitted.stefan.multigrid`), and
+incrementally (the last pressure in the predictor); the flow is stepped every
+``FLOW_EVERY`` enthalpy steps, its predictor in parts within its explicit limits.
 """
 
 from __future__ import annotations
@@ -373,8 +376,9 @@ def water_density_array(t: np.ndarray) -> np.ndarray:
 
 class MeltFlow:
     """The flow of the cavity's water inside the enthalpy solver's grid: a box of cells
-    around the liquid (``box``: slices of the unpadded grid), stepped after every enthalpy
-    step, carrying the liquid's sensible heat. Viscosity at 2 °C (1.67 mPa s; the Vogel
+    around the liquid (``box``: slices of the unpadded grid), stepped after every
+    ``every`` enthalpy steps for their time together, carrying the liquid's sensible heat.
+    Viscosity at 2 °C (1.67 mPa s; the Vogel
     equation of :mod:`whitted.stefan.convection`), constant."""
 
     G = 9.80665
@@ -411,9 +415,6 @@ class MeltFlow:
         #: tracer particles carried by the flow (for the film): positions in cell units of the
         #: box (a cell's centre at i + 1/2), seeded by :meth:`seed_tracers`
         self.tracers = np.zeros((0, 3))
-
-    def stable_dt(self) -> float:
-        return 0.9 * self.flow.stable_dt(0.4)
 
     def projection_dt(self) -> float:
         """The longest step between two projections: the time the fastest water takes to
