@@ -389,7 +389,8 @@ GALLIUM = {"rho": 6093.0, "c": 381.5, "k": 32.0, "latent": 80160.0, "mu": 1.81e-
 
 def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None,
                  changes: dict | None = None, mushy: float | None = None,
-                 taus: tuple[float, ...] | None = None) -> list[dict]:
+                 taus: tuple[float, ...] | None = None,
+                 depth: float | None = None) -> list[dict]:
     """Gau & Viskanta's gallium melting in 2-D (the flow solver coupled to the enthalpy
     method, the enthalpy-porosity sink): the melted length along the top, middle and bottom
     rows of cells (liquid fraction summed, over the width) at the experiment's times, beside
@@ -397,7 +398,9 @@ def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None,
     (interpolated linearly to the same time). ``last``: only the first ``last`` times.
     ``changes``: values that replace :data:`GALLIUM`'s (a study of what the answer depends
     on); ``mushy``: the Carman-Kozeny constant (default Brent et al.'s); ``taus``: other
-    times (tau) than the measured ones (then no measured front beside them)."""
+    times (tau) than the measured ones (then no measured front beside them). ``depth`` (m):
+    a 3-D cavity that deep between adiabatic no-slip walls (the fronts then on its middle
+    plane, the melted fraction of the whole); None: 2-D."""
     from .flow import MeltFlow
     from .properties import Phase
 
@@ -408,13 +411,14 @@ def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None,
     nx = int(round(g["width"] / dx))
     ny = int(round(g["height"] / dx))
     dx = g["width"] / nx  # the width exact; the height within half a cell
-    shape = (nx, ny, 1)
+    nz = 1 if depth is None else max(1, int(round(depth / dx)))
+    shape = (nx, ny, nz)
     t_cold = g["t_cold"] - g["t_melt"]
     H = np.full(shape, props.enthalpy(t_cold, liquid=False))
     kind = np.ones(shape, dtype=np.uint8)
     faces = (Faces.adiabatic().set("x-", math.inf, g["t_hot"] - g["t_melt"])
              .set("x+", math.inf, t_cold))
-    flow = MeltFlow((slice(0, nx), slice(0, ny), slice(0, 1)), dx, props,
+    flow = MeltFlow((slice(0, nx), slice(0, ny), slice(0, nz)), dx, props,
                     viscosity=g["mu"] / g["rho"], expansion=g["beta"], mushy=mushy)
     solver = EnthalpySolver(H, kind, dx, props, faces=faces, flow=flow)
     alpha = phase.diffusivity
@@ -425,9 +429,11 @@ def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None,
     for i, tau in enumerate(taus):
         t = tau * g["width"] ** 2 / (ref["stefan"] * alpha)
         solver.advance(t)
-        f = solver.liquid_fraction()[:, :, 0]
-        row = {"minutes": t / 60.0, "tau": tau, "cells": f"{nx}x{ny}", "dx_mm": dx * 1e3,
-               "melted": float(f.mean()), "speed_mm_s": flow.speed() * 1e3,
+        f3 = solver.liquid_fraction()
+        f = f3[:, :, nz // 2]
+        cells = f"{nx}x{ny}" + ("" if nz == 1 else f"x{nz}")
+        row = {"minutes": t / 60.0, "tau": tau, "cells": cells, "dx_mm": dx * 1e3,
+               "melted": float(f3.mean()), "speed_mm_s": flow.speed() * 1e3,
                "energy_rel": solver.energy_error() / solver.heat_in,
                "melted_ref": float(np.interp(tau, ref["melted_tau"], ref["melted"],
                                                left=math.nan))}
