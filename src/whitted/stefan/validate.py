@@ -400,7 +400,8 @@ def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None,
     on); ``mushy``: the Carman-Kozeny constant (default Brent et al.'s); ``taus``: other
     times (tau) than the measured ones (then no measured front beside them). ``depth`` (m):
     a 3-D cavity that deep between adiabatic no-slip walls (the fronts then on its middle
-    plane, the melted fraction of the whole); None: 2-D."""
+    plane, the melted fraction of the whole, ``melted_plane`` that of the middle plane);
+    None: 2-D."""
     from .flow import MeltFlow
     from .properties import Phase
 
@@ -433,7 +434,8 @@ def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None,
         f = f3[:, :, nz // 2]
         cells = f"{nx}x{ny}" + ("" if nz == 1 else f"x{nz}")
         row = {"minutes": t / 60.0, "tau": tau, "cells": cells, "dx_mm": dx * 1e3,
-               "melted": float(f3.mean()), "speed_mm_s": flow.speed() * 1e3,
+               "melted": float(f3.mean()), "melted_plane": float(f.mean()),
+               "speed_mm_s": flow.speed() * 1e3,
                "energy_rel": solver.energy_error() / solver.heat_in,
                "melted_ref": float(np.interp(tau, ref["melted_tau"], ref["melted"],
                                                left=math.nan))}
