@@ -28,25 +28,7 @@ def _whitted(*args: str) -> subprocess.CompletedProcess:
 
 def test_every_variant_is_named_once():
     names = variant_names()
-    # caustics add only the photon tracer, compiled for the general geometry: one variant
-    assert len(names) == len(set(names)) == len(GEOMETRY) * len(KINDS) - 1 == 7
-    assert "general/caustics" in names and "plain/caustics" not in names
-
-
-def test_the_photon_tracer_takes_every_scene_as_the_general_kind():
-    from numba import typeof
-
-    from whitted.kernels.features import as_general
-
-    plain = compile_scene(tiny_scene(False, "caustics")).geometry
-    general = compile_scene(tiny_scene(True, "caustics"), flatten_limit=0).geometry
-    assert typeof(plain) != typeof(general)
-    assert typeof(as_general(plain)) == typeof(general)
-    cast = as_general(plain)
-    np.testing.assert_array_equal(cast.unbounded, plain.unbounded)
-    assert cast.inst_box.shape == plain.inst_box.shape
-    again = as_general(general)  # already general: the very same arrays
-    assert again.inst_box is general.inst_box and again.unbounded is general.unbounded
+    assert len(names) == len(set(names)) == len(GEOMETRY) * len(KINDS) == 8
 
 
 def test_instances_and_extras_share_the_general_kernels():
@@ -116,7 +98,7 @@ def test_the_queue_hands_a_general_kind_out_only_after_the_general_render_kernel
             break
         assert queue.take() == name
         taken.append(name)
-    assert sorted(taken) == ["plain/adaptive", "plain/aovs", "stefan"]
+    assert sorted(taken) == ["plain/adaptive", "plain/aovs", "plain/caustics", "stefan"]
     assert queue.todo == ["general/adaptive", "general/aovs"]
     queue.finish("general/render", 12.5)
     assert queue.take() == "general/adaptive"

@@ -363,15 +363,12 @@ def shoot_pass(compiled: CompiledScene, rows: np.ndarray, clear: np.ndarray,
                cancelled: Callable[[], bool] = lambda: False) -> np.ndarray:
     """The records the photons of one pass store, in photon order (chunks of photons not
     started once ``cancelled()`` is true are left out: the render is being cancelled)."""
-    from ..kernels.features import as_general
     from ..kernels.photons import trace_photons
     from ..kernels.strict import strict
 
     # compiled without fast-math (kernels/strict.py): the same photons on every CPU target,
-    # cold compiled or loaded from the cache; for the general kind of geometry only
-    # (features.as_general): one compile of it serves every scene
+    # cold compiled or loaded from the cache
     tracer = strict(trace_photons)
-    geometry = as_general(compiled.geometry)
     settings = np.zeros(N_SET)
     settings[SET_SEED] = params.seed
     settings[SET_PASS] = pass_index
@@ -387,9 +384,11 @@ def shoot_pass(compiled: CompiledScene, rows: np.ndarray, clear: np.ndarray,
     def run(k: int) -> None:
         if cancelled():
             return
-        tracer(geometry, compiled.materials, clear, compiled.lights.table, rows, settings,
-               int(bounds[k]), int(bounds[k + 1]), out, counts, np.empty(BVH_STACK, np.int32),
-               np.empty(MAX_MEDIA, np.int32), np.empty(MAX_MEDIA, np.int32))
+        tracer(compiled.geometry, compiled.materials, clear,
+                      compiled.lights.table, rows, settings, int(bounds[k]),
+                      int(bounds[k + 1]), out, counts,
+                      np.empty(BVH_STACK, np.int32), np.empty(MAX_MEDIA, np.int32),
+                      np.empty(MAX_MEDIA, np.int32))
 
     if pool is None:
         for k in range(chunks):

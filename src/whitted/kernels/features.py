@@ -76,18 +76,6 @@ def extras_possible(geo_type) -> bool:
     return field_type.dtype == types.int64
 
 
-def as_general(geometry):
-    """``geometry`` (a GeometryArrays) with the types of the general kind (float64
-    ``inst_box``, int64 ``unbounded``): what kernels compiled only for that kind take. The
-    photon tracer is one of them (compile/photon_map.py): compiled without fast-math, it
-    computes the same photons in either kind, and shooting them is a small part of a
-    render, so one compile of it serves every scene."""
-    import numpy as np
-
-    return geometry._replace(inst_box=geometry.inst_box.astype(np.float64, copy=False),
-                             unbounded=geometry.unbounded.astype(EXTRAS_DTYPE, copy=False))
-
-
 @overload(has_extras, inline="always")
 def _has_extras(geo):
     if extras_possible(geo):

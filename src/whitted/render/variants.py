@@ -5,9 +5,9 @@ The render kernels are specialised on a scene's arrays (kernels/features.py): *p
 instances, no tori or CSG objects) or *general* (either or both), and the render kernel has
 two kinds: plain and with *adaptive* anti-aliasing; the AOV kernel (depth, normal, id) is one
 more. Caustics need the photon tracer (compile/photon_map.py, its IEEE twins of the
-kernels, kernels/strict.py), compiled for the general geometry only; their gather is a
-run-time choice of the render kernel (kernels/caustics.py), as are focal blur, area lights,
-textures and media, compiled with it.
+kernels, kernels/strict.py), one for each kind of geometry; their gather is a run-time choice
+of the render kernel (kernels/caustics.py), as are focal blur, area lights, textures and
+media, compiled with it.
 """
 
 from __future__ import annotations
@@ -22,11 +22,7 @@ KINDS = ("render", "caustics", "adaptive", "aovs")
 
 
 def variant_names() -> list[str]:
-    """Every variant's name. Caustics add only the photon tracer, which is compiled for the
-    general geometry whatever the scene (kernels/features.py ``as_general``): one variant,
-    ``general/caustics``, serves both kinds of geometry."""
-    return [f"{geometry}/{kind}" for geometry in GEOMETRY for kind in KINDS
-            if (geometry, kind) != ("plain", "caustics")]
+    return [f"{geometry}/{kind}" for geometry in GEOMETRY for kind in KINDS]
 
 
 def tiny_scene(extras: bool, kind: str):
