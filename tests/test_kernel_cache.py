@@ -225,6 +225,50 @@ def test_a_file_rewritten_before_its_kernel_is_looked_up_is_no_damage(tmp_path, 
     assert "damaged kernel cache file" in capsys.readouterr().err
 
 
+def test_the_start_up_check_leaves_sealed_files_to_their_look_up(tmp_path, capsys):
+    """The start-up check (lazy) reads only the folder's listing: a sealed file truncated
+    in place (the same inode, another size) is not looked at then, and is found, deleted
+    and reported in one line when its kernel is looked up; the other kernel's files are
+    loaded as sealed, and a fresh check of every file agrees."""
+    state = _fake_cache(tmp_path)
+    index = Path(state.folder, "kernels_1/a-1.py311.nbi")
+    os.truncate(index, 100)
+    again = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert again.verify(lazy=True) == 0
+    assert index.exists() and capsys.readouterr().err == ""
+    assert again.check_function("compile_2", "b-2.py311") == 0
+    assert again.check_function("kernels_1", "a-1.py311") == 1
+    assert not index.exists()
+    assert capsys.readouterr().err == (f"warning: 1 damaged kernel cache file in "
+                                       f"{state.folder} deleted; compiling it again\n")
+    assert _cache.KernelCache(state.folder, own=True, helper=False).verify() == 0
+    assert _names(again) == _names(state) - {"kernels_1/a-1.py311.nbi"}
+
+
+def test_the_start_up_check_of_a_sealed_folder_takes_no_lock(tmp_path, monkeypatch):
+    """A warm folder whose files are all as sealed is checked at start-up without the lock
+    (nothing to delete or write); a file nobody sealed sends the check under the lock,
+    which deletes it."""
+    state = _fake_cache(tmp_path)
+    again = _cache.KernelCache(state.folder, own=True, helper=False)
+
+    def no_lock():
+        raise AssertionError("the lock was taken")
+
+    monkeypatch.setattr(again, "_acquire", no_lock)
+    assert again.verify(lazy=True) == 0
+    assert set(again._deferred) == _names(state)
+    monkeypatch.undo()
+    stray = Path(state.folder, "kernels_1/c-9.py311.nbi")
+    stray.write_bytes(b"unsealed")
+    taken = []
+    third = _cache.KernelCache(state.folder, own=True, helper=False)
+    monkeypatch.setattr(third, "_acquire", lambda: taken.append(True))
+    assert third.verify(lazy=True) == 0
+    assert taken and not stray.exists()
+    assert set(third._deferred) == _names(state)
+
+
 def test_a_file_another_process_rewrote_and_sealed_after_the_check_is_no_damage(
         tmp_path, capsys):
     """Two processes on one folder: the first checks lazily at start-up; the second then
@@ -293,14 +337,14 @@ def test_a_file_renamed_in_while_the_start_up_check_reads_the_folder_is_no_damag
     other = _hold_compiling_marker(state.folder, started, release)
     index = Path(state.folder, "kernels_1/a-1.py311.nbi")
     first = _cache.KernelCache(state.folder, own=True, helper=False)
-    listed = first._files
+    listed = first._entries
 
     def list_then_rewrite():
         files = listed()
         _rewrite(index, b"another signature from the compiling process")
         return files
 
-    monkeypatch.setattr(first, "_files", list_then_rewrite)
+    monkeypatch.setattr(first, "_entries", list_then_rewrite)
     try:
         while not started.exists():  # an event, not a time: it exits on any failure
             assert other.poll() is None, "the other process ended before compiling"
@@ -350,6 +394,33 @@ def test_a_damaged_list_of_sums_drops_everything_with_one_warning(tmp_path, caps
     assert len(err) == 1 and "list of checksums" in err[0] and err[0].startswith("warning:")
 
 
+def test_a_whitted_process_started_by_another_chooses_its_folder_itself(tmp_path):
+    """A whitted process started by another (a bench run, a farm worker) inherits the
+    NUMBA_CACHE_DIR its parent set: it takes it as whitted's own and chooses its folder again
+    (for its own sources), not as a folder the user named; a folder the user named stays
+    the user's."""
+    code = ("import json; from whitted.jit import cache; s = cache.prepare(); "
+            "print(json.dumps([s.folder, s.own, str(cache.cache_dir())]))")
+
+    def chosen(**settings: str) -> list:
+        env = {k: v for k, v in os.environ.items()
+               if k not in ("NUMBA_CACHE_DIR", _cache.OWN_FOLDER_ENV)}
+        env.update(PYTHONPATH=str(REPO_ROOT / "src"), WHITTED_CACHE_DIR=str(tmp_path / "c"),
+                   **settings)
+        run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                             env=env, timeout=300, cwd=tmp_path)
+        assert run.returncode == 0, run.stderr
+        return json.loads(run.stdout.strip().splitlines()[-1])
+
+    parents = str(tmp_path / "parents")
+    folder, own, ours = chosen(NUMBA_CACHE_DIR=parents, **{_cache.OWN_FOLDER_ENV: parents})
+    assert (folder, own) == (ours, True) and Path(ours).parent == tmp_path / "c"
+    users = str(tmp_path / "users")
+    folder, own, _ = chosen(NUMBA_CACHE_DIR=users, **{_cache.OWN_FOLDER_ENV: parents})
+    assert (folder, own) == (users, False)
+    assert chosen(NUMBA_CACHE_DIR=users)[:2] == [users, False]
+
+
 def test_other_programs_files_in_a_users_numba_cache_dir_are_kept(tmp_path):
     state = _fake_cache(tmp_path, own=False)
     other = Path(state.folder, "elsewhere_3/theirs-4.py311.nbi")
@@ -384,7 +455,7 @@ def test_an_unusable_folder_falls_back_with_one_warning(tmp_path, monkeypatch, c
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "user"))
     monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
     monkeypatch.setattr(_cache, "_state", None)
-    monkeypatch.setattr(_cache, "_set_numba_cache_dir", lambda folder: None)
+    monkeypatch.setattr(_cache, "_set_numba_cache_dir", lambda folder, own=True: None)
     state = _cache.prepare()
     assert state.folder == str(tmp_path / "user" / "whitted" / _cache._folder_name())
     err = capsys.readouterr().err.splitlines()
@@ -421,7 +492,7 @@ def test_a_warm_folder_that_cannot_be_written_is_loaded_from_as_it_is(tmp_path, 
     monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
     monkeypatch.delenv(_cache.HELPER_ENV, raising=False)
     monkeypatch.setattr(_cache, "_state", None)
-    monkeypatch.setattr(_cache, "_set_numba_cache_dir", lambda folder: None)
+    monkeypatch.setattr(_cache, "_set_numba_cache_dir", lambda folder, own=True: None)
     state = _cache.prepare()
     err = capsys.readouterr().err.splitlines()
     if damaged:

@@ -83,6 +83,64 @@ def test_warm_render_to_a_pipe_imports_no_rich(tmp_path):
     assert "rich" not in loaded
 
 
+def _run_main(argv: list[str]) -> str:
+    """``whitted ARGV`` run by the command's own entry point, in the checking process."""
+    return f"""
+        import sys
+        import whitted.cli.main as main
+        main.EXIT_AT_ONCE_WHEN_ABANDONED = False  # back here, to list what was imported
+        sys.argv = ["whitted", *{argv!r}]
+        try:
+            main.main()
+        except SystemExit as exc:
+            assert exc.code in (0, None), exc.code
+    """
+
+
+def test_a_render_looks_for_no_pydantic_plugins(tmp_path):
+    """``whitted render`` validates its scene without pydantic's search of every installed
+    distribution for plugins (cli/main.py); a user's own setting is kept."""
+    out = tmp_path / "x.png"
+    code = _run_main(["render", str(REPO_ROOT / "examples" / "glass_cube.toml"), "-W", "24",
+                      "-H", "16", "-q", "-o", str(out)]) + """
+        from pydantic.plugin import _loader
+        assert _loader._plugins is None, "searched for plugins"
+        import os
+        print("SETTING=" + os.environ["PYDANTIC_DISABLE_PLUGINS"])
+    """
+    loaded = _modules_after(code, tmp_path)
+    assert out.stat().st_size > 0 and "pydantic" in loaded
+    script = textwrap.dedent(code).replace('assert _loader._plugins is None, "searched for '
+                                           'plugins"', "")
+    env = {**os.environ, "PYTHONPATH": str(REPO_ROOT / "src"), "PYDANTIC_DISABLE_PLUGINS": ""}
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         cwd=tmp_path, env=env, timeout=600)
+    assert run.returncode == 0, run.stderr
+    assert "SETTING=\n" in run.stdout
+
+
+def test_a_warm_render_imports_no_file_lock_library(tmp_path):
+    """A render whose kernels are all in the cache, as sealed, checks the cache without its
+    lock (jit/cache.py): filelock is not imported (21 modules). The first run may compile;
+    a copy of the warm cache keeps other processes' compiles out of the check."""
+    import shutil
+
+    from whitted.jit.cache import prepare
+
+    warm = Path(prepare().folder)
+    cache = tmp_path / "cache"
+    if warm.is_dir():
+        shutil.copytree(warm, cache / warm.name, ignore=shutil.ignore_patterns("whitted.lock"))
+    out = tmp_path / "x.png"
+    code = _run_main(["render", str(REPO_ROOT / "benchmarks" / "seed000.toml"), "-W", "24",
+                      "-H", "16", "-q", "-o", str(out)])
+    settings = {"WHITTED_CACHE_DIR": str(cache), "NUMBA_CACHE_DIR": ""}
+    _modules_after(code, tmp_path, **settings)  # may compile
+    loaded = _modules_after(code, tmp_path, **settings)
+    assert out.stat().st_size > 0 and "numba" in loaded
+    assert "filelock" not in loaded
+
+
 def test_plain_line_is_what_rich_prints_and_needs_no_rich(tmp_path, monkeypatch):
     """cli/console.py writes a plain line to a file that is not a terminal itself: the same
     bytes rich writes for it (markup and emoji codes stay literal)."""
@@ -129,6 +187,31 @@ def test_numba_imported_through_whitted_skips_its_scipy_and_yaml_probes(tmp_path
         assert _lean_numba._finder not in sys.meta_path  # one-shot: gone once numba is in
     """, tmp_path)
     assert {"numba", "scipy", "yaml"} <= loaded
+
+
+def test_numba_imported_through_whitted_skips_its_coverage_probe(tmp_path):
+    """Numba imports coverage.py to report compiled lines to a running measurement: through
+    whitted it is skipped when coverage.py is not imported (no measurement can be running),
+    and still importable afterwards; with coverage.py imported first (``coverage run``,
+    pytest-cov), Numba sees it as without whitted."""
+    pytest.importorskip("coverage")
+    loaded = _modules_after("""
+        import whitted, sys
+        import numba
+        from numba.misc import coverage_support
+        assert "coverage" not in sys.modules, "probed"
+        assert coverage_support.coverage_available is False
+        import coverage
+        assert coverage.Coverage
+    """, tmp_path, COVERAGE_PROCESS_START="", COVERAGE_PROCESS_CONFIG="")  # not measured
+    assert {"numba", "coverage"} <= loaded
+    _modules_after("""
+        import coverage
+        import whitted
+        import numba
+        from numba.misc import coverage_support
+        assert coverage_support.coverage_available is True
+    """, tmp_path)
 
 
 def test_numba_config_file_still_read_through_whitted(tmp_path):

@@ -23,7 +23,7 @@ _marks.mark("interpreter")  # the interpreter has started and reached whitted
 
 from .jit import lean_numba as _lean_numba  # noqa: E402
 
-_lean_numba.install()  # Numba's import without its SciPy and PyYAML probes
+_lean_numba.install()  # Numba's import without its SciPy, PyYAML and coverage probes
 
 #: public name -> the module that defines it
 _LAZY = {

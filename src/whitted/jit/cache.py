@@ -5,7 +5,10 @@ so a change in a helper it calls would leave a stale machine-code copy behind. w
 therefore puts its cache in a folder named after a hash of all kernel sources: any change to
 any kernel starts a fresh cache, and different whitted versions never share one. The folder
 is ``$WHITTED_CACHE_DIR/numba-<hash>`` (default ``~/.cache/whitted``; ``numba-<hash>-stock``
-with ``WHITTED_NUMBA_TUNING=0``); an explicit ``NUMBA_CACHE_DIR`` set by the user wins.
+with ``WHITTED_NUMBA_TUNING=0``); an explicit ``NUMBA_CACHE_DIR`` set by the user wins. whitted
+points Numba at the folder through ``NUMBA_CACHE_DIR`` too, and says so in
+``WHITTED_OWN_NUMBA_CACHE_DIR``: a whitted process started by another (a bench run, a farm
+worker) inherits both and chooses its own folder again, as a process started by the user does.
 
 **A folder that cannot be used** (read-only, a file, ``/proc``, ``/dev/null``): whitted says so
 in one ``warning:`` line and uses the per-user folder instead, or, when that cannot be used
@@ -41,8 +44,12 @@ cache file against it:
   process compiling, it is damage like any other;
 - a damaged list is a list of nothing: every file is then compiled again, with one warning.
 
-A file as sealed (its entry's size and inode) has its content checked only when its kernel is
-first looked up (:meth:`KernelCache.check_function`). Other processes keep writing meanwhile:
+A file as sealed (its entry's inode, which the folder's listing gives without a ``stat``) has
+its content, and so its size, checked only when its kernel is first looked up
+(:meth:`KernelCache.check_function`): a process reads the listing and the list, and hashes
+the few files it loads. A warm folder whose files are all as sealed is checked so without
+the lock (there is nothing to delete or write); anything else is checked under it. Other
+processes keep writing meanwhile:
 a file that no longer has the sum the start-up check saw is judged under the lock, against
 the list and the markers as they are then: sealed since by another process, it is loaded;
 a new file (another inode) while another process is compiling is that process's work, kept
@@ -65,6 +72,7 @@ render waits and then loads what the first compiled.
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import json
 import os
@@ -95,8 +103,19 @@ LOCK_WAIT_SECONDS = 900.0  # a process holding the lock longer than this is not 
 
 def kernel_source_hash(root: Path | None = None) -> str:
     """A hash of the sources that decide the kernels' machine code, under ``root`` (whitted's
-    package folder unless given)."""
-    root = root if root is not None else Path(__file__).parents[1]
+    package folder unless given: read once a process, which names its cache folder and
+    digests its jobs with it)."""
+    if root is None:
+        return _own_kernel_source_hash()
+    return _kernel_source_hash(root)
+
+
+@functools.cache
+def _own_kernel_source_hash() -> str:
+    return _kernel_source_hash(Path(__file__).parents[1])
+
+
+def _kernel_source_hash(root: Path) -> str:
     h = hashlib.sha256()
     paths = [path for folder in KERNEL_DIRS for path in sorted((root / folder).rglob("*.py"))]
     for path in paths + [root / name for name in KERNEL_FILES]:
@@ -305,8 +324,12 @@ class KernelCache:
         return busy
 
     # ---------------------------------------------------------------- sums
-    def _files(self) -> dict[str, os.stat_result]:
-        found: dict[str, os.stat_result] = {}
+    def _entries(self) -> dict[str, os.DirEntry]:
+        """The cache files in the folder (one level down), by name, as listed: their inodes
+        come with the listing (``DirEntry.inode()``, no system call on POSIX); their status
+        costs a ``stat`` each, made only where needed (a cache of every variant holds about
+        a thousand files, and a process loads a few of them)."""
+        found: dict[str, os.DirEntry] = {}
         root = self.folder
         try:
             folders = [e for e in os.scandir(root) if e.is_dir(follow_symlinks=False)]
@@ -319,8 +342,14 @@ class KernelCache:
                 continue
             for entry in entries:
                 if entry.name.endswith(CACHE_SUFFIXES):
-                    with contextlib.suppress(OSError):
-                        found[f"{sub.name}/{entry.name}"] = entry.stat(follow_symlinks=False)
+                    found[f"{sub.name}/{entry.name}"] = entry
+        return found
+
+    def _files(self) -> dict[str, os.stat_result]:
+        found: dict[str, os.stat_result] = {}
+        for name, entry in self._entries().items():
+            with contextlib.suppress(OSError):
+                found[name] = entry.stat(follow_symlinks=False)
         return found
 
     def _read_sums(self) -> tuple[dict, bool]:
@@ -375,31 +404,39 @@ class KernelCache:
     def verify(self, lazy: bool = False) -> int:
         """Check every cache file against the list (module docstring); delete what fails.
         Returns how many damaged files were deleted. ``lazy``: a file that is as sealed (its
-        entry's size and inode) has its content checked only when a kernel of its is first
+        entry's inode) has its content checked only when a kernel of its is first
         looked up in this process (:meth:`check_function`, from jit/locator.py), so a process
         hashes the few files it loads, not the whole cache of every variant."""
         if self.folder is None or self.helper:
+            return 0
+        if lazy and self._all_as_sealed():
             return 0
         with self.locked():
             sums, damaged_list = self._read_sums()
             damaged = 0
             deleted = refreshed = False
-            files = self._files()
+            files = self._entries()
             rewriting = self.others_compiling()
-            for name, st in files.items():
+            for name, listed in files.items():
                 path = os.path.join(self.folder, name)
                 entry = sums.get(name)
                 if lazy and not damaged_list and entry is not None \
-                        and entry[1] == st.st_size and entry[2:] == [st.st_ino]:
+                        and entry[2:] == [_inode(listed)]:
+                    # the file as sealed (the same inode): its content, and so its size, is
+                    # checked when its kernel is first looked up, without a stat now
                     self._deferred[name] = entry[0]
-                    self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
+                    self._seen[name] = (entry[2], entry[1], 0)
                     continue
-                digest, now = self._read_file(path) if entry is not None else (None, None)
-                if now is not None:
-                    st = now  # the file hashed (Numba may have renamed a new one in since)
-                elif entry is not None and not os.path.lexists(path):
-                    sums.pop(name, None)  # gone since the folder was listed: nothing to judge
-                    refreshed = True
+                digest, st = self._read_file(path) if entry is not None else (None, None)
+                if st is None:
+                    try:
+                        st = listed.stat(follow_symlinks=False)
+                    except OSError:
+                        st = None
+                if st is None:  # gone since the folder was listed: nothing to judge
+                    if entry is not None:
+                        sums.pop(name, None)
+                        refreshed = True
                     continue
                 good = entry is not None and entry[1] == st.st_size and digest == entry[0]
                 if good:
@@ -441,6 +478,32 @@ class KernelCache:
                 self.unsealed = True
                 self.seal()
             return damaged
+
+    def _all_as_sealed(self) -> bool:
+        """The lazy start-up check of a warm folder, without the lock: True when every
+        cache file listed is as sealed (its entry's inode) and every entry names a listed
+        file. Then there is nothing to delete or to write, and each file's content is left
+        for its kernel's first look-up (:meth:`check_function`), as :meth:`verify` leaves
+        it. Anything else (a file not in the list, another inode, an entry without its file,
+        a damaged list) is for the check under the lock. The list is written whole or not
+        at all (a new file renamed over it), so it is read whole without the lock; a file
+        another process writes or deletes meanwhile is judged when it is looked up."""
+        sums, damaged_list = self._read_sums()
+        if damaged_list or not sums:
+            return False
+        files = self._entries()
+        if len(files) != len(sums):
+            return False
+        found = []
+        for name, listed in files.items():
+            entry = sums.get(name)
+            if entry is None or entry[2:] != [_inode(listed)]:
+                return False
+            found.append((name, entry))
+        for name, entry in found:
+            self._deferred[name] = entry[0]
+            self._seen[name] = (entry[2], entry[1], 0)
+        return True
 
     def check_function(self, subfolder: str, filename_base: str) -> int:
         """Before Numba looks up a kernel (its cache files ``<subfolder>/<filename_base>.*``):
@@ -522,10 +585,10 @@ class KernelCache:
             self._done_compiling()
             sums, damaged_list = self._read_sums()
             changed = False
-            for name, st in self._files().items():
+            for name, listed in self._entries().items():
                 seen = self._seen.get(name)
                 entry = sums.get(name)
-                if seen is not None and seen[0] == st.st_ino and entry is not None:
+                if seen is not None and entry is not None and seen[0] == _inode(listed):
                     continue  # as checked (or changed in place: not sealed)
                 digest, st = self._read_file(os.path.join(self.folder, name))
                 if digest is None:
@@ -539,6 +602,14 @@ class KernelCache:
                 changed = True
             if changed or damaged_list:
                 self._write_sums(sums)
+
+
+def _inode(entry: os.DirEntry) -> int | None:
+    """A listed file's inode (None: gone since it was listed)."""
+    try:
+        return entry.inode()
+    except OSError:  # Windows stats the file for it
+        return None
 
 
 _state: KernelCache | None = None
@@ -566,8 +637,20 @@ def read_only(path: str) -> bool:
             and os.path.abspath(path).startswith(os.path.abspath(state.folder)))
 
 
-def _set_numba_cache_dir(folder: str) -> None:
+#: set beside ``NUMBA_CACHE_DIR`` when whitted chose that folder itself (not the user): a
+#: whitted process this one starts (a bench run, a farm worker, ``whitted warm``'s workers)
+#: inherits the environment, and must take the folder as whitted's own, chosen again for its
+#: own sources, not as a folder the user named (which is checked under the lock and sealed
+#: by every process, and may hold other programs' files)
+OWN_FOLDER_ENV = "WHITTED_OWN_NUMBA_CACHE_DIR"
+
+
+def _set_numba_cache_dir(folder: str, own: bool = True) -> None:
     os.environ["NUMBA_CACHE_DIR"] = folder
+    if own:
+        os.environ[OWN_FOLDER_ENV] = folder
+    else:
+        os.environ.pop(OWN_FOLDER_ENV, None)
     # whitted's functions filed by their folder inside whitted, not by the install path
     locators = locator_setting(os.environ.get("NUMBA_CACHE_LOCATOR_CLASSES", ""))
     os.environ["NUMBA_CACHE_LOCATOR_CLASSES"] = locators
@@ -589,6 +672,8 @@ def prepare() -> KernelCache:
             return _state
         helper = os.environ.get(HELPER_ENV) == "1"
         chosen = os.environ.get("NUMBA_CACHE_DIR")
+        if chosen and not helper and chosen == os.environ.get(OWN_FOLDER_ENV):
+            chosen = None  # whitted's own choice, inherited from the process that started this
         own = not chosen or helper
         if not chosen:
             chosen = str(cache_dir())
@@ -597,7 +682,7 @@ def prepare() -> KernelCache:
         if problem is not None and not helper and _warm_to_read(chosen):
             state = KernelCache(chosen, own, helper, read_only=True)
             if state.intact():  # a warm folder this process cannot write: loaded from only
-                _set_numba_cache_dir(chosen)
+                _set_numba_cache_dir(chosen, own)
                 _state = state
                 return state
             problem = f"{problem}; its files do not match its list of checksums"
@@ -613,12 +698,13 @@ def prepare() -> KernelCache:
                 folder = None
         if folder is None:
             os.environ.pop("NUMBA_CACHE_DIR", None)
+            os.environ.pop(OWN_FOLDER_ENV, None)
             if "numba" in sys.modules:
                 import numba
 
                 numba.config.CACHE_DIR = ""
         else:
-            _set_numba_cache_dir(folder)
+            _set_numba_cache_dir(folder, own)
         state = KernelCache(folder, own, helper)
         state.verify(lazy=_locator_checks())
         _state = state
