@@ -123,20 +123,6 @@ def caustic_irradiance(lights, p, n, shadows):
     return e0, e1, e2
 
 
-@kernel(inline="always")
-def with_caustic(lights, mats, m, albedo, p, n, local):
-    """``local`` (a hit's direct light) plus the caustic's diffuse term kd·albedo·E, E the
-    photon map's irradiance at ``p`` (exactly as a light's direct term enters)."""
-    kd = mats[m, MAT_KD]
-    if kd == 0.0:
-        return local
-    e = caustic_irradiance(lights, p, n, True)
-    # the shadow photons take away what the direct term counts: never more, but for noise
-    return (max(0.0, local[0] + kd * albedo[0] * e[0]),
-            max(0.0, local[1] + kd * albedo[1] * e[1]),
-            max(0.0, local[2] + kd * albedo[2] * e[2]))
-
-
 @kernel(entry=True)  # called from Python: the photon map's estimate at given points
 def irradiance_at(lights, points, normals, shadows, out):
     """:func:`caustic_irradiance` at each row of ``points`` (with unit ``normals``) into
@@ -149,9 +135,18 @@ def irradiance_at(lights, points, normals, shadows, out):
         out[i, 2] = e[2]
 
 
-@kernel(inline="always")
+@kernel(inline="always")  # one kernel, not two: each is compiled on its own
 def add_caustic(lights, mats, m, albedo, p, n, local):
-    """:func:`with_caustic` in renders with caustics; ``local`` unchanged without."""
+    """``local`` (a hit's direct light) plus, in renders with caustics, the caustic's diffuse
+    term kd·albedo·E, E the photon map's irradiance at ``p`` (exactly as a light's direct
+    term enters); ``local`` unchanged without caustics."""
     if not caustics_on(lights):
         return local
-    return with_caustic(lights, mats, m, albedo, p, n, local)
+    kd = mats[m, MAT_KD]
+    if kd == 0.0:
+        return local
+    e = caustic_irradiance(lights, p, n, True)
+    # the shadow photons take away what the direct term counts: never more, but for noise
+    return (max(0.0, local[0] + kd * albedo[0] * e[0]),
+            max(0.0, local[1] + kd * albedo[1] * e[1]),
+            max(0.0, local[2] + kd * albedo[2] * e[2]))
