@@ -102,7 +102,9 @@ def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, guard: Inter
         try:
             result = run_case(case, text, output, resume=not fresh, progress=progress,
                               should_stop=guard.is_set, scene_size=size,
-                              allow_large=allow_large, case_path=case_path)
+                              allow_large=allow_large, case_path=case_path,
+                              on_estimate=None if quiet else
+                              lambda line: bar.console.print(line, highlight=False))
         except CaseError as exc:
             raise _fail(str(exc)) from None
     return case, result
@@ -154,7 +156,8 @@ def validate(
     """Check the solver against exact answers and print the tables: Neumann's lambda, front
     error against cell size, the axes, the cavity's convection, the flow solver on de Vahl
     Davis's square cavity (32², with --full 32² to 128²) and on the heated cube (24³, with
-    --full 32³ to 64³), gallium melting beside Gau & Viskanta's measured front, the convective
+    --full 32³ to 64³), gallium melting beside Gau & Viskanta's measured front and at Blais
+    & Ilinca's Ra 1e5 beside their computation, the convective
     slab, the sphere,
     the energy balance."""
     from rich.table import Table
@@ -244,7 +247,7 @@ def validate(
     table = Table(title="Gallium melting from a heated wall (Gau & Viskanta 1986), 2-D: the "
                   "melted length over the width (measured, whitted)")
     for col in ("cells", "t (min)", "top ref", "top", "middle ref", "middle", "bottom ref",
-                "bottom", "melted ref", "melted", "energy (rel.)"):
+                "bottom", "melted ref", "melted", "error", "energy (rel.)"):
         table.add_column(col, justify="right")
     for mm, last in (((4.0, None), (2.0, None)) if full else ((4.0, 3),)):
         for r in v.gallium_rows(mm, last=last):
@@ -253,7 +256,23 @@ def validate(
                           f"{r['bottom_ref']:.3f}", f"{r['bottom']:.3f}",
                           "-" if math.isnan(r["melted_ref"]) else f"{r['melted_ref']:.3f}",
                           f"{r['melted']:.3f}",
+                          "-" if math.isnan(r["melted_ref"]) else
+                          f"{100 * (r['melted'] / r['melted_ref'] - 1):+.1f} %",
                           f"{r['energy_rel']:.1e}")
+    out.print(table)
+    table = Table(title="Gallium at Blais & Ilinca's Ra 1e5 (their 2-D computation's case): "
+                  "the melted fraction (measured at Ra 6.1e5, Blais & Ilinca, whitted)")
+    for col in ("cells", "t (min)", "tau", "measured", "Blais & Ilinca", "whitted", "error",
+                "top", "middle", "bottom"):
+        table.add_column(col, justify="right")
+    for mm in ((4.0, 2.0) if full else (4.0,)):
+        for r in v.gallium_ra_1e5_rows(mm):
+            table.add_row(r["cells"], f"{r['minutes']:.1f}", f"{r['tau']:.4f}",
+                          "-" if math.isnan(r["melted_ref"]) else f"{r['melted_ref']:.3f}",
+                          f"{r['melted_blais']:.3f}", f"{r['melted']:.3f}",
+                          f"{100 * (r['melted'] / r['melted_blais'] - 1):+.1f} %",
+                          f"{r['top']:.3f}",
+                          f"{r['middle']:.3f}", f"{r['bottom']:.3f}")
     out.print(table)
 
     slab = v.convective_slab()

@@ -136,6 +136,10 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
 
 SHADOW_LIST_CAP = 48  # primitives a soft-shadow bundle may list; past that its rays walk the BVH
 MIN_BUNDLE_SAMPLES = 4  # area lights with fewer samples per point skip the bundle listing
+# a light sample whose unshadowed contribution to a highlight-only surface (no diffuse term)
+# is below this, per channel, is left out without a shadow ray: far below a float32 pixel's
+# own precision at any visible brightness (2**-24 of the value) and 16-bit output's step
+NEGLIGIBLE_LIGHT = 1e-15
 
 
 @kernel
@@ -558,6 +562,17 @@ def direct_light(
                 weight = share * _falloff(table, j, dist)
             if dot(n, ldir) <= 0.0:
                 continue
+            # a surface without diffuse reflection (water, glass, air) reflects a light only
+            # in its highlight, a narrow lobe (c ** shininess); outside it the light would add
+            # less than NEGLIGIBLE_LIGHT to the colour even unshadowed, and no shadow ray is
+            # traced for it
+            highlight_only = mats[m, MAT_KD] == 0.0
+            f = (0.0, 0.0, 0.0)
+            if highlight_only:
+                f = _brdf(mats, m, albedo, n, v, ldir)
+                if max(weight * radiance[0] * f[0], max(weight * radiance[1] * f[1],
+                       weight * radiance[2] * f[2])) < NEGLIGIBLE_LIGHT:
+                    continue
             buffer = int(table[j, LIGHT_BUFFER])
             if buffer >= 0 and not has_instances(geo):
                 cell = buffer + cube_cell((-to_light[0], -to_light[1], -to_light[2]),
@@ -575,7 +590,8 @@ def direct_light(
                 blocker = found
             if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
                 continue
-            f = _brdf(mats, m, albedo, n, v, ldir)
+            if not highlight_only:
+                f = _brdf(mats, m, albedo, n, v, ldir)
             r += weight * radiance[0] * vis[0] * f[0]
             g += weight * radiance[1] * vis[1] * f[1]
             b += weight * radiance[2] * vis[2] * f[2]

@@ -30,10 +30,15 @@ DISK_PER_SAVE = 16 * 2**10  # the scene file, a row of the series
 #: Cell updates per second the documentation's figures assume (2 cores); for the time estimate.
 CELL_UPDATES_PER_SECOND = 50e6
 
-#: A flow cell's step (three predictors, the divergence, two cosine transforms, the correction
-#: and the heat it carries) in enthalpy cell updates: an estimate from the operation count
-#: (about 12 passes over the box against 1), for the time estimate and the soft limit.
-FLOW_CELL_COST = 12.0
+#: A flow box cell's cost in enthalpy cell updates (``cavity.convection = "flow"``): each
+#: part of the predictor (three components) and, once a step, the projection with what goes
+#: with it (the multigrid-preconditioned pressure, the divergence and correction, the carried
+#: heat, the fields). Measured on the default case at 48 cells (docs/stefan.md: one thread,
+#: CPU seconds per phase over 200 steps): 2.1 and 19.5 with 13 700 fluid cells in the 41³
+#: box, rounded up for the cavity's growth. The projection's cost is spread over the
+#: ``FLOW_EVERY`` enthalpy steps of a flow step.
+FLOW_PREDICT_COST = 2.5
+FLOW_PROJECT_COST = 24.0
 
 SOFT_LIMITS = {
     "cell_updates": 1.0e12,  # about 5.5 h at 50 M cell updates/s
@@ -52,15 +57,19 @@ class Estimate:
     saves: int
     memory_bytes: int
     disk_bytes: int
-    #: with ``cavity.convection = "flow"``: the flow box's cells and its steps per step
+    #: with ``cavity.convection = "flow"``: the flow box's cells, its predictor's parts a
+    #: flow step (one projection each) and the enthalpy steps a flow step spans
     flow_cells: int = 0
     flow_substeps: int = 0
+    flow_every: int = 1
 
     @property
     def cell_updates(self) -> float:
-        """Enthalpy cell updates, the flow's counted at ``FLOW_CELL_COST`` each."""
-        flow = FLOW_CELL_COST * self.flow_cells * self.flow_substeps
-        return (float(self.cells) + flow) * self.steps
+        """Enthalpy cell updates, the flow's counted in them (``FLOW_PREDICT_COST`` a box
+        cell and predictor part, ``FLOW_PROJECT_COST`` a box cell and step)."""
+        flow = (self.flow_cells * (FLOW_PREDICT_COST * self.flow_substeps + FLOW_PROJECT_COST)
+                / max(1, self.flow_every))
+        return (float(self.cells) + (flow if self.flow_cells else 0.0)) * self.steps
 
     @property
     def seconds(self) -> float:
@@ -94,6 +103,7 @@ def estimate(case: Case) -> Estimate:
     memory = BASE_BYTES + BYTES_PER_CELL * cells
     disk = saves * (DISK_PER_CELL * cells + DISK_PER_SAVE)
     flow_cells = substeps = 0
+    every = 1
     if case.cavity.model == "flow":  # the box around the cavity (Case.solver_flow), at rest
         from .convection import water_density, water_viscosity
 
@@ -104,11 +114,25 @@ def estimate(case: Case) -> Estimate:
         flow_cells = 1
         for a in range(3):
             flow_cells *= min(shape[a], int(math.ceil(2 * ext[a] / case.dx)) + 2 * margin)
+        from .flow import FLOW_EVERY
+
+        every = FLOW_EVERY
         nu = water_viscosity(2.0) / water_density(2.0)
-        substeps = max(1, math.ceil(dt / (0.9 * case.dx ** 2 / (6.0 * nu)))) if dt > 0 else 1
-        memory += 160 * flow_cells  # 3 velocities and their copies, scratch, the transforms
+        substeps = (max(1, math.ceil(every * dt / (0.9 * case.dx ** 2 / (6.0 * nu))))
+                    if dt > 0 else 1)
+        memory += 200 * flow_cells  # 3 velocities and their copies, scratch, the levels
     return Estimate(cells, shape, dt, int(min(steps, 2**62)), int(saves), int(memory), int(disk),
-                    flow_cells, substeps)
+                    flow_cells, substeps, every)
+
+
+def describe(e: Estimate, case: Case) -> str:
+    """One line: the steps, the cells and the time the run should take (to ``time.end``; a
+    breach that stops the run comes sooner)."""
+    flow = (f" and a flow box of {e.flow_cells:,} cells (a flow step every {e.flow_every} "
+            f"step(s), its predictor in {e.flow_substeps} part(s))") if e.flow_cells else ""
+    stop = " or the breach" if case.breach.action == "stop" else ""
+    return (f"estimate: {e.steps:,} steps of {e.dt:.3g} s on {e.cells:,} cells{flow}, about "
+            f"{_hours(e.seconds)} on 2 cores to t = {case.time.end:g} s{stop}")
 
 
 def machine_memory() -> int | None:
@@ -190,4 +214,4 @@ def check(case: Case, out: Path | None = None, *, allow_large: bool = False,
     return e
 
 
-__all__ = ["SOFT_LIMITS", "Estimate", "check", "estimate"]
+__all__ = ["SOFT_LIMITS", "Estimate", "check", "describe", "estimate"]

@@ -17,7 +17,10 @@ g (ρ(0 °C) − ρ(T)) / ρ(0 °C) per liquid cell (times f), ρ from Kell's eq
 its 3.98 °C maximum (:func:`whitted.stefan.convection.water_density`): warm water above
 4 °C rises, water below 4 °C sinks, the two cells of a bulk between 0 and 8 °C included. The
 liquid carries its sensible heat ρ_w c_w T across the faces (upwind), which melts the wall
-where the flow brings it.
+where the flow brings it. There the pressure is solved on the fluid cells only, by
+multigrid-preconditioned conjugate gradients (:mod:`whitted.stefan.multigrid`), and
+incrementally (the last pressure in the predictor); the flow is stepped every
+``FLOW_EVERY`` enthalpy steps, its predictor in parts within its explicit limits.
 """
 
 from __future__ import annotations
@@ -58,6 +61,12 @@ DE_VAHL_DAVIS = {
 CUBE_NU = {1.0e4: 2.054, 1.0e5: 4.337}
 
 
+#: The masked projection's tolerance (:attr:`Flow.volume_tolerance`): the divergence left may
+#: change a fluid cell's volume by 10⁻¹⁰ of itself a step (root mean square over the fluid);
+#: over the 40 000 flow steps of the default case to its breach, 4 × 10⁻⁶.
+VOLUME_TOLERANCE = 1.0e-10
+
+
 class Poisson:
     """div(grad phi) = rhs in a box of cubic cells of side dx, no flux through its walls:
     exact (to round-off) by the cosine transform. Solvable when rhs sums to 0 (then phi's
@@ -89,50 +98,33 @@ class Poisson:
 
 class MaskedPoisson:
     """div(grad phi) = rhs on the fluid cells of a box, no flux through the faces to other
-    cells or the walls: conjugate gradients (:func:`flow_kernels.jacobi_cg`, on SciPy's
-    sparse matrix) on the cells' graph Laplacian, started
-    from the last solution, Jacobi-preconditioned; the matrix is rebuilt when the fluid
-    changes. Each connected body of fluid is singular (phi up to a constant): a 10⁻¹⁰ shift of
-    the diagonal fixes the constant without moving the gradient measurably."""
+    cells or the walls: conjugate gradients preconditioned by a multigrid V-cycle
+    (:mod:`whitted.stefan.multigrid`, both cores) on the fluid's bounding box, started from
+    the last solution; the levels rebuilt when the fluid changes. Solved until the
+    divergence left after the correction is at most ``tolerance`` (1/s, root mean square
+    over the fluid cells)."""
 
     def __init__(self, shape: tuple[int, int, int], dx: float) -> None:
         self.shape = tuple(shape)
         self.dx = float(dx)
         self._mask: np.ndarray | None = None
         self._phi = np.zeros(shape)
+        self.iterations = 0  # of the last solve
+        self.solves = 0
+        self.total_iterations = 0
 
     def _build(self, fluid: np.ndarray) -> None:
-        import scipy.sparse as sp
+        from .multigrid import Hierarchy
 
-        index = -np.ones(self.shape, dtype=np.int64)
-        cells = np.flatnonzero(fluid)
-        index.flat[cells] = np.arange(len(cells))
-        rows, cols = [], []
-        for a in range(3):
-            if self.shape[a] < 2:
-                continue
-            lo = [slice(None)] * 3
-            hi = [slice(None)] * 3
-            lo[a] = slice(0, -1)
-            hi[a] = slice(1, None)
-            both = fluid[tuple(lo)] & fluid[tuple(hi)]
-            i = index[tuple(lo)][both]
-            j = index[tuple(hi)][both]
-            rows += [i, j]
-            cols += [j, i]
-        r = np.concatenate(rows) if rows else np.zeros(0, dtype=np.int64)
-        c = np.concatenate(cols) if cols else np.zeros(0, dtype=np.int64)
-        n = len(cells)
-        off = sp.coo_matrix((np.ones(len(r)), (r, c)), shape=(n, n)).tocsr()
-        degree = np.asarray(off.sum(axis=1)).ravel()
-        h2 = 1.0 / (self.dx * self.dx)
-        self.matrix = ((off - sp.diags(degree + 1e-10 * np.maximum(degree, 1.0))) * h2).tocsr()
-        self.matrix.sort_indices()
-        self._csr = (self.matrix.indptr.astype(np.int64), self.matrix.indices.astype(np.int64),
-                     self.matrix.data.astype(np.float64))
-        self._inv_diag = 1.0 / (-(degree + 1e-10 * np.maximum(degree, 1.0)) * h2 - 1e-300)
-        self.cells = cells
         self._mask = fluid.copy()
+        idx = np.argwhere(fluid)
+        if idx.size == 0:
+            self.crop = None
+            return
+        lo, hi = idx.min(axis=0), idx.max(axis=0) + 1
+        self.crop = tuple(slice(int(a), int(b)) for a, b in zip(lo, hi, strict=True))
+        self.fluid_cells = int(fluid.sum())
+        self.hierarchy = Hierarchy(fluid[self.crop], self.dx)
 
     def zero_closed(self, u, v, w, fluid: np.ndarray) -> None:
         """No flow through a face unless both its cells are fluid (the walls' faces stay 0)."""
@@ -141,19 +133,22 @@ class MaskedPoisson:
         if fluid.shape[2] > 1:
             w[:, :, 1:-1][~(fluid[:, :, 1:] & fluid[:, :, :-1])] = 0.0
 
-    def solve(self, fluid: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    def solve(self, fluid: np.ndarray, rhs: np.ndarray, tolerance: float) -> np.ndarray:
+        """phi on the fluid cells (0 elsewhere) for ``rhs`` (div u* / dt); ``tolerance``:
+        the divergence (1/s, root mean square) the correction may leave, divided by dt."""
         if self._mask is None or not np.array_equal(self._mask, fluid):
             self._build(fluid)
         phi = np.zeros(self.shape)
-        if len(self.cells) == 0:
+        if self.crop is None:
             return phi
-        b = np.ascontiguousarray(rhs.flat[self.cells], dtype=np.float64)
-        x = np.ascontiguousarray(self._phi.flat[self.cells], dtype=np.float64)
-        scale = float(np.abs(b).max())
-        if scale == 0.0:
-            return phi
-        fk.jacobi_cg(*self._csr, self._inv_diag, b, x, 1e-9, 2000)
-        phi.flat[self.cells] = x
+        inside = self._mask[self.crop]
+        b = np.where(inside, -rhs[self.crop], 0.0).ravel()
+        x = np.where(inside, self._phi[self.crop], 0.0).ravel()
+        tol = float(tolerance) * np.sqrt(self.fluid_cells)
+        self.iterations = self.hierarchy.solve(b, x, tol)
+        self.solves += 1
+        self.total_iterations += self.iterations
+        phi[self.crop] = x.reshape(inside.shape)
         self._phi = phi
         return phi
 
@@ -175,26 +170,55 @@ class Flow:
         self._v = np.zeros_like(self.v)
         self._w = np.zeros_like(self.w)
         self._div = np.zeros(shape)
+        #: incremental projection (with ``fluid``): the last projection's pressure acts in
+        #: the predictor, and the projection solves for its change
+        self.incremental = False
+        self.pressure = np.zeros(shape)
         self._zero = np.zeros(shape)
         self.poisson = Poisson(shape, dx, workers=-1)
         self._masked = MaskedPoisson(shape, dx)
+        #: the masked projection's tolerance: the volume a fluid cell may gain or lose in a
+        #: step through the divergence left, as a fraction of the cell (root mean square)
+        self.volume_tolerance = VOLUME_TOLERANCE
+
+    def viscous_dt(self) -> float:
+        """The explicit diffusion's limit dx²/(2 d nu)."""
+        return self.dx * self.dx / (2.0 * (2 if self.flat else 3) * self.nu)
+
+    def advective_dt(self, cfl: float = 0.5) -> float:
+        """The advection's limit cfl dx / (|u| + |v| + |w|) (inf at rest)."""
+        speed = (np.abs(self.u).max() + np.abs(self.v).max()
+                 + (0.0 if self.flat else np.abs(self.w).max()))
+        return cfl * self.dx / speed if speed > 0.0 else math.inf
 
     def stable_dt(self, cfl: float = 0.5) -> float:
         """The explicit step's limit: diffusion (dx²/(2 d nu)) and advection (cfl dx / |u|)."""
-        dims = 2 if self.flat else 3
-        dt = self.dx * self.dx / (2.0 * dims * self.nu)
-        speed = (np.abs(self.u).max() + np.abs(self.v).max()
-                 + (0.0 if self.flat else np.abs(self.w).max()))
-        if speed > 0.0:
-            dt = min(dt, cfl * self.dx / speed)
-        return dt
+        return min(self.viscous_dt(), self.advective_dt(cfl))
 
     def step(self, dt: float, buoyancy: np.ndarray, sink: np.ndarray | None = None,
-             fluid: np.ndarray | None = None) -> None:
+             fluid: np.ndarray | None = None, parts: bool = False) -> None:
         """One step: ``buoyancy`` (m/s², per cell, along +axis 1, which is up), the
         enthalpy-porosity ``sink`` (1/s per cell; None: none) and, with ``fluid``, the
-        projection on those cells only (:meth:`project`)."""
+        projection on those cells only (:meth:`project`). ``parts``: the predictor in as
+        many explicit parts as keep each within 0.9 of the limits at the speed of the
+        moment (:meth:`stable_dt` with cfl 0.4), then one projection for the whole step."""
         sink = self._zero if sink is None else sink
+        left = dt
+        while left > 1e-12 * dt:
+            h = left
+            if parts:
+                h = min(left, 0.9 * self.stable_dt(0.4))
+                if left - h < 0.05 * h:
+                    h = left
+            self._predict(h, buoyancy, sink)
+            if self.incremental and fluid is not None:
+                fk.correct_damped(self.u, self.v, self.w, self.pressure, h, self.dx, sink,
+                                  self.flat)
+                self._masked.zero_closed(self.u, self.v, self.w, fluid)
+            left -= h
+        self.project(dt, fluid)
+
+    def _predict(self, dt: float, buoyancy: np.ndarray, sink: np.ndarray) -> None:
         dx, nu, flat = self.dx, self.nu, self.flat
         t = (1, 0, 2)
         fk.predict(self.u, self.v, self.w, nu, dt, dx, self._zero, sink, self._u, flat, False)
@@ -208,7 +232,6 @@ class Flow:
         self.u, self._u = self._u, self.u
         self.v, self._v = self._v, self.v
         self.w, self._w = self._w, self.w
-        self.project(dt, fluid)
 
     def project(self, dt: float, fluid: np.ndarray | None = None) -> None:
         """Make the velocity divergence-free: in the whole box (cosine transform), or, with
@@ -217,9 +240,13 @@ class Flow:
         if fluid is not None:
             self._masked.zero_closed(self.u, self.v, self.w, fluid)
             fk.divergence(self.u, self.v, self.w, self.dx, self._div, self.flat)
-            phi = self._masked.solve(fluid, self._div / dt)
+            phi = self._masked.solve(fluid, self._div / dt,
+                                    self.volume_tolerance / (dt * dt))
             fk.correct(self.u, self.v, self.w, phi, dt, self.dx, self.flat)
             self._masked.zero_closed(self.u, self.v, self.w, fluid)
+            if self.incremental:
+                self.pressure += phi
+                self.pressure[~fluid] = 0.0
             return
         fk.divergence(self.u, self.v, self.w, self.dx, self._div, self.flat)
         phi = self.poisson.solve(self._div / dt)
@@ -325,6 +352,18 @@ def _mean_nusselt(T: np.ndarray, flow: Flow, dx: float) -> float:
 
 # --- the melt --------------------------------------------------------------------------------
 
+#: The flow in the melt is projected once an enthalpy step, and more often when the fastest
+#: water would cross more than this fraction of a cell in between (its predictor keeps to
+#: the explicit limits in parts of its own). Gallium (4 mm cells, 2-4 cm/s) moves by under
+#: 0.01 of the width at 15 min between 0.4 and 0.9 (docs/stefan.md).
+PROJECTION_CFL = 0.9
+#: The flow in the melt is stepped every FLOW_EVERY enthalpy steps, for their time together
+#: (its predictor still in parts under its limits, its heat carried in parts of under half a
+#: cell): the conduction's step limit is far below the flow's time scales.
+FLOW_EVERY = 2
+#: the melt's projection incremental (:attr:`Flow.incremental`)
+INCREMENTAL = True
+
 MUSHY_CONSTANT = 1.6e6  # kg/m³s: the Carman-Kozeny constant C (Brent, Voller & Reid 1988)
 
 
@@ -337,18 +376,20 @@ def water_density_array(t: np.ndarray) -> np.ndarray:
 
 class MeltFlow:
     """The flow of the cavity's water inside the enthalpy solver's grid: a box of cells
-    around the liquid (``box``: slices of the unpadded grid), stepped after every enthalpy
-    step, carrying the liquid's sensible heat. Viscosity at 2 °C (1.67 mPa s; the Vogel
+    around the liquid (``box``: slices of the unpadded grid), stepped after every
+    ``every`` enthalpy steps for their time together, carrying the liquid's sensible heat.
+    Viscosity at 2 °C (1.67 mPa s; the Vogel
     equation of :mod:`whitted.stefan.convection`), constant."""
 
     G = 9.80665
 
     def __init__(self, box: tuple[slice, slice, slice], dx: float, props,
                  t_viscosity: float = 2.0, viscosity: float | None = None,
-                 expansion: float | None = None) -> None:
+                 expansion: float | None = None, mushy: float | None = None) -> None:
         """``viscosity`` (kinematic, m²/s) and ``expansion`` (beta, 1/K: the Boussinesq
         buoyancy g beta (T - T_melt)) replace water's (Vogel's viscosity at ``t_viscosity``,
-        Kell's density) for another liquid (the gallium benchmark)."""
+        Kell's density) for another liquid (the gallium benchmark); ``mushy`` the
+        Carman-Kozeny constant (kg/m³s; default :data:`MUSHY_CONSTANT`)."""
         from .convection import water_density, water_viscosity
 
         self.box = box
@@ -358,20 +399,28 @@ class MeltFlow:
         self.nu = (water_viscosity(t_viscosity) / water_density(t_viscosity)
                    if viscosity is None else float(viscosity))
         self.flow = Flow(shape, dx, self.nu)
+        self.flow.incremental = INCREMENTAL
         self.props = props
         self.dx = float(dx)
         self._out = np.zeros(shape)
         self._buoy = np.zeros(shape)
         self._open = np.ones(shape)  # the faces' weights: the velocity is 0 off the fluid
         self.box0 = np.array([s.start + 1 for s in box], dtype=np.int64)  # padded indices
-        self.sink_c = MUSHY_CONSTANT / props.water.rho
+        #: the projection at least every time the fastest water crosses this much of a cell
+        self.projection_cfl = PROJECTION_CFL
+        #: stepped after every ``every`` enthalpy steps, for their time together
+        self.every = FLOW_EVERY
+        self.sink_c = (MUSHY_CONSTANT if mushy is None else float(mushy)) / props.water.rho
         self.time = 0.0
         #: tracer particles carried by the flow (for the film): positions in cell units of the
         #: box (a cell's centre at i + 1/2), seeded by :meth:`seed_tracers`
         self.tracers = np.zeros((0, 3))
 
-    def stable_dt(self) -> float:
-        return 0.9 * self.flow.stable_dt(0.4)
+    def projection_dt(self) -> float:
+        """The longest step between two projections: the time the fastest water takes to
+        cross ``projection_cfl`` of a cell (inf at rest). The predictor's stability limits
+        are met by its parts (:meth:`Flow.step`)."""
+        return self.projection_cfl * self.flow.advective_dt(1.0)
 
     def fields(self, Hp: np.ndarray, kindp: np.ndarray):
         """Liquid fraction, temperature and sensible heat (J/m³) of the box's cells."""
@@ -393,7 +442,7 @@ class MeltFlow:
         else:
             buoy = self.G * self.expansion * T * f
         sink = self.sink_c * (1.0 - f) ** 2 / (f ** 3 + 1.0e-3)
-        self.flow.step(dt, buoy, sink, fluid=f >= 0.5)
+        self.flow.step(dt, buoy, sink, fluid=f >= 0.5, parts=True)
         # the heat goes with the new velocity: in as many parts as keep each under half a cell
         parts = max(1, int(math.ceil(self.speed() * dt / (0.5 * self.dx))))
         for q in range(parts):
@@ -441,8 +490,8 @@ class MeltFlow:
     def state(self) -> dict:
         """What a resumed run needs to go on with the flow as it was."""
         return {"flow_u": self.flow.u, "flow_v": self.flow.v, "flow_w": self.flow.w,
-                "flow_tracers": self.tracers, "flow_box": np.array(
-                    [[s.start, s.stop] for s in self.box])}
+                "flow_pressure": self.flow.pressure, "flow_tracers": self.tracers,
+                "flow_box": np.array([[s.start, s.stop] for s in self.box])}
 
     def restore(self, z) -> None:
         """The flow of a saved state (:meth:`state`), when its box is this one's."""
@@ -452,6 +501,8 @@ class MeltFlow:
         self.flow.u[...] = z["flow_u"]
         self.flow.v[...] = z["flow_v"]
         self.flow.w[...] = z["flow_w"]
+        if "flow_pressure" in z:  # (a state saved before the incremental projection: 0)
+            self.flow.pressure[...] = z["flow_pressure"]
         self.tracers = np.array(z["flow_tracers"], dtype=np.float64).reshape(-1, 3)
 
     def speed(self) -> float:

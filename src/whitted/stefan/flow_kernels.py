@@ -16,8 +16,6 @@ cell; its face value the mean of the two cells') taken implicitly: u* = (u + dt 
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..jit import builder, numba_object
 
 #: Numba's parallel range, in the kernels' globals once Numba is loaded (jit/decorators.py)
@@ -114,6 +112,27 @@ def correct(u, v, w, phi, dt, dx, flat):
 
 
 @builder(parallel=True, error_model="numpy")
+def correct_damped(u, v, w, phi, dt, dx, sink, flat):
+    """u -= dt grad(phi) / (1 + dt a) on the interior faces, ``a`` the face's sink (the mean
+    of its two cells'): the pressure of the last projection inside the predictor, braked by
+    the implicit sink as the predictor's other terms are."""
+    n0, n1, n2 = phi.shape
+    g = dt / dx
+    for i in prange(n0):
+        for j in range(n1):
+            for k in range(n2):
+                if i > 0:
+                    a = 0.5 * (sink[i, j, k] + sink[i - 1, j, k])
+                    u[i, j, k] -= g * (phi[i, j, k] - phi[i - 1, j, k]) / (1.0 + dt * a)
+                if j > 0:
+                    a = 0.5 * (sink[i, j, k] + sink[i, j - 1, k])
+                    v[i, j, k] -= g * (phi[i, j, k] - phi[i, j - 1, k]) / (1.0 + dt * a)
+                if k > 0 and not flat:
+                    a = 0.5 * (sink[i, j, k] + sink[i, j, k - 1])
+                    w[i, j, k] -= g * (phi[i, j, k] - phi[i, j, k - 1]) / (1.0 + dt * a)
+
+
+@builder(parallel=True, error_model="numpy")
 def temperature_step(T, u, v, w, alpha, dt, dx, t_low, t_high, out, flat):
     """One explicit step of dT/dt + div(u T) = alpha lap T in the box: the walls across axis
     0 held at ``t_low`` (first) and ``t_high`` (last), the others adiabatic; central fluxes
@@ -189,63 +208,6 @@ def advect_enthalpy(H, box0, u, v, w, frac, heat, dt, dx, flat, out):
         for j in range(n1):
             for k in range(n2):
                 H[box0[0] + i, box0[1] + j, box0[2] + k] += out[i, j, k]
-
-
-@builder(error_model="numpy")
-def jacobi_cg(indptr, indices, data, inv_diag, b, x, rtol, maxiter):
-    """Conjugate gradients, Jacobi-preconditioned, on the symmetric definite matrix in CSR
-    form (``indptr``, ``indices``, ``data``; ``inv_diag`` its diagonal's inverse): ``x``
-    (the start, overwritten by the solution) until the residual's norm is at most ``rtol``
-    times b's (SciPy's ``cg`` test with ``atol=0``), at most ``maxiter`` iterations. One
-    thread, each iteration's loops fused: SciPy's own ``cg`` spends most of its time in
-    Python between the matrix products at the melt's sizes. Returns the iterations done."""
-    n = b.shape[0]
-    r = np.empty(n)
-    z = np.empty(n)
-    p = np.empty(n)
-    ap = np.empty(n)
-    bb = 0.0
-    rr = 0.0
-    rz = 0.0
-    for i in range(n):
-        s = 0.0
-        for e in range(indptr[i], indptr[i + 1]):
-            s += data[e] * x[indices[e]]
-        ri = b[i] - s
-        r[i] = ri
-        zi = inv_diag[i] * ri
-        z[i] = zi
-        p[i] = zi
-        bb += b[i] * b[i]
-        rr += ri * ri
-        rz += ri * zi
-    tol2 = rtol * rtol * bb
-    it = 0
-    while it < maxiter and rr > tol2:
-        pap = 0.0
-        for i in range(n):
-            s = 0.0
-            for e in range(indptr[i], indptr[i + 1]):
-                s += data[e] * p[indices[e]]
-            ap[i] = s
-            pap += p[i] * s
-        alpha = rz / pap
-        rr = 0.0
-        rz_new = 0.0
-        for i in range(n):
-            x[i] += alpha * p[i]
-            ri = r[i] - alpha * ap[i]
-            r[i] = ri
-            zi = inv_diag[i] * ri
-            z[i] = zi
-            rr += ri * ri
-            rz_new += ri * zi
-        beta = rz_new / rz
-        rz = rz_new
-        for i in range(n):
-            p[i] = z[i] + beta * p[i]
-        it += 1
-    return it
 
 
 @builder(parallel=True, error_model="numpy")

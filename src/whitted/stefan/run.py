@@ -171,14 +171,17 @@ def _save_surfaces(out: Path, index: int, solver: EnthalpySolver, case: Case,
 def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
              progress: Callable[[float, float, str], None] | None = None,
              should_stop: Callable[[], bool] | None = None, scene_size: tuple[int, int] =
-             (480, 360), allow_large: bool = False, case_path: Path | None = None) -> RunResult:
+             (480, 360), allow_large: bool = False, case_path: Path | None = None,
+             on_estimate: Callable[[str], None] | None = None) -> RunResult:
     """Solve ``case`` into the folder ``out`` (see the module docstring).
 
     Before any work the cost is estimated (:func:`whitted.stefan.budget.check`: refused over
     the machine's memory or free disk, or over a soft limit unless ``allow_large``), and
     ``out`` must be a folder whitted made (:func:`whitted.stefan.folder.prepare`): ``resume``
     False (``--fresh``) removes the files whitted wrote there and nothing else.
-    ``case_path``: the case file read, which the run must not write over."""
+    ``case_path``: the case file read, which the run must not write over. ``on_estimate``
+    is given the estimate's line (:func:`whitted.stefan.budget.describe`) once the checks
+    pass, before the solving starts."""
     from . import budget, folder
 
     out = Path(out)
@@ -190,13 +193,15 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
     existing = 0
     if resume and folder.is_marked(out) and (out / "fields").is_dir():
         existing = len(state_files(out / "fields"))
-    budget.check(case, out, allow_large=allow_large, existing_saves=existing,
-                 file=None if case_path is None else str(case_path))
+    cost = budget.check(case, out, allow_large=allow_large, existing_saves=existing,
+                        file=None if case_path is None else str(case_path))
     folder.prepare(out, fresh=not resume, digest=digest)
     if resume and _latest_state(out / "fields", digest) is None and state_files(out / "fields"):
         raise CaseError("holds a run of a different case (use a new folder or --fresh)",
                         file=str(out))
     _atomic_bytes(case_file, case_text.encode())
+    if on_estimate is not None:  # every check passed: the run starts
+        on_estimate(budget.describe(cost, case))
     frame = grid_frame(case)
     result = RunResult(out, cells=frame.shape)
     air = case.solver_air()

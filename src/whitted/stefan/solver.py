@@ -109,8 +109,8 @@ class EnthalpySolver:
         elif dt > self.dt_limit:
             raise ValueError(f"time step {dt:g} s is over the stability limit "
                              f"{self.dt_limit:.4g} s")
-        # the cavity water's flow (flow.MeltFlow): stepped after every enthalpy step, in
-        # shorter steps of its own when its limit (viscosity, the speed of now) is below dt
+        # the cavity water's flow (flow.MeltFlow): stepped after every enthalpy step, projected
+        # once or more (MeltFlow.projection_dt), its predictor in parts within its limits
         self.flow = flow
         self.dt = float(dt)
         self.stop_on_breach = stop_on_breach
@@ -201,9 +201,14 @@ class EnthalpySolver:
                 if did == 0:
                     break
                 done += 1
-                left = self.dt  # in steps under the flow's limit at its velocity of now
+                every = max(1, int(self.flow.every))  # the flow every that many steps
+                if self.steps % every != 0:  # (counted from the start: chunks change nothing)
+                    if self.breached and self.stop_on_breach:
+                        break
+                    continue
+                left = every * self.dt  # projected once, or more often at the speed of now
                 while left > 1e-12 * self.dt:
-                    h = min(left, self.flow.stable_dt())
+                    h = min(left, self.flow.projection_dt())
                     if left - h < 0.05 * h:
                         h = left
                     self.flow.step(self._Hp, self._kindp, h)

@@ -387,48 +387,102 @@ GALLIUM = {"rho": 6093.0, "c": 381.5, "k": 32.0, "latent": 80160.0, "mu": 1.81e-
            "width": 0.0889, "height": 0.0635}
 
 
-def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None) -> list[dict]:
+def gallium_rows(dx_mm: float = 2.0, last: int | None = None, progress=None,
+                 changes: dict | None = None, mushy: float | None = None,
+                 taus: tuple[float, ...] | None = None,
+                 depth: float | None = None) -> list[dict]:
     """Gau & Viskanta's gallium melting in 2-D (the flow solver coupled to the enthalpy
     method, the enthalpy-porosity sink): the melted length along the top, middle and bottom
     rows of cells (liquid fraction summed, over the width) at the experiment's times, beside
     the measured front, and the melted fraction of the cavity beside the measured one
-    (interpolated linearly to the same time). ``last``: only the first ``last`` times."""
+    (interpolated linearly to the same time). ``last``: only the first ``last`` times.
+    ``changes``: values that replace :data:`GALLIUM`'s (a study of what the answer depends
+    on); ``mushy``: the Carman-Kozeny constant (default Brent et al.'s); ``taus``: other
+    times (tau) than the measured ones (then no measured front beside them). ``depth`` (m):
+    a 3-D cavity that deep between adiabatic no-slip walls (the fronts then on its middle
+    plane, the melted fraction of the whole, ``melted_plane`` that of the middle plane);
+    None: 2-D."""
     from .flow import MeltFlow
     from .properties import Phase
 
-    g = GALLIUM
+    g = {**GALLIUM, **(changes or {})}
     phase = Phase(rho=g["rho"], c=g["c"], k=g["k"])
     props = Properties(ice=phase, water=phase, latent_heat=g["latent"])
     dx = dx_mm * 1e-3
     nx = int(round(g["width"] / dx))
     ny = int(round(g["height"] / dx))
     dx = g["width"] / nx  # the width exact; the height within half a cell
-    shape = (nx, ny, 1)
+    nz = 1 if depth is None else max(1, int(round(depth / dx)))
+    shape = (nx, ny, nz)
     t_cold = g["t_cold"] - g["t_melt"]
     H = np.full(shape, props.enthalpy(t_cold, liquid=False))
     kind = np.ones(shape, dtype=np.uint8)
     faces = (Faces.adiabatic().set("x-", math.inf, g["t_hot"] - g["t_melt"])
              .set("x+", math.inf, t_cold))
-    flow = MeltFlow((slice(0, nx), slice(0, ny), slice(0, 1)), dx, props,
-                    viscosity=g["mu"] / g["rho"], expansion=g["beta"])
+    flow = MeltFlow((slice(0, nx), slice(0, ny), slice(0, nz)), dx, props,
+                    viscosity=g["mu"] / g["rho"], expansion=g["beta"], mushy=mushy)
     solver = EnthalpySolver(H, kind, dx, props, faces=faces, flow=flow)
     alpha = phase.diffusivity
     ref = GAU_VISKANTA
-    taus = ref["tau"][:last]
+    measured = taus is None
+    taus = ref["tau"][:last] if measured else tuple(taus)
     rows = []
     for i, tau in enumerate(taus):
         t = tau * g["width"] ** 2 / (ref["stefan"] * alpha)
         solver.advance(t)
-        f = solver.liquid_fraction()[:, :, 0]
-        row = {"minutes": t / 60.0, "tau": tau, "cells": f"{nx}x{ny}", "dx_mm": dx * 1e3,
-               "melted": float(f.mean()), "speed_mm_s": flow.speed() * 1e3,
+        f3 = solver.liquid_fraction()
+        f = f3[:, :, nz // 2]
+        cells = f"{nx}x{ny}" + ("" if nz == 1 else f"x{nz}")
+        row = {"minutes": t / 60.0, "tau": tau, "cells": cells, "dx_mm": dx * 1e3,
+               "melted": float(f3.mean()), "melted_plane": float(f.mean()),
+               "speed_mm_s": flow.speed() * 1e3,
                "energy_rel": solver.energy_error() / solver.heat_in,
                "melted_ref": float(np.interp(tau, ref["melted_tau"], ref["melted"],
                                                left=math.nan))}
         for name, j in (("top", ny - 1), ("middle", ny // 2), ("bottom", 0)):
             row[name] = float(f[:, j].sum()) / nx
-            row[name + "_ref"] = ref[name][i]
+            row[name + "_ref"] = ref[name][i] if measured else math.nan
         rows.append(row)
         if progress is not None:
             progress(row)
+    return rows
+
+
+#: Blais & Ilinca (2018), Comput. Fluids 172, 564-581: their 2-D computation's melted fraction
+#: of the gallium cavity against tau, as the Lethe project tabulates it beside the experiment
+#: (github.com/chaos-polymtl/lethe, examples/multiphysics/melting-cavity/
+#: compare-melting-cavity.py; sorted by tau here). Their case, as Lethe's example of it sets
+#: it up (melting-cavity.rst, its parameter file): Ra 10⁵ on the height, Pr 0.01818, Ste
+#: 0.041, the walls at 38 and 28 °C, melting at 29.8 °C: a sixth of the experiment's Ra.
+BLAIS_ILINCA = {
+    "tau": (0.00094, 0.00262, 0.00457, 0.00685, 0.01116, 0.01801, 0.02473, 0.02964, 0.03401,
+            0.03891, 0.04368, 0.04812, 0.05323, 0.05759, 0.06452, 0.07433, 0.08266, 0.08931,
+            0.09597, 0.09899),
+    "melted": (0.0372, 0.0670, 0.0856, 0.1079, 0.1423, 0.1898, 0.2344, 0.2614, 0.2874, 0.3163,
+               0.3442, 0.3721, 0.4000, 0.4242, 0.4651, 0.5153, 0.5600, 0.5935, 0.6279,
+               0.6437),
+}
+
+
+def gallium_ra_1e5_changes() -> dict:
+    """:data:`GALLIUM` changed to Blais & Ilinca's case (:data:`BLAIS_ILINCA`): gallium's
+    conductivity, density and heat capacity (so the same diffusivity and times), its
+    viscosity and expansion set for Pr 0.01818 and Ra 10⁵ on the height, the latent heat for
+    Ste 0.041, melting at 29.8 °C between walls at 38 and 28 °C."""
+    g = GALLIUM
+    alpha = g["k"] / (g["rho"] * g["c"])
+    nu = 0.01818 * alpha
+    d_t = 38.0 - 29.8
+    beta = 1.0e5 * nu * alpha / (9.80665 * d_t * g["height"] ** 3)
+    return {"mu": nu * g["rho"], "beta": beta, "t_melt": 273.15 + 29.8,
+            "t_hot": 273.15 + 38.0, "t_cold": 273.15 + 28.0, "latent": g["c"] * d_t / 0.041}
+
+
+def gallium_ra_1e5_rows(dx_mm: float = 4.0, progress=None) -> list[dict]:
+    """Gallium at Blais & Ilinca's Ra 10⁵ (:func:`gallium_ra_1e5_changes`) at the measured
+    times: the melted fraction beside their computation and the experiment's."""
+    rows = gallium_rows(dx_mm, progress=progress, changes=gallium_ra_1e5_changes())
+    for r in rows:
+        r["melted_blais"] = float(np.interp(r["tau"], BLAIS_ILINCA["tau"],
+                                            BLAIS_ILINCA["melted"]))
     return rows

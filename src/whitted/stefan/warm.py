@@ -44,7 +44,7 @@ def _warm_flow() -> None:
     solver = EnthalpySolver(H, kind, case.dx, case.solver_properties(),
                             faces=case.solver_faces(), air=case.solver_air(),
                             flow=case.solver_flow(H, kind))
-    solver.run_steps(1)
+    solver.run_steps(solver.flow.every)  # (the flow steps after its every-th enthalpy step)
     flat = Flow((4, 4, 1), 0.25, 0.71)
     T = np.zeros((4, 4, 1))
     fk.temperature_step(T, flat.u, flat.v, flat.w, 1.0, 1e-3, 0.25, 0.5, -0.5, T.copy(), True)
