@@ -85,3 +85,26 @@ def test_an_open_shell_and_early_or_odd_input():
     for k in range(1, 13):
         w.tick(100.0 + 10.0 * k, 10.0 + 20.0 * k)  # then 2 s/s
     assert w.pace() == pytest.approx(2.0)
+
+
+def test_the_run_shows_the_time_left_on_a_terminal_and_ends_cleanly(tmp_path):
+    # `whitted stefan run` on a terminal (TTY_COMPATIBLE=1): the bar says the time left to the
+    # breach, bounded by the end, and the bar's ending (rich's Live writing its last line)
+    # goes through a real console: exit 0, no internal error
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    case = tmp_path / "small.toml"
+    case.write_text("[grid]\ncells = 16\n[time]\nsave_every = 120.0\n")
+    env = {**os.environ, "TTY_COMPATIBLE": "1", "COLUMNS": "160",
+           "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src")}
+    env.pop("FORCE_COLOR", None)
+    done = subprocess.run([sys.executable, "-m", "whitted", "stefan", "run", str(case), "-o",
+                           str(tmp_path / "out")], env=env, capture_output=True, text=True,
+                          timeout=600)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "internal error" not in done.stderr
+    assert "to the breach (" in done.stderr and "to the end at most)" in done.stderr
+    assert "breach: the shell opened" in done.stdout
