@@ -108,3 +108,14 @@ def test_the_run_shows_the_time_left_on_a_terminal_and_ends_cleanly(tmp_path):
     assert "internal error" not in done.stderr
     assert "to the breach (" in done.stderr and "to the end at most)" in done.stderr
     assert "breach: the shell opened" in done.stdout
+
+
+def test_the_breach_is_foretold_where_the_grid_opens():
+    # the grid opens with some ice still measured (an outer cell drained next to a cavity
+    # cell half liquid: 0 to half a cell); foretold at a quarter of a 2 mm cell, 0.5 mm: the
+    # 6 mm shell thinning at 0.004 mm/s reaches it at 1375 s, not 1500 s
+    left = TimeLeft(end=7200.0, stops_at_breach=True, opens_at=0.5)
+    _drive(left, pace=4.0, shell0=6.0, rate=0.004, t_stop=600.0)
+    assert left.breach_at() == pytest.approx(1375.0)
+    left.row(1380.0, 0.45)  # already below it, not yet open: imminent
+    assert left.breach_at() == 1380.0

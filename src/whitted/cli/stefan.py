@@ -89,7 +89,7 @@ def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, guard: Inter
     from ..stefan.eta import TimeLeft
 
     # the bar runs to time.end; the time left says when the breach will stop the run first
-    left = TimeLeft(case.time.end, case.breach.action == "stop")
+    left = TimeLeft(case.time.end, case.breach.action == "stop", opens_at=case.dx * 1e3 / 4)
     columns = (TextColumn("[bold]{task.description}"), BarColumn(), TaskProgressColumn(),
                TextColumn("t = {task.fields[t]}"), TextColumn("{task.fields[left]}"))
     with Progress(*columns, console=err.console, transient=True,

@@ -3,9 +3,14 @@ run, against the breach as the thinnest shell's thinning foretells it.
 
 The wall clock's pace (simulated seconds per wall second) is measured over the last
 ``window`` wall seconds of progress. The breach is foretold from the saved rows: a straight
-line through the thinnest shell of the last ``fit`` saves (least squares) reaches zero at
-the foretold breach; none while the shell is not thinning (then the end bounds the time
-left: "until the end at most").
+line through the thinnest shell of the last ``fit`` saves (least squares) reaches
+``opens_at`` at the foretold breach; none while the shell is not thinning (then the end
+bounds the time left: "until the end at most").
+
+The grid opens before the measured shell reaches zero: the solver calls it a breach when an
+outer cell has drained (no ice left) next to a cavity cell at least half liquid, so the
+thinnest shell then measures between 0 and half a cell; ``whitted stefan run`` foretells the
+middle, a quarter of a cell (``opens_at``).
 """
 
 from __future__ import annotations
@@ -33,12 +38,14 @@ class TimeLeft:
     """Feed it progress (:meth:`tick`: simulated time at a wall time) and the saved rows
     (:meth:`row`: the time and the thinnest shell); :meth:`estimate` and :meth:`text` say
     what is left. ``end``: the case's ``time.end``; ``stops_at_breach``: the case stops
-    there (``breach.action = "stop"``)."""
+    there (``breach.action = "stop"``); ``opens_at``: the thinnest shell (mm) at which the
+    breach is foretold."""
 
     def __init__(self, end: float, stops_at_breach: bool, window: float = 60.0,
-                 fit: int = 4) -> None:
+                 fit: int = 4, opens_at: float = 0.0) -> None:
         self.end = float(end)
         self.stops_at_breach = bool(stops_at_breach)
+        self.opens_at = max(0.0, float(opens_at))
         self.window = float(window)
         self.fit = max(2, int(fit))
         self._ticks: deque[tuple[float, float]] = deque()
@@ -69,13 +76,13 @@ class TimeLeft:
         return (t1 - t0) / (w1 - w0)
 
     def breach_at(self) -> float | None:
-        """The simulated time the thinnest shell reaches zero on the straight line through
-        the last saves (None: fewer than two, or not thinning)."""
+        """The simulated time the thinnest shell reaches ``opens_at`` on the straight line
+        through the last saves (None: fewer than two, or not thinning)."""
         if not self.stops_at_breach or len(self._rows) < 2:
             return None
         ts = [r[0] for r in self._rows]
         ss = [r[1] for r in self._rows]
-        if ss[-1] <= 0.0:
+        if ss[-1] <= self.opens_at:
             return ts[-1]
         mt = sum(ts) / len(ts)
         ms = sum(ss) / len(ss)
@@ -86,7 +93,7 @@ class TimeLeft:
         if slope >= 0.0:
             return None
         # from the last save: its shell, thinning at the fitted rate
-        return ts[-1] + ss[-1] / -slope
+        return ts[-1] + (ss[-1] - self.opens_at) / -slope
 
     def estimate(self, t: float) -> Estimate:
         pace = self.pace()
