@@ -9,7 +9,11 @@ compiled in this one process:
     rm -rf /tmp/cp; WHITTED_CACHE_DIR=/tmp/cp WHITTED_COMPILE_HELPER=0 \\
         PYTHONPATH=src python benchmarks/compile_profile.py [SCENE.toml] [--top 25]
 
-The process's CPU seconds (user + system) for the whole compile are printed too.
+The process's CPU seconds (user + system) for the whole compile are printed too. With
+Numba's ``NUMBA_LLVM_PASS_TIMINGS=1`` (documented), LLVM's function passes (each function's
+own IR) and module passes (its final module, every callee's module linked in and optimised
+again) are summed, and the functions whose module passes took longest listed with the size of
+their optimised module: how much of the compile is callees optimised once more per level.
 """
 
 from __future__ import annotations
@@ -43,6 +47,43 @@ def compile_times(buffer) -> list[tuple[str, str, float, float]]:
             if stack:
                 stack[-1][3] += inclusive
     return rows
+
+
+def llvm_passes(buffer, top: int) -> None:
+    """LLVM's pass times per compile (``NUMBA_LLVM_PASS_TIMINGS=1``): function passes and
+    module passes, in all and for the ``top`` functions whose module passes took longest."""
+    from numba.core import config
+
+    if not config.LLVM_PASS_TIMINGS:
+        return
+    rows = []
+    seen = set()
+    for _ts, ev in buffer:
+        if ev.is_start:
+            continue
+        disp = ev.data["dispatcher"]
+        for sig, cres in disp.overloads.items():
+            if (id(disp), sig) in seen:
+                continue
+            seen.add((id(disp), sig))
+            timings = cres.metadata.get("llvm_pass_timings")
+            if timings is None:
+                continue
+            function = module = 0.0
+            for record in timings:
+                secs = record.timings.get_total_time()
+                if record.name.startswith("Function passes"):
+                    function += secs
+                else:
+                    module += secs
+            name = disp.py_func.__module__ + "." + disp.py_func.__qualname__
+            rows.append((module, function, name, disp, sig))
+    print(f"\nLLVM passes: function {sum(r[1] for r in rows):.2f} s, module "
+          f"{sum(r[0] for r in rows):.2f} s ({len(rows)} compiles)")
+    print(f"{'module s':>8} {'function s':>10} {'IR lines':>9}  function")
+    for module, function, name, disp, sig in sorted(rows, key=lambda r: -r[0])[:top]:
+        lines = disp.inspect_llvm(sig).count("\n")
+        print(f"{module:8.2f} {function:10.2f} {lines:9d}  {name}")
 
 
 def main() -> None:
@@ -115,6 +156,8 @@ def main() -> None:
     print("\ncompiler passes, exclusive s: all compiles | " + top_name)
     for name, secs in sorted(per_pass.items(), key=lambda kv: -kv[1])[:12]:
         print(f"{secs:8.2f} {per_pass_top.get(name, 0.0):8.2f}  {name}")
+
+    llvm_passes(rec.buffer, args.top)
 
     from whitted.kernels.tiles import render_tiles
 

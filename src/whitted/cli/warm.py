@@ -6,9 +6,10 @@ The default scene's kernels (with the scene builders and the OBJ reader) come fi
 process and its compile helper (both cores); then the other variants (render/variants.py) and
 the Stefan solver's kernels are handed out, one at a time, to ``--jobs`` worker processes (one
 per core), each compiling into the same cache (jit/cache.py keeps it consistent). A kind of
-the general kernels (caustics, adaptive anti-aliasing, AOVs) is handed out only once the
-general render kernel is in the cache: it shares that kernel's callees, which it then loads
-instead of compiling them a second time in another process. A variant already in the cache
+the general kernels that shares the render kernel's callees (adaptive anti-aliasing, AOVs) is
+handed out only once the general render kernel is in the cache: it then loads them instead of
+compiling them a second time in another process. The photon tracers (the caustics variants)
+share nothing with the render kernels and start at once. A variant already in the cache
 loads in a fraction of a second, so a second ``whitted warm`` is quick.
 """
 
@@ -38,10 +39,11 @@ def _all_names() -> list[str]:
 
 def _first(name: str) -> str | None:
     """The variant that must be in the cache before ``name`` is compiled: the render kernel
-    of its geometry, whose callees it shares (plain/render is compiled before any)."""
+    of its geometry, whose callees it shares (plain/render is compiled before any; the
+    photon tracer of the caustics variants shares none)."""
     geometry, _, kind = name.partition("/")
-    return None if name == STEFAN or kind == "render" or geometry == "plain" else \
-        f"{geometry}/render"
+    return None if name == STEFAN or kind in ("render", "caustics") or geometry == "plain" \
+        else f"{geometry}/render"
 
 
 def _order(names: list[str]) -> list[str]:

@@ -1,20 +1,20 @@
-"""The caustics' side of the render kernel: the photon map's gather and the switch that
-compiles it in only for renders with caustics (docs/caustics.md).
+"""The caustics' side of the render kernel: the photon map's gather, and the test that
+turns it on in renders with caustics (docs/caustics.md).
 
-A render without caustics passes a ``LightArrays`` whose ``photons`` are float64 and empty
-(layout.NO_CAUSTICS_DTYPE); with caustics they are float32. The two are different Numba
-types, so the render kernel is compiled once per kind, and in the kind without caustics
-:func:`caustics_on` is the constant False (the integrator's shadow rays see the material
-table itself) and :func:`add_caustic` adds nothing: the integrator's machine code is what it
-was before caustics existed (the same images, bit for bit), and the gather is never
-compiled for it (as features.py does for mesh instances).
+Caustics are a run-time choice of the one render kernel, not a kind compiled of its own: a
+render without caustics passes a ``LightArrays`` whose ``photon_grid`` holds no pass
+(layout.GRID_PASS entries), and :func:`caustics_on` reads that while it runs. Measured side by
+side (docs/performance.md, the variant table), a render kernel compiled without the gather
+was within 3 % of this one on scenes without caustics, and each kind cost a full compile of
+the render kernel (the render tree again, for each kind of geometry); the images are the same
+bit for bit.
 """
 
 from __future__ import annotations
 
 import math
 
-from ..jit import kernel, overload
+from ..jit import kernel
 from .layout import (
     GRID_BITS,
     GRID_INV_CELL,
@@ -31,23 +31,11 @@ from .layout import (
 PLANE_FRACTION = 0.5
 
 
-def _photons_possible(lights_type) -> bool:
-    from numba import types
-
-    fields = dict(zip(lights_type.fields, lights_type.types, strict=True))
-    return fields["photons"].dtype == types.float32
-
-
+@kernel(inline="always")
 def caustics_on(lights):
-    """True when the render has a photon map (resolved when the kernel is compiled)."""
-    return lights.photons.dtype.name == "float32"
-
-
-@overload(caustics_on, inline="always")
-def _caustics_on(lights):
-    if not _photons_possible(lights):
-        return lambda lights: False
-    return lambda lights: True
+    """True when the render has a photon map: its grid holds at least one pass (the photon
+    map may still be empty, when no photon reached a clear or mirrored body)."""
+    return lights.photon_grid.shape[0] > GRID_PASS
 
 
 @kernel(inline="always")
@@ -135,20 +123,6 @@ def caustic_irradiance(lights, p, n, shadows):
     return e0, e1, e2
 
 
-@kernel(inline="always")
-def with_caustic(lights, mats, m, albedo, p, n, local):
-    """``local`` (a hit's direct light) plus the caustic's diffuse term kd·albedo·E, E the
-    photon map's irradiance at ``p`` (exactly as a light's direct term enters)."""
-    kd = mats[m, MAT_KD]
-    if kd == 0.0:
-        return local
-    e = caustic_irradiance(lights, p, n, True)
-    # the shadow photons take away what the direct term counts: never more, but for noise
-    return (max(0.0, local[0] + kd * albedo[0] * e[0]),
-            max(0.0, local[1] + kd * albedo[1] * e[1]),
-            max(0.0, local[2] + kd * albedo[2] * e[2]))
-
-
 @kernel(entry=True)  # called from Python: the photon map's estimate at given points
 def irradiance_at(lights, points, normals, shadows, out):
     """:func:`caustic_irradiance` at each row of ``points`` (with unit ``normals``) into
@@ -161,17 +135,18 @@ def irradiance_at(lights, points, normals, shadows, out):
         out[i, 2] = e[2]
 
 
+@kernel(inline="always")  # one kernel, not two: each is compiled on its own
 def add_caustic(lights, mats, m, albedo, p, n, local):
-    """:func:`with_caustic` in renders with caustics; ``local`` unchanged, and nothing
-    compiled, without."""
+    """``local`` (a hit's direct light) plus, in renders with caustics, the caustic's diffuse
+    term kd·albedo·E, E the photon map's irradiance at ``p`` (exactly as a light's direct
+    term enters); ``local`` unchanged without caustics."""
     if not caustics_on(lights):
         return local
-    return with_caustic(lights, mats, m, albedo, p, n, local)
-
-
-@overload(add_caustic, inline="always")
-def _add_caustic(lights, mats, m, albedo, p, n, local):
-    if not _photons_possible(lights):
-        return lambda lights, mats, m, albedo, p, n, local: local
-    return lambda lights, mats, m, albedo, p, n, local: with_caustic(lights, mats, m, albedo,
-                                                                     p, n, local)
+    kd = mats[m, MAT_KD]
+    if kd == 0.0:
+        return local
+    e = caustic_irradiance(lights, p, n, True)
+    # the shadow photons take away what the direct term counts: never more, but for noise
+    return (max(0.0, local[0] + kd * albedo[0] * e[0]),
+            max(0.0, local[1] + kd * albedo[1] * e[1]),
+            max(0.0, local[2] + kd * albedo[2] * e[2]))

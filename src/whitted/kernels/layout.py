@@ -237,10 +237,7 @@ GRID_BITS = 1  # bits of each cell coordinate in the hash (kernels/caustics.py's
 GRID_R2_MAX = 2  # the largest squared radius (pass 0's)
 GRID_PASSES = 3
 GRID_PASS = 4
-#: dtype of ``photons`` in scenes without caustics: kernels compiled without the gather
-#: (kernels/caustics.py), as ``inst_box`` marks scenes without instances (features.py)
-NO_CAUSTICS_DTYPE = "float64"
-_NO_PHOTONS = np.zeros((0, PHOTON_WIDTH), NO_CAUSTICS_DTYPE)
+_NO_PHOTONS = np.zeros((0, PHOTON_WIDTH), np.float32)
 _NO_CELLS = np.zeros(1, np.int32)
 _NO_GRID = np.zeros(GRID_PASS, np.float64)
 _NO_MATS = np.zeros((0, N_MAT_PARAMS), np.float64)
@@ -255,10 +252,11 @@ class LightArrays(NamedTuple):
     the analytic primitives that could block a shadow ray travelling through it: a shadow ray
     tests those instead of walking the BVH.
 
-    The photon map (compile/photon_map.py, docs/caustics.md) is empty, with ``photons`` of
-    dtype NO_CAUSTICS_DTYPE, in renders without caustics: the render kernel is then compiled
-    without its gather. With caustics, ``photons`` (float32) are sorted by the hash of their
-    grid cell, ``photon_cells[h]:photon_cells[h + 1]`` being the photons of hash ``h``, and
+    The photon map (compile/photon_map.py, docs/caustics.md) is empty in renders without
+    caustics, and its ``photon_grid`` holds no pass: the render kernel skips its gather
+    (kernels/caustics.py ``caustics_on``). With caustics, ``photons`` are sorted by the hash
+    of their grid cell, ``photon_cells[h]:photon_cells[h + 1]`` being the photons of hash
+    ``h``, and
     ``shadow_materials`` is the material table shadow rays see: the clear bodies'
     materials (bounded, kt > 0) pass all the light, as if the bodies were not there; the
     caustic and shadow photons add and take away what the bodies do to it

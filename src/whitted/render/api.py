@@ -385,21 +385,15 @@ class RenderJob:
         self.progress(Progress(done, total, int(counters.sum()), elapsed, eta, chunk, rays))
 
     def _caustics_stage(self, compiled, params, stats) -> tuple[object, float]:
-        """The photon map, and the render kernel's kind with caustics compiled (the first
-        time) or loaded here rather than in the first tile (its time is compile time).
-        Returns (the lights with the photon map, the seconds shooting photons took)."""
+        """The photon map (the render kernel is the one renders without caustics run: the
+        gather is a run-time choice, kernels/caustics.py). Returns (the lights with the
+        photon map, the seconds shooting photons took)."""
         from ..compile.photon_map import PhotonStats, photon_lights
-        from ..kernels.tiles import lane_workspace, render_tiles
 
         stats.photons = PhotonStats()
         lights = photon_lights(compiled, params, self.settings.caustics, self.threads,
                                lambda: self.cancel_token.cancelled, stats.photons)
         stats.warnings.extend(stats.photons.warnings)
-        start = time.perf_counter()
-        render_tiles(np.zeros((0, 4), np.int32), self.framebuffer, compiled.geometry,
-                     compiled.materials, lights, params, np.zeros((0, N_RAY_KINDS), np.int64),
-                     lane_workspace(params.max_depth), 0, 1)
-        stats.compile_seconds += time.perf_counter() - start
         return lights, stats.photons.seconds
 
     def run(self) -> Image:
@@ -423,10 +417,9 @@ class RenderJob:
 
         wall_start = time.perf_counter()
         stats = self.stats
-        # the plain render kernel only where this render runs it: caustics and adaptive
-        # anti-aliasing run kinds of their own, loaded in their stages below
-        plain_kernel = (self.settings.caustics.photons == 0
-                        and self.settings.antialias is None)
+        # the plain render kernel only where this render runs it: adaptive anti-aliasing
+        # runs a kind of its own, loaded in its stage below
+        plain_kernel = self.settings.antialias is None
         stats.compile_seconds = 0.0
         if not kernels_cached():  # a first run: the default variant, builders and the OBJ
             stats.compile_seconds = warm_up_kernels()  # reader, compiled on both cores

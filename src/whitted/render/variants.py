@@ -3,9 +3,11 @@ rendering a tiny scene that needs it: what ``whitted warm`` compiles ahead of us
 
 The render kernels are specialised on a scene's arrays (kernels/features.py): *plain* (no mesh
 instances, no tori or CSG objects) or *general* (either or both), and the render kernel has
-three kinds: plain, with *caustics* (a photon map in the lights) and with *adaptive*
-anti-aliasing; the AOV kernel (depth, normal, id) is one more. Focal blur, area lights,
-textures and media are run-time choices inside these kernels, compiled with them.
+two kinds: plain and with *adaptive* anti-aliasing; the AOV kernel (depth, normal, id) is one
+more. Caustics need the photon tracer (compile/photon_map.py, its IEEE twins of the
+kernels, kernels/strict.py), one for each kind of geometry; their gather is a run-time choice
+of the render kernel (kernels/caustics.py), as are focal blur, area lights, textures and
+media, compiled with it.
 """
 
 from __future__ import annotations
@@ -56,6 +58,14 @@ def warm_variant(name: str) -> float:
         render_aovs(scene)
     else:
         compiled = compile_scene(scene, flatten_limit=0 if instances else 65_536)
+        if kind == "caustics":
+            # the photon tracer first: its kernels are its own, so this process compiles
+            # them while another compiles the render kernel (which the render then loads)
+            from ..compile.params import render_params
+            from ..compile.photon_map import photon_lights
+
+            photon_lights(compiled, render_params(scene, compiled, scene.render),
+                          scene.render.caustics)
         RenderJob(scene, compiled=compiled, threads=1).run()
         if kind == "aovs":  # the AOV kernel of instanced scenes (after their render kernel)
             _aovs_of(scene, compiled)
