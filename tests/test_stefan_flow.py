@@ -44,6 +44,29 @@ def test_de_vahl_davis_square_cavity_at_32_cells(ra, nu_tol, vel_tol):
     assert r.nu_wall == pytest.approx(r.nu, rel=1e-3)  # steady: the wall's flux is the mean
     assert r.u_max == pytest.approx(ref["u_max"], rel=vel_tol)
     assert r.v_max == pytest.approx(ref["v_max"], rel=vel_tol)
+    # where they are (parabola through the three largest samples): measured y(u_max) 0.8135
+    # and 0.8226, x(v_max) 0.1786 and 0.1185 against 0.813/0.823 and 0.178/0.119, within
+    # 0.001 of the side on cells of 0.031; a third of a cell allowed. A reversed buoyancy
+    # would put them at 1 - y and 1 - x (the flow turning the other way), far outside.
+    assert r.y_umax == pytest.approx(ref["y_umax"], abs=0.01)
+    assert r.x_vmax == pytest.approx(ref["x_vmax"], abs=0.01)
+
+
+def test_the_validation_rows_give_the_maxima_their_places_and_the_extrapolation():
+    # Ra 1e4 on 16² and 32² (about a second): measured u_max error +0.41 % then +0.06 %,
+    # v_max +2.7 % then +0.47 % (falling 6x), y(u_max) 0.8219 then 0.8226 against 0.823,
+    # x(v_max) 0.1165 then 0.1185 against 0.119; the 16²/32² extrapolation within 0.3 %
+    from whitted.stefan.validate import flow_cavity_rows
+
+    coarse, fine, ext = flow_cavity_rows((16, 32), ras=(1e4,))
+    assert (coarse["y_ref"], coarse["x_ref"]) == (0.823, 0.119)
+    assert 2.0 < coarse["v_error_pct"] < 3.5 and 0.2 < fine["v_error_pct"] < 0.7
+    assert abs(fine["u_error_pct"]) < abs(coarse["u_error_pct"]) < 0.6
+    for r in (coarse, fine, ext):
+        assert abs(r["y_error"]) < 0.004 and abs(r["x_error"]) < 0.004
+        assert r["y_error"] == pytest.approx(r["y_umax"] - 0.823)
+    assert ext["grid"] == "16²/32² extrapolated" and ext["steps"] is None
+    assert abs(ext["u_error_pct"]) < 0.3 and abs(ext["v_error_pct"]) < 0.3
 
 
 def test_the_heated_cube_converges_to_the_published_nusselt_number():

@@ -82,29 +82,31 @@ def _solve(case_path: Path, output: Path, fresh: bool, quiet: bool, guard: Inter
     if output.exists() and not output.is_dir():
         raise _fail(f"{output}: exists and is not a folder")
     _check_run_outputs(case_path, output)
-    from rich.progress import (
-        BarColumn,
-        Progress,
-        TaskProgressColumn,
-        TextColumn,
-        TimeRemainingColumn,
-    )
+    import time
 
+    from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn
+
+    from ..stefan.eta import TimeLeft
+
+    # the bar runs to time.end; the time left says when the breach will stop the run first
+    left = TimeLeft(case.time.end, case.breach.action == "stop", opens_at=case.dx * 1e3 / 4)
     columns = (TextColumn("[bold]{task.description}"), BarColumn(), TaskProgressColumn(),
-               TextColumn("t = {task.fields[t]}"), TimeRemainingColumn())
-    with Progress(*columns, console=err, transient=True,
+               TextColumn("t = {task.fields[t]}"), TextColumn("{task.fields[left]}"))
+    with Progress(*columns, console=err.console, transient=True,
                   disable=quiet or not err.is_terminal) as bar:
-        task = bar.add_task("melting", total=1.0, t="0 s")
+        task = bar.add_task("melting", total=1.0, t="0 s", left="")
 
         def progress(fraction: float, t: float, what: str) -> None:
-            bar.update(task, completed=fraction, t=f"{t:.0f} s")
+            left.tick(time.monotonic(), t)
+            bar.update(task, completed=fraction, t=f"{t:.0f} s", left=left.text(t))
 
         try:
             result = run_case(case, text, output, resume=not fresh, progress=progress,
                               should_stop=guard.is_set, scene_size=size,
                               allow_large=allow_large, case_path=case_path,
                               on_estimate=None if quiet else
-                              lambda line: bar.console.print(line, highlight=False))
+                              lambda line: bar.console.print(line, highlight=False),
+                              on_row=lambda r: left.row(r["time_s"], r["min_shell_mm"]))
         except CaseError as exc:
             raise _fail(str(exc)) from None
     return case, result
@@ -220,11 +222,22 @@ def validate(
     for col in ("Ra", "grid", "Nu ref", "Nu", "error", "u_max ref", "u_max", "error",
                 "v_max ref", "v_max", "error"):
         table.add_column(col, justify="right")
-    for r in v.flow_cavity_rows(grids):
+    cavity = v.flow_cavity_rows(grids)
+    for r in cavity:
         table.add_row(f"{r['ra']:.0e}", r["grid"], f"{r['nu_ref']:.3f}", f"{r['nu']:.4f}",
                       f"{r['nu_error_pct']:+.2f} %", f"{r['u_ref']:.3f}", f"{r['u_max']:.3f}",
                       f"{r['u_error_pct']:+.2f} %", f"{r['v_ref']:.3f}", f"{r['v_max']:.3f}",
                       f"{r['v_error_pct']:+.2f} %")
+    out.print(table)
+    table = Table(title="Where the square cavity's velocity maxima are (units of the side; "
+                  "reference, whitted, difference)")
+    for col in ("Ra", "grid", "y(u_max) ref", "y(u_max)", "difference", "x(v_max) ref",
+                "x(v_max)", "difference"):
+        table.add_column(col, justify="right")
+    for r in cavity:
+        table.add_row(f"{r['ra']:.0e}", r["grid"], f"{r['y_ref']:.3f}", f"{r['y_umax']:.4f}",
+                      f"{r['y_error']:+.4f}", f"{r['x_ref']:.4f}", f"{r['x_vmax']:.4f}",
+                      f"{r['x_error']:+.4f}")
     out.print(table)
 
     cubes = (32, 48, 64) if full else (24,)

@@ -35,17 +35,20 @@ from . import flow_kernels as fk
 
 #: de Vahl Davis (1983), Int. J. Numer. Methods Fluids 3, 249-264: the mean Nusselt number of
 #: the square cavity (Pr 0.71), the largest horizontal velocity on the vertical centre line and
-#: the largest vertical velocity on the horizontal one (units alpha / L). Read here: the
-#: Nusselt numbers as the specification quotes them, u_max (all four) and v_max at Ra 10³
-#: from the benchmark column of Cardinal's verification page
-#: (https://cardinal.cels.anl.gov/vv/square_cavity_natural_convection.html). v_max at 10⁴-10⁶
-#: (19.617, 68.59, 219.36) are the paper's as commonly tabled; the page read here cut off
-#: before them.
+#: its height, the largest vertical velocity on the horizontal centre line and its distance
+#: from the hot wall (units alpha / L and L). Read here: the Nusselt numbers, u_max and v_max
+#: at every Ra from the benchmark column of Cardinal's verification page
+#: (https://cardinal.cels.anl.gov/vv/square_cavity_natural_convection.html, its Table 2);
+#: u_max 3.649 at y 0.813 (Ra 10³) from a public simulation input that quotes the paper
+#: (found with the code search, which does not name its repository); v_max at x 0.066
+#: (Ra 10⁵) from a public FEM script that checks itself against it
+#: (https://pastebin.com/Y4gxSnYR). The other positions (y 0.823, 0.855, 0.850; x 0.178,
+#: 0.119, 0.0379) are the paper's as commonly tabled, not read here.
 DE_VAHL_DAVIS = {
-    1.0e3: {"nu": 1.118, "u_max": 3.649, "v_max": 3.697},
-    1.0e4: {"nu": 2.243, "u_max": 16.178, "v_max": 19.617},
-    1.0e5: {"nu": 4.519, "u_max": 34.73, "v_max": 68.59},
-    1.0e6: {"nu": 8.800, "u_max": 64.63, "v_max": 219.36},
+    1.0e3: {"nu": 1.118, "u_max": 3.649, "y_umax": 0.813, "v_max": 3.697, "x_vmax": 0.178},
+    1.0e4: {"nu": 2.243, "u_max": 16.178, "y_umax": 0.823, "v_max": 19.617, "x_vmax": 0.119},
+    1.0e5: {"nu": 4.519, "u_max": 34.73, "y_umax": 0.855, "v_max": 68.59, "x_vmax": 0.066},
+    1.0e6: {"nu": 8.800, "u_max": 64.63, "y_umax": 0.850, "v_max": 219.36, "x_vmax": 0.0379},
 }
 
 #: The differentially heated cube (Pr 0.71, hot and cold opposite vertical walls, the other
@@ -271,19 +274,27 @@ class CavityResult:
     seconds: float
     cell_updates_per_s: float
     dims: int = 2
+    y_umax: float = math.nan  # the height of u_max (units of L)
+    x_vmax: float = math.nan  # the distance of v_max from the hot wall
 
 
-def _peak(values: np.ndarray) -> float:
-    """The largest of samples at unit spacing, refined by the parabola through the largest
-    and its two neighbours."""
+def _peak_at(values: np.ndarray) -> tuple[float, float]:
+    """The largest of samples at unit spacing and where it is (in samples from the first),
+    both refined by the parabola through the largest and its two neighbours."""
     m = int(np.argmax(values))
     if 0 < m < len(values) - 1:
         a, b, c = values[m - 1], values[m], values[m + 1]
         den = a - 2.0 * b + c
         if den < 0.0:
             x = 0.5 * (a - c) / den
-            return float(b - 0.25 * (a - c) * x)
-    return float(values[m])
+            return float(b - 0.25 * (a - c) * x), m + float(x)
+    return float(values[m]), float(m)
+
+
+def _peak(values: np.ndarray) -> float:
+    """The largest of samples at unit spacing, refined by the parabola through the largest
+    and its two neighbours."""
+    return _peak_at(values)[0]
 
 
 def heated_cavity(ra: float, cells: int, pr: float = 0.71, dims: int = 2, tol: float = 1e-6,
@@ -336,8 +347,11 @@ def heated_cavity(ra: float, cells: int, pr: float = 0.71, dims: int = 2, tol: f
     if n2 > 1 and n2 % 2 == 0:  # the cube's mid plane z = 1/2 between two cell layers
         ucol = 0.5 * (flow.u[n // 2, :, mid_z - 1] + ucol) if n % 2 == 0 else ucol
         vrow = 0.5 * (flow.v[:, n // 2, mid_z - 1] + vrow) if n % 2 == 0 else vrow
-    return CavityResult(ra, n, nu, float(hot.mean()), _peak(ucol), _peak(vrow), steps,
-                        seconds, n * n * n2 * steps / max(seconds, 1e-9), dims)
+    u_max, ju = _peak_at(ucol)  # u sampled at the cell centres' heights (j + 1/2) dx
+    v_max, iv = _peak_at(vrow)  # v at the cell centres' x
+    return CavityResult(ra, n, nu, float(hot.mean()), u_max, v_max, steps, seconds,
+                        n * n * n2 * steps / max(seconds, 1e-9), dims, (ju + 0.5) * dx,
+                        (iv + 0.5) * dx)
 
 
 def _mean_nusselt(T: np.ndarray, flow: Flow, dx: float) -> float:

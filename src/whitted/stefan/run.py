@@ -172,7 +172,8 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
              progress: Callable[[float, float, str], None] | None = None,
              should_stop: Callable[[], bool] | None = None, scene_size: tuple[int, int] =
              (480, 360), allow_large: bool = False, case_path: Path | None = None,
-             on_estimate: Callable[[str], None] | None = None) -> RunResult:
+             on_estimate: Callable[[str], None] | None = None,
+             on_row: Callable[[dict], None] | None = None) -> RunResult:
     """Solve ``case`` into the folder ``out`` (see the module docstring).
 
     Before any work the cost is estimated (:func:`whitted.stefan.budget.check`: refused over
@@ -181,7 +182,9 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
     False (``--fresh``) removes the files whitted wrote there and nothing else.
     ``case_path``: the case file read, which the run must not write over. ``on_estimate``
     is given the estimate's line (:func:`whitted.stefan.budget.describe`) once the checks
-    pass, before the solving starts."""
+    pass, before the solving starts. ``on_row`` is given every row of ``series.csv`` (those
+    of a resumed run first), as it is saved (:class:`whitted.stefan.eta.TimeLeft` reads the
+    thinnest shell's thinning from them)."""
     from . import budget, folder
 
     out = Path(out)
@@ -241,6 +244,9 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
         rows = []
         _record(out, solver, case, frame, digest, index, initial_cavity, rows, result,
                 scene_size)
+    if on_row is not None:
+        for r in rows:
+            on_row(r)
     end = case.time.end
     every = case.time.save_every
     t_solve = wallclock.perf_counter()
@@ -258,6 +264,8 @@ def run_case(case: Case, case_text: str, out: Path, *, resume: bool = True,
         index += 1
         _record(out, solver, case, frame, digest, index, initial_cavity, rows, result,
                 scene_size)
+        if on_row is not None:
+            on_row(rows[-1])
         if progress is not None:
             progress(solver.time / end, solver.time, "saved")
         if not (solver.kind == 1).any() or rows[-1]["ice_volume_cm3"] <= 0.0:

@@ -235,9 +235,9 @@ def enclosure_rows() -> list[dict]:
 def flow_cavity_rows(grids: tuple[int, ...] = (32,), ras: tuple[float, ...] = (1e3, 1e4, 1e5, 1e6),
                      progress=None) -> list[dict]:
     """The flow solver (:mod:`whitted.stefan.flow`) on de Vahl Davis's square cavity at each
-    Ra and grid: mean Nusselt number and the centre lines' velocity maxima against the
-    benchmark, their errors; with two grids or more, the Richardson extrapolation of the
-    last two (second order: (4 f_fine - f_coarse) / 3) as a row of its own."""
+    Ra and grid: mean Nusselt number and the centre lines' velocity maxima and where they
+    are, against the benchmark, their errors; with two grids or more, the Richardson
+    extrapolation of the last two (second order: (4 f_fine - f_coarse) / 3) as a row of its own."""
     from .flow import DE_VAHL_DAVIS, heated_cavity
 
     rows = []
@@ -250,12 +250,13 @@ def flow_cavity_rows(grids: tuple[int, ...] = (32,), ras: tuple[float, ...] = (1
                 progress(ra, n, r)
             found.append(r)
             rows.append(_cavity_row(ra, f"{n}²", r.nu, r.u_max, r.v_max, ref, r.steps,
-                                    r.seconds))
+                                    r.seconds, r.y_umax, r.x_vmax))
         if len(found) >= 2 and found[-1].cells == 2 * found[-2].cells:
             a, b = found[-2], found[-1]
-            ext = [(4.0 * getattr(b, q) - getattr(a, q)) / 3.0 for q in ("nu", "u_max", "v_max")]
-            rows.append(_cavity_row(ra, f"{a.cells}²/{b.cells}² extrapolated", *ext, ref,
-                                    None, None))
+            ext = [(4.0 * getattr(b, q) - getattr(a, q)) / 3.0
+                   for q in ("nu", "u_max", "v_max", "y_umax", "x_vmax")]
+            rows.append(_cavity_row(ra, f"{a.cells}²/{b.cells}² extrapolated", *ext[:3], ref,
+                                    None, None, *ext[3:]))
     return rows
 
 
@@ -295,13 +296,17 @@ def _cube_row(ra, grid, nu, u_max, v_max, ref, steps, seconds, rate) -> dict:
             "steps": steps, "seconds": seconds, "cell_updates_per_s": rate}
 
 
-def _cavity_row(ra, grid, nu, u_max, v_max, ref, steps, seconds) -> dict:
+def _cavity_row(ra, grid, nu, u_max, v_max, ref, steps, seconds, y_umax, x_vmax) -> dict:
+    """One row: each quantity, its reference and the error (relative for the maxima, the
+    difference in units of L for their positions)."""
     return {"ra": ra, "grid": grid, "nu": nu, "nu_ref": ref["nu"],
             "nu_error_pct": 100.0 * (nu / ref["nu"] - 1.0), "u_max": u_max,
             "u_ref": ref["u_max"], "u_error_pct": 100.0 * (u_max / ref["u_max"] - 1.0),
+            "y_umax": y_umax, "y_ref": ref["y_umax"], "y_error": y_umax - ref["y_umax"],
             "v_max": v_max, "v_ref": ref["v_max"],
-            "v_error_pct": 100.0 * (v_max / ref["v_max"] - 1.0), "steps": steps,
-            "seconds": seconds}
+            "v_error_pct": 100.0 * (v_max / ref["v_max"] - 1.0),
+            "x_vmax": x_vmax, "x_ref": ref["x_vmax"], "x_error": x_vmax - ref["x_vmax"],
+            "steps": steps, "seconds": seconds}
 
 
 def energy_balance(cells: int = 16, t_end: float = 600.0) -> dict:
