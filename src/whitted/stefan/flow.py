@@ -223,15 +223,10 @@ class Flow:
 
     def _predict(self, dt: float, buoyancy: np.ndarray, sink: np.ndarray) -> None:
         dx, nu, flat = self.dx, self.nu, self.flat
-        t = (1, 0, 2)
-        fk.predict(self.u, self.v, self.w, nu, dt, dx, self._zero, sink, self._u, flat, False)
-        fk.predict(self.v.transpose(t), self.u.transpose(t), self.w.transpose(t), nu, dt, dx,
-                   buoyancy.transpose(t), sink.transpose(t), self._v.transpose(t), flat, False)
+        fk.predict(self.u, self.v, self.w, nu, dt, dx, self._zero, sink, self._u, flat, 0)
+        fk.predict(self.u, self.v, self.w, nu, dt, dx, buoyancy, sink, self._v, flat, 1)
         if not flat:
-            t = (2, 1, 0)
-            fk.predict(self.w.transpose(t), self.v.transpose(t), self.u.transpose(t), nu, dt,
-                       dx, self._zero.transpose(t), sink.transpose(t), self._w.transpose(t),
-                       False, True)
+            fk.predict(self.u, self.v, self.w, nu, dt, dx, self._zero, sink, self._w, flat, 2)
         self.u, self._u = self._u, self.u
         self.v, self._v = self._v, self.v
         self.w, self._w = self._w, self.w

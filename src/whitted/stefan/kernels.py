@@ -269,7 +269,7 @@ def _neighbour(i, j, k, face):
     return i, j, k + 1
 
 
-@builder(entry=False, numba_inline=True)
+@builder(entry=False)
 def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain, air_h,
                   air_ice, air_t, i, j, k, scale, out, m, rescale, occ, is_surface):
     """The boundary heat of one surface cell, added to Hn; drain if it is all liquid and a
@@ -415,6 +415,17 @@ def _index_surface(surface, ns, plane_start, plane_cells):
         fill[q] += 1
 
 
+@builder(entry=False)
+def _copy(a, b):
+    """b = a, element by element (of arrays of one shape): what ``b[...] = a`` does, without
+    the broadcast's shape check and the error message Numba compiles for it."""
+    nx, ny, nz = a.shape
+    for i in range(nx):
+        for j in range(ny):
+            for k in range(nz):
+                b[i, j, k] = a[i, j, k]
+
+
 @builder(parallel=True)
 def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
                        air_t, surface, scale, n_surface, is_surface, n_steps, totals,
@@ -473,7 +484,7 @@ def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h
         if breach > 0.0 and stop_on_breach:
             break
     if done % 2 == 1:  # the result is in the second buffer
-        H[...] = Hn
+        _copy(Hn, H)
     return done
 
 
@@ -524,7 +535,7 @@ def run_steps_serial(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
         if breach > 0.0 and stop_on_breach:
             break
     if done % 2 == 1:
-        H[...] = Hn
+        _copy(Hn, H)
     return done
 
 
