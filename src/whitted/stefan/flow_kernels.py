@@ -58,19 +58,19 @@ def predict(u, v, w, nu, dt, dx, force, sink, out, flat, axis):
     2) after one explicit step of advection, diffusion, ``force`` (per cell, along ``axis``;
     the face takes the mean of its two cells) and the implicit ``sink`` (1/s per cell). Wall
     faces (first and last along ``axis``) are 0. The arrays are the flow's own (C order);
-    the kernel works on views with ``axis`` first (:func:`_predict_views`), so that one
-    compiled kernel serves the three components."""
+    the kernel works on views with ``axis`` first (:func:`_predict_views`): the arrays
+    themselves (C order), a transpose (any order) and the reversed axes (Fortran order),
+    so the three layouts are compiled once each whatever the caller's arrays, and each
+    loop runs at the speed of its layout (the A-order view of every component took
+    1.5 times as long at 40³)."""
     if axis == 0:
-        t = (0, 1, 2)
-        q, p, r = u.transpose(t), v.transpose(t), w.transpose(t)
+        _predict_views(u, v, w, nu, dt, dx, force, sink, out, flat, False)
     elif axis == 1:
         t = (1, 0, 2)
-        q, p, r = v.transpose(t), u.transpose(t), w.transpose(t)
+        _predict_views(v.transpose(t), u.transpose(t), w.transpose(t), nu, dt, dx,
+                       force.transpose(t), sink.transpose(t), out.transpose(t), flat, False)
     else:
-        t = (2, 1, 0)
-        q, p, r = w.transpose(t), v.transpose(t), u.transpose(t)
-    _predict_views(q, p, r, nu, dt, dx, force.transpose(t), sink.transpose(t),
-                   out.transpose(t), flat and axis < 2, axis == 2)
+        _predict_views(w.T, v.T, u.T, nu, dt, dx, force.T, sink.T, out.T, False, True)
 
 
 @builder(entry=False, parallel=True, error_model="numpy")

@@ -269,7 +269,7 @@ def _neighbour(i, j, k, face):
     return i, j, k + 1
 
 
-@builder(entry=False)
+@builder(entry=False, numba_inline=True)
 def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain, air_h,
                   air_ice, air_t, i, j, k, scale, out, m, rescale, occ, is_surface):
     """The boundary heat of one surface cell, added to Hn; drain if it is all liquid and a
