@@ -114,3 +114,25 @@ def test_the_warm_up_loads_the_kernel_a_torus_or_csg_scene_renders_with():
     wanted = [str(a.dtype) for a in compiled.geometry]
     assert any(geometry_dtypes(sig) == wanted for sig in tiles.render_tiles.signatures)
     assert warm_up.warm_up_kernels(compiled) == 0.0  # and only once
+
+
+def test_the_expected_compile_count_is_the_real_one(tmp_path):
+    """The progress bar of a first compile reaches its end when the count of functions
+    compiled reaches ``EXPECTED_COMPILES``: a cold compile of the plain variant (an empty
+    cache folder, in a process of its own, without the helper, which only moves compiles
+    from one process to the other) compiles that many, give or take 10 %."""
+    script = (
+        "from numba.core import event\n"
+        "from whitted.jit import load_numba\n"
+        "from whitted.render import warm_up\n"
+        "load_numba()\n"
+        "with event.install_recorder('numba:compile') as rec:\n"
+        "    warm_up.warm_up_kernels()\n"
+        "print(sum(1 for _, ev in rec.buffer if ev.is_end))\n")
+    env = dict(os.environ, WHITTED_CACHE_DIR=str(tmp_path), WHITTED_COMPILE_HELPER="0")
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                            env=env, timeout=600)
+    assert result.returncode == 0, result.stderr
+    compiled = int(result.stdout.split()[-1])
+    expected = warm_up.EXPECTED_COMPILES[False]
+    assert abs(compiled - expected) <= 0.1 * expected, (compiled, expected)
