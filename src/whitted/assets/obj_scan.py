@@ -514,7 +514,8 @@ def scan_obj(data, fill, info, positions, texcoords, normals, corner_v, corner_v
             i, name_end = _rest_of_line(data, i, n)  # (name_end >= name_start)
             for k in range(name_start, name_end):
                 if _is_control(data[k]):
-                    _fail(info, ERR_CONTROL_BYTE, line, name_start, name_end, 0, data[k], 0)
+                    _fail(info, ERR_CONTROL_BYTE, line, name_start, name_end, 0, np.int64(data[k]),
+                          0)
                     return
             if is_usemtl:
                 if fill:

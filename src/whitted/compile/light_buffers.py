@@ -80,7 +80,7 @@ def list_cell_occluders(geo, mats, light, reach, res, lists, counts, opaque, sta
     cap = lists.shape[1]
     for cell in range(first, last):
         n = 0
-        all_opaque = True
+        all_opaque = n == 0  # True, typed bool (a literal compiles list_cone_leaves twice)
         for j in range(geo.unbounded.shape[0]):
             i = geo.unbounded[j]
             if (geo.prim_info[i, PRIM_TYPE] == SHAPE_PLANE and geo.prim_info[i, PRIM_XFORM] < 0

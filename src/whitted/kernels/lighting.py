@@ -173,7 +173,7 @@ def list_bundle_occluders(geo, mats, p, centre, radius, tmin, stack, listed):
     walk the BVH one by one). The shadow rays of the bundle test only the listed primitives:
     the same hits as a walk, found without one."""
     n = 0
-    opaque = True
+    opaque = n == 0  # True, typed bool: a literal True compiles list_cone_leaves twice
     for j in range(geo.unbounded.shape[0]):
         i = geo.unbounded[j]
         if (is_world_plane(geo.prim_info[i, PRIM_TYPE], geo.prim_info[i, PRIM_XFORM])
@@ -234,7 +234,7 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
     n = -1 when an opaque surface blocks the segment (the walk stops there and ``hits[1]``
     names it)."""
     n = 0
-    full = False
+    full = n < 0  # False, typed bool: a literal False compiles keep_nearest twice
     inv = inverse_direction(d)
     j, leaf, leaf_end, top = start_scene_walk(geo, stack, False)
     k = 0
