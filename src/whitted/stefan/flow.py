@@ -223,10 +223,19 @@ class Flow:
 
     def _predict(self, dt: float, buoyancy: np.ndarray, sink: np.ndarray) -> None:
         dx, nu, flat = self.dx, self.nu, self.flat
-        fk.predict(self.u, self.v, self.w, nu, dt, dx, self._zero, sink, self._u, flat, 0)
-        fk.predict(self.u, self.v, self.w, nu, dt, dx, buoyancy, sink, self._v, flat, 1)
+        t = (1, 0, 2)
+        fk.predict(self.u, self.v, self.w, nu, dt, dx, self._zero, sink, self._u, flat, False)
+        # a flat box's views along v are Fortran-ordered (a length-1 last axis), those of
+        # its two-face-deep w are not; w is not read there (flat), so u's view stands in
+        # for it and the kernel is the one compiled for the last component of a 3-D box
+        p = self.u.transpose(t)
+        fk.predict(self.v.transpose(t), p, p if flat else self.w.transpose(t), nu, dt, dx,
+                   buoyancy.transpose(t), sink.transpose(t), self._v.transpose(t), flat, False)
         if not flat:
-            fk.predict(self.u, self.v, self.w, nu, dt, dx, self._zero, sink, self._w, flat, 2)
+            t = (2, 1, 0)
+            fk.predict(self.w.transpose(t), self.v.transpose(t), self.u.transpose(t), nu, dt,
+                       dx, self._zero.transpose(t), sink.transpose(t), self._w.transpose(t),
+                       False, True)
         self.u, self._u = self._u, self.u
         self.v, self._v = self._v, self.v
         self.w, self._w = self._w, self.w

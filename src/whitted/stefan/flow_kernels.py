@@ -52,34 +52,15 @@ def _predict_at(q, p, r, visc, inv, dt, force, sink, out, flat, i, j, k):
     out[i, j, k] = (qc + dt * (visc * lap - adv + f)) / (1.0 + dt * a)
 
 
-@builder(error_model="numpy")
-def predict(u, v, w, nu, dt, dx, force, sink, out, flat, axis):
-    """``out`` = the predicted component ``axis`` of the velocity (``u``, ``v``, ``w``: 0, 1,
-    2) after one explicit step of advection, diffusion, ``force`` (per cell, along ``axis``;
-    the face takes the mean of its two cells) and the implicit ``sink`` (1/s per cell). Wall
-    faces (first and last along ``axis``) are 0. The arrays are the flow's own (C order);
-    the kernel works on views with ``axis`` first (:func:`_predict_views`): the arrays
-    themselves (C order), a transpose (any order) and the reversed axes (Fortran order),
-    so the three layouts are compiled once each whatever the caller's arrays, and each
-    loop runs at the speed of its layout (the A-order view of every component took
-    1.5 times as long at 40³)."""
-    if axis == 0:
-        _predict_views(u, v, w, nu, dt, dx, force, sink, out, flat, False)
-    elif axis == 1:
-        t = (1, 0, 2)
-        _predict_views(v.transpose(t), u.transpose(t), w.transpose(t), nu, dt, dx,
-                       force.transpose(t), sink.transpose(t), out.transpose(t), flat, False)
-    else:
-        _predict_views(w.T, v.T, u.T, nu, dt, dx, force.T, sink.T, out.T, False, True)
-
-
-@builder(entry=False, parallel=True, error_model="numpy")
-def _predict_views(q, p, r, nu, dt, dx, force, sink, out, flat, along_inner):
-    """:func:`predict` on views with the component's axis first (``q`` the component, ``p``
-    and ``r`` those along axes 1 and 2 of the views). ``along_inner``: the loop along axis 0
-    innermost, parallel over axis 2 (for the views whose axis 0 is the arrays' contiguous
-    one: the last component, 13 times faster at 48³ than striding across planes); the same
-    operations per face either way."""
+@builder(parallel=True, error_model="numpy")
+def predict(q, p, r, nu, dt, dx, force, sink, out, flat, along_inner):
+    """``out`` = the predicted component ``q`` (along axis 0 of these views; ``p`` and ``r``
+    the components along axes 1 and 2) after one explicit step of advection, diffusion,
+    ``force`` (per cell, along axis 0; the face takes the mean of its two cells) and the
+    implicit ``sink`` (1/s per cell). Wall faces (first and last along axis 0) are 0.
+    ``along_inner``: the loop along axis 0 innermost, parallel over axis 2 (for the views
+    whose axis 0 is the arrays' contiguous one: the last component, 13 times faster at 48³
+    than striding across planes); the same operations per face either way."""
     n0 = q.shape[0] - 1
     n1 = q.shape[1]
     n2 = q.shape[2]
