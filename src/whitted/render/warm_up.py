@@ -62,8 +62,8 @@ HELPER_WAIT_SECONDS = 120.0  # a helper still busy after this is stopped (never 
 #: plain variant; 105 + 88 for the general one once the plain one is cached, as the render
 #: API compiles the plain variant first; each kernel other kernels call counts once, as its
 #: twin; less the two kernels since compiled once instead of twice, keep_nearest and
-#: list_cone_leaves). Only the progress shown depends on it: a count that drifted (kernels changed, a
-#: different split between the processes) makes the fraction approximate.
+#: list_cone_leaves). Only the progress shown depends on it: a count that drifted (kernels
+#: changed, a different split between the processes) makes the fraction approximate.
 EXPECTED_COMPILES = {False: 215, True: 191}
 TINY_OBJ = b"""v 0 0 0
 v 1 0 0
