@@ -264,7 +264,6 @@ def frame_view():
     cannot take; stock Numba (runtime on) uses ``numba.carray``. Tuned dispatcher only."""
     from numba import types
     from numba.extending import intrinsic
-    from numba.np.arrayobj import make_array, populate_array
 
     @intrinsic
     def view(typingctx, pointer, count):
@@ -273,6 +272,10 @@ def frame_view():
         array_type = types.Array(pointer.dtype, 1, "C")
 
         def codegen(context, builder, sig, args):
+            # imported here, when a kernel is compiled: NumPy's array code in Numba (20-40
+            # ms with the string and hashing code it imports) is no part of a warm render
+            from numba.np.arrayobj import make_array, populate_array
+
             data, n = args
             array = make_array(array_type)(context, builder)
             item = context.get_value_type(pointer.dtype)
