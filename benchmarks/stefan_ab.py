@@ -4,7 +4,7 @@ the trees and thread counts interleaved round by round, ratios to the first tree
 
     python benchmarks/stefan_ab.py OLD_TREE NEW_TREE [--cells 64] [--rounds 3] [--threads 1,2]
 
-A tree is a checkout's root (``git worktree add /work/wt-old f9bebe4``); its ``src`` goes
+A tree is a checkout's root (``git worktree add ../whitted-old f9bebe4``); its ``src`` goes
 first on PYTHONPATH and its kernels are cached in its own ``.cache``. It works with trees from
 before ``whitted stefan bench`` (the case API of then is bridged below). Each measurement is
 ``--reps`` runs of ``--steps`` steps after a warm-up: the best and the median run are printed,

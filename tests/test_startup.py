@@ -159,7 +159,7 @@ def test_plain_line_is_what_rich_prints_and_needs_no_rich(tmp_path, monkeypatch)
                  "warning: \u00e9t\u00e9 \u2192 \u6f22\u5b57", "x" * 300, "", "a\tb",
                  "cr\rhere \x07\x0b\x0c"):
         ours, theirs = io.StringIO(), io.StringIO()
-        LazyConsole(file=ours, highlight=False, soft_wrap=True, emoji=False).line(text)
+        LazyConsole(file=ours, highlight=False, soft_wrap=True, emoji=False).echo(text)
         Console(file=theirs, highlight=False, soft_wrap=True, emoji=False).print(
             Text(text), soft_wrap=True)
         assert ours.getvalue() == theirs.getvalue()
@@ -168,7 +168,7 @@ def test_plain_line_is_what_rich_prints_and_needs_no_rich(tmp_path, monkeypatch)
     assert console.is_terminal is False and console._made is None  # rich not needed
     loaded = _modules_after("""
         from whitted.cli.console import out, err
-        out.line("plain")
+        out.echo("plain")
         assert not err.is_terminal
     """, tmp_path)
     assert "rich" not in loaded

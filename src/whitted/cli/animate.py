@@ -140,7 +140,7 @@ class _FilmProgress:
 
             self._progress = Progress(
                 TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
-                TaskProgressColumn(), TimeRemainingColumn(), console=err, transient=True)
+                TaskProgressColumn(), TimeRemainingColumn(), console=err.console, transient=True)
             self._progress.__enter__()
             self._frames = self._progress.add_task("frames", total=self.total)
             self._tiles = self._progress.add_task("frame tiles", total=None)
@@ -169,4 +169,4 @@ class _FilmProgress:
             elif not self.quiet:
                 result = p.result
                 state = f"{result.seconds:.2f} s" if result.rendered else "already done"
-                out.line(f"frame {p.frame} ({self.done}/{self.total}): {state}")
+                out.echo(f"frame {p.frame} ({self.done}/{self.total}): {state}")

@@ -4,13 +4,18 @@ Importing rich costs tens of milliseconds; `whitted --help` and the import of th
 it (tests/test_startup.py). User text is printed literally: no markup, no emoji codes (a
 ":100:" on an error line stays ":100:").
 
-A line of plain text (:meth:`LazyConsole.line`) is written as it is while the console has not
+A line of plain text (:meth:`LazyConsole.echo`) is written as it is while the console has not
 been made: what rich writes for unstyled printable text printed with ``soft_wrap`` is the text
 and a newline, on a terminal or not (text with tabs or control characters goes to rich, which
 expands or drops them). A render never imports rich when its output goes to a pipe or
 a file (a script, a film's frames, a farm worker, a benchmark), nor on a terminal when it ends
 before its progress bar would appear (cli/render.py ``PROGRESS_DELAY``): 25-70 ms of its
 start-up.
+
+A :class:`LazyConsole` stands in for rich's ``Console`` wherever rich takes one (a ``Progress``,
+a ``Live``, a ``Status``): it adds only names rich's ``Console`` does not have (``echo``) and
+answers ``is_terminal`` as rich does, so rich calling any of its console's methods on it (a
+``Live`` ending with ``console.line()``) reaches the real console.
 """
 
 from __future__ import annotations
@@ -20,7 +25,8 @@ import sys
 
 
 class LazyConsole:
-    """A rich ``Console`` made on first use."""
+    """A rich ``Console`` made on first use; every attribute but :meth:`echo` and the
+    lazily answered ``is_terminal`` is the console's own."""
 
     def __init__(self, **options) -> None:
         self._options = options
@@ -38,7 +44,7 @@ class LazyConsole:
         return getattr(self.console, name)
 
     @property
-    def _file(self):
+    def _target(self):
         return self._options.get("file") or (sys.stderr if self._options.get("stderr")
                                              else sys.stdout)
 
@@ -63,16 +69,16 @@ class LazyConsole:
         force_color = os.environ.get("FORCE_COLOR")
         if force_color is not None:
             return force_color != ""
-        isatty = getattr(self._file, "isatty", None)
+        isatty = getattr(self._target, "isatty", None)
         try:
             return False if isatty is None else bool(isatty())
         except ValueError:  # a closed file
             return False
 
-    def line(self, text: str) -> None:
+    def echo(self, text: str) -> None:
         """Print ``text`` as it is (no markup, no style) and a newline."""
         if self._made is None and text.isprintable():  # rich drops or expands the others
-            file = self._file
+            file = self._target
             file.write(text + "\n")
             file.flush()
             return

@@ -33,8 +33,8 @@ def examples(
         if not names:
             raise fail("whitted's examples are not installed with this copy of whitted")
         for name in names:
-            out.line(name)
-        out.line(f"(in {shipped_dir('examples')}; `whitted examples DIR` copies them)")
+            out.echo(name)
+        out.echo(f"(in {shipped_dir('examples')}; `whitted examples DIR` copies them)")
         return
     try:
         copied, kept = copy_examples(folder)
@@ -46,6 +46,6 @@ def examples(
     line = f"copied {len(copied)} files into {folder}"
     if kept:
         line += f"; kept {len(kept)} already there (not replaced)"
-    out.line(line)
+    out.echo(line)
     if copied or kept:
-        out.line(f"try: whitted render {folder / 'glass_cube.toml'} -o cube.png")
+        out.echo(f"try: whitted render {folder / 'glass_cube.toml'} -o cube.png")

@@ -95,7 +95,7 @@ def bar(label: str, quiet: bool) -> Progress | None:
     )
 
     return Progress(TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn(),
-                    TimeRemainingColumn(), console=err, transient=True)
+                    TimeRemainingColumn(), console=err.console, transient=True)
 
 
 def render_still_on_farm(scene: Scene, output: Path, *, cluster: str | None,
@@ -213,7 +213,7 @@ def animate_on_farm(scene: Scene, plan: FilmPlan, *, force: bool, quiet: bool,
                 if progress is not None:
                     progress.update(task, completed=p.done, total=p.total)
                 elif not quiet and p.result.rendered:
-                    out.line(f"frame {p.frame} ({p.done}/{p.total})")
+                    out.echo(f"frame {p.frame} ({p.done}/{p.total})")
 
             with progress if progress is not None else nullcontext():
                 task = progress.add_task("frames", total=total) if progress else None

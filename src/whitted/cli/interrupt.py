@@ -155,5 +155,5 @@ class InterruptGuard:
         """Print ``<word>: message`` (one line) and return the exit to raise (130 or 143)."""
         import typer
 
-        err.line(f"{self.word}: {' '.join(message.split())}")
+        err.echo(f"{self.word}: {' '.join(message.split())}")
         return typer.Exit(self.exit_code)

@@ -85,7 +85,7 @@ def main() -> None:
         sys.exit(EXIT_USER_ERROR)
     except (typer.Abort, KeyboardInterrupt):  # a second signal: stopped at once
         signum = last_signal()
-        err.line(f"{'terminated' if signum == signal.SIGTERM else 'interrupted'}: stopped at "
+        err.echo(f"{'terminated' if signum == signal.SIGTERM else 'interrupted'}: stopped at "
                  "once (what was being written was not kept)")
         sys.exit(exit_code_of(signum))
     except typer.Exit as exc:  # raised with standalone_mode=False only by an eager callback

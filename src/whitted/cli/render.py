@@ -273,7 +273,7 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
     assert image is not None
     marks.mark("rendered")
     for warning in stats.warnings:
-        err.line(f"warning: {warning}")
+        err.echo(f"warning: {warning}")
     written = [str(output)]
     plain = not (finish.alpha or finish.exposure or finish.quality is not None
                  or finish.region is not None)
@@ -283,7 +283,7 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
             from .tile_state import TileState, foreign, save_state
 
             if foreign(finish.state):  # a file of someone else's by that name: kept
-                err.line(f"warning: {finish.state} is not whitted's: the tiles are kept in "
+                err.echo(f"warning: {finish.state} is not whitted's: the tiles are kept in "
                          f"{output} only (--continue cannot finish it)")
             else:
                 save_state(finish.state, TileState(finish.digest, job.tiles_finished.copy(),
@@ -312,7 +312,7 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
         raise fail(str(exc)) from None
     stats.wall_seconds = time.perf_counter() - process_start
     if not quiet or interrupted.is_set():
-        out.line(f"{stats.summary()} -> {', '.join(written)}")
+        out.echo(f"{stats.summary()} -> {', '.join(written)}")
     if marks.enabled():  # whitted bench --startup: the moments, and the job's own figures
         marks.note("build", stats.build_seconds)
         marks.note("kernels", stats.compile_seconds)

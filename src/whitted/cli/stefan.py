@@ -477,4 +477,4 @@ def _frame_line(p) -> None:
     """One line per frame finished (render_film's progress), on stdout."""
     if p.event == "done":
         state = f"{p.result.seconds:.2f} s" if p.result.rendered else "already done"
-        out.line(f"frame {p.frame} ({p.done}/{p.total}): {state}")
+        out.echo(f"frame {p.frame} ({p.done}/{p.total}): {state}")

@@ -132,7 +132,7 @@ def sweep(
                 paths.append(path)
                 if not quiet:
                     state = f"{result.seconds:.2f} s" if result.rendered else "already done"
-                    out.line(f"{cell.label} ({cell.index + 1}/{len(cells)}): {state}")
+                    out.echo(f"{cell.label} ({cell.index + 1}/{len(cells)}): {state}")
         except WhittedError as exc:
             raise fail(str(exc)) from None
         except OSError as exc:

@@ -187,13 +187,13 @@ def warm(
         raise fail(f"--jobs: must be 0 (one per core) to 1024 (got {jobs})")
     jobs = jobs or available_threads()
     start = time.perf_counter()
-    err.line("compiling the default scene's kernels (the first time: both cores)")
+    err.echo("compiling the default scene's kernels (the first time: both cores)")
     first = warm_up_kernels()
     names = _all_names()
     queue = _Queue(names)
     queue.times["plain/render"] = first
     workers = min(jobs, len(names))
-    err.line(f"compiling {len(names)} more variants in {workers} process"
+    err.echo(f"compiling {len(names)} more variants in {workers} process"
              f"{'es' * (workers > 1)}")
     procs: list[subprocess.Popen] = []
     threads = [threading.Thread(target=_work, args=(queue, procs), daemon=True,
@@ -211,9 +211,9 @@ def warm(
                 proc.wait()
     for name in ["plain/render", *names]:
         if name in queue.times:
-            out.line(f"{name:28} {queue.times[name]:7.2f} s")
+            out.echo(f"{name:28} {queue.times[name]:7.2f} s")
     total = time.perf_counter() - start
     if queue.failed:
         reason = queue.errors[0] if queue.errors else sorted(queue.failed)[0]
         raise fail(f"a compile failed: {reason}")
-    out.line(f"every kernel is in the cache: {total:.1f} s")
+    out.echo(f"every kernel is in the cache: {total:.1f} s")
