@@ -376,3 +376,26 @@ def test_property_small_inputs(boxes, n_bins):
     check_bvh(bvh, lo, hi)
     if lo.shape[0]:
         check_rays(bvh, lo, hi, n_rays=12, seed=len(boxes))
+
+
+@pytest.mark.parametrize("n, start, end, axis", [(1, 0, 1, 0), (2, 0, 2, 1), (37, 5, 30, 2),
+                                                 (256, 0, 256, 0), (301, 17, 300, 1)])
+def test_sort_range_is_numpys_stable_sort(n, start, end, axis):
+    """The depth guard's in-place sort (merge sort, rows moved along the permutation's cycles,
+    every buffer the caller's) orders a range exactly as NumPy's stable argsort does: ties
+    (only 7 distinct keys here) keep their order, rows outside the range are untouched."""
+    from whitted.compile.bvh import _NCOL, _sort_range
+
+    rng = np.random.default_rng(n)
+    rows = rng.integers(0, 7, (n, _NCOL)).astype(np.float64) + rng.random((n, _NCOL)) * [
+        1, 1, 1, 1, 1, 1, 0, 0, 0]
+    idx = rng.permutation(n).astype(np.int32)
+    order = np.argsort(rows[start:end, 6 + axis], kind="stable")
+    want_rows = rows.copy()
+    want_idx = idx.copy()
+    want_rows[start:end] = rows[start:end][order]
+    want_idx[start:end] = idx[start:end][order]
+    _sort_range(rows, idx, start, end, axis, np.empty(n), np.empty(n, np.int64),
+                np.empty(n, np.int64), np.empty(_NCOL + 1))
+    np.testing.assert_array_equal(rows, want_rows)
+    np.testing.assert_array_equal(idx, want_idx)

@@ -141,6 +141,44 @@ def test_a_warm_render_imports_no_file_lock_library(tmp_path):
     assert "filelock" not in loaded
 
 
+def test_a_warm_render_needs_neither_numbas_runtime_nor_its_array_code(tmp_path):
+    """The render kernels and the builders of a warm render (BVH, wide BVH, OBJ reader,
+    light buffers) are compiled without Numba's runtime and allocate nothing: loading them
+    neither compiles the runtime's functions (``rtsys.library`` is not made) nor imports
+    Numba's NumPy array code (``numba.np.arrayobj``, with its string and hashing code)."""
+    import shutil
+
+    from whitted.jit.cache import prepare
+
+    warm = Path(prepare().folder)
+    cache = tmp_path / "cache"
+    if warm.is_dir():
+        shutil.copytree(warm, cache / warm.name, ignore=shutil.ignore_patterns("whitted.lock"))
+    out = tmp_path / "x.png"
+    code = textwrap.dedent(_run_main(["render", str(REPO_ROOT / "benchmarks" / "seed000.toml"),
+                                      "-W", "24", "-H", "16", "-q", "-o", str(out)]))
+    code += textwrap.dedent("""
+        from numba.core.runtime.nrt import rtsys
+        try:
+            rtsys.library
+            print("RUNTIME=made")
+        except RuntimeError:
+            print("RUNTIME=none")
+        print("ARRAYOBJ=" + str("numba.np.arrayobj" in sys.modules))
+    """)
+    settings = {"WHITTED_CACHE_DIR": str(cache), "NUMBA_CACHE_DIR": ""}
+    env = {**os.environ, **settings}
+    env["PYTHONPATH"] = os.pathsep.join(
+        [str(REPO_ROOT / "src"), *filter(None, [env.get("PYTHONPATH")])])
+    for _ in range(2):  # the first run may compile
+        result = subprocess.run([sys.executable, "-c", code],
+                                capture_output=True, text=True, cwd=tmp_path, env=env,
+                                timeout=600)
+        assert result.returncode == 0, result.stderr
+    assert out.stat().st_size > 0
+    assert "RUNTIME=none" in result.stdout and "ARRAYOBJ=False" in result.stdout, result.stdout
+
+
 def test_plain_line_is_what_rich_prints_and_needs_no_rich(tmp_path, monkeypatch):
     """cli/console.py writes a plain line to a file that is not a terminal itself: the same
     bytes rich writes for it (markup and emoji codes stay literal)."""

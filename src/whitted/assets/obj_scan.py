@@ -561,7 +561,6 @@ def scan_obj(data, fill, info, positions, texcoords, normals, corner_v, corner_v
     info[INFO_LINES] = line
 
 
-@builder  # allocates its results
 def split_corners(vertex_count, corner_v, corner_vt, corner_vn):
     """Per-vertex attributes from per-corner indices, without moving any vertex.
 
@@ -573,18 +572,28 @@ def split_corners(vertex_count, corner_v, corner_vt, corner_vn):
     for vertices that no face uses.
     """
     triangles = corner_v.shape[0]
-    capacity = vertex_count + 3 * triangles
+    capacity = int(vertex_count) + 3 * triangles  # every corner a vertex of its own at most
     source_position = np.empty(capacity, np.int64)
     texcoord_index = np.empty(capacity, np.int64)
     normal_index = np.empty(capacity, np.int64)
-    next_copy = np.empty(capacity, np.int64)  # chain of copies made of one position
+    faces = np.empty((triangles, 3), np.int32)
+    used = _split_corners(vertex_count, corner_v, corner_vt, corner_vn, faces, source_position,
+                          texcoord_index, normal_index, np.empty(capacity, np.int64))
+    return faces, source_position[:used], texcoord_index[:used], normal_index[:used]
+
+
+@_scanner
+def _split_corners(vertex_count, corner_v, corner_vt, corner_vn, faces, source_position,
+                   texcoord_index, normal_index, next_copy):
+    """split_corners' work in the caller's arrays (each of vertex_count + 3 T entries;
+    ``next_copy``: the chain of copies made of one position); returns the vertices used."""
+    triangles = corner_v.shape[0]
     for k in range(vertex_count):
         source_position[k] = k
         texcoord_index[k] = -2
         normal_index[k] = -2
         next_copy[k] = -1
     used = vertex_count
-    faces = np.empty((triangles, 3), np.int32)
     for t in range(triangles):
         for c in range(3):
             v = corner_v[t, c]
@@ -611,7 +620,7 @@ def split_corners(vertex_count, corner_v, corner_vt, corner_vn):
                     break
                 slot = next_copy[slot]
             faces[t, c] = slot
-    return faces, source_position[:used], texcoord_index[:used], normal_index[:used]
+    return used
 
 
 @_scanner

@@ -26,7 +26,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..jit import builder
+from ..jit import builder as _builder
+
+#: the builders here allocate nothing (build_bvh hands them every array), so they run without
+#: Numba's runtime: loading them needs neither the runtime's functions nor NumPy's array code
+builder = _builder(_nrt=False)
 
 LEAF_HARD_CAP = 16  # a node with more primitives than this is always split
 MAX_DEPTH = 60  # root has depth 0; no leaf is deeper than this
@@ -140,19 +144,67 @@ def _swap(rows, idx, a, b):
 
 
 @builder
-def _sort_range(rows, idx, start, end, axis):
-    """Sort rows[start:end] (and idx) by centroid on ``axis``; stable, hence deterministic."""
-    keys = np.empty(end - start, np.float64)
-    for j in range(start, end):
-        keys[j - start] = _centroid(rows, j, axis)
-    order = np.argsort(keys, kind="mergesort")
-    tmp_rows = rows[start:end].copy()
-    tmp_idx = idx[start:end].copy()
-    for j in range(end - start):
-        o = order[j]
-        for k in range(_NCOL):
-            rows[start + j, k] = tmp_rows[o, k]
-        idx[start + j] = tmp_idx[o]
+def _sort_range(rows, idx, start, end, axis, keys, order, spare, row):
+    """Sort rows[start:end] (and idx) by centroid on ``axis``; stable, hence deterministic.
+    A bottom-up merge sort of the positions, then the rows moved along the permutation's
+    cycles: ``keys`` (float64), ``order``, ``spare`` (int64, each at least end - start long)
+    and ``row`` (_NCOL + 1 float64) are the caller's scratch."""
+    n = end - start
+    for j in range(n):
+        keys[j] = _centroid(rows, start + j, axis)
+        order[j] = j
+    src = order
+    dst = spare
+    width = 1
+    while width < n:
+        for lo in range(0, n, 2 * width):
+            mid = min(lo + width, n)
+            hi = min(lo + 2 * width, n)
+            i = lo
+            j = mid
+            k = lo
+            while i < mid and j < hi:
+                if keys[src[j]] < keys[src[i]]:  # ties keep the left run first: stable
+                    dst[k] = src[j]
+                    j += 1
+                else:
+                    dst[k] = src[i]
+                    i += 1
+                k += 1
+            while i < mid:
+                dst[k] = src[i]
+                i += 1
+                k += 1
+            while j < hi:
+                dst[k] = src[j]
+                j += 1
+                k += 1
+        t = src
+        src = dst
+        dst = t
+        width *= 2
+    # position p takes the row at src[p]; dst marks the positions already filled
+    for p in range(n):
+        dst[p] = 0
+    for p in range(n):
+        if dst[p] != 0 or src[p] == p:
+            continue
+        for c in range(_NCOL):
+            row[c] = rows[start + p, c]
+        row[_NCOL] = idx[start + p]
+        q = p
+        while True:
+            dst[q] = 1
+            s = src[q]
+            if s == p:
+                for c in range(_NCOL):
+                    rows[start + q, c] = row[c]
+                idx[start + q] = np.int32(row[_NCOL])
+                break
+            for c in range(_NCOL):
+                rows[start + q, c] = rows[start + s, c]
+            idx[start + q] = idx[start + s]
+            q = s
 
 
 @builder
@@ -228,25 +280,20 @@ def _sah_axis(rows, start, end, axis, cmin, scale, nb, bin_cnt, bin_box, r_area,
 
 @builder
 def _build(rows, idx, n_bins, leaf_cap, node_min, node_max, node_offset, node_count, node_axis,
-           traversal_cost):
-    """Build the tree in place; returns the number of nodes written."""
+           traversal_cost, bin_cnt, bin_box, r_area, r_cnt, st_i, st_f, bounds, sort_keys,
+           sort_order, sort_spare):
+    """Build the tree in place; returns the number of nodes written. The scratch arrays
+    (:func:`_scratch`) come from the caller: this builder allocates nothing."""
     n = rows.shape[0]
     if n == 0:
         return 0
 
-    bin_cnt = np.zeros((3, n_bins), np.int64)
-    bin_box = np.empty((3, n_bins, 6), np.float64)
-    r_area = np.empty(n_bins, np.float64)
-    r_cnt = np.empty(n_bins, np.int64)
-
     # pending right children: (start, end, parent, depth) and their box + centroid bounds.
     # Pending entries have distinct depths in 1..MAX_DEPTH, so this never overflows.
-    cap = MAX_DEPTH + 4
-    st_i = np.empty((cap, 4), np.int64)
-    st_f = np.empty((cap, 12), np.float64)
-    cur = np.empty(12, np.float64)  # bounds of the node being processed
-    left_f = np.empty(12, np.float64)
-    right_f = np.empty(12, np.float64)
+    cur = bounds[0]  # bounds of the node being processed
+    left_f = bounds[1]
+    right_f = bounds[2]
+    row = bounds[3]  # one working row and its index, for the sort
 
     _range_bounds(rows, 0, n, cur)
     st_i[0, 0] = 0
@@ -391,7 +438,8 @@ def _build(rows, idx, n_bins, leaf_cap, node_min, node_max, node_offset, node_co
                         make_leaf = True
                     else:
                         if ext > 0.0:
-                            _sort_range(rows, idx, start, end, axis)
+                            _sort_range(rows, idx, start, end, axis, sort_keys,
+                                        sort_order, sort_spare, row)
                         mid = start + count // 2
                         _range_bounds(rows, start, mid, left_f)
                         _range_bounds(rows, mid, end, right_f)
@@ -490,6 +538,7 @@ def build_bvh(
         node_count,
         node_axis,
         float(traversal_cost),
+        *_scratch(n, int(n_bins)),
     )
     del rows
     return BVH(
@@ -500,6 +549,18 @@ def build_bvh(
         node_axis=_trim(node_axis, m),
         prim_order=prim_order,
     )
+
+
+def _scratch(n: int, n_bins: int) -> tuple:
+    """The working arrays of :func:`_build`: the SAH bins, the stack of pending right children
+    (entries have distinct depths in 1..MAX_DEPTH), the node bounds and the sort's buffers
+    (pages are touched only if a range is ever sorted)."""
+    cap = MAX_DEPTH + 4
+    return (np.zeros((3, n_bins), np.int64), np.empty((3, n_bins, 6), np.float64),
+            np.empty(n_bins, np.float64), np.empty(n_bins, np.int64),
+            np.empty((cap, 4), np.int64), np.empty((cap, 12), np.float64),
+            np.empty((4, 12), np.float64), np.empty(n, np.float64), np.empty(n, np.int64),
+            np.empty(n, np.int64))
 
 
 def _trim(a: np.ndarray, m: int) -> np.ndarray:

@@ -16,7 +16,7 @@ import numpy as np
 from ..jit import builder
 
 
-@builder
+@builder(_nrt=False)  # allocates nothing: no Numba runtime
 def _corner_normals(corner_angle, face_unit, order, starts, cos_crease, out):
     n_keys = starts.shape[0] - 1
     for k in range(n_keys):

@@ -314,14 +314,14 @@ def check_radius(compiled: CompiledScene, settings: CausticsSettings) -> None:
                          where="render.caustics.radius")
 
 
-@builder
-def build_grid(photons, inv_cell, bits):
-    """``photons`` sorted by the hash row of their grid cell (stable: the order within a
-    row is the order shot) and the hash table's row starts (2^(3 bits) rows)."""
+@builder(_nrt=False)
+def _fill_grid(photons, inv_cell, bits, keys, cells, fill, out):
+    """``out``: ``photons`` sorted by the hash row of their grid cell (stable: the order
+    within a row is the order shot); ``cells`` (zeroed, 2^(3 bits) + 1 entries): the hash
+    table's row starts. ``keys`` (one int64 a photon) and ``fill`` (one int32 a row) are
+    scratch. Every array comes from the caller: no Numba runtime."""
     n = photons.shape[0]
     rows = 1 << (3 * bits)
-    keys = np.empty(n, np.int64)
-    cells = np.zeros(rows + 1, np.int32)
     for q in range(n):
         h = cell_hash(cell_of(np.float64(photons[q, 0]), inv_cell),
                       cell_of(np.float64(photons[q, 1]), inv_cell),
@@ -330,12 +330,23 @@ def build_grid(photons, inv_cell, bits):
         cells[h + 1] += 1
     for h in range(rows):
         cells[h + 1] += cells[h]
-    fill = cells[:-1].copy()
-    out = np.empty_like(photons)
+    for h in range(rows):
+        fill[h] = cells[h]
     for q in range(n):
         h = keys[q]
-        out[fill[h]] = photons[q]
+        for c in range(photons.shape[1]):
+            out[fill[h], c] = photons[q, c]
         fill[h] += 1
+
+
+def build_grid(photons: np.ndarray, inv_cell: float, bits: int) -> tuple[np.ndarray, np.ndarray]:
+    """``photons`` sorted by the hash row of their grid cell (stable: the order within a
+    row is the order shot) and the hash table's row starts (2^(3 bits) rows)."""
+    rows = 1 << (3 * int(bits))
+    cells = np.zeros(rows + 1, np.int32)
+    out = np.empty_like(photons)
+    _fill_grid(photons, inv_cell, bits, np.empty(photons.shape[0], np.int64), cells,
+               np.empty(rows, np.int32), out)
     return out, cells
 
 

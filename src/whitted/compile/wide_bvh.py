@@ -24,10 +24,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..jit import builder
+from ..jit import builder as _builder
 from ..kernels.layout import WIDE, WIDE_COUNT, WIDE_LINK, WIDE_ROWS
 
 EXACT_FLOAT32 = 1 << 24  # whole numbers below this are exact in float32
+
+#: the collapse allocates nothing (wide_nodes hands it every array): no Numba runtime
+builder = _builder(_nrt=False)
 
 
 @builder
@@ -57,14 +60,13 @@ def _above(x):
 
 
 @builder
-def _collapse(lo, hi, offset, count, box):
+def _collapse(lo, hi, offset, count, box, queue, kids):
     """Fill ``box`` (room for one wide node per binary node) breadth first from
     the binary BVH (lo, hi, offset, count: left child i + 1, right child offset[i]). Returns
-    the number of wide nodes."""
-    queue = np.empty(len(count), np.int64)  # the binary node each wide node comes from
+    the number of wide nodes. ``queue`` (one int64 per binary node: the binary node each wide
+    node comes from) and ``kids`` (WIDE int64) are the caller's scratch."""
     queue[0] = 0
     made = 1
-    kids = np.empty(WIDE, np.int64)
     for w in range(len(count)):
         if w == made:
             break
@@ -124,5 +126,6 @@ def wide_nodes(bvh) -> np.ndarray:
     made = _collapse(np.ascontiguousarray(bvh.node_min, np.float64),
                      np.ascontiguousarray(bvh.node_max, np.float64),
                      np.ascontiguousarray(bvh.node_offset, np.int64),
-                     np.ascontiguousarray(bvh.node_count, np.int64), box)
+                     np.ascontiguousarray(bvh.node_count, np.int64), box,
+                     np.empty(m, np.int64), np.empty(WIDE, np.int64))
     return np.ascontiguousarray(box[:made])

@@ -31,8 +31,11 @@ What the tuned dispatcher does:
 - **Loading without refreshing the compiler's registries**: before it looks in the cache,
   Numba's ``FunctionCache.load_overload`` installs every implementation registry, and the
   NumPy one probes for a BLAS by importing ``scipy.linalg`` (0.25-0.35 s of a warm render's
-  start-up); machine code read back needs only the runtime (``rtsys.initialize``). A compile
-  after a miss refreshes them itself.
+  start-up); machine code read back needs only the runtime (``rtsys.initialize``), and a
+  kernel compiled without it (``_nrt=False``: every render kernel, the builders that
+  allocate nothing) not even that: the runtime's functions are compiled by LLVM in the
+  process that first needs them (20-40 ms), which a warm render of analytic shapes never
+  does. A compile after a miss refreshes them itself.
 - **The compile helper's share** (:attr:`KernelCache.wait_for_helper`, render/warm_up.py):
   on a cold compile, a kernel the helper process is compiling is waited for and loaded
   instead of being compiled twice.
@@ -153,8 +156,13 @@ def _make_classes():
 
                 read_only_miss()
 
+        #: whether the kernel was compiled with Numba's runtime (``_nrt``); the machine code
+        #: of one without it calls none of the runtime's functions
+        runtime = True
+
         def load_overload(self, sig, target_context):
-            rtsys.initialize(target_context)  # what loading needs of Numba's refresh
+            if self.runtime:  # what loading needs of Numba's refresh
+                rtsys.initialize(target_context)
             data = None
             with self._guard_against_spurious_io_errors():
                 data = self._load_overload(sig, target_context)
@@ -183,6 +191,7 @@ def _make_classes():
 
         def enable_caching(self):
             self._cache = KernelCache(self.py_func)
+            self._cache.runtime = self.targetoptions.get("_nrt", True) is not False
 
         def get_call_template(self, args, kws):
             if not self.specialise_constants:
@@ -255,7 +264,6 @@ def frame_view():
     cannot take; stock Numba (runtime on) uses ``numba.carray``. Tuned dispatcher only."""
     from numba import types
     from numba.extending import intrinsic
-    from numba.np.arrayobj import make_array, populate_array
 
     @intrinsic
     def view(typingctx, pointer, count):
@@ -264,6 +272,10 @@ def frame_view():
         array_type = types.Array(pointer.dtype, 1, "C")
 
         def codegen(context, builder, sig, args):
+            # imported here, when a kernel is compiled: NumPy's array code in Numba (20-40
+            # ms with the string and hashing code it imports) is no part of a warm render
+            from numba.np.arrayobj import make_array, populate_array
+
             data, n = args
             array = make_array(array_type)(context, builder)
             item = context.get_value_type(pointer.dtype)
