@@ -245,6 +245,36 @@ def test_the_start_up_check_leaves_sealed_files_to_their_look_up(tmp_path, capsy
     assert _names(again) == _names(state) - {"kernels_1/a-1.py311.nbi"}
 
 
+def test_a_rewrite_given_the_sealed_inode_again_is_no_damage_while_its_writer_compiles(
+        tmp_path, capsys):
+    """The start-up check (lazy) trusted a sealed file by its inode; another process, still
+    compiling, then wrote that index anew and the file system gave the new file the old
+    inode again (another size): at the look-up it is that process's work, kept without a
+    word; a file changed in place at its sealed size is damage all the same."""
+    state = _fake_cache(tmp_path)
+    again = _cache.KernelCache(state.folder, own=True, helper=False)
+    assert again.verify(lazy=True) == 0
+    started, release = tmp_path / "started", tmp_path / "release"
+    other = _hold_compiling_marker(state.folder, started, release)
+    try:
+        while not started.exists():  # an event, not a time: it exits on any failure
+            assert other.poll() is None, "the other process ended before compiling"
+            time.sleep(0.02)
+        index = Path(state.folder, "kernels_1/a-1.py311.nbi")
+        inode = index.stat().st_ino
+        index.write_bytes(b"another signature, the same inode")
+        assert index.stat().st_ino == inode
+        _flip(Path(state.folder, "compile_2/b-2.py311.0.nbc"), 3)
+        assert again.check_function("kernels_1", "a-1.py311") == 0
+        assert index.read_bytes() == b"another signature, the same inode"
+        assert capsys.readouterr().err == ""
+        assert again.check_function("compile_2", "b-2.py311") == 1
+        assert "damaged kernel cache file" in capsys.readouterr().err
+    finally:
+        release.touch()
+        other.wait(timeout=60)
+
+
 def test_the_start_up_check_of_a_sealed_folder_takes_no_lock(tmp_path, monkeypatch):
     """A warm folder whose files are all as sealed is checked at start-up without the lock
     (nothing to delete or write); a file nobody sealed sends the check under the lock,

@@ -532,10 +532,13 @@ class KernelCache:
                     # written anew by another process since verify() and sealed by it
                     self._seen[name] = (st.st_ino, st.st_size, st.st_mtime_ns)
                     continue
-                if seen is not None and seen[0] != st.st_ino and not self.read_only:
+                if seen is not None and (seen[0] != st.st_ino or seen[1] != st.st_size) \
+                        and not self.read_only:
                     # a new file renamed in since verify() (as Numba writes) and not sealed
-                    # yet: while its writer is still compiling, it is that process's work
-                    # (whole, and sealed by it): kept, never taken for damage
+                    # yet (a new inode, or the old inode given again by the file system to
+                    # the new file of another size): while its writer is still compiling,
+                    # it is that process's work (whole, and sealed by it): kept, never taken
+                    # for damage; a file changed in place at its sealed size is damage
                     if rewriting is None:
                         rewriting = self.others_compiling()
                     if rewriting:
