@@ -207,6 +207,9 @@ def test_a_flow_run_saves_its_flow_and_tracers_and_the_scene_shows_them(tmp_path
         assert np.abs(z["flow_v"]).max() > 0.0
         np.testing.assert_array_equal(solver.flow.flow.v, z["flow_v"])
         np.testing.assert_array_equal(solver.flow.tracers, z["flow_tracers"])
+        # and with the pressure solve's last answer as its next first guess, as it ran
+        assert np.abs(z["flow_phi"]).max() > 0.0
+        np.testing.assert_array_equal(solver.flow.flow._masked._phi, z["flow_phi"])
 
 
 

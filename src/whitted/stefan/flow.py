@@ -40,7 +40,7 @@ from . import flow_kernels as fk
 #: at every Ra from the benchmark column of Cardinal's verification page
 #: (https://cardinal.cels.anl.gov/vv/square_cavity_natural_convection.html, its Table 2);
 #: u_max 3.649 at y 0.813 (Ra 10³) from a public simulation input that quotes the paper
-#: (found with the code search, which does not name its repository); v_max at x 0.066
+#: (its repository not named where it was read); v_max at x 0.066
 #: (Ra 10⁵) from a public FEM script that checks itself against it
 #: (https://pastebin.com/Y4gxSnYR). The other positions (y 0.823, 0.855, 0.850; x 0.178,
 #: 0.119, 0.0379) are the paper's as commonly tabled, not read here.
@@ -295,12 +295,6 @@ def _peak_at(values: np.ndarray) -> tuple[float, float]:
     return float(values[m]), float(m)
 
 
-def _peak(values: np.ndarray) -> float:
-    """The largest of samples at unit spacing, refined by the parabola through the largest
-    and its two neighbours."""
-    return _peak_at(values)[0]
-
-
 def heated_cavity(ra: float, cells: int, pr: float = 0.71, dims: int = 2, tol: float = 1e-6,
                   t_max: float = 3.0, progress=None) -> CavityResult:
     """The square (``dims`` 2) or cubic (3) cavity of side 1, hot wall (T = +1/2) at x = 0,
@@ -509,6 +503,7 @@ class MeltFlow:
         """What a resumed run needs to go on with the flow as it was."""
         return {"flow_u": self.flow.u, "flow_v": self.flow.v, "flow_w": self.flow.w,
                 "flow_pressure": self.flow.pressure, "flow_tracers": self.tracers,
+                "flow_phi": self.flow._masked._phi,
                 "flow_box": np.array([[s.start, s.stop] for s in self.box])}
 
     def restore(self, z) -> None:
@@ -521,6 +516,8 @@ class MeltFlow:
         self.flow.w[...] = z["flow_w"]
         if "flow_pressure" in z:  # (a state saved before the incremental projection: 0)
             self.flow.pressure[...] = z["flow_pressure"]
+        if "flow_phi" in z:  # the pressure solve's last answer, its next first guess
+            self.flow._masked._phi = np.array(z["flow_phi"], dtype=np.float64)
         self.tracers = np.array(z["flow_tracers"], dtype=np.float64).reshape(-1, 3)
 
     def speed(self) -> float:
