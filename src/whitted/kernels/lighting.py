@@ -18,7 +18,7 @@ from .accel import (
 from .csg import csg_surfaces
 from .extras import body_medium
 from .features import extras_possible, has_extras, has_instances, instances_possible
-from .hit_list import keep_nearest
+from .hit_list import MAX_SHADOW_HITS, keep_nearest
 from .layout import (
     CELL_COUNT,
     CELL_FIRST,
@@ -54,7 +54,7 @@ from .layout import (
 from .light_buffer import cube_cell
 from .media import absorbed, media_enter, media_leave
 from .mesh import OPAQUE_KT
-from .sampling import concentric_disk, random_pair, stratum
+from .sampling import SAMPLE_CHUNK, stratified_disk, stratum
 from .shapes import INF
 from .shapes.dispatch import crossed_twice, is_csg_object, is_extra, is_world_plane
 from .traverse import (
@@ -140,6 +140,10 @@ MIN_BUNDLE_SAMPLES = 4  # area lights with fewer samples per point skip the bund
 # is below this, per channel, is left out without a shadow ray: far below a float32 pixel's
 # own precision at any visible brightness (2**-24 of the value) and 16-bit output's step
 NEGLIGIBLE_LIGHT = 1e-15
+# an area light's points on its disk, drawn ahead of their shadow rays, wait in the shadow
+# rays' hits buffer past its MAX_SHADOW_HITS (t, primitive) pairs: SAMPLE_CHUNK (x, y) pairs
+DISK_POINTS = 2 * MAX_SHADOW_HITS
+HITS_BUFFER = DISK_POINTS + 2 * SAMPLE_CHUNK  # the length of a lane's hits buffer
 
 
 @kernel
@@ -530,10 +534,11 @@ def direct_light(
         cx = -1
         cy = 0
         for _s in range(n_samples):
-            cx += 1
-            if cx == m_cols:
-                cx = 0
-                cy += 1
+            chunk = _s % SAMPLE_CHUNK
+            if kind == LIGHT_DISK and chunk == 0:  # the next points of the disk, drawn ahead
+                dim, cx, cy = stratified_disk(params.seed, rng[0], rng[1], dim, cx, cy, m_cols,
+                                              m_rows, min(SAMPLE_CHUNK, n_samples - _s), hits,
+                                              DISK_POINTS)
             # one shadow ray per sample (one call site: the shadow code is inlined once)
             if kind == LIGHT_DIRECTIONAL:
                 travel = vload(table, j, LIGHT_DIRECTION)
@@ -545,11 +550,8 @@ def direct_light(
             else:
                 target = centre
                 if kind == LIGHT_DISK:
-                    ju, jw = random_pair(params.seed, rng[0], rng[1], dim)
-                    u = (cx + ju) / m_cols
-                    w = (cy + jw) / m_rows
-                    dim += 2
-                    dx, dy = concentric_disk(u, w)
+                    dx = hits[DISK_POINTS + 2 * chunk]
+                    dy = hits[DISK_POINTS + 2 * chunk + 1]
                     rad = table[j, LIGHT_RADIUS]
                     target = madd(madd(centre, vload(table, j, LIGHT_DISK_U), dx * rad),
                                   vload(table, j, LIGHT_DISK_V), dy * rad)
