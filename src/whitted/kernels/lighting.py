@@ -50,6 +50,8 @@ from .layout import (
     PRIM_TYPE,
     PRIM_XFORM,
     RAY_SHADOW,
+    SHAPE_SPHERE,
+    SHAPE_TRIANGLE,
 )
 from .light_buffer import cube_cell
 from .media import absorbed, media_enter, media_leave
@@ -57,6 +59,7 @@ from .mesh import OPAQUE_KT
 from .sampling import SAMPLE_CHUNK, stratified_disk, stratum
 from .shapes import INF
 from .shapes.dispatch import crossed_twice, is_csg_object, is_extra, is_world_plane
+from .shapes.flat import EDGE_TOL
 from .traverse import (
     box_entry,
     cone_meets_box,
@@ -64,7 +67,7 @@ from .traverse import (
     next_scene_candidate,
     start_scene_walk,
 )
-from .vec import dot, madd, normalize, sub, vload
+from .vec import cross, dot, madd, normalize, sub, vload
 
 
 @kernel
@@ -188,8 +191,82 @@ def list_bundle_occluders(geo, mats, p, centre, radius, tmin, stack, listed):
         listed[n] = i
         n += 1
         opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
-    return list_cone_leaves(geo, mats, p, sub(centre, p), radius * (1.0 + 1e-7) + 1e-12, stack,
-                            listed, n, SHADOW_LIST_CAP, opaque)
+    n, opaque = list_cone_leaves(geo, mats, p, sub(centre, p), radius * (1.0 + 1e-7) + 1e-12,
+                                 stack, listed, n, SHADOW_LIST_CAP, opaque)
+    if n <= 0:
+        return n, opaque
+    return _keep_bundle_occluders(geo, mats, p, centre, radius, listed, n)
+
+
+# a ball is kept in a bundle's list when it comes within this much more than its radius of
+# the bundle (relative to the radius, and to the bundle's length): far more than the
+# rounding of the tests that could find it hit (a ray passing farther than this outside a
+# sphere has a discriminant below -1e-12 of its squared distances: no rounding makes it a hit)
+BALL_SLACK = 1e-6
+
+
+@kernel
+def _ball_meets_bundle(c, r, p, axis, length, sin_a, cos_a, reach):
+    """Could a segment from ``p`` to a point of the light's ball meet the ball of radius ``r``
+    around ``c``? Those segments lie in the cone from apex ``p`` along ``axis`` (unit
+    direction times ``length``) of half-angle ``a`` (its sine and cosine) cut at ``reach``
+    from the apex: the ball is tested against that solid cone, with BALL_SLACK to spare."""
+    v = sub(c, p)
+    along = dot(v, axis) / length
+    side = cross(v, axis)
+    q = math.sqrt(dot(side, side)) / length  # the distance of c from the cone's axis
+    r = r * (1.0 + BALL_SLACK) + BALL_SLACK * reach
+    if along - r > reach:
+        return False  # beyond the light
+    off = q * cos_a - along * sin_a  # c's distance from the cone's side (inside: <= 0)
+    if off <= r:
+        if along * cos_a + q * sin_a >= 0.0:
+            return True  # within r of the side, or inside
+        return dot(v, v) <= r * r  # behind the apex: the apex is its nearest point
+    return False
+
+
+@kernel
+def _keep_bundle_occluders(geo, mats, p, centre, radius, listed, n):
+    """Of ``listed[:n]`` (a bundle's list from its BVH leaves) keep, in order, those that a
+    ray of the bundle could meet: spheres and triangles whose own bounding ball misses the
+    bundle's cone (:func:`_ball_meets_bundle`) are left out, every other shape is kept.
+    Returns (the count kept, whether all kept are opaque)."""
+    axis = sub(centre, p)
+    length = math.sqrt(dot(axis, axis))
+    grown = radius * (1.0 + BALL_SLACK) + 1e-12
+    near = length <= 2.0 * grown  # the point is (nearly) within the light's ball: keep all
+    sin_a = grown / length if not near else 0.0
+    cos_a = math.sqrt(1.0 - sin_a * sin_a)
+    reach = length + grown
+    kept = 0
+    opaque = True
+    P = geo.prim_params
+    for k in range(n):
+        i = listed[k]
+        meets = True
+        typ = geo.prim_info[i, PRIM_TYPE]
+        if not near and geo.prim_info[i, PRIM_XFORM] < 0:  # its numbers are in world space
+            if typ == SHAPE_SPHERE:
+                meets = _ball_meets_bundle(vload(P, i, 0), P[i, 3], p, axis, length, sin_a,
+                                           cos_a, reach)
+            elif typ == SHAPE_TRIANGLE:
+                v0 = vload(P, i, 0)
+                e1 = vload(P, i, 3)
+                e2 = vload(P, i, 6)
+                c = madd(v0, (e1[0] + e2[0], e1[1] + e2[1], e1[2] + e2[2]), 1.0 / 3.0)
+                a = sub(v0, c)
+                b = sub(madd(v0, e1, 1.0), c)
+                d = sub(madd(v0, e2, 1.0), c)
+                # the corners' farthest, and the edge tolerance of the hit test beyond them
+                r = (math.sqrt(max(dot(a, a), max(dot(b, b), dot(d, d))))
+                     + 4.0 * EDGE_TOL * (math.sqrt(dot(e1, e1)) + math.sqrt(dot(e2, e2))))
+                meets = _ball_meets_bundle(c, r, p, axis, length, sin_a, cos_a, reach)
+        if meets:
+            listed[kept] = i
+            kept += 1
+            opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
+    return kept, opaque
 
 
 @kernel(inline="always")
