@@ -206,7 +206,7 @@ BALL_SLACK = 1e-6
 
 
 @kernel
-def _ball_meets_bundle(c, r, p, axis, length, sin_a, cos_a, reach):
+def ball_meets_bundle(c, r, p, axis, length, sin_a, cos_a, reach):
     """Could a segment from ``p`` to a point of the light's ball meet the ball of radius ``r``
     around ``c``? Those segments lie in the cone from apex ``p`` along ``axis`` (unit
     direction times ``length``) of half-angle ``a`` (its sine and cosine) cut at ``reach``
@@ -227,10 +227,25 @@ def _ball_meets_bundle(c, r, p, axis, length, sin_a, cos_a, reach):
 
 
 @kernel
+def triangle_ball(P, i):
+    """(centre, radius) of a ball holding triangle row ``i`` and every point its hit test
+    can find (:func:`.shapes.triangle.intersect_triangle` allows EDGE_TOL past its edges)."""
+    v0 = vload(P, i, 0)
+    e1 = vload(P, i, 3)
+    e2 = vload(P, i, 6)
+    c = madd(v0, (e1[0] + e2[0], e1[1] + e2[1], e1[2] + e2[2]), 1.0 / 3.0)
+    a = sub(v0, c)
+    b = sub(madd(v0, e1, 1.0), c)
+    d = sub(madd(v0, e2, 1.0), c)
+    far = math.sqrt(max(dot(a, a), max(dot(b, b), dot(d, d))))  # the farthest corner
+    return c, far + 4.0 * EDGE_TOL * (math.sqrt(dot(e1, e1)) + math.sqrt(dot(e2, e2)))
+
+
+@kernel
 def _keep_bundle_occluders(geo, mats, p, centre, radius, listed, n):
     """Of ``listed[:n]`` (a bundle's list from its BVH leaves) keep, in order, those that a
     ray of the bundle could meet: spheres and triangles whose own bounding ball misses the
-    bundle's cone (:func:`_ball_meets_bundle`) are left out, every other shape is kept.
+    bundle's cone (:func:`ball_meets_bundle`) are left out, every other shape is kept.
     Returns (the count kept, whether all kept are opaque)."""
     axis = sub(centre, p)
     length = math.sqrt(dot(axis, axis))
@@ -248,20 +263,11 @@ def _keep_bundle_occluders(geo, mats, p, centre, radius, listed, n):
         typ = geo.prim_info[i, PRIM_TYPE]
         if not near and geo.prim_info[i, PRIM_XFORM] < 0:  # its numbers are in world space
             if typ == SHAPE_SPHERE:
-                meets = _ball_meets_bundle(vload(P, i, 0), P[i, 3], p, axis, length, sin_a,
+                meets = ball_meets_bundle(vload(P, i, 0), P[i, 3], p, axis, length, sin_a,
                                            cos_a, reach)
             elif typ == SHAPE_TRIANGLE:
-                v0 = vload(P, i, 0)
-                e1 = vload(P, i, 3)
-                e2 = vload(P, i, 6)
-                c = madd(v0, (e1[0] + e2[0], e1[1] + e2[1], e1[2] + e2[2]), 1.0 / 3.0)
-                a = sub(v0, c)
-                b = sub(madd(v0, e1, 1.0), c)
-                d = sub(madd(v0, e2, 1.0), c)
-                # the corners' farthest, and the edge tolerance of the hit test beyond them
-                r = (math.sqrt(max(dot(a, a), max(dot(b, b), dot(d, d))))
-                     + 4.0 * EDGE_TOL * (math.sqrt(dot(e1, e1)) + math.sqrt(dot(e2, e2))))
-                meets = _ball_meets_bundle(c, r, p, axis, length, sin_a, cos_a, reach)
+                c, r = triangle_ball(P, i)
+                meets = ball_meets_bundle(c, r, p, axis, length, sin_a, cos_a, reach)
         if meets:
             listed[kept] = i
             kept += 1
