@@ -526,6 +526,79 @@ def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch,
 
 
 @kernel
+def disk_below_horizon(table, j, p, n):
+    """True when every point of disk light ``j`` lies below the plane through ``p`` normal
+    to ``n`` (the shaded surface's horizon) by more than the rounding of any sample's test
+    ``n·l <= 0``: no sample of it can light ``p``. The disk's points are centre + rad·(x·U +
+    y·V) with x² + y² <= 1, so n·(point - p) is at most n·(centre - p) + rad·|(n·U, n·V)|."""
+    to_centre = sub(vload(table, j, LIGHT_POSITION), p)
+    rad = table[j, LIGHT_RADIUS]
+    nu = dot(n, vload(table, j, LIGHT_DISK_U))
+    nv = dot(n, vload(table, j, LIGHT_DISK_V))
+    highest = dot(n, to_centre) + rad * math.sqrt(nu * nu + nv * nv)
+    # far above the rounding of the samples' points and directions, at any coordinates
+    margin = 1e-9 * (math.sqrt(dot(to_centre, to_centre)) + rad + abs(p[0]) + abs(p[1])
+                     + abs(p[2]))
+    return highest < -margin
+
+
+@kernel
+def _cone_cos_max(w, axis, length, sin_a, cos_a):
+    """The largest cosine between unit-free ``w`` and a direction of the cone about ``axis``
+    (its length ``length``) of half-angle a, times |w|: |w| cos(max(0, b - a)), b the angle
+    from ``w`` to the axis."""
+    w_len = math.sqrt(dot(w, w))
+    if w_len == 0.0:
+        return 0.0
+    cos_b = min(1.0, max(-1.0, dot(w, axis) / (w_len * length)))
+    if cos_b >= cos_a:
+        return w_len
+    return w_len * (cos_b * cos_a + math.sqrt(1.0 - cos_b * cos_b) * sin_a)
+
+
+@kernel
+def disk_highlight_bound(table, j, mats, m, p, n, v, radiance, share):
+    """At least the most (in any channel) that one sample of disk light ``j`` adds to the
+    highlight of material ``m`` at ``p`` (the only light a surface without diffuse
+    reflection reflects; ``n`` the normal, ``v`` the unit direction to the eye), or INF
+    where it is not bounded. The highlight's cosine is bounded over the
+    cone of directions l from ``p`` to the disk's ball: Phong's r·v = l·rv (rv: v mirrored
+    about n) by the cone's nearest direction to rv; Blinn's n·h = (n·l + n·v) / |l + v| by
+    the largest n·l over the smallest |l + v|; generously (1e-9 added to the cosine)."""
+    to_centre = sub(vload(table, j, LIGHT_POSITION), p)
+    length = math.sqrt(dot(to_centre, to_centre))
+    rad = table[j, LIGHT_RADIUS] * (1.0 + 1e-9)
+    if length <= 2.0 * rad:
+        return INF
+    sin_a = rad / length  # the cone's half-angle a
+    cos_a = math.sqrt(1.0 - sin_a * sin_a)
+    ndv = dot(n, v)
+    if mats[m, MAT_BLINN] != 0.0:
+        top = _cone_cos_max(n, to_centre, length, sin_a, cos_a) + ndv
+        # the smallest l·v: the cone's farthest direction from v
+        far = -_cone_cos_max((-v[0], -v[1], -v[2]), to_centre, length, sin_a, cos_a)
+        bottom = 2.0 + 2.0 * far
+        if top <= 0.0:
+            c_max = 0.0
+        elif bottom <= 1e-6:
+            return INF
+        else:
+            c_max = top / math.sqrt(bottom)
+    else:
+        rv = (2.0 * ndv * n[0] - v[0], 2.0 * ndv * n[1] - v[1], 2.0 * ndv * n[2] - v[2])
+        c_max = _cone_cos_max(rv, to_centre, length, sin_a, cos_a)
+    c_max += 1e-9
+    spec = 0.0
+    if c_max > 0.0:
+        spec = mats[m, MAT_KS] * highlight_power(c_max, mats[m, MAT_SHININESS])
+    weight = share * _falloff(table, j, length - rad)  # the nearest point of the ball
+    most = 0.0
+    for k in range(3):
+        most = max(most, weight * radiance[k] * spec * mats[m, MAT_SPECULAR + k])
+    return most
+
+
+@kernel
 def _falloff(lights, j, dist):
     mode = lights[j, LIGHT_FALLOFF]
     if mode == 1.0:
@@ -604,6 +677,13 @@ def direct_light(
         n_samples = int(table[j, LIGHT_SAMPLES]) if kind == LIGHT_DISK else 1
         share = 1.0 / n_samples
         centre = vload(table, j, LIGHT_POSITION)
+        if kind == LIGHT_DISK and (disk_below_horizon(table, j, p, n) or (
+                mats[m, MAT_KD] == 0.0 and disk_highlight_bound(
+                    table, j, mats, m, p, n, v, radiance, share) < 0.5 * NEGLIGIBLE_LIGHT)):
+            # none of its samples would pass the tests below (n·l > 0, a highlight's light
+            # not negligible): left out at once, with the random numbers they would have used
+            dim += 2 * n_samples
+            continue
         blocker = -1  # what shadowed this light's previous sample from p
         occluders = listed  # the array holding the list of possible occluders
         list_first = 0
