@@ -309,59 +309,9 @@ def list_cone_leaves(geo, mats, apex, axis, radius, stack, out, n, cap, opaque):
     return n, opaque
 
 
-@kernel(inline="always")
-def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, listed, list_first,
-                            n_listed):
-    """The analytic surface crossings on the segment (tmin, tmax), in one walk of the scene
-    BVH (or, when ``n_listed`` >= 0, of the primitives ``listed[list_first:][:n_listed]``),
-    into ``hits``
-    as (t, primitive) pairs sorted by t: both crossings of a closed body (they are convex: at
-    most two, the second searched from ``step`` past the first), the nearest MAX_SHADOW_HITS
-    of them. Returns (n, full): full when there were more (walk again from past the last one);
-    n = -1 when an opaque surface blocks the segment (the walk stops there and ``hits[1]``
-    names it)."""
-    n = 0
-    full = n < 0  # False, typed bool: a literal False compiles keep_nearest twice
-    inv = inverse_direction(d)
-    j, leaf, leaf_end, top = start_scene_walk(geo, stack, False)
-    k = 0
-    while True:
-        if n_listed >= 0:
-            if k == n_listed:
-                break
-            i = listed[list_first + k]
-            k += 1
-        else:
-            i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, tmax, stack,
-                                                             j, leaf, leaf_end, top, False)
-            if i < 0:
-                break
-        if (has_extras(geo) and is_extra(geo.prim_info[i, PRIM_TYPE])
-                and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] >= OPAQUE_KT):
-            # a clear torus or CSG object: every crossing (a CSG object's as its leaves)
-            n, full = gather_extra_hits_if_extras(geo, i, o, d, inv, tmin, tmax, step, hits,
-                                                  n, full)
-            continue
-        t = hit_analytic(geo, i, o, d, tmin, tmax)
-        if t == INF:
-            continue
-        # the material is looked up only for the surfaces hit (most candidates miss)
-        if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT:
-            hits[1] = i
-            return -1, False
-        n, full = keep_nearest(hits, n, t, i, full)
-        # a closed analytic body is crossed twice (the triangles of a flattened solid mesh
-        # are each crossed once: their body's other side is other triangles)
-        if crossed_twice(geo.prim_info[i, PRIM_TYPE], geo.prim_info[i, PRIM_SOLID]):
-            t = hit_analytic(geo, i, o, d, t * (1.0 + 1e-12) + step, tmax)
-            if t < INF:
-                n, full = keep_nearest(hits, n, t, i, full)
-    return n, full
-
-
 @kernel
 def gather_extra_hits(geo, i, o, d, inv, tmin, tmax, step, hits, n, full):
-    """:func:`gather_transparent_hits` for a torus or CSG object ``i``: its crossings in
+    """A shadow ray's walk (:func:`direct_light`) at a torus or CSG object ``i``: its crossings in
     (tmin, tmax), a CSG object's as (t, leaf) pairs from one walk (:func:`.csg.csg_surfaces`),
     a torus's each found from past the one before (up to four)."""
     if is_csg_object(geo.prim_info[i, PRIM_TYPE]):
@@ -419,9 +369,10 @@ def _absorb(mats, scratch, count, length, trans):
             absorbed(trans[2], mats[m, MAT_ATTEN + 2], length))
 
 
-@kernel(inline="always")  # as when it was written inside shadow_transmittance
+@kernel(inline="always")  # as when it was written inside the shadow ray's code
 def _shadow_through_instances(geo, mats, params, o, d, dist, media, n_media, scratch, stack):
-    """:func:`shadow_transmittance` in scenes with mesh instances: an any-hit walk first,
+    """A shadow ray's transmittance (:func:`direct_light`) in scenes with mesh instances, from
+    ``epsilon`` to ``dist`` along unit ``d``: an any-hit walk first,
     then, only when it met transparent surfaces, the crossings one nearest hit at a time.
     ``scratch[:n_media]`` already holds a copy of ``media[:n_media]``."""
     count = n_media
@@ -465,64 +416,6 @@ def _shadow_through_instances_if_instances(geo, mats, params, o, d, dist, media,
     return (lambda geo, mats, params, o, d, dist, media, n_media, scratch, stack:
             _shadow_through_instances(geo, mats, params, o, d, dist, media, n_media, scratch,
                                       stack))
-
-
-@kernel(inline="always")
-def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch, stack, hits,
-                         blocker, listed, list_first, n_listed, listed_opaque):
-    """Fraction of light (per channel) that reaches ``o`` from ``dist`` along unit ``d``.
-
-    The segment starts at ``epsilon`` along the ray (not offset along the normal), so a
-    shadow ray from a surface point passes exactly where the geometry says: a point whose
-    light path grazes an occluder's edge is shadowed as the lecture computes it.
-
-    Each transparent occluder multiplies by its ``kt·color`` where the ray enters it, and the
-    medium the shadow ray is in absorbs ``exp(-attenuation·length)`` segment by segment (the
-    ray starts in the media ``media[:n_media]`` of the point being shaded).
-
-    ``blocker`` (or -1) is an opaque analytic primitive that blocked a previous shadow ray
-    from the same point (the next sample of the same area light, say): it is tried first, and
-    when it blocks this ray too no walk is needed. When ``n_listed`` >= 0, the ray's possible
-    occluders are ``listed[list_first:][:n_listed]`` (a bundle's list, see
-    :func:`list_bundle_occluders`, or a light-buffer cell's) and no BVH walk is made; when
-    they are all opaque (``listed_opaque``) the first one hit ends the search.
-    Returns (transmittance, the opaque primitive that blocked the ray or -1)."""
-    if blocker >= 0 and hit_analytic(geo, blocker, o, d, params.epsilon, dist) < INF:
-        return (0.0, 0.0, 0.0), blocker
-    if n_listed >= 0 and listed_opaque:
-        for k in range(list_first, list_first + n_listed):
-            if hit_analytic(geo, listed[k], o, d, params.epsilon, dist) < INF:
-                return (0.0, 0.0, 0.0), listed[k]
-        return _absorb(mats, media, n_media, dist - params.epsilon, (1.0, 1.0, 1.0)), -1
-    for k in range(n_media):
-        scratch[k] = media[k]
-    count = n_media
-    trans = (1.0, 1.0, 1.0)
-    t_from = params.epsilon
-    if not has_instances(geo):
-        # walks gather the surfaces on the segment, sorted, a buffer-full at a time; one
-        # closer than ``epsilon`` to the previous crossing is the same crossing (a shared
-        # edge, a touching pair) and is skipped, as the stepping walk below would
-        for _ in range(64):
-            n, full = gather_transparent_hits(geo, mats, o, d, t_from, dist, params.epsilon,
-                                              stack, hits, listed, list_first, n_listed)
-            if n == -1:
-                return (0.0, 0.0, 0.0), int(hits[1])
-            for k in range(n):
-                t = hits[2 * k]
-                if t <= t_from:
-                    continue
-                trans = _absorb(mats, scratch, count, t - t_from, trans)
-                count, trans = _pass_surface(geo, mats, int(hits[2 * k + 1]), -1, 0.0, 0.0, o,
-                                             d, t, scratch, count, trans)
-                if max(trans[0], max(trans[1], trans[2])) < 1e-4:
-                    return (0.0, 0.0, 0.0), -1
-                t_from = t * (1.0 + 1e-12) + params.epsilon
-            if not full:
-                break
-        return _absorb(mats, scratch, count, dist - t_from, trans), -1
-    return shadow_through_instances_if_instances(geo, mats, params, o, d, dist, media, n_media,
-                                                 scratch, stack)
 
 
 @kernel
@@ -663,7 +556,33 @@ def direct_light(
     """Light reflected toward ``v`` at point ``p`` with shading normal ``n`` (facing ``v``) by
     every non-ambient light; ``albedo`` is the diffuse colour there. ``rng`` = (pixel, sample,
     first dimension) for area-light samples. A point light's shadow ray tests the list of its
-    light-buffer cell; an area light's samples share the list of their bundle."""
+    light-buffer cell; an area light's samples share the list of their bundle.
+
+    One function from the lights down to the walks of the shadow rays, in three nested parts:
+    each light's samples; each sample's shadow ray (its transmittance); the walks that gather
+    that ray's surface crossings. Numba compiles every separately compiled function on its
+    own and LLVM optimises, in each, the whole of the code it calls once more: written as
+    functions calling functions, the shadow code was optimised and turned into machine code
+    once per level, here once (docs/performance.md, the flat-tree round). Leaves with no deep
+    callees (the BRDF, the media, the bundle's list) stay functions.
+
+    **The shadow ray** runs from ``epsilon`` along ``ldir`` (not offset along the normal) to
+    ``tmax``, so it passes exactly where the geometry says: a point whose light path grazes an
+    occluder's edge is shadowed as the lecture computes it. Each transparent occluder
+    multiplies by its ``kt·color`` where the ray enters it, and the medium the ray is in
+    absorbs ``exp(-attenuation·length)`` segment by segment (it starts in the media
+    ``media[:n_media]`` of the point being shaded). ``blocker`` is an opaque analytic
+    primitive that blocked a previous sample's ray from ``p`` (the same area light's): it is
+    tried first, and when it blocks this ray too no walk is needed. When ``n_listed`` >= 0,
+    the ray's possible occluders are ``occluders[list_first:][:n_listed]`` (a bundle's list,
+    see :func:`list_bundle_occluders`, or a light-buffer cell's) and no BVH walk is made;
+    when they are all opaque (``listed_opaque``) the first one hit ends the search.
+
+    **A walk** gathers the analytic surface crossings on (t_from, tmax), from the scene BVH
+    (or the listed primitives), into ``hits`` as (t, primitive) pairs sorted by t: both
+    crossings of a closed body (they are convex: at most two, the second searched from
+    ``epsilon`` past the first), the nearest MAX_SHADOW_HITS of them; ``full`` when there were
+    more (walk again from past the last one). An opaque surface hit ends it (``opaque``)."""
     r = 0.0
     g = 0.0
     b = 0.0
@@ -671,6 +590,7 @@ def direct_light(
         return (r, g, b)
     dim = rng[2]
     table = lights.table
+    eps = params.epsilon
     for j in range(table.shape[0]):
         kind = table[j, LIGHT_TYPE]
         radiance = vload(table, j, LIGHT_RADIANCE)
@@ -691,7 +611,7 @@ def direct_light(
         listed_opaque = False
         if kind == LIGHT_DISK and n_samples >= MIN_BUNDLE_SAMPLES and not has_instances(geo):
             n_listed, listed_opaque = list_bundle_occluders(
-                geo, mats, p, centre, table[j, LIGHT_RADIUS], params.epsilon, stack, listed)
+                geo, mats, p, centre, table[j, LIGHT_RADIUS], eps, stack, listed)
         # samples are stratified over a grid of m_cols x m_rows cells, walked cell by cell
         _, _, m_cols, m_rows = stratum(0, n_samples)
         cx = -1
@@ -723,7 +643,7 @@ def direct_light(
                 if dist == 0.0:
                     continue
                 ldir = (to_light[0] / dist, to_light[1] / dist, to_light[2] / dist)
-                tmax = dist - params.epsilon
+                tmax = dist - eps
                 weight = share * _falloff(table, j, dist)
             if dot(n, ldir) <= 0.0:
                 continue
@@ -747,14 +667,105 @@ def direct_light(
                 n_listed = lights.buffer_cells[cell, CELL_COUNT]
                 listed_opaque = lights.buffer_cells[cell, CELL_OPAQUE] != 0
             counters[RAY_SHADOW] += 1
-            vis, found = shadow_transmittance(
-                geo, mats, params, p, ldir, tmax, media, n_media, scratch, stack, hits, blocker,
-                occluders, list_first, n_listed, listed_opaque,
-            )
-            if found >= 0:
-                blocker = found
+
+            # the shadow ray: its transmittance ``vis``; a sample whose ray an opaque surface
+            # blocks is left (that surface becomes the next sample's ``blocker``)
+            if blocker >= 0 and hit_analytic(geo, blocker, p, ldir, eps, tmax) < INF:
+                continue
+            opaque = -1  # an opaque primitive found on the ray
+            if n_listed >= 0 and listed_opaque:
+                for k in range(list_first, list_first + n_listed):
+                    if hit_analytic(geo, occluders[k], p, ldir, eps, tmax) < INF:
+                        opaque = occluders[k]
+                        break
+                if opaque >= 0:
+                    blocker = opaque
+                    continue
+                vis = _absorb(mats, media, n_media, tmax - eps, (1.0, 1.0, 1.0))
+            else:
+                for k in range(n_media):
+                    scratch[k] = media[k]
+                if has_instances(geo):
+                    vis, _ = shadow_through_instances_if_instances(
+                        geo, mats, params, p, ldir, tmax, media, n_media, scratch, stack)
+                else:
+                    # walks gather the surfaces on the segment, sorted, a buffer-full at a
+                    # time; one closer than ``epsilon`` to the previous crossing is the same
+                    # crossing (a shared edge, a touching pair) and is skipped, as the
+                    # stepping walk of instance scenes would
+                    count = n_media
+                    vis = (1.0, 1.0, 1.0)
+                    t_from = eps
+                    inv = inverse_direction(ldir)
+                    for _ in range(64):
+                        # a walk (see the docstring) over (t_from, tmax)
+                        n_hits = 0
+                        full = n_hits < 0  # False, typed bool (a literal: keep_nearest twice)
+                        cand, leaf, leaf_end, top = start_scene_walk(geo, stack, False)
+                        k = 0
+                        while True:
+                            if n_listed >= 0:
+                                if k == n_listed:
+                                    break
+                                i = occluders[list_first + k]
+                                k += 1
+                            else:
+                                i, cand, leaf, leaf_end, top = next_scene_candidate(
+                                    geo, p, inv, t_from, tmax, stack, cand, leaf, leaf_end, top,
+                                    False)
+                                if i < 0:
+                                    break
+                            if (has_extras(geo) and is_extra(geo.prim_info[i, PRIM_TYPE])
+                                    and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT]
+                                    >= OPAQUE_KT):
+                                # a clear torus or CSG object: every crossing (a CSG
+                                # object's as its leaves)
+                                n_hits, full = gather_extra_hits_if_extras(
+                                    geo, i, p, ldir, inv, t_from, tmax, eps, hits, n_hits, full)
+                                continue
+                            t = hit_analytic(geo, i, p, ldir, t_from, tmax)
+                            if t == INF:
+                                continue
+                            # the material is looked up only for the surfaces hit (most
+                            # candidates miss)
+                            if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT:
+                                opaque = i
+                                break
+                            n_hits, full = keep_nearest(hits, n_hits, t, i, full)
+                            # a closed analytic body is crossed twice (the triangles of a
+                            # flattened solid mesh are each crossed once: their body's other
+                            # side is other triangles)
+                            if crossed_twice(geo.prim_info[i, PRIM_TYPE],
+                                             geo.prim_info[i, PRIM_SOLID]):
+                                t = hit_analytic(geo, i, p, ldir, t * (1.0 + 1e-12) + eps, tmax)
+                                if t < INF:
+                                    n_hits, full = keep_nearest(hits, n_hits, t, i, full)
+                        if opaque >= 0:
+                            break
+                        # the light through the crossings gathered, nearest first
+                        for k in range(n_hits):
+                            t = hits[2 * k]
+                            if t <= t_from:
+                                continue
+                            vis = _absorb(mats, scratch, count, t - t_from, vis)
+                            count, vis = _pass_surface(geo, mats, int(hits[2 * k + 1]), -1, 0.0,
+                                                       0.0, p, ldir, t, scratch, count, vis)
+                            if max(vis[0], max(vis[1], vis[2])) < 1e-4:
+                                vis = (0.0, 0.0, 0.0)
+                                full = False  # no light left: no more walks
+                                break
+                            t_from = t * (1.0 + 1e-12) + eps
+                        if not full:
+                            break
+                    if opaque >= 0:
+                        blocker = opaque
+                        continue
+                    if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
+                        continue
+                    vis = _absorb(mats, scratch, count, tmax - t_from, vis)
             if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
                 continue
+
             if not highlight_only:
                 f = _brdf(mats, m, albedo, n, v, ldir)
             r += weight * radiance[0] * vis[0] * f[0]
