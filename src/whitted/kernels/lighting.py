@@ -492,6 +492,18 @@ def disk_highlight_bound(table, j, mats, m, p, n, v, radiance, share):
 
 
 @kernel
+def disk_left_out(table, j, mats, m, p, n, v, radiance, share):
+    """True when no sample of disk light ``j`` would pass :func:`direct_light`'s tests at
+    ``p`` (material ``m``, normal ``n``, toward the eye ``v``): the disk below the horizon,
+    or a surface without diffuse reflection whose highlight it lights negligibly."""
+    if disk_below_horizon(table, j, p, n):
+        return True
+    return (mats[m, MAT_KD] == 0.0 and disk_highlight_bound(table, j, mats, m, p, n, v,
+                                                            radiance, share)
+            < 0.5 * NEGLIGIBLE_LIGHT)
+
+
+@kernel
 def _falloff(lights, j, dist):
     mode = lights[j, LIGHT_FALLOFF]
     if mode == 1.0:
@@ -597,9 +609,7 @@ def direct_light(
         n_samples = int(table[j, LIGHT_SAMPLES]) if kind == LIGHT_DISK else 1
         share = 1.0 / n_samples
         centre = vload(table, j, LIGHT_POSITION)
-        if kind == LIGHT_DISK and (disk_below_horizon(table, j, p, n) or (
-                mats[m, MAT_KD] == 0.0 and disk_highlight_bound(
-                    table, j, mats, m, p, n, v, radiance, share) < 0.5 * NEGLIGIBLE_LIGHT)):
+        if kind == LIGHT_DISK and disk_left_out(table, j, mats, m, p, n, v, radiance, share):
             # none of its samples would pass the tests below (n·l > 0, a highlight's light
             # not negligible): left out at once, with the random numbers they would have used
             dim += 2 * n_samples
