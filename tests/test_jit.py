@@ -189,6 +189,68 @@ def test_stock_numba_runs_the_same_kernels(tmp_path, why):
     assert list((tmp_path / "cache").rglob("*total*.nbc"))
 
 
+LINK_LATER = """
+import sys
+import numpy as np
+from whitted.jit import kernel, load_numba
+
+load_numba()
+
+
+@kernel
+def scaled(a, i):
+    return 2.0 * a[i]
+
+
+@kernel(entry=True)
+def doubled_sum(a):
+    s = 0.0
+    for i in range(a.shape[0]):
+        s += scaled(a, i)
+    return s
+
+
+@kernel(entry=True, cache=sys.argv[1] == "cold")
+def plus_one(a):
+    return doubled_sum(a) + 1.0
+
+
+def parsed(library):
+    return getattr(library, "_linking_bitcode", None) is None
+
+
+a = np.arange(4.0)
+print("ENTRY", doubled_sum(a))
+(entry,) = doubled_sum.dispatcher.overloads.values()
+print("PARSED BEFORE", parsed(entry.library))
+print("CALLER", plus_one(a))  # compiled here on the warm run: links doubled_sum in
+print("PARSED AFTER", parsed(entry.library), entry.library._shared_module is not None)
+"""
+
+
+@tuned_only
+def test_kernels_read_back_link_into_a_later_compile(tmp_path):
+    """A warm process reads a kernel's machine code back without parsing its module for
+    linking (LinkLaterLibrary: a warm render compiles nothing); a kernel compiled later in
+    the process that calls it links it in, parsed then, with the right result."""
+    env = dict(os.environ, WHITTED_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("NUMBA_CACHE_DIR", None)
+    (tmp_path / "run.py").write_text(LINK_LATER)
+    outputs = []
+    for mode in ("cold", "warm"):  # all compiled (and cached); then plus_one alone compiled
+        run = subprocess.run([sys.executable, "run.py", mode], cwd=tmp_path, env=env,
+                             capture_output=True, text=True, timeout=600)
+        assert run.returncode == 0, run.stderr[-2000:]
+        assert run.stderr == ""
+        outputs.append(run.stdout)
+    cold, warm = outputs
+    for out in outputs:
+        assert "ENTRY 12.0\n" in out and "CALLER 13.0\n" in out  # 2 * (0+1+2+3), + 1
+        assert "PARSED AFTER True True" in out
+    assert "PARSED BEFORE True" in cold  # compiled in that process
+    assert "PARSED BEFORE False" in warm  # read back, not linked yet
+
+
 def test_private_names_are_listed_and_checked():
     """Every private name the tuned dispatcher uses is listed; a Numba outside the verified
     versions turns it off."""
@@ -197,7 +259,8 @@ def test_private_names_are_listed_and_checked():
     with open(dispatcher.__file__) as f:
         source = f.read()
     for name in ("get_call_template", "_load_overload", "rtsys.initialize", "_nrt",
-                 "no_cpython_wrapper", "forceinline", "FunctionCache"):
+                 "no_cpython_wrapper", "forceinline", "FunctionCache", "JITCodeLibrary",
+                 "_get_module_for_linking", "unserialize_library"):
         assert name in source.split("PRIVATE_NAMES = (", 1)[1].split(")\n", 1)[0], name
 
 

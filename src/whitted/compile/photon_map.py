@@ -258,14 +258,23 @@ def fitted_radius(positions: np.ndarray, guess: float,
         return guess
     r = guess
     pos = positions.astype(np.float64)
+    cells = np.empty_like(pos)
+    edges = np.empty(len(pos) + 1, bool)  # where a run of equal keys starts or ends
+    edges[0] = edges[-1] = True
     for _ in range(2):
         h = 2.0 * r
         # the cells shifted off the origin: a floor at y = 0 would lie on their boundary,
         # its photons split between two rows of cells by their last bits
-        cells = np.floor(pos / h + GRID_SHIFT).astype(np.int64)
-        keys = (cells[:, 0] * 73856093) ^ (cells[:, 1] * 19349663) ^ (cells[:, 2] * 83492791)
-        _, inverse, counts = np.unique(keys, return_inverse=True, return_counts=True)
-        density = float(np.median(counts[inverse])) / (h * h)
+        np.divide(pos, h, out=cells)
+        cells += GRID_SHIFT
+        ints = np.floor(cells, out=cells).astype(np.int64)
+        keys = (ints[:, 0] * 73856093) ^ (ints[:, 1] * 19349663) ^ (ints[:, 2] * 83492791)
+        # each photon's cell count: the lengths of the runs of equal keys, sorted (the
+        # median over the photons is that of each run's length repeated by itself)
+        keys.sort()
+        np.not_equal(keys[1:], keys[:-1], out=edges[1:-1])
+        counts = np.diff(np.flatnonzero(edges))
+        density = float(np.median(np.repeat(counts, counts))) / (h * h)
         r = min(4.0 * guess, max(guess / 8.0, math.sqrt(neighbours / (math.pi * density))))
     return r
 

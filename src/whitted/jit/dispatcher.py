@@ -36,6 +36,13 @@ What the tuned dispatcher does:
   allocate nothing) not even that: the runtime's functions are compiled by LLVM in the
   process that first needs them (20-40 ms), which a warm render of analytic shapes never
   does. A compile after a miss refreshes them itself.
+- **Machine code read back without its module for linking**: a kernel's cache entry holds its
+  machine code and the LLVM bitcode of its module, which Numba parses at every load (and
+  walks for its symbols) only so that a kernel compiled later in the process can link it in.
+  A warm render compiles nothing: :class:`LinkLaterLibrary` keeps the bitcode unparsed until
+  a compile links the kernel (28 ms of LLVM parsing and 8 ms of symbol walks in a warm
+  caustics render's eight kernels, AMD EPYC); the machine code itself is loaded as Numba
+  loads it, and its entry points are looked up in it.
 - **The compile helper's share** (:attr:`KernelCache.wait_for_helper`, render/warm_up.py):
   on a cold compile, a kernel the helper process is compiling is waited for and loaded
   instead of being compiled twice.
@@ -63,6 +70,11 @@ PRIVATE_NAMES = (
     "numba.core.caching.FunctionCache (subclassed): load_overload, _load_overload, "
     "_guard_against_spurious_io_errors (overridden), _cache_path, _py_func, _impl_class",
     "numba.core.runtime.rtsys.initialize",
+    "numba.core.codegen.JITCodeLibrary (subclassed): _unserialize, enable_object_caching, "
+    "_set_compiled_object, _finalize_final_module, _ensure_finalized, _get_module_for_linking "
+    "(overridden), get_pointer_to_function (overridden), _shared_module, _codegen._engine "
+    "(_load_defined_symbols, get_function_address); a codegen's unserialize_library and "
+    "_library_class",
     "target options _nrt, no_cpython_wrapper, no_cfunc_wrapper, forceinline",
     "numba.np.arrayobj.make_array, populate_array (frame_view: an array over stack slots "
     "without the runtime, which numba.carray needs)",
@@ -121,6 +133,7 @@ def widen_integer(ty):
 
 def _make_classes():
     from numba.core.caching import FunctionCache
+    from numba.core.codegen import Codegen, JITCodeLibrary, JitEngine
     from numba.core.registry import CPUDispatcher
     from numba.core.runtime import rtsys
 
@@ -128,9 +141,16 @@ def _make_classes():
                                           "enable_caching")),
                          (FunctionCache, ("load_overload", "_load_overload",
                                           "_guard_against_spurious_io_errors")),
-                         (rtsys, ("initialize",))):
+                         (rtsys, ("initialize",)),
+                         (JITCodeLibrary, ("_unserialize", "enable_object_caching",
+                                           "_set_compiled_object", "_finalize_final_module",
+                                           "_ensure_finalized", "_get_module_for_linking",
+                                           "get_pointer_to_function")),
+                         (Codegen, ("unserialize_library",)),
+                         (JitEngine, ("_load_defined_symbols", "get_function_address"))):
         for name in names:
             getattr(owner, name)  # AttributeError: not the Numba this was verified with
+    link_later = _link_later_class(JITCodeLibrary)
 
     class KernelCache(FunctionCache):
         """Numba's on-disk cache of one kernel, waiting for the compile helper when it is
@@ -163,13 +183,19 @@ def _make_classes():
         def load_overload(self, sig, target_context):
             if self.runtime:  # what loading needs of Numba's refresh
                 rtsys.initialize(target_context)
+            _read_back_lazily(target_context.codegen(), link_later)
             data = None
-            with self._guard_against_spurious_io_errors():
-                data = self._load_overload(sig, target_context)
-            wait = KernelCache.wait_for_helper
-            if data is None and wait is not None and wait(self._py_func.__qualname__):
+            was = getattr(_loading, "active", False)
+            _loading.active = True  # (under Numba's compiler lock, as every load)
+            try:
                 with self._guard_against_spurious_io_errors():
                     data = self._load_overload(sig, target_context)
+                wait = KernelCache.wait_for_helper
+                if data is None and wait is not None and wait(self._py_func.__qualname__):
+                    with self._guard_against_spurious_io_errors():
+                        data = self._load_overload(sig, target_context)
+            finally:
+                _loading.active = was
             return data
 
     class KernelDispatcher(CPUDispatcher):
@@ -213,6 +239,70 @@ def _make_classes():
 
 
 _twin_lock = threading.Lock()
+#: set while this thread reads a kernel back from whitted's cache (``KernelCache``)
+_loading = threading.local()
+
+
+def _link_later_class(base):
+    """Numba's JIT code library, read back from the cache without parsing its module for
+    linking until a compile links it (module docstring)."""
+    import llvmlite.binding as ll
+
+    class LinkLaterLibrary(base):
+        _linking_bitcode = None  # the module for linking, not parsed yet
+
+        @classmethod
+        def read_back(cls, codegen, state):
+            """Numba's ``_unserialize`` of machine code ("object"), the module for linking
+            left as bitcode."""
+            name, _, (object_code, linking_bitcode) = state
+            self = cls(codegen, name)
+            self.enable_object_caching()
+            self._set_compiled_object(object_code)
+            self._linking_bitcode = linking_bitcode
+            self._finalize_final_module()  # the machine code loaded, as Numba loads it
+            return self
+
+        def _parse_linking_module(self) -> None:
+            bitcode = self._linking_bitcode
+            if bitcode is not None:
+                self._shared_module = ll.parse_bitcode(bitcode)
+                # what Numba's read-back notes: the symbols it defines
+                self._codegen._engine._load_defined_symbols(self._shared_module)
+                self._linking_bitcode = None
+
+        def _get_module_for_linking(self):
+            self._parse_linking_module()  # a compile links this kernel in: parsed now
+            return super()._get_module_for_linking()
+
+        def get_pointer_to_function(self, name):
+            self._ensure_finalized()
+            if self._linking_bitcode is None:
+                return super().get_pointer_to_function(name)
+            # its symbols not noted yet: asked of the machine code loaded (0 when it does
+            # not define ``name``, as Numba answers)
+            return self._codegen._engine.get_function_address(name)
+
+    return LinkLaterLibrary
+
+
+def _read_back_lazily(codegen, link_later) -> None:
+    """Have ``codegen`` read whitted's kernels back with ``link_later`` (while
+    ``_loading.active``); everything else, and a codegen of another library class, as
+    Numba does."""
+    if getattr(codegen, "_whitted_link_later", False):
+        return
+    original = codegen.unserialize_library
+    library_class = codegen._library_class
+
+    def unserialize_library(serialized):
+        if (getattr(_loading, "active", False) and serialized[1] == "object"
+                and library_class is link_later.__mro__[1]):
+            return link_later.read_back(codegen, serialized)
+        return original(serialized)
+
+    codegen.unserialize_library = unserialize_library
+    codegen._whitted_link_later = True
 
 
 def kernel_cache_class():
