@@ -251,6 +251,72 @@ def test_kernels_read_back_link_into_a_later_compile(tmp_path):
     assert "PARSED BEFORE False" in warm  # read back, not linked yet
 
 
+EXTENSIONS = """
+from importlib import metadata
+
+scans = []
+real = metadata.entry_points
+
+
+def counted(*args, **kwargs):
+    scans.append(1)
+    return real(*args, **kwargs)
+
+
+metadata.entry_points = counted
+from whitted.jit import kernel, load_numba
+
+load_numba()
+
+
+@kernel(entry=True)
+def twice(x):
+    return 2.0 * x
+
+
+print("RESULT", twice(1.5), "SCANS", len(scans))
+"""
+
+
+@tuned_only
+def test_numba_extensions_are_looked_for_only_when_the_installed_ones_changed(tmp_path):
+    """The scan of every distribution's entry points for Numba extensions is skipped while
+    the kernel cache folder records none in the same, unchanged folders; a distribution
+    with a ``numba_extensions`` entry point installed (or removed) there is found at once,
+    and its ``init`` runs as Numba runs it."""
+    site = tmp_path / "site"
+    site.mkdir()
+    env = dict(os.environ, WHITTED_CACHE_DIR=str(tmp_path / "cache"),
+               PYTHONPATH=os.pathsep.join([str(site), str(Path(__file__).parents[1] / "src"),
+                                           os.environ.get("PYTHONPATH", "")]))
+    env.pop("NUMBA_CACHE_DIR", None)
+    (tmp_path / "run.py").write_text(EXTENSIONS)
+
+    def run() -> str:
+        done = subprocess.run([sys.executable, "run.py"], cwd=tmp_path, env=env,
+                              capture_output=True, text=True, timeout=600)
+        assert done.returncode == 0, done.stderr[-2000:]
+        assert "RESULT 3.0" in done.stdout
+        return done.stdout
+
+    first, second = run(), run()
+    assert "SCANS 1" in first and "SCANS 0" in second  # looked for once, then recorded
+    info = site / "fakeext-1.0.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: fakeext\nVersion: 1.0\n")
+    (info / "entry_points.txt").write_text("[numba_extensions]\ninit = fakeext_init:init\n")
+    (site / "fakeext_init.py").write_text("def init():\n    print('EXTENSION INIT')\n")
+    for out in (run(), run()):  # installed: found, and initialised in every process
+        assert "EXTENSION INIT" in out and "SCANS 0" not in out
+    (site / "fakeext_init.py").unlink()
+    for path in info.iterdir():
+        path.unlink()
+    info.rmdir()
+    gone, again = run(), run()
+    assert "EXTENSION INIT" not in gone + again
+    assert "SCANS 1" in gone and "SCANS 0" in again
+
+
 def test_private_names_are_listed_and_checked():
     """Every private name the tuned dispatcher uses is listed; a Numba outside the verified
     versions turns it off."""
@@ -260,7 +326,7 @@ def test_private_names_are_listed_and_checked():
         source = f.read()
     for name in ("get_call_template", "_load_overload", "rtsys.initialize", "_nrt",
                  "no_cpython_wrapper", "forceinline", "FunctionCache", "JITCodeLibrary",
-                 "_get_module_for_linking", "unserialize_library"):
+                 "_get_module_for_linking", "unserialize_library", "_already_initialized"):
         assert name in source.split("PRIVATE_NAMES = (", 1)[1].split(")\n", 1)[0], name
 
 

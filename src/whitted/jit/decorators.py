@@ -108,6 +108,11 @@ def load_numba() -> None:
                 config.SLP_VECTORIZE = 1
         from numba.core import event
 
+        from .dispatcher import skip_absent_extensions
+
+        state = prepare()
+        if state.own and not state.read_only and not state.helper:  # whitted's own folder
+            skip_absent_extensions(state.folder)
         event.register("numba:compile", _compile_listener())
         while _deferred:
             _deferred.pop(0)()
