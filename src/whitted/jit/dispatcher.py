@@ -51,6 +51,11 @@ What the tuned dispatcher does:
   modification times: a later process seeing the same folders unchanged (a distribution
   installed or removed changes its folder) skips the scan. Where there are extensions, or
   anything differs, Numba scans as usual.
+- **No NumPy masked arrays imported to type plain ones**: Numba's typing of an array
+  argument asks ``isinstance(value, np.ma.MaskedArray)``, and NumPy imports ``numpy.ma`` on
+  that first look (8-13 ms of every warm render). No masked array exists before ``numpy.ma``
+  is imported, so :func:`_typeof_array` asks only once it is; otherwise it types the array
+  as Numba does.
 - **The compile helper's share** (:attr:`KernelCache.wait_for_helper`, render/warm_up.py):
   on a cold compile, a kernel the helper process is compiling is waited for and loaded
   instead of being compiled twice.
@@ -80,6 +85,8 @@ PRIVATE_NAMES = (
     "_guard_against_spurious_io_errors (overridden), _cache_path, _py_func, _impl_class",
     "numba.core.runtime.rtsys.initialize",
     "numba.core.entrypoints._already_initialized (set: no extensions to initialise)",
+    "numba.core.typing.typeof._typeof_ndarray (replaced for np.ndarray in typeof_impl), "
+    "numba.np.numpy_support.from_dtype, map_layout",
     "numba.core.codegen.JITCodeLibrary (subclassed): _unserialize, enable_object_caching, "
     "_set_compiled_object, _finalize_final_module, _ensure_finalized, _get_module_for_linking "
     "(overridden), get_pointer_to_function (overridden), _shared_module, _codegen._engine "
@@ -147,6 +154,8 @@ def _make_classes():
     from numba.core.codegen import Codegen, JITCodeLibrary, JitEngine
     from numba.core.registry import CPUDispatcher
     from numba.core.runtime import rtsys
+    from numba.core.typing import typeof
+    from numba.np import numpy_support
 
     for owner, names in ((CPUDispatcher, ("get_call_template", "get_overload",
                                           "enable_caching")),
@@ -159,9 +168,12 @@ def _make_classes():
                                            "get_pointer_to_function")),
                          (Codegen, ("unserialize_library",)),
                          (JitEngine, ("_load_defined_symbols", "get_function_address")),
-                         (entrypoints, ("_already_initialized", "init_all"))):
+                         (entrypoints, ("_already_initialized", "init_all")),
+                         (typeof, ("_typeof_ndarray", "typeof_impl")),
+                         (numpy_support, ("from_dtype", "map_layout"))):
         for name in names:
             getattr(owner, name)  # AttributeError: not the Numba this was verified with
+    _type_arrays_without_numpy_ma(typeof.typeof_impl, numpy_support)
     link_later = _link_later_class(JITCodeLibrary)
 
     class KernelCache(FunctionCache):
@@ -253,6 +265,27 @@ def _make_classes():
 _twin_lock = threading.Lock()
 #: set while this thread reads a kernel back from whitted's cache (``KernelCache``)
 _loading = threading.local()
+
+
+def _type_arrays_without_numpy_ma(typeof_impl, numpy_support) -> None:
+    """Numba's typing of NumPy arrays, asking whether an array is masked only once
+    ``numpy.ma`` is imported (module docstring)."""
+    import numpy as np
+    from numba.core import errors, types
+
+    def _typeof_array(val, c):
+        ma = sys.modules.get("numpy.ma")
+        if ma is not None and isinstance(val, ma.MaskedArray):
+            raise errors.NumbaTypeError("Unsupported array type: numpy.ma.MaskedArray.")
+        try:
+            dtype = numpy_support.from_dtype(val.dtype)
+        except errors.NumbaNotImplementedError:
+            raise errors.NumbaValueError(f"Unsupported array dtype: {val.dtype}") from None
+        layout = numpy_support.map_layout(val)
+        readonly = not val.flags.writeable
+        return types.Array(dtype, val.ndim, layout, readonly=readonly)
+
+    typeof_impl.register(np.ndarray)(_typeof_array)
 
 
 #: the record, in the kernel cache folder, that no Numba extension is installed
