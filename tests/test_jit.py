@@ -301,20 +301,23 @@ def test_numba_extensions_are_looked_for_only_when_the_installed_ones_changed(tm
 
     first, second = run(), run()
     assert "SCANS 1" in first and "SCANS 0" in second  # looked for once, then recorded
-    info = site / "fakeext-1.0.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: fakeext\nVersion: 1.0\n")
-    (info / "entry_points.txt").write_text("[numba_extensions]\ninit = fakeext_init:init\n")
-    (site / "fakeext_init.py").write_text("def init():\n    print('EXTENSION INIT')\n")
-    for out in (run(), run()):  # installed: found, and initialised in every process
-        assert "EXTENSION INIT" in out and "SCANS 0" not in out
-    (site / "fakeext_init.py").unlink()
-    for path in info.iterdir():
-        path.unlink()
-    info.rmdir()
-    gone, again = run(), run()
-    assert "EXTENSION INIT" not in gone + again
-    assert "SCANS 1" in gone and "SCANS 0" in again
+    for where in (site, tmp_path):  # a folder of sys.path; the working folder (the script's)
+        info = where / "fakeext-1.0.dist-info"
+        info.mkdir()
+        (info / "METADATA").write_text("Metadata-Version: 2.1\nName: fakeext\nVersion: 1.0\n")
+        (info / "entry_points.txt").write_text("[numba_extensions]\ninit = fakeext_init:init\n")
+        (where / "fakeext_init.py").write_text("def init():\n    print('EXTENSION INIT')\n")
+        for out in (run(), run()):  # installed: found, and initialised in every process
+            assert "EXTENSION INIT" in out and "SCANS 0" not in out
+        (where / "fakeext_init.py").unlink()
+        for path in info.iterdir():
+            path.unlink()
+        info.rmdir()
+        gone, again = run(), run()  # removed: looked for again (or as first recorded)
+        assert "EXTENSION INIT" not in gone + again
+        assert "SCANS 0" in again
+    (tmp_path / "other files.txt").write_text("")  # the working folder's other files: no scan
+    assert "SCANS 0" in run()
 
 
 def test_private_names_are_listed_and_checked():

@@ -291,15 +291,27 @@ def _type_arrays_without_numpy_ma(typeof_impl, numpy_support) -> None:
 #: the record, in the kernel cache folder, that no Numba extension is installed
 EXTENSIONS_RECORD = "whitted-numba-extensions.json"
 RECORDS_KEPT = 8  # sys.path variants remembered
+DISTRIBUTION_SUFFIXES = (".dist-info", ".egg-info")
 
 
 def _path_stamps() -> list:
     """The folders distributions are found in (``sys.path``) with their modification times
-    and inodes (a distribution installed or removed there changes its folder's time)."""
-    stamps = []
+    and inodes (a distribution installed or removed there changes its folder's time); for
+    the working folder (``python -m``, ``-c``), whose time changes with every file made in
+    it, the names of the distributions in it."""
+    try:
+        cwd = os.getcwd()
+    except OSError:
+        cwd = None
+    stamps: list = []
     for entry in sys.path:
+        folder = entry or "."
         try:
-            st = os.stat(entry or ".")
+            if cwd is not None and os.path.abspath(folder) == cwd:
+                stamps.append([entry, sorted(e.name for e in os.scandir(folder)
+                                             if e.name.endswith(DISTRIBUTION_SUFFIXES))])
+                continue
+            st = os.stat(folder)
         except OSError:
             stamps.append([entry])
         else:
