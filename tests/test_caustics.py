@@ -259,6 +259,17 @@ def test_a_photon_map_too_big_for_memory_is_refused():
         check_photon_memory(CausticsSettings(photons=50_000_000, passes=4096))
 
 
+def test_the_photon_maps_memory_counts_each_threads_slots_not_every_photons():
+    """1,000,000 photons on 2 threads: 16 calls of 62,500 photons, each thread's 6 slots of
+    40 bytes for the photons of one call (30,000,000 bytes), a pass's counts (4,000,000), the
+    photons stored, three copies of 40 bytes and 16 bytes of keys and table each
+    (136,000,000). On one thread: 8 calls of 125,000 photons, the same 30,000,000 bytes of
+    slots; two passes store twice the photons."""
+    assert check_photon_memory(CausticsSettings(photons=1_000_000), threads=2) == 170_000_000
+    assert check_photon_memory(CausticsSettings(photons=1_000_000, passes=2), threads=1) \
+        == 30_000_000 + 4_000_000 + 272_000_000
+
+
 def test_disk_light_casts_a_soft_caustic_of_the_same_power():
     point = [{"type": "point", "position": [0, 6, 0], "intensity": 1.0,
               "falloff": "inverse_square"}]

@@ -280,12 +280,20 @@ def fitted_radius(positions: np.ndarray, guess: float,
     return r
 
 
+def chunk_bounds(photons: int, threads: int) -> np.ndarray:
+    """Where the tracer's calls of a pass start and end: 8 calls a thread (they balance the
+    load), each of CHUNK_MIN to CHUNK_MAX photons."""
+    chunks = max(1, min(8 * threads, -(-photons // CHUNK_MIN)), -(-photons // CHUNK_MAX))
+    return np.linspace(0, photons, chunks + 1).astype(np.int64)
+
+
 def check_photon_memory(settings: CausticsSettings, threads: int = 1) -> int:
-    """The bytes a photon map of these settings may take (each pass's output slots and
-    counts; the photons stored, one per photon shot on average, three copies while the grid
-    is sorted, their cell keys and two hash-table rows each);
+    """The bytes a photon map of these settings may take (each thread's output slots for
+    its calls, a pass's counts; the photons stored, one per photon shot on average, three
+    copies while the grid is sorted, their cell keys and two hash-table rows each);
     :class:`SceneError` naming the key when that is more than half the memory available."""
-    need = (settings.photons * (SLOTS * PHOTON_BYTES + 4)
+    widest = int(np.diff(chunk_bounds(settings.photons, threads)).max())
+    need = (threads * widest * SLOTS * PHOTON_BYTES + settings.photons * 4
             + settings.photons * settings.passes * (3 * PHOTON_BYTES + 8 + 8))
     from ..files.memory import memory_room
 
@@ -397,9 +405,8 @@ def shoot_pass(compiled: CompiledScene, rows: np.ndarray, clear: np.ndarray,
     settings[SET_EPSILON] = params.epsilon
     settings[SET_SLOTS] = SLOTS
     counts = np.zeros(photons, np.int32)
-    # 8 calls a thread (they balance the load), each of CHUNK_MIN to CHUNK_MAX photons
-    chunks = max(1, min(8 * threads, -(-photons // CHUNK_MIN)), -(-photons // CHUNK_MAX))
-    bounds = np.linspace(0, photons, chunks + 1).astype(np.int64)
+    bounds = chunk_bounds(photons, threads)
+    chunks = len(bounds) - 1
     widest = int(np.diff(bounds).max())
     # each thread's call writes its photons' slots into rows of its own, used again by its
     # next call (not one row block for every photon of the pass: 48 MB to fault in at
