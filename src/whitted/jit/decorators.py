@@ -108,11 +108,9 @@ def load_numba() -> None:
                 config.SLP_VECTORIZE = 1
         from numba.core import event
 
-        from .dispatcher import skip_absent_extensions
+        from .array_typing import install as type_arrays_without_numpy_ma
 
-        state = prepare()
-        if state.own and not state.read_only and not state.helper:  # whitted's own folder
-            skip_absent_extensions(state.folder)
+        type_arrays_without_numpy_ma()
         event.register("numba:compile", _compile_listener())
         while _deferred:
             _deferred.pop(0)()

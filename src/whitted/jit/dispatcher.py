@@ -36,26 +36,6 @@ What the tuned dispatcher does:
   allocate nothing) not even that: the runtime's functions are compiled by LLVM in the
   process that first needs them (20-40 ms), which a warm render of analytic shapes never
   does. A compile after a miss refreshes them itself.
-- **Machine code read back without its module for linking**: a kernel's cache entry holds its
-  machine code and the LLVM bitcode of its module, which Numba parses at every load (and
-  walks for its symbols) only so that a kernel compiled later in the process can link it in.
-  A warm render compiles nothing: :class:`LinkLaterLibrary` keeps the bitcode unparsed until
-  a compile links the kernel (28 ms of LLVM parsing and 8 ms of symbol walks in a warm
-  caustics render's eight kernels, AMD EPYC); the machine code itself is loaded as Numba
-  loads it, and its entry points are looked up in it.
-- **No scan for Numba extensions that are not there**: before its first dispatcher Numba runs
-  the ``numba_extensions`` entry points of every installed distribution, which means reading
-  the entry points of all of them (107 files, some 500 system calls and 6 ms in the
-  development environment). :func:`skip_absent_extensions` records in the kernel cache
-  folder that the scan found none, with the folders it looked in (``sys.path``) and their
-  modification times: a later process seeing the same folders unchanged (a distribution
-  installed or removed changes its folder) skips the scan. Where there are extensions, or
-  anything differs, Numba scans as usual.
-- **No NumPy masked arrays imported to type plain ones**: Numba's typing of an array
-  argument asks ``isinstance(value, np.ma.MaskedArray)``, and NumPy imports ``numpy.ma`` on
-  that first look (8-13 ms of every warm render). No masked array exists before ``numpy.ma``
-  is imported, so :func:`_typeof_array` asks only once it is; otherwise it types the array
-  as Numba does.
 - **The compile helper's share** (:attr:`KernelCache.wait_for_helper`, render/warm_up.py):
   on a cold compile, a kernel the helper process is compiling is waited for and loaded
   instead of being compiled twice.
@@ -65,7 +45,6 @@ from __future__ import annotations
 
 import contextlib
 import os
-import sys
 import threading
 import types as pytypes
 
@@ -84,14 +63,6 @@ PRIVATE_NAMES = (
     "numba.core.caching.FunctionCache (subclassed): load_overload, _load_overload, "
     "_guard_against_spurious_io_errors (overridden), _cache_path, _py_func, _impl_class",
     "numba.core.runtime.rtsys.initialize",
-    "numba.core.entrypoints._already_initialized (set: no extensions to initialise)",
-    "numba.core.typing.typeof._typeof_ndarray (replaced for np.ndarray in typeof_impl), "
-    "numba.np.numpy_support.from_dtype, map_layout",
-    "numba.core.codegen.JITCodeLibrary (subclassed): _unserialize, enable_object_caching, "
-    "_set_compiled_object, _finalize_final_module, _ensure_finalized, _get_module_for_linking "
-    "(overridden), get_pointer_to_function (overridden), _shared_module, _codegen._engine "
-    "(_load_defined_symbols, get_function_address); a codegen's unserialize_library and "
-    "_library_class",
     "target options _nrt, no_cpython_wrapper, no_cfunc_wrapper, forceinline",
     "numba.np.arrayobj.make_array, populate_array (frame_view: an array over stack slots "
     "without the runtime, which numba.carray needs)",
@@ -149,32 +120,17 @@ def widen_integer(ty):
 
 
 def _make_classes():
-    from numba.core import entrypoints
     from numba.core.caching import FunctionCache
-    from numba.core.codegen import Codegen, JITCodeLibrary, JitEngine
     from numba.core.registry import CPUDispatcher
     from numba.core.runtime import rtsys
-    from numba.core.typing import typeof
-    from numba.np import numpy_support
 
     for owner, names in ((CPUDispatcher, ("get_call_template", "get_overload",
                                           "enable_caching")),
                          (FunctionCache, ("load_overload", "_load_overload",
                                           "_guard_against_spurious_io_errors")),
-                         (rtsys, ("initialize",)),
-                         (JITCodeLibrary, ("_unserialize", "enable_object_caching",
-                                           "_set_compiled_object", "_finalize_final_module",
-                                           "_ensure_finalized", "_get_module_for_linking",
-                                           "get_pointer_to_function")),
-                         (Codegen, ("unserialize_library",)),
-                         (JitEngine, ("_load_defined_symbols", "get_function_address")),
-                         (entrypoints, ("_already_initialized", "init_all")),
-                         (typeof, ("_typeof_ndarray", "typeof_impl")),
-                         (numpy_support, ("from_dtype", "map_layout"))):
+                         (rtsys, ("initialize",))):
         for name in names:
             getattr(owner, name)  # AttributeError: not the Numba this was verified with
-    _type_arrays_without_numpy_ma(typeof.typeof_impl, numpy_support)
-    link_later = _link_later_class(JITCodeLibrary)
 
     class KernelCache(FunctionCache):
         """Numba's on-disk cache of one kernel, waiting for the compile helper when it is
@@ -207,19 +163,13 @@ def _make_classes():
         def load_overload(self, sig, target_context):
             if self.runtime:  # what loading needs of Numba's refresh
                 rtsys.initialize(target_context)
-            _read_back_lazily(target_context.codegen(), link_later)
             data = None
-            was = getattr(_loading, "active", False)
-            _loading.active = True  # (under Numba's compiler lock, as every load)
-            try:
+            with self._guard_against_spurious_io_errors():
+                data = self._load_overload(sig, target_context)
+            wait = KernelCache.wait_for_helper
+            if data is None and wait is not None and wait(self._py_func.__qualname__):
                 with self._guard_against_spurious_io_errors():
                     data = self._load_overload(sig, target_context)
-                wait = KernelCache.wait_for_helper
-                if data is None and wait is not None and wait(self._py_func.__qualname__):
-                    with self._guard_against_spurious_io_errors():
-                        data = self._load_overload(sig, target_context)
-            finally:
-                _loading.active = was
             return data
 
     class KernelDispatcher(CPUDispatcher):
@@ -263,165 +213,6 @@ def _make_classes():
 
 
 _twin_lock = threading.Lock()
-#: set while this thread reads a kernel back from whitted's cache (``KernelCache``)
-_loading = threading.local()
-
-
-def _type_arrays_without_numpy_ma(typeof_impl, numpy_support) -> None:
-    """Numba's typing of NumPy arrays, asking whether an array is masked only once
-    ``numpy.ma`` is imported (module docstring)."""
-    import numpy as np
-    from numba.core import errors, types
-
-    def _typeof_array(val, c):
-        ma = sys.modules.get("numpy.ma")
-        if ma is not None and isinstance(val, ma.MaskedArray):
-            raise errors.NumbaTypeError("Unsupported array type: numpy.ma.MaskedArray.")
-        try:
-            dtype = numpy_support.from_dtype(val.dtype)
-        except errors.NumbaNotImplementedError:
-            raise errors.NumbaValueError(f"Unsupported array dtype: {val.dtype}") from None
-        layout = numpy_support.map_layout(val)
-        readonly = not val.flags.writeable
-        return types.Array(dtype, val.ndim, layout, readonly=readonly)
-
-    typeof_impl.register(np.ndarray)(_typeof_array)
-
-
-#: the record, in the kernel cache folder, that no Numba extension is installed
-EXTENSIONS_RECORD = "whitted-numba-extensions.json"
-RECORDS_KEPT = 8  # sys.path variants remembered
-DISTRIBUTION_SUFFIXES = (".dist-info", ".egg-info")
-
-
-def _path_stamps() -> list:
-    """The folders distributions are found in (``sys.path``) with their modification times
-    and inodes (a distribution installed or removed there changes its folder's time); for
-    the working folder (``python -m``, ``-c``), whose time changes with every file made in
-    it, the names of the distributions in it."""
-    try:
-        cwd = os.getcwd()
-    except OSError:
-        cwd = None
-    stamps: list = []
-    for entry in sys.path:
-        folder = entry or "."
-        try:
-            if cwd is not None and os.path.abspath(folder) == cwd:
-                stamps.append([entry, sorted(e.name for e in os.scandir(folder)
-                                             if e.name.endswith(DISTRIBUTION_SUFFIXES))])
-                continue
-            st = os.stat(folder)
-        except OSError:
-            stamps.append([entry])
-        else:
-            stamps.append([entry, st.st_mtime_ns, st.st_ino])
-    return stamps
-
-
-def skip_absent_extensions(folder: str | None) -> bool:
-    """Before Numba's first dispatcher (tuned only): mark Numba's extensions initialised when
-    ``folder`` (the kernel cache folder) records that there are none in these very folders
-    (module docstring); otherwise look for them once and record what was found. True when
-    Numba's own scan was spared."""
-    if not tuned() or folder is None:
-        return False
-    import json
-    from importlib import metadata
-
-    from numba.core import entrypoints
-
-    if entrypoints._already_initialized:
-        return False
-    path = os.path.join(folder, EXTENSIONS_RECORD)
-    stamps = _path_stamps()
-    try:
-        with open(path, "rb") as f:
-            records = json.loads(f.read())
-    except (OSError, ValueError):
-        records = []
-    # one record a sys.path: "whitted" and "python -m whitted" (or the compile helper) see
-    # other first folders (the script's, the working folder)
-    records = [r for r in records if isinstance(r, dict)] if isinstance(records, list) else []
-    if any(r.get("paths") == stamps and r.get("extensions") == 0 for r in records):
-        entrypoints._already_initialized = True
-        return True
-    found = len(metadata.entry_points().select(group="numba_extensions", name="init"))
-    if found == 0:
-        entrypoints._already_initialized = True  # what Numba's scan would have found
-    records = [r for r in records if r.get("paths") != stamps][-(RECORDS_KEPT - 1):]
-    records.append({"paths": stamps, "extensions": found})
-    tmp = f"{path}.{os.getpid()}.tmp"
-    try:
-        with open(tmp, "w") as f:
-            json.dump(records, f)
-        os.replace(tmp, path)
-    except OSError:  # a folder that cannot take it: scanned again next time
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-    return False
-
-
-def _link_later_class(base):
-    """Numba's JIT code library, read back from the cache without parsing its module for
-    linking until a compile links it (module docstring)."""
-    import llvmlite.binding as ll
-
-    class LinkLaterLibrary(base):
-        _linking_bitcode = None  # the module for linking, not parsed yet
-
-        @classmethod
-        def read_back(cls, codegen, state):
-            """Numba's ``_unserialize`` of machine code ("object"), the module for linking
-            left as bitcode."""
-            name, _, (object_code, linking_bitcode) = state
-            self = cls(codegen, name)
-            self.enable_object_caching()
-            self._set_compiled_object(object_code)
-            self._linking_bitcode = linking_bitcode
-            self._finalize_final_module()  # the machine code loaded, as Numba loads it
-            return self
-
-        def _parse_linking_module(self) -> None:
-            bitcode = self._linking_bitcode
-            if bitcode is not None:
-                self._shared_module = ll.parse_bitcode(bitcode)
-                # what Numba's read-back notes: the symbols it defines
-                self._codegen._engine._load_defined_symbols(self._shared_module)
-                self._linking_bitcode = None
-
-        def _get_module_for_linking(self):
-            self._parse_linking_module()  # a compile links this kernel in: parsed now
-            return super()._get_module_for_linking()
-
-        def get_pointer_to_function(self, name):
-            self._ensure_finalized()
-            if self._linking_bitcode is None:
-                return super().get_pointer_to_function(name)
-            # its symbols not noted yet: asked of the machine code loaded (0 when it does
-            # not define ``name``, as Numba answers)
-            return self._codegen._engine.get_function_address(name)
-
-    return LinkLaterLibrary
-
-
-def _read_back_lazily(codegen, link_later) -> None:
-    """Have ``codegen`` read whitted's kernels back with ``link_later`` (while
-    ``_loading.active``); everything else, and a codegen of another library class, as
-    Numba does."""
-    if getattr(codegen, "_whitted_link_later", False):
-        return
-    original = codegen.unserialize_library
-    library_class = codegen._library_class
-
-    def unserialize_library(serialized):
-        if (getattr(_loading, "active", False) and serialized[1] == "object"
-                and library_class is link_later.__mro__[1]):
-            return link_later.read_back(codegen, serialized)
-        return original(serialized)
-
-    codegen.unserialize_library = unserialize_library
-    codegen._whitted_link_later = True
 
 
 def kernel_cache_class():
