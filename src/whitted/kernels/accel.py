@@ -22,6 +22,7 @@ from .extras import (
 from .features import has_extras, has_instances, instances_possible
 from .layout import (
     MAT_KT,
+    MESH_NORMALS,
     MESH_STACK_BASE,
     PRIM_MATERIAL,
     PRIM_TYPE,
@@ -176,11 +177,15 @@ def surface_normals(geo, prim, tri, b1, b2, p):
                 ns = flipped_if_extras(geo, prim, ns)
             return n, ns
         return n, n
-    ng, ns = mesh_normals_if_instances(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
+    mesh = int(geo.prim_params[prim, 0])
+    ng, ns = mesh_normals_if_instances(geo, mesh, tri, b1, b2)
     xf = geo.prim_info[prim, PRIM_XFORM]
     if xf < 0:
         return ng, ns
-    return _normal_to_world(geo.xforms, xf, ng), _normal_to_world(geo.xforms, xf, ns)
+    wg = _normal_to_world(geo.xforms, xf, ng)
+    if geo.mesh_info[mesh, MESH_NORMALS] < 0:  # flat shading: ns is ng, mapped once
+        return wg, wg
+    return wg, _normal_to_world(geo.xforms, xf, ns)
 
 
 @kernel(inline="always")
