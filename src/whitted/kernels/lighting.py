@@ -19,7 +19,7 @@ from .accel import (
 from .csg import csg_surfaces
 from .extras import body_medium
 from .features import extras_possible, has_extras, has_instances, instances_possible
-from .hit_list import keep_nearest
+from .hit_list import MAX_SHADOW_HITS, keep_nearest
 from .layout import (
     CELL_COUNT,
     CELL_FIRST,
@@ -51,13 +51,16 @@ from .layout import (
     PRIM_TYPE,
     PRIM_XFORM,
     RAY_SHADOW,
+    SHAPE_SPHERE,
+    SHAPE_TRIANGLE,
 )
 from .light_buffer import cube_cell
 from .media import absorbed, media_enter, media_leave
 from .mesh import OPAQUE_KT
-from .sampling import concentric_disk, random_pair, stratum
+from .sampling import SAMPLE_CHUNK, stratified_disk, stratum
 from .shapes import INF
 from .shapes.dispatch import crossed_twice, is_csg_object, is_extra, is_world_plane
+from .shapes.flat import EDGE_TOL
 from .traverse import (
     box_entry,
     cone_meets_box,
@@ -65,7 +68,7 @@ from .traverse import (
     next_scene_candidate,
     start_scene_walk,
 )
-from .vec import dot, madd, normalize, sub, vload
+from .vec import cross, dot, madd, normalize, sub, vload
 
 
 @kernel
@@ -141,6 +144,10 @@ MIN_BUNDLE_SAMPLES = 4  # area lights with fewer samples per point skip the bund
 # is below this, per channel, is left out without a shadow ray: far below a float32 pixel's
 # own precision at any visible brightness (2**-24 of the value) and 16-bit output's step
 NEGLIGIBLE_LIGHT = 1e-15
+# an area light's points on its disk, drawn ahead of their shadow rays, wait in the shadow
+# rays' hits buffer past its MAX_SHADOW_HITS (t, primitive) pairs: SAMPLE_CHUNK (x, y) pairs
+DISK_POINTS = 2 * MAX_SHADOW_HITS
+HITS_BUFFER = DISK_POINTS + 2 * SAMPLE_CHUNK  # the length of a lane's hits buffer
 
 
 @kernel
@@ -185,8 +192,88 @@ def list_bundle_occluders(geo, mats, p, centre, radius, tmin, stack, listed):
         listed[n] = i
         n += 1
         opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
-    return list_cone_leaves(geo, mats, p, sub(centre, p), radius * (1.0 + 1e-7) + 1e-12, stack,
-                            listed, n, SHADOW_LIST_CAP, opaque)
+    n, opaque = list_cone_leaves(geo, mats, p, sub(centre, p), radius * (1.0 + 1e-7) + 1e-12,
+                                 stack, listed, n, SHADOW_LIST_CAP, opaque)
+    if n <= 0:
+        return n, opaque
+    return _keep_bundle_occluders(geo, mats, p, centre, radius, listed, n)
+
+
+# a ball is kept in a bundle's list when it comes within this much more than its radius of
+# the bundle (relative to the radius, and to the bundle's length): far more than the
+# rounding of the tests that could find it hit (a ray passing farther than this outside a
+# sphere has a discriminant below -1e-12 of its squared distances: no rounding makes it a hit)
+BALL_SLACK = 1e-6
+
+
+@kernel
+def ball_meets_bundle(c, r, p, axis, length, sin_a, cos_a, reach):
+    """Could a segment from ``p`` to a point of the light's ball meet the ball of radius ``r``
+    around ``c``? Those segments lie in the cone from apex ``p`` along ``axis`` (unit
+    direction times ``length``) of half-angle ``a`` (its sine and cosine) cut at ``reach``
+    from the apex: the ball is tested against that solid cone, with BALL_SLACK to spare."""
+    v = sub(c, p)
+    along = dot(v, axis) / length
+    side = cross(v, axis)
+    q = math.sqrt(dot(side, side)) / length  # the distance of c from the cone's axis
+    r = r * (1.0 + BALL_SLACK) + BALL_SLACK * reach
+    if along - r > reach:
+        return False  # beyond the light
+    off = q * cos_a - along * sin_a  # c's distance from the cone's side (inside: <= 0)
+    if off <= r:
+        if along * cos_a + q * sin_a >= 0.0:
+            return True  # within r of the side, or inside
+        return dot(v, v) <= r * r  # behind the apex: the apex is its nearest point
+    return False
+
+
+@kernel
+def triangle_ball(P, i):
+    """(centre, radius) of a ball holding triangle row ``i`` and every point its hit test
+    can find (:func:`.shapes.triangle.intersect_triangle` allows EDGE_TOL past its edges)."""
+    v0 = vload(P, i, 0)
+    e1 = vload(P, i, 3)
+    e2 = vload(P, i, 6)
+    c = madd(v0, (e1[0] + e2[0], e1[1] + e2[1], e1[2] + e2[2]), 1.0 / 3.0)
+    a = sub(v0, c)
+    b = sub(madd(v0, e1, 1.0), c)
+    d = sub(madd(v0, e2, 1.0), c)
+    far = math.sqrt(max(dot(a, a), max(dot(b, b), dot(d, d))))  # the farthest corner
+    return c, far + 4.0 * EDGE_TOL * (math.sqrt(dot(e1, e1)) + math.sqrt(dot(e2, e2)))
+
+
+@kernel
+def _keep_bundle_occluders(geo, mats, p, centre, radius, listed, n):
+    """Of ``listed[:n]`` (a bundle's list from its BVH leaves) keep, in order, those that a
+    ray of the bundle could meet: spheres and triangles whose own bounding ball misses the
+    bundle's cone (:func:`ball_meets_bundle`) are left out, every other shape is kept.
+    Returns (the count kept, whether all kept are opaque)."""
+    axis = sub(centre, p)
+    length = math.sqrt(dot(axis, axis))
+    grown = radius * (1.0 + BALL_SLACK) + 1e-12
+    near = length <= 2.0 * grown  # the point is (nearly) within the light's ball: keep all
+    sin_a = grown / length if not near else 0.0
+    cos_a = math.sqrt(1.0 - sin_a * sin_a)
+    reach = length + grown
+    kept = 0
+    opaque = True
+    P = geo.prim_params
+    for k in range(n):
+        i = listed[k]
+        meets = True
+        typ = geo.prim_info[i, PRIM_TYPE]
+        if not near and geo.prim_info[i, PRIM_XFORM] < 0:  # its numbers are in world space
+            if typ == SHAPE_SPHERE:
+                meets = ball_meets_bundle(vload(P, i, 0), P[i, 3], p, axis, length, sin_a,
+                                           cos_a, reach)
+            elif typ == SHAPE_TRIANGLE:
+                c, r = triangle_ball(P, i)
+                meets = ball_meets_bundle(c, r, p, axis, length, sin_a, cos_a, reach)
+        if meets:
+            listed[kept] = i
+            kept += 1
+            opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
+    return kept, opaque
 
 
 @kernel(inline="always")
@@ -456,10 +543,11 @@ def direct_light(
         cx = -1
         cy = 0
         for _s in range(n_samples):
-            cx += 1
-            if cx == m_cols:
-                cx = 0
-                cy += 1
+            chunk = _s % SAMPLE_CHUNK
+            if kind == LIGHT_DISK and chunk == 0:  # the next points of the disk, drawn ahead
+                dim, cx, cy = stratified_disk(params.seed, rng[0], rng[1], dim, cx, cy, m_cols,
+                                              m_rows, min(SAMPLE_CHUNK, n_samples - _s), hits,
+                                              DISK_POINTS)
             # one shadow ray per sample (one call site: the shadow code is inlined once)
             if kind == LIGHT_DIRECTIONAL:
                 travel = vload(table, j, LIGHT_DIRECTION)
@@ -471,11 +559,8 @@ def direct_light(
             else:
                 target = centre
                 if kind == LIGHT_DISK:
-                    ju, jw = random_pair(params.seed, rng[0], rng[1], dim)
-                    u = (cx + ju) / m_cols
-                    w = (cy + jw) / m_rows
-                    dim += 2
-                    dx, dy = concentric_disk(u, w)
+                    dx = hits[DISK_POINTS + 2 * chunk]
+                    dy = hits[DISK_POINTS + 2 * chunk + 1]
                     rad = table[j, LIGHT_RADIUS]
                     target = madd(madd(centre, vload(table, j, LIGHT_DISK_U), dx * rad),
                                   vload(table, j, LIGHT_DISK_V), dy * rad)
