@@ -63,6 +63,15 @@ def hit_analytic(geo, i, o, d, tmin, tmax):
     return intersect_local(typ, geo.prim_params, i, o, d, tmin, tmax)
 
 
+@kernel(inline="always")
+def hit_part(geo, i, o, d, inv, tmin, tmax):
+    """(t, the primitive whose surface it is) for analytic primitive ``i``: ``i`` itself, or
+    for a CSG object the leaf whose surface shows (``inv``: the ray's inverse direction)."""
+    if has_extras(geo) and is_csg_object(geo.prim_info[i, PRIM_TYPE]):
+        return csg_hit_if_extras(geo, i, o, d, inv, tmin, tmax)
+    return hit_analytic(geo, i, o, d, tmin, tmax), np.int64(i)
+
+
 @kernel
 def hit_instance(geo, i, o, d, inv, tmin, tmax, stack):
     """(t, triangle, b1, b2) of the ray with mesh instance ``i``; t = INF on a miss. ``inv``
@@ -157,6 +166,17 @@ def surface_normals(geo, prim, tri, b1, b2, p):
     return _normal_to_world(geo.xforms, xf, ng), _normal_to_world(geo.xforms, xf, ns)
 
 
+@kernel(inline="always")
+def geometric_normal(geo, prim, tri, b1, b2, p):
+    """The geometric unit normal of :func:`surface_normals`, without the shading one: what
+    decides whether a ray enters or leaves a body (a smooth triangle's blended normal is not
+    computed)."""
+    if tri < 0:
+        return world_normal(geo, prim, p)
+    n, _ = surface_normals(geo, prim, tri, b1, b2, p)
+    return n
+
+
 @kernel
 def closest_instance_hit(geo, o, d, inv, tmin, tmax, stack):
     """Nearest mesh-instance hit in (tmin, tmax), as :func:`closest_hit` returns it
@@ -211,9 +231,8 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
     ``stack`` is caller-owned int32 scratch space (BVH_STACK entries: layout.py).
 
     First the analytic shapes (the unbounded ones, then the BVH's leaves, through one call
-    site of the intersection routines; a CSG object's hit is the leaf whose surface shows),
-    then, only when the scene has meshes, the mesh instances' own BVH up to the nearest hit
-    so far."""
+    site of the intersection routines), then, only when the scene has meshes, the mesh
+    instances' own BVH up to the nearest hit so far."""
     best_t = tmax
     best = -1
     inv = inverse_direction(d)
@@ -223,12 +242,7 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
                                                          leaf, leaf_end, top, True)
         if i < 0:
             break
-        if has_extras(geo) and is_csg_object(geo.prim_info[i, PRIM_TYPE]):
-            # a CSG object: the leaf whose surface shows
-            t, part = csg_hit_if_extras(geo, i, o, d, inv, tmin, best_t)
-        else:
-            t = hit_analytic(geo, i, o, d, tmin, best_t)
-            part = np.int64(i)
+        t, part = hit_part(geo, i, o, d, inv, tmin, best_t)
         if t < best_t:
             best_t = t
             best = part

@@ -9,12 +9,11 @@ import math
 from ..jit import kernel, overload
 from .accel import (
     closest_hit,
+    geometric_normal,
     hit_analytic,
     hit_material,
     instance_occludes,
     occludes,
-    surface_normals,
-    world_normal,
 )
 from .csg import csg_surfaces
 from .extras import body_medium
@@ -346,12 +345,7 @@ def _pass_surface(geo, mats, prim, tri, b1, b2, o, d, t, scratch, count, trans):
     kt = mats[m, MAT_KT]
     entering = True
     if geo.prim_info[prim, PRIM_SOLID]:
-        # the geometric normal (a smooth triangle's blended one plays no part here)
-        p = madd(o, d, t)
-        if tri < 0:
-            n = world_normal(geo, prim, p)
-        else:
-            n, _ = surface_normals(geo, prim, tri, b1, b2, p)
+        n = geometric_normal(geo, prim, tri, b1, b2, madd(o, d, t))
         entering = dot(d, n) < 0.0
         body = body_medium(geo, prim, m)  # a CSG object is one body (extras.py)
         if entering:
