@@ -31,6 +31,7 @@ from ..kernels.layout import (
 from ..scene.materials import Material
 from ..scene.scene import Scene
 from ..scene.shapes import CSG, Mesh
+from .bvh_frame import choose_frame, rotation_of
 from .csg import add_csg
 from .embree import attach_embree
 from .geometry import box_corners, corners_bounds
@@ -103,6 +104,7 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
     warnings: list[str] = []
     instanced = 0
     flat = 0
+    rotations: list[tuple[int, np.ndarray]] = []  # (triangles, rotation) of flattened meshes
 
     def source_of(obj_index: int, shape: Mesh) -> MeshSource:
         key = geometry_key(scene, shape)
@@ -138,6 +140,9 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
             src, rows = sources[key]
             if uses[key] * len(src.faces) <= flatten_limit:
                 added = add_flat_mesh(b, meshes, src, rows, shape, m, override, obj_index)
+                turn = rotation_of(m)
+                if added and turn is not None:
+                    rotations.append((added, turn))
                 flat += added
                 instanced += added
                 continue
@@ -188,7 +193,12 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
     bounded = np.flatnonzero(finite & ~is_instance).astype(np.int32)
     instances = np.flatnonzero(is_instance).astype(np.int32)
     unbounded = np.flatnonzero(~finite & walked)
-    bvh = cached_build_bvh(lo[bounded], hi[bounded])
+    # the scene BVH's boxes in the orientation of its biggest flattened mesh, where that makes
+    # them smaller (bvh_frame.py)
+    bvh_frame, frame_lo, frame_hi = choose_frame(rotations, prim_type[bounded],
+                                                 params[bounded], prim_xform[bounded],
+                                                 lo[bounded], hi[bounded])
+    bvh = cached_build_bvh(frame_lo, frame_hi)
     inst_bvh = cached_build_bvh(lo[instances], hi[instances])
     prim_info = np.empty((len(prim_type), N_PRIM_INFO), np.int32)
     prim_info[:, PRIM_TYPE] = prim_type
@@ -217,6 +227,7 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
         node_link=node_link,
         node_wide=wide_nodes(bvh),
         node_prims=np.ascontiguousarray(bounded[bvh.prim_order], dtype=np.int32),
+        bvh_frame=bvh_frame,
         unbounded=unbounded.astype(EXTRAS_DTYPE if general else np.int32),
         inst_box=inst_box,
         inst_link=inst_link,

@@ -59,6 +59,8 @@ from .shapes import INF
 from .shapes.dispatch import crossed_twice, is_csg_object, is_extra, is_world_plane
 from .traverse import (
     box_entry,
+    bvh_frame_point,
+    bvh_frame_ray,
     cone_meets_box,
     inverse_direction,
     next_scene_candidate,
@@ -116,9 +118,10 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
     of the intersection routines), then the mesh instances when there are any."""
     seen_transparent = 0
     inv = inverse_direction(d)
+    fo, finv = bvh_frame_ray(geo, o, d, inv)  # the ray the boxes see
     j, leaf, leaf_end, top = start_scene_walk(geo, stack, False)
     while True:
-        i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, tmax, stack, j,
+        i, j, leaf, leaf_end, top = next_scene_candidate(geo, fo, finv, tmin, tmax, stack, j,
                                                          leaf, leaf_end, top, False)
         if i < 0:
             break
@@ -197,6 +200,8 @@ def list_cone_leaves(geo, mats, apex, axis, radius, stack, out, n, cap, opaque):
     be more than ``cap``."""
     if geo.node_box.shape[0] == 0:
         return n, opaque
+    apex = bvh_frame_point(geo, apex)  # the cone as the boxes see it (rotation keeps radius)
+    axis = bvh_frame_point(geo, axis)
     top = 0
     stack[0] = 0
     while top >= 0:
@@ -236,6 +241,7 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
     n = 0
     full = n < 0  # False, typed bool: a literal False compiles keep_nearest twice
     inv = inverse_direction(d)
+    fo, finv = bvh_frame_ray(geo, o, d, inv)  # the ray the boxes see
     j, leaf, leaf_end, top = start_scene_walk(geo, stack, False)
     k = 0
     while True:
@@ -245,7 +251,7 @@ def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, list
             i = listed[list_first + k]
             k += 1
         else:
-            i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, tmax, stack,
+            i, j, leaf, leaf_end, top = next_scene_candidate(geo, fo, finv, tmin, tmax, stack,
                                                              j, leaf, leaf_end, top, False)
             if i < 0:
                 break
