@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels.layout import SHAPE_TRIANGLE
+from ..kernels.layout import SHAPE_SPHERE, SHAPE_TRIANGLE
 
 MIN_GAIN = 0.8  # a frame is taken when its boxes' summed area is at most this of the world's
 FRAME_PAD = 1e-9  # each turned box is widened by this times the scene's largest coordinate
@@ -54,8 +54,8 @@ def frame_bounds(frame: np.ndarray, prim_type: np.ndarray, params: np.ndarray,
                  pad: float) -> tuple[np.ndarray, np.ndarray]:
     """Boxes in the frame turned by ``frame`` (3x3) of the primitives whose world boxes are
     ``lo``, ``hi`` (rows of finite bounds): a world-space triangle's from its three corners,
-    any other primitive's from the eight corners of its world box (which holds it); each
-    widened by ``pad``."""
+    a world-space ball's around its turned centre, any other primitive's from the eight
+    corners of its world box (which holds it); each widened by ``pad``."""
     corners = np.empty((len(lo), 8, 3))
     for k in range(8):
         corners[:, k, 0] = np.where(k & 1, hi[:, 0], lo[:, 0])
@@ -68,7 +68,15 @@ def frame_bounds(frame: np.ndarray, prim_type: np.ndarray, params: np.ndarray,
         corners[tri] = np.concatenate(
             [tri_corners, np.repeat(tri_corners[:, :1], 5, axis=1)], axis=1)
     turned = corners @ frame.T
-    return turned.min(axis=1) - pad, turned.max(axis=1) + pad
+    f_lo = turned.min(axis=1) - pad
+    f_hi = turned.max(axis=1) + pad
+    ball = np.flatnonzero((prim_type == SHAPE_SPHERE) & (prim_xform < 0))
+    if len(ball):  # a ball's box turns with its centre
+        centre = params[ball, 0:3] @ frame.T
+        radius = params[ball, 3:4]
+        f_lo[ball] = centre - radius - pad
+        f_hi[ball] = centre + radius + pad
+    return f_lo, f_hi
 
 
 def _area(lo: np.ndarray, hi: np.ndarray) -> float:
