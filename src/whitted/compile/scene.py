@@ -67,6 +67,11 @@ class CompiledScene:
     prim_hi: np.ndarray | None = None
 
 
+#: scene BVHs of this many bounded primitives are built with the SAH on all three axes
+ALL_AXES_FROM = 4096
+ALL_AXES_UP_TO = 1 << 20  # past this the build's time matters more (three times the binning)
+
+
 def packed_nodes(bvh, dtype) -> tuple[np.ndarray, np.ndarray]:
     """A BVH's nodes in the kernel layout: boxes (M, 2, 3) and links (M, 2) (layout.py)."""
     box = np.empty((len(bvh.node_count), 2, 3), dtype)
@@ -198,7 +203,10 @@ def compile_scene(scene: Scene, flatten_limit: int = FLATTEN_LIMIT, *,
     bvh_frame, frame_lo, frame_hi = choose_frame(rotations, prim_type[bounded],
                                                  params[bounded], prim_xform[bounded],
                                                  lo[bounded], hi[bounded])
-    bvh = cached_build_bvh(frame_lo, frame_hi)
+    # a big scene BVH (flattened meshes) is split on the best of all three axes: nested,
+    # turned shells gave 4-11 % faster renders (docs/performance.md); small ones keep theirs
+    bvh = cached_build_bvh(frame_lo, frame_hi,
+                           all_axes=ALL_AXES_FROM <= len(bounded) <= ALL_AXES_UP_TO)
     inst_bvh = cached_build_bvh(lo[instances], hi[instances])
     prim_info = np.empty((len(prim_type), N_PRIM_INFO), np.int32)
     prim_info[:, PRIM_TYPE] = prim_type
