@@ -4,6 +4,10 @@ then ``--runs`` times, and the ratio B / A of their best render times is taken p
 so a machine whose speed drifts weighs on both alike. The float32 framebuffers of A and B
 must be bitwise equal (their SHA-256 is compared).
 
+With ``--cpu`` the figure compared is the render's CPU seconds (the process's user + system
+time over the render calls: one thread's work, whatever else the machine runs) instead of
+the render's wall time.
+
 A and B differ by environment settings (``--a``, ``--b``: ``NAME=VALUE`` words) and by
 ``PYTHONPATH`` (two checkouts) or cache folders (``WHITTED_CACHE_DIR``):
 
@@ -17,6 +21,7 @@ import argparse
 import hashlib
 import json
 import os
+import resource
 import shlex
 import statistics
 import subprocess
@@ -33,14 +38,21 @@ def worker(scene_name: str, runs: int, threads: int) -> None:
     job = RenderJob(scene, compiled=compiled, threads=threads)
     job.run()
     digest = hashlib.sha256(job.framebuffer.tobytes()).hexdigest()
-    times = []
+    times, cpu = [], []
     for _ in range(runs):
         job = RenderJob(scene, compiled=compiled, threads=threads)
+        before = cpu_seconds()
         job.run()
+        cpu.append(cpu_seconds() - before)
         times.append(job.stats.render_seconds)
         if hashlib.sha256(job.framebuffer.tobytes()).hexdigest() != digest:
             raise SystemExit("the image changed between runs")
-    print(json.dumps({"render_s": times, "sha256": digest}))
+    print(json.dumps({"render_s": times, "render_cpu_s": cpu, "sha256": digest}))
+
+
+def cpu_seconds() -> float:
+    ru = resource.getrusage(resource.RUSAGE_SELF)
+    return ru.ru_utime + ru.ru_stime
 
 
 def launch(env_words: str, scene: str, runs: int, threads: int) -> dict:
@@ -62,21 +74,26 @@ def main() -> None:
     parser.add_argument("--b", default="", help="B's environment settings")
     parser.add_argument("--runs", type=int, default=3, help="timed renders in each process")
     parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--cpu", action="store_true",
+                        help="compare the renders' CPU seconds, not their wall time")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.worker:
         worker(args.scene, args.pairs, args.threads)
         return
     ratios, best_a, best_b, digests = [], [], [], set()
+    figure = "render_cpu_s" if args.cpu else "render_s"
     for _ in range(args.pairs):
         a = launch(args.a, args.scene, args.runs, args.threads)
         b = launch(args.b, args.scene, args.runs, args.threads)
-        best_a.append(min(a["render_s"]))
-        best_b.append(min(b["render_s"]))
+        best_a.append(min(a[figure]))
+        best_b.append(min(b[figure]))
         ratios.append(best_b[-1] / best_a[-1])
         digests |= {a["sha256"], b["sha256"]}
-    print(f"{args.scene}: A {statistics.median(best_a):.3f} s, B {statistics.median(best_b):.3f}"
-          f" s (medians of each process's best of {args.runs}); B / A pair by pair: median "
+    kind = "CPU" if args.cpu else "wall"
+    print(f"{args.scene} ({kind}): A {statistics.median(best_a):.3f} s, B "
+          f"{statistics.median(best_b):.3f} s (medians of each process's best of {args.runs}); "
+          f"B / A pair by pair: median "
           f"{statistics.median(ratios):.3f} ({min(ratios):.3f}-{max(ratios):.3f}), "
           f"{args.pairs} pairs; framebuffers {'identical' if len(digests) == 1 else 'DIFFER'}")
 

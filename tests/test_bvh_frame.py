@@ -17,10 +17,15 @@ from whitted.bench.models import rounded_box_mesh
 from whitted.compile import bvh_frame
 from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import closest_hit, hit_analytic
-from whitted.kernels.hit_list import MAX_SHADOW_HITS
 from whitted.kernels.layout import BVH_STACK
-from whitted.kernels.lighting import any_occluder, gather_transparent_hits
+from whitted.kernels.lighting import any_occluder
 from whitted.kernels.shapes import INF
+from whitted.kernels.traverse import (
+    bvh_frame_ray,
+    inverse_direction,
+    next_scene_candidate,
+    start_scene_walk,
+)
 from whitted.render.api import RenderJob
 
 
@@ -134,9 +139,6 @@ def test_walks_in_the_frame_find_what_brute_force_finds(seed, scale, n_spheres, 
     geo, mats = compiled.geometry, compiled.materials
     assert geo.bvh_frame.shape == (3, 3)
     stack = np.empty(BVH_STACK, np.int32)
-    hits = np.empty(2 * MAX_SHADOW_HITS)
-    hits_listed = np.empty(2 * MAX_SHADOW_HITS)
-    walked = np.concatenate([geo.unbounded, geo.node_prims]).astype(np.int32)
     n_prims = geo.prim_info.shape[0]
     rng = np.random.default_rng(seed + 1)
     for o, d in _rays(rng, scale, 30):
@@ -151,13 +153,16 @@ def test_walks_in_the_frame_find_what_brute_force_finds(seed, scale, n_spheres, 
             assert t == best and ts[prim] == best
         state = any_occluder(geo, mats, o, d, tmin, tmax, stack)
         assert state == (0 if best == INF else 2)
-        # the walk gathers the crossings that listing every primitive gathers, in order
-        n, full = gather_transparent_hits(geo, mats, o, d, tmin, tmax, 1e-9 * scale, stack,
-                                          hits, walked, 0, -1)
-        n2, full2 = gather_transparent_hits(geo, mats, o, d, tmin, tmax, 1e-9 * scale, stack,
-                                            hits_listed, walked, 0, len(walked))
-        assert (n, full) == (n2, full2)
-        assert np.array_equal(hits[:2 * n], hits_listed[:2 * n])
+        # the shadow rays' gathering walk (through the wide nodes) meets every primitive hit
+        fo, finv = bvh_frame_ray(geo, o, d, inverse_direction(d))
+        cursor = start_scene_walk(geo, stack, False)
+        met = set()
+        while True:
+            i, *cursor = next_scene_candidate(geo, fo, finv, tmin, tmax, stack, *cursor, False)
+            if i < 0:
+                break
+            met.add(int(i))
+        assert {i for i in range(n_prims) if ts[i] < INF} <= met
 
 
 @pytest.mark.parametrize("rotate", [(0.0, 30.0, 0.0), (20.0, -50.0, 35.0)])

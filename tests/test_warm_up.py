@@ -22,21 +22,20 @@ from whitted.scene.scene import RenderSettings, Scene
 def test_helper_compiles_the_signatures_render_tiles_calls(monkeypatch, instances):
     """The helper's work is only of use if the render kernel asks for exactly these variants.
 
-    Uncached copies of render_tiles and of the callers of the helper's kernels (trace_path,
-    direct_light) are compiled here: they ask for the variants of their callees (which load
-    or compile), and those are what the callees' twins then list in ``overloads``."""
+    Uncached copies of render_tiles and of trace_path (the caller of the helper's kernels)
+    are compiled here: they ask for the variants of their callees (which load or compile),
+    and those are what the callees' twins then list in ``overloads``."""
     def fresh(dispatcher):
         return kernel(cache=False, inline="always")(dispatcher.py_func)
 
     monkeypatch.setattr(tiles, "trace_path", fresh(integrator.trace_path))
-    monkeypatch.setattr(integrator, "direct_light", fresh(integrator.direct_light))
     stand_in = warm_up.stand_in_scene(instances)
     fresh_render_tiles = kernel(cache=False)(tiles.render_tiles.py_func)
     params = render_params(Scene(), stand_in, RenderSettings(width=1, height=1))
     fresh_render_tiles(np.zeros((0, 4), np.int32), np.zeros((1, 1, 3), np.float32),
                        stand_in.geometry, stand_in.materials, stand_in.lights, params,
                        np.zeros((1, N_RAY_KINDS), np.int64), tiles.lane_workspace(1), 0, 1)
-    delegated = render_callees(stand_in.geometry, stand_in.materials, params)
+    delegated = render_callees(stand_in.geometry, stand_in.materials, stand_in.lights, params)
     assert delegated
     for dispatcher, argument_types in delegated:
         assert tuple(argument_types) in dispatcher.callee.overloads, (

@@ -14,10 +14,10 @@ compiled is each kernel's twin for calls from kernels (``callee``).
 The share is chosen by measured compile times (docs/performance.md): for scenes without mesh
 instances the helper also compiles all the builders and the OBJ loader, so it takes only
 ``surface_normals``, the first callee ``render_tiles`` reaches after ``closest_hit``; for
-scenes with mesh instances (the builders are already cached) it takes the shadow rays
-(``shadow_transmittance``), the deepest part of ``direct_light``: what remains here is
-``closest_hit``, normals, colour, then ``direct_light`` and ``render_tiles``, each inlining
-the one below (work only this process can do, as it needs everything below it).
+scenes with mesh instances (the builders are already cached) it takes the direct light with
+its shadow rays (``direct_light``, one function down to the shadow rays' walks): what remains
+here is ``closest_hit``, normals, colour, the caustics and ``render_tiles``, which inlines
+them all (work only this process can do, as it needs everything below it).
 """
 
 from __future__ import annotations
@@ -28,26 +28,26 @@ from .accel import surface_normals
 from .features import instances_possible
 from .geometry_ref import GeometryRef
 from .layout import GeometryArrays
-from .lighting import shadow_transmittance
+from .lighting import direct_light
 
 VEC3 = types.UniTuple(types.float64, 3)
 INT = types.int64
 REAL = types.float64
-BOOL = types.boolean
 INT32S = types.int32[::1]  # a lane's scratch lists and traversal stack: contiguous int32
 REALS = types.float64[::1]
+INT64S = types.int64[::1]  # a lane's ray counts
 
 
-def render_callees(geometry: GeometryArrays, materials, params):
-    """(kernel, argument types) pairs for a scene with these arrays and render parameters
-    (their types pick the variant: with or without mesh instances), in the order the render
-    kernel needs them."""
+def render_callees(geometry: GeometryArrays, materials, lights, params):
+    """(kernel, argument types) pairs for a scene with these arrays, lights and render
+    parameters (their types pick the variant: with or without mesh instances), in the order
+    the render kernel needs them."""
     geo = typeof(geometry)
     if instances_possible(geo):  # render_tiles passes the geometry by reference
         geo = GeometryRef(geo)
     mats = typeof(materials)
     if instances_possible(geo):
-        return [(shadow_transmittance, (geo, mats, typeof(params), VEC3, VEC3, REAL, INT32S,
-                                        INT, INT32S, INT32S, REALS, INT, INT32S, INT, INT,
-                                        BOOL))]
+        return [(direct_light, (geo, mats, typeof(lights), typeof(params), VEC3, VEC3, VEC3,
+                                INT, VEC3, INT32S, INT, INT32S, INT32S, REALS, INT32S, INT64S,
+                                types.UniTuple(INT, 3)))]
     return [(surface_normals, (geo, INT, INT, REAL, REAL, VEC3))]

@@ -18,7 +18,7 @@ from .accel import (
 from .csg import csg_surfaces
 from .extras import body_medium
 from .features import extras_possible, has_extras, has_instances, instances_possible
-from .hit_list import keep_nearest
+from .hit_list import MAX_SHADOW_HITS, keep_nearest
 from .layout import (
     CELL_COUNT,
     CELL_FIRST,
@@ -50,13 +50,16 @@ from .layout import (
     PRIM_TYPE,
     PRIM_XFORM,
     RAY_SHADOW,
+    SHAPE_SPHERE,
+    SHAPE_TRIANGLE,
 )
 from .light_buffer import cube_cell
 from .media import absorbed, media_enter, media_leave
 from .mesh import OPAQUE_KT
-from .sampling import concentric_disk, random_pair, stratum
+from .sampling import SAMPLE_CHUNK, stratified_disk, stratum
 from .shapes import INF
 from .shapes.dispatch import crossed_twice, is_csg_object, is_extra, is_world_plane
+from .shapes.flat import EDGE_TOL
 from .traverse import (
     box_entry,
     bvh_frame_point,
@@ -66,7 +69,7 @@ from .traverse import (
     next_scene_candidate,
     start_scene_walk,
 )
-from .vec import dot, madd, normalize, sub, vload
+from .vec import cross, dot, madd, normalize, sub, vload
 
 
 @kernel
@@ -143,6 +146,10 @@ MIN_BUNDLE_SAMPLES = 4  # area lights with fewer samples per point skip the bund
 # is below this, per channel, is left out without a shadow ray: far below a float32 pixel's
 # own precision at any visible brightness (2**-24 of the value) and 16-bit output's step
 NEGLIGIBLE_LIGHT = 1e-15
+# an area light's points on its disk, drawn ahead of their shadow rays, wait in the shadow
+# rays' hits buffer past its MAX_SHADOW_HITS (t, primitive) pairs: SAMPLE_CHUNK (x, y) pairs
+DISK_POINTS = 2 * MAX_SHADOW_HITS
+HITS_BUFFER = DISK_POINTS + 2 * SAMPLE_CHUNK  # the length of a lane's hits buffer
 
 
 @kernel
@@ -187,8 +194,88 @@ def list_bundle_occluders(geo, mats, p, centre, radius, tmin, stack, listed):
         listed[n] = i
         n += 1
         opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
-    return list_cone_leaves(geo, mats, p, sub(centre, p), radius * (1.0 + 1e-7) + 1e-12, stack,
-                            listed, n, SHADOW_LIST_CAP, opaque)
+    n, opaque = list_cone_leaves(geo, mats, p, sub(centre, p), radius * (1.0 + 1e-7) + 1e-12,
+                                 stack, listed, n, SHADOW_LIST_CAP, opaque)
+    if n <= 0:
+        return n, opaque
+    return _keep_bundle_occluders(geo, mats, p, centre, radius, listed, n)
+
+
+# a ball is kept in a bundle's list when it comes within this much more than its radius of
+# the bundle (relative to the radius, and to the bundle's length): far more than the
+# rounding of the tests that could find it hit (a ray passing farther than this outside a
+# sphere has a discriminant below -1e-12 of its squared distances: no rounding makes it a hit)
+BALL_SLACK = 1e-6
+
+
+@kernel
+def ball_meets_bundle(c, r, p, axis, length, sin_a, cos_a, reach):
+    """Could a segment from ``p`` to a point of the light's ball meet the ball of radius ``r``
+    around ``c``? Those segments lie in the cone from apex ``p`` along ``axis`` (unit
+    direction times ``length``) of half-angle ``a`` (its sine and cosine) cut at ``reach``
+    from the apex: the ball is tested against that solid cone, with BALL_SLACK to spare."""
+    v = sub(c, p)
+    along = dot(v, axis) / length
+    side = cross(v, axis)
+    q = math.sqrt(dot(side, side)) / length  # the distance of c from the cone's axis
+    r = r * (1.0 + BALL_SLACK) + BALL_SLACK * reach
+    if along - r > reach:
+        return False  # beyond the light
+    off = q * cos_a - along * sin_a  # c's distance from the cone's side (inside: <= 0)
+    if off <= r:
+        if along * cos_a + q * sin_a >= 0.0:
+            return True  # within r of the side, or inside
+        return dot(v, v) <= r * r  # behind the apex: the apex is its nearest point
+    return False
+
+
+@kernel
+def triangle_ball(P, i):
+    """(centre, radius) of a ball holding triangle row ``i`` and every point its hit test
+    can find (:func:`.shapes.triangle.intersect_triangle` allows EDGE_TOL past its edges)."""
+    v0 = vload(P, i, 0)
+    e1 = vload(P, i, 3)
+    e2 = vload(P, i, 6)
+    c = madd(v0, (e1[0] + e2[0], e1[1] + e2[1], e1[2] + e2[2]), 1.0 / 3.0)
+    a = sub(v0, c)
+    b = sub(madd(v0, e1, 1.0), c)
+    d = sub(madd(v0, e2, 1.0), c)
+    far = math.sqrt(max(dot(a, a), max(dot(b, b), dot(d, d))))  # the farthest corner
+    return c, far + 4.0 * EDGE_TOL * (math.sqrt(dot(e1, e1)) + math.sqrt(dot(e2, e2)))
+
+
+@kernel
+def _keep_bundle_occluders(geo, mats, p, centre, radius, listed, n):
+    """Of ``listed[:n]`` (a bundle's list from its BVH leaves) keep, in order, those that a
+    ray of the bundle could meet: spheres and triangles whose own bounding ball misses the
+    bundle's cone (:func:`ball_meets_bundle`) are left out, every other shape is kept.
+    Returns (the count kept, whether all kept are opaque)."""
+    axis = sub(centre, p)
+    length = math.sqrt(dot(axis, axis))
+    grown = radius * (1.0 + BALL_SLACK) + 1e-12
+    near = length <= 2.0 * grown  # the point is (nearly) within the light's ball: keep all
+    sin_a = grown / length if not near else 0.0
+    cos_a = math.sqrt(1.0 - sin_a * sin_a)
+    reach = length + grown
+    kept = 0
+    opaque = True
+    P = geo.prim_params
+    for k in range(n):
+        i = listed[k]
+        meets = True
+        typ = geo.prim_info[i, PRIM_TYPE]
+        if not near and geo.prim_info[i, PRIM_XFORM] < 0:  # its numbers are in world space
+            if typ == SHAPE_SPHERE:
+                meets = ball_meets_bundle(vload(P, i, 0), P[i, 3], p, axis, length, sin_a,
+                                           cos_a, reach)
+            elif typ == SHAPE_TRIANGLE:
+                c, r = triangle_ball(P, i)
+                meets = ball_meets_bundle(c, r, p, axis, length, sin_a, cos_a, reach)
+        if meets:
+            listed[kept] = i
+            kept += 1
+            opaque = opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
+    return kept, opaque
 
 
 @kernel(inline="always")
@@ -227,60 +314,9 @@ def list_cone_leaves(geo, mats, apex, axis, radius, stack, out, n, cap, opaque):
     return n, opaque
 
 
-@kernel(inline="always")
-def gather_transparent_hits(geo, mats, o, d, tmin, tmax, step, stack, hits, listed, list_first,
-                            n_listed):
-    """The analytic surface crossings on the segment (tmin, tmax), in one walk of the scene
-    BVH (or, when ``n_listed`` >= 0, of the primitives ``listed[list_first:][:n_listed]``),
-    into ``hits``
-    as (t, primitive) pairs sorted by t: both crossings of a closed body (they are convex: at
-    most two, the second searched from ``step`` past the first), the nearest MAX_SHADOW_HITS
-    of them. Returns (n, full): full when there were more (walk again from past the last one);
-    n = -1 when an opaque surface blocks the segment (the walk stops there and ``hits[1]``
-    names it)."""
-    n = 0
-    full = n < 0  # False, typed bool: a literal False compiles keep_nearest twice
-    inv = inverse_direction(d)
-    fo, finv = bvh_frame_ray(geo, o, d, inv)  # the ray the boxes see
-    j, leaf, leaf_end, top = start_scene_walk(geo, stack, False)
-    k = 0
-    while True:
-        if n_listed >= 0:
-            if k == n_listed:
-                break
-            i = listed[list_first + k]
-            k += 1
-        else:
-            i, j, leaf, leaf_end, top = next_scene_candidate(geo, fo, finv, tmin, tmax, stack,
-                                                             j, leaf, leaf_end, top, False)
-            if i < 0:
-                break
-        if (has_extras(geo) and is_extra(geo.prim_info[i, PRIM_TYPE])
-                and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] >= OPAQUE_KT):
-            # a clear torus or CSG object: every crossing (a CSG object's as its leaves)
-            n, full = gather_extra_hits_if_extras(geo, i, o, d, inv, tmin, tmax, step, hits,
-                                                  n, full)
-            continue
-        t = hit_analytic(geo, i, o, d, tmin, tmax)
-        if t == INF:
-            continue
-        # the material is looked up only for the surfaces hit (most candidates miss)
-        if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT:
-            hits[1] = i
-            return -1, False
-        n, full = keep_nearest(hits, n, t, i, full)
-        # a closed analytic body is crossed twice (the triangles of a flattened solid mesh
-        # are each crossed once: their body's other side is other triangles)
-        if crossed_twice(geo.prim_info[i, PRIM_TYPE], geo.prim_info[i, PRIM_SOLID]):
-            t = hit_analytic(geo, i, o, d, t * (1.0 + 1e-12) + step, tmax)
-            if t < INF:
-                n, full = keep_nearest(hits, n, t, i, full)
-    return n, full
-
-
 @kernel
 def gather_extra_hits(geo, i, o, d, inv, tmin, tmax, step, hits, n, full):
-    """:func:`gather_transparent_hits` for a torus or CSG object ``i``: its crossings in
+    """A shadow ray's walk (:func:`direct_light`) at a torus or CSG object ``i``: its crossings in
     (tmin, tmax), a CSG object's as (t, leaf) pairs from one walk (:func:`.csg.csg_surfaces`),
     a torus's each found from past the one before (up to four)."""
     if is_csg_object(geo.prim_info[i, PRIM_TYPE]):
@@ -338,9 +374,10 @@ def _absorb(mats, scratch, count, length, trans):
             absorbed(trans[2], mats[m, MAT_ATTEN + 2], length))
 
 
-@kernel(inline="always")  # as when it was written inside shadow_transmittance
+@kernel(inline="always")  # as when it was written inside the shadow ray's code
 def _shadow_through_instances(geo, mats, params, o, d, dist, media, n_media, scratch, stack):
-    """:func:`shadow_transmittance` in scenes with mesh instances: an any-hit walk first,
+    """A shadow ray's transmittance (:func:`direct_light`) in scenes with mesh instances, from
+    ``epsilon`` to ``dist`` along unit ``d``: an any-hit walk first,
     then, only when it met transparent surfaces, the crossings one nearest hit at a time.
     ``scratch[:n_media]`` already holds a copy of ``media[:n_media]``."""
     count = n_media
@@ -384,64 +421,6 @@ def _shadow_through_instances_if_instances(geo, mats, params, o, d, dist, media,
     return (lambda geo, mats, params, o, d, dist, media, n_media, scratch, stack:
             _shadow_through_instances(geo, mats, params, o, d, dist, media, n_media, scratch,
                                       stack))
-
-
-@kernel(inline="always")
-def shadow_transmittance(geo, mats, params, o, d, dist, media, n_media, scratch, stack, hits,
-                         blocker, listed, list_first, n_listed, listed_opaque):
-    """Fraction of light (per channel) that reaches ``o`` from ``dist`` along unit ``d``.
-
-    The segment starts at ``epsilon`` along the ray (not offset along the normal), so a
-    shadow ray from a surface point passes exactly where the geometry says: a point whose
-    light path grazes an occluder's edge is shadowed as the lecture computes it.
-
-    Each transparent occluder multiplies by its ``kt·color`` where the ray enters it, and the
-    medium the shadow ray is in absorbs ``exp(-attenuation·length)`` segment by segment (the
-    ray starts in the media ``media[:n_media]`` of the point being shaded).
-
-    ``blocker`` (or -1) is an opaque analytic primitive that blocked a previous shadow ray
-    from the same point (the next sample of the same area light, say): it is tried first, and
-    when it blocks this ray too no walk is needed. When ``n_listed`` >= 0, the ray's possible
-    occluders are ``listed[list_first:][:n_listed]`` (a bundle's list, see
-    :func:`list_bundle_occluders`, or a light-buffer cell's) and no BVH walk is made; when
-    they are all opaque (``listed_opaque``) the first one hit ends the search.
-    Returns (transmittance, the opaque primitive that blocked the ray or -1)."""
-    if blocker >= 0 and hit_analytic(geo, blocker, o, d, params.epsilon, dist) < INF:
-        return (0.0, 0.0, 0.0), blocker
-    if n_listed >= 0 and listed_opaque:
-        for k in range(list_first, list_first + n_listed):
-            if hit_analytic(geo, listed[k], o, d, params.epsilon, dist) < INF:
-                return (0.0, 0.0, 0.0), listed[k]
-        return _absorb(mats, media, n_media, dist - params.epsilon, (1.0, 1.0, 1.0)), -1
-    for k in range(n_media):
-        scratch[k] = media[k]
-    count = n_media
-    trans = (1.0, 1.0, 1.0)
-    t_from = params.epsilon
-    if not has_instances(geo):
-        # walks gather the surfaces on the segment, sorted, a buffer-full at a time; one
-        # closer than ``epsilon`` to the previous crossing is the same crossing (a shared
-        # edge, a touching pair) and is skipped, as the stepping walk below would
-        for _ in range(64):
-            n, full = gather_transparent_hits(geo, mats, o, d, t_from, dist, params.epsilon,
-                                              stack, hits, listed, list_first, n_listed)
-            if n == -1:
-                return (0.0, 0.0, 0.0), int(hits[1])
-            for k in range(n):
-                t = hits[2 * k]
-                if t <= t_from:
-                    continue
-                trans = _absorb(mats, scratch, count, t - t_from, trans)
-                count, trans = _pass_surface(geo, mats, int(hits[2 * k + 1]), -1, 0.0, 0.0, o,
-                                             d, t, scratch, count, trans)
-                if max(trans[0], max(trans[1], trans[2])) < 1e-4:
-                    return (0.0, 0.0, 0.0), -1
-                t_from = t * (1.0 + 1e-12) + params.epsilon
-            if not full:
-                break
-        return _absorb(mats, scratch, count, dist - t_from, trans), -1
-    return shadow_through_instances_if_instances(geo, mats, params, o, d, dist, media, n_media,
-                                                 scratch, stack)
 
 
 @kernel
@@ -509,7 +488,33 @@ def direct_light(
     """Light reflected toward ``v`` at point ``p`` with shading normal ``n`` (facing ``v``) by
     every non-ambient light; ``albedo`` is the diffuse colour there. ``rng`` = (pixel, sample,
     first dimension) for area-light samples. A point light's shadow ray tests the list of its
-    light-buffer cell; an area light's samples share the list of their bundle."""
+    light-buffer cell; an area light's samples share the list of their bundle.
+
+    One function from the lights down to the walks of the shadow rays, in three nested parts:
+    each light's samples; each sample's shadow ray (its transmittance); the walks that gather
+    that ray's surface crossings. Numba compiles every separately compiled function on its
+    own and LLVM optimises, in each, the whole of the code it calls once more: written as
+    functions calling functions, the shadow code was optimised and turned into machine code
+    once per level, here once (docs/performance.md, the flat-tree round). Leaves with no deep
+    callees (the BRDF, the media, the bundle's list) stay functions.
+
+    **The shadow ray** runs from ``epsilon`` along ``ldir`` (not offset along the normal) to
+    ``tmax``, so it passes exactly where the geometry says: a point whose light path grazes an
+    occluder's edge is shadowed as the lecture computes it. Each transparent occluder
+    multiplies by its ``kt·color`` where the ray enters it, and the medium the ray is in
+    absorbs ``exp(-attenuation·length)`` segment by segment (it starts in the media
+    ``media[:n_media]`` of the point being shaded). ``blocker`` is an opaque analytic
+    primitive that blocked a previous sample's ray from ``p`` (the same area light's): it is
+    tried first, and when it blocks this ray too no walk is needed. When ``n_listed`` >= 0,
+    the ray's possible occluders are ``occluders[list_first:][:n_listed]`` (a bundle's list,
+    see :func:`list_bundle_occluders`, or a light-buffer cell's) and no BVH walk is made;
+    when they are all opaque (``listed_opaque``) the first one hit ends the search.
+
+    **A walk** gathers the analytic surface crossings on (t_from, tmax), from the scene BVH
+    (or the listed primitives), into ``hits`` as (t, primitive) pairs sorted by t: both
+    crossings of a closed body (they are convex: at most two, the second searched from
+    ``epsilon`` past the first), the nearest MAX_SHADOW_HITS of them; ``full`` when there were
+    more (walk again from past the last one). An opaque surface hit ends it (``opaque``)."""
     r = 0.0
     g = 0.0
     b = 0.0
@@ -517,6 +522,7 @@ def direct_light(
         return (r, g, b)
     dim = rng[2]
     table = lights.table
+    eps = params.epsilon
     for j in range(table.shape[0]):
         kind = table[j, LIGHT_TYPE]
         radiance = vload(table, j, LIGHT_RADIANCE)
@@ -530,16 +536,17 @@ def direct_light(
         listed_opaque = False
         if kind == LIGHT_DISK and n_samples >= MIN_BUNDLE_SAMPLES and not has_instances(geo):
             n_listed, listed_opaque = list_bundle_occluders(
-                geo, mats, p, centre, table[j, LIGHT_RADIUS], params.epsilon, stack, listed)
+                geo, mats, p, centre, table[j, LIGHT_RADIUS], eps, stack, listed)
         # samples are stratified over a grid of m_cols x m_rows cells, walked cell by cell
         _, _, m_cols, m_rows = stratum(0, n_samples)
         cx = -1
         cy = 0
         for _s in range(n_samples):
-            cx += 1
-            if cx == m_cols:
-                cx = 0
-                cy += 1
+            chunk = _s % SAMPLE_CHUNK
+            if kind == LIGHT_DISK and chunk == 0:  # the next points of the disk, drawn ahead
+                dim, cx, cy = stratified_disk(params.seed, rng[0], rng[1], dim, cx, cy, m_cols,
+                                              m_rows, min(SAMPLE_CHUNK, n_samples - _s), hits,
+                                              DISK_POINTS)
             # one shadow ray per sample (one call site: the shadow code is inlined once)
             if kind == LIGHT_DIRECTIONAL:
                 travel = vload(table, j, LIGHT_DIRECTION)
@@ -551,11 +558,8 @@ def direct_light(
             else:
                 target = centre
                 if kind == LIGHT_DISK:
-                    ju, jw = random_pair(params.seed, rng[0], rng[1], dim)
-                    u = (cx + ju) / m_cols
-                    w = (cy + jw) / m_rows
-                    dim += 2
-                    dx, dy = concentric_disk(u, w)
+                    dx = hits[DISK_POINTS + 2 * chunk]
+                    dy = hits[DISK_POINTS + 2 * chunk + 1]
                     rad = table[j, LIGHT_RADIUS]
                     target = madd(madd(centre, vload(table, j, LIGHT_DISK_U), dx * rad),
                                   vload(table, j, LIGHT_DISK_V), dy * rad)
@@ -564,7 +568,7 @@ def direct_light(
                 if dist == 0.0:
                     continue
                 ldir = (to_light[0] / dist, to_light[1] / dist, to_light[2] / dist)
-                tmax = dist - params.epsilon
+                tmax = dist - eps
                 weight = share * _falloff(table, j, dist)
             if dot(n, ldir) <= 0.0:
                 continue
@@ -588,14 +592,106 @@ def direct_light(
                 n_listed = lights.buffer_cells[cell, CELL_COUNT]
                 listed_opaque = lights.buffer_cells[cell, CELL_OPAQUE] != 0
             counters[RAY_SHADOW] += 1
-            vis, found = shadow_transmittance(
-                geo, mats, params, p, ldir, tmax, media, n_media, scratch, stack, hits, blocker,
-                occluders, list_first, n_listed, listed_opaque,
-            )
-            if found >= 0:
-                blocker = found
+
+            # the shadow ray: its transmittance ``vis``; a sample whose ray an opaque surface
+            # blocks is left (that surface becomes the next sample's ``blocker``)
+            if blocker >= 0 and hit_analytic(geo, blocker, p, ldir, eps, tmax) < INF:
+                continue
+            opaque = -1  # an opaque primitive found on the ray
+            if n_listed >= 0 and listed_opaque:
+                for k in range(list_first, list_first + n_listed):
+                    if hit_analytic(geo, occluders[k], p, ldir, eps, tmax) < INF:
+                        opaque = occluders[k]
+                        break
+                if opaque >= 0:
+                    blocker = opaque
+                    continue
+                vis = _absorb(mats, media, n_media, tmax - eps, (1.0, 1.0, 1.0))
+            else:
+                for k in range(n_media):
+                    scratch[k] = media[k]
+                if has_instances(geo):
+                    vis, _ = shadow_through_instances_if_instances(
+                        geo, mats, params, p, ldir, tmax, media, n_media, scratch, stack)
+                else:
+                    # walks gather the surfaces on the segment, sorted, a buffer-full at a
+                    # time; one closer than ``epsilon`` to the previous crossing is the same
+                    # crossing (a shared edge, a touching pair) and is skipped, as the
+                    # stepping walk of instance scenes would
+                    count = n_media
+                    vis = (1.0, 1.0, 1.0)
+                    t_from = eps
+                    inv = inverse_direction(ldir)
+                    fo, finv = bvh_frame_ray(geo, p, ldir, inv)  # the ray the boxes see
+                    for _ in range(64):
+                        # a walk (see the docstring) over (t_from, tmax)
+                        n_hits = 0
+                        full = n_hits < 0  # False, typed bool (a literal: keep_nearest twice)
+                        cand, leaf, leaf_end, top = start_scene_walk(geo, stack, False)
+                        k = 0
+                        while True:
+                            if n_listed >= 0:
+                                if k == n_listed:
+                                    break
+                                i = occluders[list_first + k]
+                                k += 1
+                            else:
+                                i, cand, leaf, leaf_end, top = next_scene_candidate(
+                                    geo, fo, finv, t_from, tmax, stack, cand, leaf, leaf_end,
+                                    top, False)
+                                if i < 0:
+                                    break
+                            if (has_extras(geo) and is_extra(geo.prim_info[i, PRIM_TYPE])
+                                    and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT]
+                                    >= OPAQUE_KT):
+                                # a clear torus or CSG object: every crossing (a CSG
+                                # object's as its leaves)
+                                n_hits, full = gather_extra_hits_if_extras(
+                                    geo, i, p, ldir, inv, t_from, tmax, eps, hits, n_hits, full)
+                                continue
+                            t = hit_analytic(geo, i, p, ldir, t_from, tmax)
+                            if t == INF:
+                                continue
+                            # the material is looked up only for the surfaces hit (most
+                            # candidates miss)
+                            if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT:
+                                opaque = i
+                                break
+                            n_hits, full = keep_nearest(hits, n_hits, t, i, full)
+                            # a closed analytic body is crossed twice (the triangles of a
+                            # flattened solid mesh are each crossed once: their body's other
+                            # side is other triangles)
+                            if crossed_twice(geo.prim_info[i, PRIM_TYPE],
+                                             geo.prim_info[i, PRIM_SOLID]):
+                                t = hit_analytic(geo, i, p, ldir, t * (1.0 + 1e-12) + eps, tmax)
+                                if t < INF:
+                                    n_hits, full = keep_nearest(hits, n_hits, t, i, full)
+                        if opaque >= 0:
+                            break
+                        # the light through the crossings gathered, nearest first
+                        for k in range(n_hits):
+                            t = hits[2 * k]
+                            if t <= t_from:
+                                continue
+                            vis = _absorb(mats, scratch, count, t - t_from, vis)
+                            count, vis = _pass_surface(geo, mats, int(hits[2 * k + 1]), -1, 0.0,
+                                                       0.0, p, ldir, t, scratch, count, vis)
+                            if max(vis[0], max(vis[1], vis[2])) < 1e-4:
+                                vis = (0.0, 0.0, 0.0)
+                                full = False  # no light left: no more walks
+                                break
+                            t_from = t * (1.0 + 1e-12) + eps
+                        if not full:
+                            break
+                    if opaque >= 0:
+                        blocker = opaque
+                        continue
+                    if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
+                        continue
+                    vis = _absorb(mats, scratch, count, tmax - t_from, vis)
             if vis[0] == 0.0 and vis[1] == 0.0 and vis[2] == 0.0:
                 continue
+
             if not highlight_only:
                 f = _brdf(mats, m, albedo, n, v, ldir)
             r += weight * radiance[0] * vis[0] * f[0]

@@ -71,3 +71,36 @@ def concentric_disk(u, v):
         r = b
         phi = (math.pi / 2.0) - (math.pi / 4.0) * (a / b)
     return r * math.cos(phi), r * math.sin(phi)
+
+
+SAMPLE_CHUNK = 64  # an area light's samples drawn ahead at a time (:func:`stratified_disk`)
+
+
+@kernel
+def stratified_disk(seed, pixel, sample, dim, cx, cy, m_cols, m_rows, count, out, first):
+    """The next ``count`` points of the unit disk of an area light's stratified samples: the
+    grid of ``m_cols`` x ``m_rows`` cells walked cell by cell from cell (``cx``, ``cy``)
+    (exclusive), one jittered point a cell, point k from the random pair of dimensions
+    ``dim + 2k``, ``dim + 2k + 1``, mapped by :func:`concentric_disk`; it goes to
+    ``out[first + 2k]``, ``out[first + 2k + 1]``. Returns (dim, cx, cy) after them.
+
+    The same numbers as drawing each point where its shadow ray is traced, found faster: the
+    random pairs in a loop of their own (independent integer hashes, which the compiler
+    packs into vector lanes), then the points in another, which holds few values across the
+    call to the sine and cosine (every vector register is the caller's to save), where the
+    loop of the shadow rays held many. ``out[first:]`` holds the pairs in between."""
+    for k in range(count):
+        ju, jw = random_pair(seed, pixel, sample, dim + 2 * k)
+        out[first + 2 * k] = ju
+        out[first + 2 * k + 1] = jw
+    for k in range(count):
+        cx += 1
+        if cx == m_cols:
+            cx = 0
+            cy += 1
+        u = (cx + out[first + 2 * k]) / m_cols
+        w = (cy + out[first + 2 * k + 1]) / m_rows
+        dx, dy = concentric_disk(u, w)
+        out[first + 2 * k] = dx
+        out[first + 2 * k + 1] = dy
+    return dim + 2 * count, cx, cy

@@ -15,7 +15,6 @@ import numpy as np
 
 from ..jit import kernel, numba_object
 from .accel import closest_hit, surface_normals
-from .hit_list import MAX_SHADOW_HITS
 from .integrator import N_STACK_F, N_STACK_I, trace_path
 from .layout import (
     BVH_STACK,
@@ -24,7 +23,7 @@ from .layout import (
     PRIM_OBJECT,
     RAY_PRIMARY,
 )
-from .lighting import SHADOW_LIST_CAP
+from .lighting import HITS_BUFFER, SHADOW_LIST_CAP
 from .sampling import concentric_disk, random_pair, stratum
 from .vec import dot, madd, normalize, sub
 
@@ -51,7 +50,8 @@ def own_lines(shape, dtype=np.float64) -> np.ndarray:
 
 def lane_workspace(max_depth: int):
     """Scratch arrays one lane reuses for every ray: the ray stack (float and int parts), two
-    media lists, the BVH traversal stack, a shadow ray's sorted surface hits, the list of
+    media lists, the BVH traversal stack, a shadow ray's sorted surface hits (and after them
+    an area light's points drawn ahead, lighting.DISK_POINTS), the list of
     what may block an area light's bundle of shadow rays and the tile's ray counts by kind.
     Allocated in Python: the kernels run without the Numba runtime's reference counting,
     which would otherwise cost a third of the time. Each on cache lines of its own
@@ -62,7 +62,7 @@ def lane_workspace(max_depth: int):
         own_lines(MAX_MEDIA, np.int32),
         own_lines(MAX_MEDIA, np.int32),
         own_lines(BVH_STACK, np.int32),
-        own_lines(2 * MAX_SHADOW_HITS),
+        own_lines(HITS_BUFFER),
         own_lines(SHADOW_LIST_CAP, np.int32),
         own_lines(N_RAY_KINDS, np.int64),
     )

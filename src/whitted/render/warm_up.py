@@ -441,7 +441,7 @@ def _delegated(instances: bool) -> list:
 
     stand_in = stand_in_scene(instances)
     return [(dispatcher.callee, argument_types) for dispatcher, argument_types
-            in render_callees(stand_in.geometry, stand_in.materials,
+            in render_callees(stand_in.geometry, stand_in.materials, stand_in.lights,
                               _stand_in_params(stand_in))]
 
 
