@@ -11,7 +11,9 @@ import pytest
 
 from whitted import render
 from whitted.compile.photon_map import (
+    GRID_SHIFT,
     check_photon_memory,
+    fitted_radius,
     irradiance,
     pass_radii,
     scene_photon_map,
@@ -163,6 +165,46 @@ def test_radius_shrinks_as_progressive_photon_mapping_prescribes():
     assert r[3] ** 2 == pytest.approx(0.01 * 1.7 / 2 * 2.7 / 3 * 3.7 / 4)
 
 
+def _fitted_radius_by_counting(positions, guess, neighbours=256):
+    """fitted_radius's definition, photon by photon: the median over the photons of the
+    count of photons in their cell (a dictionary of cells), twice."""
+    r = guess
+    pos = positions.astype(np.float64)
+    for _ in range(2):
+        h = 2.0 * r
+        cells = [tuple(c) for c in np.floor(pos / h + GRID_SHIFT).astype(np.int64)]
+        keys = [(x * 73856093) ^ (y * 19349663) ^ (z * 83492791) for x, y, z in cells]
+        count = {}
+        for key in keys:
+            count[key] = count.get(key, 0) + 1
+        density = float(np.median([count[key] for key in keys])) / (h * h)
+        r = min(4.0 * guess, max(guess / 8.0, math.sqrt(neighbours / (math.pi * density))))
+    return r
+
+
+def test_the_fitted_radius_counts_each_photons_cell():
+    """A worked case: 1,024 photons on the floor (y = 0), 4 in each of 256 cells of side
+    2 x 0.05 (the guess): density 4 / 0.01 = 400 a unit area, so the radius gathering 256
+    photons is sqrt(256 / (400 pi)) = 0.451, kept within 4 x the guess (0.2); the second
+    round's cells of side 0.4 hold 64 photons (576 of the 1,024 photons are in such cells,
+    the others at the edges): the same density, 0.2 again. And random sets of photons give
+    the definition's radius, bit for bit."""
+    side = np.arange(16) * 0.1 + 0.01  # the cells 0.1 wide: [k - 0.5, k + 0.5) x 0.1
+    grid = np.array([[x + dx, 0.0, z + dz] for x in side for z in side
+                     for dx in (0.02, 0.03) for dz in (0.02, 0.03)], np.float32)
+    assert len(grid) == 1024
+    assert fitted_radius(grid, 0.05) == 0.2
+    rng = np.random.default_rng(7)
+    for trial in range(40):
+        n = int(rng.integers(256, 3000))
+        spread = rng.uniform(0.05, 3.0)
+        pos = np.c_[rng.normal(0, spread, n), np.zeros(n) if trial % 2 else
+                    rng.normal(0, spread, n), rng.normal(0, spread, n)].astype(np.float32)
+        guess = float(rng.uniform(0.005, 1.0))
+        assert fitted_radius(pos, guess) == _fitted_radius_by_counting(pos, guess), trial
+    assert fitted_radius(pos[:255], 0.3) == 0.3  # too few photons to fit: the guess
+
+
 def test_photon_map_is_the_same_on_any_number_of_threads():
     scene = scene_of([{"type": "sphere", "center": [0, 2, 0], "radius": 1.0,
                        "material": GLASS}], photons=20_000, passes=2)
@@ -215,6 +257,17 @@ def test_bad_caustics_settings_are_refused(key, value):
 def test_a_photon_map_too_big_for_memory_is_refused():
     with pytest.raises(SceneError, match=r"render\.caustics"):
         check_photon_memory(CausticsSettings(photons=50_000_000, passes=4096))
+
+
+def test_the_photon_maps_memory_counts_each_threads_slots_not_every_photons():
+    """1,000,000 photons on 2 threads: 16 calls of 62,500 photons, each thread's 6 slots of
+    40 bytes for the photons of one call (30,000,000 bytes), a pass's counts (4,000,000), the
+    photons stored, three copies of 40 bytes and 16 bytes of keys and table each
+    (136,000,000). On one thread: 8 calls of 125,000 photons, the same 30,000,000 bytes of
+    slots; two passes store twice the photons."""
+    assert check_photon_memory(CausticsSettings(photons=1_000_000), threads=2) == 170_000_000
+    assert check_photon_memory(CausticsSettings(photons=1_000_000, passes=2), threads=1) \
+        == 30_000_000 + 4_000_000 + 272_000_000
 
 
 def test_disk_light_casts_a_soft_caustic_of_the_same_power():

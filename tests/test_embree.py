@@ -22,6 +22,7 @@ from whitted.compile.embree import embree_addresses, embree_library, resolve_mes
 from whitted.compile.scene import compile_scene
 from whitted.errors import SceneError
 from whitted.kernels.accel import closest_hit
+from whitted.kernels.embree import float32_above, float32_below
 from whitted.kernels.layout import BVH_STACK
 from whitted.kernels.lighting import any_occluder
 
@@ -249,3 +250,52 @@ def test_scenes_without_big_meshes_never_load_embree(tmp_path):
                          timeout=600, cwd=tmp_path)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip().splitlines()[-1] == "CLEAN"
+
+
+@njit(cache=False)
+def _inward(xs, above, below):
+    for k in range(xs.shape[0]):
+        above[k] = float32_above(xs[k])
+        below[k] = float32_below(xs[k])
+
+
+def _reference_above(x):
+    y = np.float32(x)
+    if np.float64(y) <= x:
+        y = np.nextafter(y, np.float32(np.inf))
+    return np.float64(y)
+
+
+def _reference_below(x):
+    if x == np.inf:
+        return x
+    y = np.float32(x)
+    if np.float64(y) >= x:
+        y = np.nextafter(y, np.float32(-np.inf))
+    return np.float64(y)
+
+
+def test_segment_ends_round_inward_to_the_next_float32_as_nextafter_does():
+    """Embree's closed float32 segment from whitted's open one: the bit-level step of
+    kernels/embree.py gives np.nextafter's float32 on every kind of value (zeros of both
+    signs, subnormals, the largest finite, infinities, values a float32 holds exactly and
+    values between two), bit for bit."""
+    tiny = float(np.finfo(np.float32).smallest_subnormal)
+    big = float(np.finfo(np.float32).max)
+    special = [0.0, -0.0, tiny, -tiny, tiny / 3, -tiny / 3, 2 * tiny, 1e-40, -1e-40,
+               1.1754942e-38, 1.0, -1.0, 0.1, -0.1, 1e-4, 50.0, 1e30, big, -big,
+               big * (1 + 1e-9), -big * (1 + 1e-9), 1e39, -1e39, 1e300, -1e300,
+               np.inf, -np.inf, np.nan]
+    rng = np.random.default_rng(3)
+    random = rng.standard_normal(2000) * 10.0 ** rng.uniform(-40, 38, 2000)
+    exact = rng.standard_normal(500).astype(np.float32).astype(np.float64)
+    xs = np.concatenate([special, random, exact])
+    above, below = np.empty_like(xs), np.empty_like(xs)
+    _inward(xs, above, below)
+    with np.errstate(over="ignore"):
+        want_above = np.array([_reference_above(x) for x in xs])
+        want_below = np.array([_reference_below(x) for x in xs])
+    assert above.view(np.int64).tolist() == want_above.view(np.int64).tolist()
+    assert below.view(np.int64).tolist() == want_below.view(np.int64).tolist()
+    finite = np.isfinite(xs) & (np.abs(xs) < big)
+    assert np.all(above[finite] > xs[finite]) and np.all(below[finite] < xs[finite])

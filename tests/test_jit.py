@@ -189,6 +189,60 @@ def test_stock_numba_runs_the_same_kernels(tmp_path, why):
     assert list((tmp_path / "cache").rglob("*total*.nbc"))
 
 
+ARRAY_TYPING = """
+import sys
+import numpy as np
+import numba
+from numba import types
+from whitted.jit import kernel, load_numba
+
+load_numba()
+
+
+@kernel(entry=True)
+def first_of(a):
+    return a[0, 0]
+
+
+c = np.arange(6.0).reshape(2, 3)
+f = np.asfortranarray(c)
+strided = np.arange(12.0).reshape(2, 6)[:, ::2]
+frozen = c.copy()
+frozen.flags.writeable = False
+print("TYPES", numba.typeof(c) == types.Array(types.float64, 2, "C"),
+      numba.typeof(f) == types.Array(types.float64, 2, "F"),
+      numba.typeof(strided) == types.Array(types.float64, 2, "A"),
+      numba.typeof(frozen) == types.Array(types.float64, 2, "C", readonly=True),
+      numba.typeof(np.zeros(3, np.int32)) == types.Array(types.int32, 1, "C"))
+print("CALLS", first_of(c), first_of(f), first_of(strided), first_of(frozen))
+print("MA", "numpy.ma" in sys.modules)
+import numpy.ma
+
+try:
+    numba.typeof(numpy.ma.masked_array(c))
+except numba.core.errors.NumbaTypeError as exc:
+    print("MASKED", exc)
+"""
+
+
+def test_arrays_are_typed_as_numba_types_them_without_importing_masked_arrays(tmp_path):
+    """Numba's typing of array arguments, registered through its public typeof_impl
+    (jit/array_typing.py): the same types for C, Fortran, strided and read-only arrays,
+    without importing numpy.ma; once it is imported, a masked array is refused as Numba
+    refuses it."""
+    (tmp_path / "run.py").write_text(ARRAY_TYPING)
+    env = dict(os.environ, WHITTED_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("NUMBA_CACHE_DIR", None)
+    for _ in range(2):  # compiled (which may import anything), then loaded from the cache
+        run = subprocess.run([sys.executable, "run.py"], cwd=tmp_path, capture_output=True,
+                             text=True, timeout=600, env=env)
+        assert run.returncode == 0, run.stderr[-2000:]
+        assert "TYPES True True True True True" in run.stdout
+        assert "CALLS 0.0 0.0 0.0 0.0" in run.stdout
+        assert "MASKED Unsupported array type: numpy.ma.MaskedArray." in run.stdout
+    assert "MA False" in run.stdout
+
+
 def test_private_names_are_listed_and_checked():
     """Every private name the tuned dispatcher uses is listed; a Numba outside the verified
     versions turns it off."""

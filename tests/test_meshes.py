@@ -195,6 +195,37 @@ def test_smooth_normals_interpolate_the_corners(layout):
     assert surface_normals(geo, prim, tri, b1, b2, p)[1] == pytest.approx((0, 0, 1))
 
 
+@pytest.mark.parametrize("layout", LAYOUTS[1:])
+def test_normals_of_a_transformed_instance_flat_and_smooth(layout):
+    """An instance turned, scaled unevenly and moved: its normals in world space are the
+    mesh's own mapped by the inverse transpose and normalised; a flat mesh's shading normal
+    is its geometric one (mapped once), a smooth one's the corners' blend, mapped."""
+    transform = TRANSFORMS[1]
+    m = transform.matrix()[:3, :3]
+    to_world = np.linalg.inv(m).T
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+    normals = np.array([[0, 0, 1], [1, 0, 1], [0, 1, 1]], float) / [[1], [math.sqrt(2)],
+                                                                      [math.sqrt(2)]]
+    local_hit = np.array([0.25, 0.5, 0.0])
+    world_hit = m @ local_hit + transform.matrix()[:3, 3]
+    n_world = to_world @ [0.0, 0.0, 1.0]
+    n_world /= np.linalg.norm(n_world)
+    ray_o = tuple(world_hit + 2.0 * n_world)
+    ray_d = tuple(-n_world)
+    for smooth in (False, True):
+        mesh = whitted.Mesh(v, [[0, 1, 2]], normals=normals, smooth=smooth, transform=transform)
+        geo, prim, tri, b1, b2, p = _one_triangle_hit(mesh, ray_o, ray_d, layout)
+        assert p == pytest.approx(tuple(world_hit), abs=1e-6)
+        ng, ns = surface_normals(geo, prim, tri, b1, b2, p)
+        assert ng == pytest.approx(tuple(n_world), abs=1e-6)
+        if not smooth:
+            assert ns == ng
+            continue
+        blend = to_world @ (0.25 * normals[0] + 0.25 * normals[1] + 0.5 * normals[2])
+        assert ns == pytest.approx(tuple(blend / np.linalg.norm(blend)), abs=1e-6)
+        assert abs(np.dot(ns, ng)) < 0.999  # a different direction from the geometric one
+
+
 @pytest.mark.parametrize("layout", LAYOUTS)
 def test_computed_smooth_normals_respect_the_crease_angle(layout):
     v, f = cube()

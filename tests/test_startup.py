@@ -179,6 +179,31 @@ def test_a_warm_render_needs_neither_numbas_runtime_nor_its_array_code(tmp_path)
     assert "RUNTIME=none" in result.stdout and "ARRAYOBJ=False" in result.stdout, result.stdout
 
 
+@pytest.mark.parametrize("scene, options", [
+    ("seed000", []), ("caustics", ["--set", "render.caustics.photons=3000"])])
+def test_a_warm_render_imports_no_masked_arrays(tmp_path, scene, options):
+    """Numba types array arguments without importing NumPy's masked arrays
+    (jit/dispatcher.py), and the photon map's set-up uses nothing that imports them:
+    ``numpy.ma`` (8-13 ms) is no part of a warm render, with caustics or without."""
+    import shutil
+
+    from whitted.jit.cache import prepare
+
+    warm = Path(prepare().folder)
+    cache = tmp_path / "cache"
+    if warm.is_dir():
+        shutil.copytree(warm, cache / warm.name, ignore=shutil.ignore_patterns("whitted.lock"))
+    out = tmp_path / "x.png"
+    code = textwrap.dedent(_run_main([
+        "render", str(REPO_ROOT / "benchmarks" / f"{scene}.toml"), "-W", "24", "-H", "16",
+        "-q", "-o", str(out), *options]))
+    settings = {"WHITTED_CACHE_DIR": str(cache), "NUMBA_CACHE_DIR": ""}
+    _modules_after(code, tmp_path, **settings)  # may compile
+    loaded = _modules_after(code + "\nassert 'numpy.ma' not in sys.modules, 'numpy.ma'\n",
+                            tmp_path, **settings)
+    assert out.stat().st_size > 0 and "numba" in loaded
+
+
 def test_plain_line_is_what_rich_prints_and_needs_no_rich(tmp_path, monkeypatch):
     """cli/console.py writes a plain line to a file that is not a terminal itself: the same
     bytes rich writes for it (markup and emoji codes stay literal)."""

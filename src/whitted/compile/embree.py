@@ -15,10 +15,13 @@ the system's (Debian's ``libembree4-4``). Without any, ``auto`` is whitted's wal
 ``WHITTED_EMBREE_LIBRARY=none`` switches Embree off.
 
 Embree scenes are built in robust mode (watertight: no ray slips between two triangles that
-share an edge) with its high build quality (spatial splits: long thin triangles are where
-they pay). A mesh whose triangles mix opaque and transparent materials gets two more Embree
-scenes, one of each, so a shadow ray asks "anything opaque?" and "anything transparent?" with
-one ``rtcOccluded1`` each, exactly what whitted's own any-hit walk answers.
+share an edge). The high build quality is asked for too (spatial splits, where long thin
+triangles gain), but Embree 4 gives a robust scene its standard builder whatever the quality
+(``BVH8Triangle4v``); such a scene traced 14-17 % slower per ray than Embree's default, not
+watertight one (docs/performance.md, "The Embree path, second round"). A mesh whose
+triangles mix opaque and transparent materials gets two more Embree scenes, one of each, so
+a shadow ray asks "anything opaque?" and "anything transparent?" with one ``rtcOccluded1``
+each, exactly what whitted's own any-hit walk answers.
 
 The handles, and the addresses of ``rtcIntersect1`` and ``rtcOccluded1``, go in the meshes'
 ``mesh_info`` rows (``MESH_EMBREE``); the scenes live as long as that array (its buffer owns

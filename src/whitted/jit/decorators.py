@@ -108,6 +108,9 @@ def load_numba() -> None:
                 config.SLP_VECTORIZE = 1
         from numba.core import event
 
+        from .array_typing import install as type_arrays_without_numpy_ma
+
+        type_arrays_without_numpy_ma()
         event.register("numba:compile", _compile_listener())
         while _deferred:
             _deferred.pop(0)()

@@ -22,12 +22,20 @@ from .extras import (
 from .features import has_extras, has_instances, instances_possible
 from .layout import (
     MAT_KT,
+    MESH_NORMALS,
     MESH_STACK_BASE,
     PRIM_MATERIAL,
     PRIM_TYPE,
     PRIM_XFORM,
 )
-from .mesh import OPAQUE_KT, mesh_closest_hit, mesh_occlusion
+from .mesh import (
+    OPAQUE_KT,
+    embree_closest_hit,
+    embree_occlusion,
+    mesh_closest_hit,
+    mesh_occlusion,
+    uses_embree,
+)
 from .shapes import INF
 from .shapes.dispatch import (
     has_shading_normal,
@@ -78,22 +86,32 @@ def hit_instance(geo, i, o, d, inv, tmin, tmax, stack):
     """(t, triangle, b1, b2) of the ray with mesh instance ``i``; t = INF on a miss. ``inv``
     is the world ray's inverse direction (reused when the instance has no transform)."""
     xf = geo.prim_info[i, PRIM_XFORM]
+    mesh = int(geo.prim_params[i, 0])
+    if uses_embree(geo, mesh):  # straight to Embree: no inverse direction, one call less
+        if xf >= 0:
+            o, d = to_object(geo.xforms, xf, o, d)
+        return embree_closest_hit(geo, mesh, o, d, tmin, tmax)
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
         inv = inverse_direction(d)
-    return mesh_closest_hit(geo, int(geo.prim_params[i, 0]), o, d, inv, tmin, tmax, stack,
-                            MESH_STACK_BASE)
+    return mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, MESH_STACK_BASE)
 
 
 @kernel
 def instance_occludes(geo, mats, i, o, d, inv, tmin, tmax, stack):
     """:func:`occludes` for a mesh instance (``inv`` as in :func:`hit_instance`)."""
     xf = geo.prim_info[i, PRIM_XFORM]
+    mesh = int(geo.prim_params[i, 0])
+    material = geo.prim_info[i, PRIM_MATERIAL]
+    if uses_embree(geo, mesh):
+        if xf >= 0:
+            o, d = to_object(geo.xforms, xf, o, d)
+        return embree_occlusion(geo, mats, mesh, material, o, d, tmin, tmax)
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
         inv = inverse_direction(d)
-    return mesh_occlusion(geo, mats, int(geo.prim_params[i, 0]), geo.prim_info[i, PRIM_MATERIAL],
-                          o, d, inv, tmin, tmax, stack, MESH_STACK_BASE)
+    return mesh_occlusion(geo, mats, mesh, material, o, d, inv, tmin, tmax, stack,
+                          MESH_STACK_BASE)
 
 
 @kernel
@@ -160,11 +178,15 @@ def surface_normals(geo, prim, tri, b1, b2, p):
                 ns = flipped_if_extras(geo, prim, ns)
             return n, ns
         return n, n
-    ng, ns = mesh_normals_if_instances(geo, int(geo.prim_params[prim, 0]), tri, b1, b2)
+    mesh = int(geo.prim_params[prim, 0])
+    ng, ns = mesh_normals_if_instances(geo, mesh, tri, b1, b2)
     xf = geo.prim_info[prim, PRIM_XFORM]
     if xf < 0:
         return ng, ns
-    return _normal_to_world(geo.xforms, xf, ng), _normal_to_world(geo.xforms, xf, ns)
+    wg = _normal_to_world(geo.xforms, xf, ng)
+    if geo.mesh_info[mesh, MESH_NORMALS] < 0:  # flat shading: ns is ng, mapped once
+        return wg, wg
+    return wg, _normal_to_world(geo.xforms, xf, ns)
 
 
 @kernel(inline="always")

@@ -15,6 +15,11 @@ the next process).
 direction 4-6, time 7, tfar 8, mask 9, id 10, flags 11; the hit's geometric normal 12-14,
 u 15, v 16, primID 17, geomID 18, instID 19. Embree's barycentric (u, v) are whitted's
 (b1, b2): hit = (1-u-v)·v0 + u·v1 + v·v2.
+
+Embree's segment [tnear, tfar] is closed and in float32, whitted's (tmin, tmax) open, so the
+callers round its ends inward to float32 (:func:`float32_above`, :func:`float32_below`): the
+next float32 is found on the bits, in a few instructions, where ``np.nextafter`` was a call
+into the C library per end and per Embree call.
 """
 
 from __future__ import annotations
@@ -73,6 +78,58 @@ def _load(builder, words, k):
 def _load_int(builder, words, k):
     slot = builder.bitcast(builder.gep(words, [ir.Constant(_I32, k)]), _I32.as_pointer())
     return builder.load(slot)
+
+
+def _step(builder, y, up):
+    """The float32 next to ``y`` (not NaN, not the infinity it steps toward) toward +inf
+    (``up``) or -inf, on the bits: magnitude one unit up or down, +-0 to the smallest
+    subnormal of the direction's sign; what ``np.nextafter`` gives."""
+    bits = builder.bitcast(y, _I32)
+    positive = builder.fcmp_ordered(">", y, ir.Constant(_F32, 0.0))
+    one = ir.Constant(_I32, 1)
+    away = builder.add(bits, one)  # larger magnitude, same sign
+    toward = builder.sub(bits, one)  # smaller magnitude (y != 0)
+    if up:
+        moved = builder.select(positive, away, toward)
+        tiny = ir.Constant(_I32, 1)
+    else:
+        moved = builder.select(positive, toward, away)
+        tiny = ir.Constant(_I32, -0x7FFFFFFF)  # bits 0x80000001: -(smallest subnormal)
+    zero = builder.fcmp_ordered("==", y, ir.Constant(_F32, 0.0))
+    return builder.bitcast(builder.select(zero, tiny, moved), _F32)
+
+
+@intrinsic
+def float32_above(typingctx, x):
+    """The smallest float32 above ``x`` (as a float64): ``x`` rounded to float32, stepped up
+    once when the rounding did not land above it (inf stays inf, NaN stays NaN)."""
+    sig = types.float64(types.float64)
+
+    def codegen(context, builder, signature, args):
+        (x_,) = args
+        y = builder.fptrunc(x_, _F32)
+        step = builder.and_(builder.fcmp_ordered("<=", builder.fpext(y, _F64), x_),
+                            builder.fcmp_ordered("!=", y, ir.Constant(_F32, float("inf"))))
+        return builder.fpext(builder.select(step, _step(builder, y, True), y), _F64)
+
+    return sig, codegen
+
+
+@intrinsic
+def float32_below(typingctx, x):
+    """The largest float32 below ``x`` (as a float64; +inf stays +inf, NaN stays NaN): as
+    :func:`float32_above`, stepped down."""
+    sig = types.float64(types.float64)
+
+    def codegen(context, builder, signature, args):
+        (x_,) = args
+        y = builder.fptrunc(x_, _F32)
+        step = builder.and_(builder.fcmp_ordered(">=", builder.fpext(y, _F64), x_),
+                            builder.fcmp_ordered("!=", y, ir.Constant(_F32, float("-inf"))))
+        step = builder.and_(step, builder.fcmp_ordered("!=", x_, ir.Constant(_F64, float("inf"))))
+        return builder.fpext(builder.select(step, _step(builder, y, False), y), _F64)
+
+    return sig, codegen
 
 
 _VEC3 = types.UniTuple(types.float64, 3)

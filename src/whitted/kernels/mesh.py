@@ -42,6 +42,9 @@ from .traverse import slab_entry
 # kernels/embree.py's intrinsics are Numba extensions: imported with Numba (jit/decorators.py)
 embree_intersect = numba_object(f"{__package__}.embree", "embree_intersect")
 embree_occluded = numba_object(f"{__package__}.embree", "embree_occluded")
+# Embree's closed float32 segment from whitted's open (tmin, tmax): the ends rounded inward
+float32_above = numba_object(f"{__package__}.embree", "float32_above")
+float32_below = numba_object(f"{__package__}.embree", "float32_below")
 
 OPAQUE_KT = 0.01  # the lecture's rule: an occluder with kt below this blocks the light
 
@@ -83,27 +86,6 @@ def push_mesh_children(nodes, ints, node, o, inv, tmin, tmax, stack, top):
 
 
 @kernel(inline="always")
-def float32_above(x):
-    """The smallest float32 above ``x`` (as a float64): Embree's segment is closed and in
-    float32, whitted's (tmin, tmax) open, so its ends are rounded inward."""
-    y = np.float32(x)
-    if np.float64(y) <= x:
-        y = np.nextafter(y, np.float32(INF))
-    return np.float64(y)
-
-
-@kernel(inline="always")
-def float32_below(x):
-    """The largest float32 below ``x`` (as a float64; inf stays inf)."""
-    if x == INF:
-        return x
-    y = np.float32(x)
-    if np.float64(y) >= x:
-        y = np.nextafter(y, np.float32(-INF))
-    return np.float64(y)
-
-
-@kernel(inline="always")
 def embree_address(geo, mesh, k):
     """Address ``k`` (EMBREE_ALL, ..., EMBREE_OCCLUDED) of mesh ``mesh``'s row: two int32
     columns, the low and the high half."""
@@ -111,6 +93,12 @@ def embree_address(geo, mesh, k):
     low = np.int64(geo.mesh_info[mesh, MESH_EMBREE + 2 * k]) & np.int64(0xFFFFFFFF)
     high = np.int64(geo.mesh_info[mesh, MESH_EMBREE + 2 * k + 1])
     return (high << np.int64(32)) | low
+
+
+@kernel(inline="always")
+def uses_embree(geo, mesh):
+    """Is mesh ``mesh`` traced by Embree (it has an Embree scene)?"""
+    return embree_address(geo, mesh, EMBREE_ALL) != 0
 
 
 @kernel
@@ -147,7 +135,7 @@ def embree_occlusion(geo, mats, mesh, material, o, d, tmin, tmax):
 def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
     """Nearest triangle of mesh ``mesh`` hit by the ray (mesh space) in (tmin, tmax):
     (t, triangle, b1, b2), t = INF on a miss. ``stack[base:]`` is scratch."""
-    if embree_address(geo, mesh, EMBREE_ALL) != 0:
+    if uses_embree(geo, mesh):
         return embree_closest_hit(geo, mesh, o, d, tmin, tmax)
     kx, ky, kz, sx, sy, sz = shear_setup(d)
     corners = geo.mesh_leaf_corners
@@ -187,7 +175,7 @@ def mesh_closest_hit(geo, mesh, o, d, inv, tmin, tmax, stack, base):
 def mesh_occlusion(geo, mats, mesh, material, o, d, inv, tmin, tmax, stack, base):
     """Any triangle of the mesh on the segment (tmin, tmax)? 0: none; 1: an opaque one (the
     walk stops there); 2: only transparent ones. ``material`` >= 0 overrides the triangles'."""
-    if embree_address(geo, mesh, EMBREE_ALL) != 0:
+    if uses_embree(geo, mesh):
         return embree_occlusion(geo, mats, mesh, material, o, d, tmin, tmax)
     if material >= 0 and mats[material, MAT_KT] >= OPAQUE_KT:
         # one transparent material: any hit is a transparent one

@@ -353,8 +353,8 @@ def shadow_photons(geo, mats, clear, table, j, o, d, power, directional, setting
 def trace_photons(geo, mats, clear, table, emitters, settings, first, last, out, counts,
                   stack, media, scratch):
     """Photons ``first`` .. ``last - 1`` of a pass (``settings``: SET_* values): photon
-    ``i`` writes its records into rows ``i * slots ...`` of ``out`` and their number into
-    ``counts[i]``."""
+    ``i`` writes its records into rows ``(i - first) * slots ...`` of ``out`` (the calls'
+    own rows, ``(last - first) * slots`` of them) and their number into ``counts[i]``."""
     geo = geometry_ref_if_instances(geo)
     slots = int(settings[SET_SLOTS])
     seed = int(settings[SET_SEED])
@@ -373,9 +373,10 @@ def trace_photons(geo, mats, clear, table, emitters, settings, first, last, out,
         if max(power[0], max(power[1], power[2])) <= 0.0:
             continue
         j = int(emitters[e, EMIT_LIGHT])
+        row = (i - first) * slots
         n = shadow_photons(geo, mats, clear, table, j, o, d, power, directional, settings, out,
-                           i * slots, SHADOW_SLOTS, stack)
+                           row, SHADOW_SLOTS, stack)
         counts[i] = n + trace_photon(geo, mats, clear, table, j, o, d, power, directional,
                                      settings, i, i - int(emitters[e, EMIT_FIRST]), e, out,
-                                     i * slots + n, slots - n, stack, media, scratch)
+                                     row + n, slots - n, stack, media, scratch)
 
