@@ -367,12 +367,12 @@ _box = st.tuples(_coord, _coord, _coord, st.integers(0, 2), st.integers(0, 2), s
 
 
 @settings(max_examples=60, deadline=None)
-@given(st.lists(_box, min_size=0, max_size=60), st.integers(2, 16))
-def test_property_small_inputs(boxes, n_bins):
+@given(st.lists(_box, min_size=0, max_size=60), st.integers(2, 16), st.booleans())
+def test_property_small_inputs(boxes, n_bins, all_axes):
     arr = np.array(boxes, dtype=np.float64).reshape(-1, 6)
     lo = arr[:, :3]
     hi = arr[:, :3] + arr[:, 3:]
-    bvh = build_bvh(lo, hi, n_bins=n_bins)
+    bvh = build_bvh(lo, hi, n_bins=n_bins, all_axes=all_axes)
     check_bvh(bvh, lo, hi)
     if lo.shape[0]:
         check_rays(bvh, lo, hi, n_rays=12, seed=len(boxes))
@@ -399,3 +399,22 @@ def test_sort_range_is_numpys_stable_sort(n, start, end, axis):
                 np.empty(n, np.int64), np.empty(_NCOL + 1))
     np.testing.assert_array_equal(rows, want_rows)
     np.testing.assert_array_equal(idx, want_idx)
+
+
+def test_all_axes_parts_two_sheets_the_longest_axis_would_mix():
+    """Two flat sheets of small boxes, 12 wide in x and 10 apart in y (two nested shells'
+    faces): split along x, the longest centroid axis, both halves hold both sheets; with
+    ``all_axes`` the root splits along y and parts them."""
+    rng = np.random.default_rng(7)
+    c = np.column_stack([rng.uniform(0, 12, 400), np.repeat([0.0, 10.0], 200),
+                         rng.uniform(0, 4, 400)])
+    lo, hi = c - 0.02, c + 0.02
+    lo[:, 1] = hi[:, 1] = c[:, 1]
+    one = build_bvh(lo, hi)
+    every = build_bvh(lo, hi, all_axes=True)
+    check_bvh(every, lo, hi)
+    check_rays(every, lo, hi, n_rays=60)
+    assert one.node_axis[0] == 0 and every.node_axis[0] == 1
+    left, right = 1, int(every.node_offset[0])
+    assert every.node_max[left, 1] == every.node_min[left, 1]  # each child one flat sheet
+    assert every.node_max[right, 1] == every.node_min[right, 1]

@@ -8,7 +8,8 @@ its right child is ``node_offset[i]``. A leaf's primitives are
 ``prim_order[node_offset[i] : node_offset[i] + node_count[i]]``.
 
 Split rule at a node of ``n`` primitives: centroids are binned on the axis of largest centroid
-extent only (one axis keeps the build inside its time budget), and the SAH cost
+extent only (one axis keeps the build inside its time budget; ``all_axes`` bins all three
+and keeps the cheapest), and the SAH cost
 ``1 + (A_L * N_L + A_R * N_R) / A`` of the best bin boundary is compared with the leaf cost
 ``n``. The node becomes a leaf when ``n <= 1``, or when no split is cheaper than the leaf and
 ``n`` is at most the leaf cap (16). When every centroid coincides the index range is halved.
@@ -36,7 +37,6 @@ LEAF_HARD_CAP = 16  # a node with more primitives than this is always split
 MAX_DEPTH = 60  # root has depth 0; no leaf is deeper than this
 TRAVERSAL_COST = 1.0
 INTERSECTION_COST = 1.0
-SAH_ALL_AXES = False  # bin only the axis of largest centroid extent
 _BIN_SCALE_SHRINK = 1.0 - 1e-9  # keeps the largest centroid inside the last bin
 
 # working rows: columns 0-2 lower corner, 3-5 upper corner, 6-8 centroid
@@ -280,8 +280,8 @@ def _sah_axis(rows, start, end, axis, cmin, scale, nb, bin_cnt, bin_box, r_area,
 
 @builder
 def _build(rows, idx, n_bins, leaf_cap, node_min, node_max, node_offset, node_count, node_axis,
-           traversal_cost, bin_cnt, bin_box, r_area, r_cnt, st_i, st_f, bounds, sort_keys,
-           sort_order, sort_spare):
+           traversal_cost, all_axes, bin_cnt, bin_box, r_area, r_cnt, st_i, st_f, bounds,
+           sort_keys, sort_order, sort_spare):
     """Build the tree in place; returns the number of nodes written. The scratch arrays
     (:func:`_scratch`) come from the caller: this builder allocates nothing."""
     n = rows.shape[0]
@@ -353,7 +353,7 @@ def _build(rows, idx, n_bins, leaf_cap, node_min, node_max, node_offset, node_co
                     best_cost = np.inf
                     best_imb = count + 1
                     for a in range(3):
-                        if not SAH_ALL_AXES and a != axis:
+                        if not all_axes and a != axis:
                             continue
                         ea = cur[9 + a] - cur[6 + a]
                         if not ea > 0.0:
@@ -486,12 +486,16 @@ def build_bvh(
     max_leaf_size: int = 4,
     n_bins: int = 16,
     traversal_cost: float = TRAVERSAL_COST,
+    all_axes: bool = False,
 ) -> BVH:
     """BVH over N primitives with bounds ``bounds_min[i] .. bounds_max[i]`` ((N, 3) arrays).
 
     Bounds must be finite with ``min <= max`` (flat boxes are fine). Leaves hold at most
     ``max(max_leaf_size, 16)`` primitives; within that cap the SAH decides leaf sizes.
-    ``n_bins`` (>= 2) is the number of SAH bins per node. The result is deterministic.
+    ``n_bins`` (>= 2) is the number of SAH bins per node. ``all_axes`` bins all three axes
+    at each node and keeps the cheapest split (three times the binning; the scene BVH of a
+    big flattened scene uses it), instead of the axis of largest centroid extent only. The
+    result is deterministic.
     """
     bmin = np.ascontiguousarray(bounds_min, dtype=np.float64)
     bmax = np.ascontiguousarray(bounds_max, dtype=np.float64)
@@ -538,6 +542,7 @@ def build_bvh(
         node_count,
         node_axis,
         float(traversal_cost),
+        bool(all_axes),
         *_scratch(n, int(n_bins)),
     )
     del rows

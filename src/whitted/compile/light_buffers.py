@@ -117,6 +117,8 @@ def _reach(geo: GeometryArrays, light: np.ndarray) -> float:
     if geo.node_box.shape[0] == 0:
         return 1.0
     lo, hi = geo.node_box[0]
+    if geo.bvh_frame.shape[0]:  # the root box is in the BVH's frame (compile/bvh_frame.py)
+        light = geo.bvh_frame @ light
     far = np.maximum(np.abs(lo - light), np.abs(hi - light))
     return float(np.linalg.norm(far)) * (1.0 + 1e-6) + 1e-9
 

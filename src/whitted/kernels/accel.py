@@ -48,6 +48,7 @@ from .shapes.mesh import mesh_normals
 from .shapes.triangle import triangle_shading_normal
 from .traverse import (
     box_entry,
+    bvh_frame_ray,
     inverse_direction,
     next_scene_candidate,
     push_children,
@@ -258,10 +259,11 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
     best_t = tmax
     best = -1
     inv = inverse_direction(d)
+    fo, finv = bvh_frame_ray(geo, o, d, inv)  # the ray the boxes see
     j, leaf, leaf_end, top = start_scene_walk(geo, stack, True)
     while True:
-        i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, best_t, stack, j,
-                                                         leaf, leaf_end, top, True)
+        i, j, leaf, leaf_end, top = next_scene_candidate(geo, fo, finv, tmin, best_t, stack,
+                                                         j, leaf, leaf_end, top, True)
         if i < 0:
             break
         t, part = hit_part(geo, i, o, d, inv, tmin, best_t)

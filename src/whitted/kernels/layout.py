@@ -191,6 +191,10 @@ class GeometryArrays(NamedTuple):
     node_link: np.ndarray  # (M, 2) int32
     node_wide: np.ndarray  # (W, WIDE_ROWS, WIDE) float32 the same BVH in eight-wide nodes
     node_prims: np.ndarray  # (N,) int32 primitive indices in leaf order
+    # (3, 3) float64 rotation from world space into the frame node_box and node_wide are
+    # built in, or (0, 3) when they are in world space (compile/bvh_frame.py): the walks
+    # turn the ray for the box tests only
+    bvh_frame: np.ndarray
     # (U,) primitives outside the BVH (infinite planes): int32, or int64 in scenes with tori
     # or CSG objects, which selects kernels compiled with those shapes (features.py)
     unbounded: np.ndarray

@@ -62,6 +62,8 @@ from .shapes.dispatch import crossed_twice, is_csg_object, is_extra, is_world_pl
 from .shapes.flat import EDGE_TOL
 from .traverse import (
     box_entry,
+    bvh_frame_point,
+    bvh_frame_ray,
     cone_meets_box,
     inverse_direction,
     next_scene_candidate,
@@ -119,9 +121,10 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
     of the intersection routines), then the mesh instances when there are any."""
     seen_transparent = 0
     inv = inverse_direction(d)
+    fo, finv = bvh_frame_ray(geo, o, d, inv)  # the ray the boxes see
     j, leaf, leaf_end, top = start_scene_walk(geo, stack, False)
     while True:
-        i, j, leaf, leaf_end, top = next_scene_candidate(geo, o, inv, tmin, tmax, stack, j,
+        i, j, leaf, leaf_end, top = next_scene_candidate(geo, fo, finv, tmin, tmax, stack, j,
                                                          leaf, leaf_end, top, False)
         if i < 0:
             break
@@ -284,6 +287,8 @@ def list_cone_leaves(geo, mats, apex, axis, radius, stack, out, n, cap, opaque):
     be more than ``cap``."""
     if geo.node_box.shape[0] == 0:
         return n, opaque
+    apex = bvh_frame_point(geo, apex)  # the cone as the boxes see it (rotation keeps radius)
+    axis = bvh_frame_point(geo, axis)
     top = 0
     stack[0] = 0
     while top >= 0:
@@ -707,6 +712,7 @@ def direct_light(
                     vis = (1.0, 1.0, 1.0)
                     t_from = eps
                     inv = inverse_direction(ldir)
+                    fo, finv = bvh_frame_ray(geo, p, ldir, inv)  # the ray the boxes see
                     for _ in range(64):
                         # a walk (see the docstring) over (t_from, tmax)
                         n_hits = 0
@@ -721,8 +727,8 @@ def direct_light(
                                 k += 1
                             else:
                                 i, cand, leaf, leaf_end, top = next_scene_candidate(
-                                    geo, p, inv, t_from, tmax, stack, cand, leaf, leaf_end, top,
-                                    False)
+                                    geo, fo, finv, t_from, tmax, stack, cand, leaf, leaf_end,
+                                    top, False)
                                 if i < 0:
                                     break
                             if (has_extras(geo) and is_extra(geo.prim_info[i, PRIM_TYPE])

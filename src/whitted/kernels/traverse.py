@@ -33,6 +33,35 @@ def inverse_direction(d):
 
 
 @kernel(inline="always")
+def bvh_frame_ray(geo, o, d, inv):
+    """The ray (o, d) of inverse direction ``inv`` as the scene BVH's boxes see it: (origin,
+    inverse direction) turned by ``geo.bvh_frame`` (compile/bvh_frame.py), or unchanged when
+    the BVH is in world space. Only box tests use it; primitives are tested in world space."""
+    f = geo.bvh_frame
+    if f.shape[0] == 0:
+        return o, inv
+    fo = (f[0, 0] * o[0] + f[0, 1] * o[1] + f[0, 2] * o[2],
+          f[1, 0] * o[0] + f[1, 1] * o[1] + f[1, 2] * o[2],
+          f[2, 0] * o[0] + f[2, 1] * o[1] + f[2, 2] * o[2])
+    fd = (f[0, 0] * d[0] + f[0, 1] * d[1] + f[0, 2] * d[2],
+          f[1, 0] * d[0] + f[1, 1] * d[1] + f[1, 2] * d[2],
+          f[2, 0] * d[0] + f[2, 1] * d[1] + f[2, 2] * d[2])
+    return fo, inverse_direction(fd)
+
+
+@kernel(inline="always")
+def bvh_frame_point(geo, p):
+    """Point or vector ``p`` turned into the scene BVH's frame (unchanged in world space):
+    the cone tests' apex and axis."""
+    f = geo.bvh_frame
+    if f.shape[0] == 0:
+        return p
+    return (f[0, 0] * p[0] + f[0, 1] * p[1] + f[0, 2] * p[2],
+            f[1, 0] * p[0] + f[1, 1] * p[1] + f[1, 2] * p[2],
+            f[2, 0] * p[0] + f[2, 1] * p[1] + f[2, 2] * p[2])
+
+
+@kernel(inline="always")
 def slab_entry(lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, o, inv, tmin, tmax):
     """Entry distance of the ray into the box (lo, hi) when it overlaps (tmin, tmax), else
     INF: the slab test every node box of every BVH level goes through."""
