@@ -5,8 +5,9 @@ so a machine whose speed drifts weighs on both alike. The float32 framebuffers o
 must be bitwise equal (their SHA-256 is compared).
 
 With ``--cpu`` the figure compared is the render's CPU seconds (the process's user + system
-time over the render calls: one thread's work, whatever else the machine runs) instead of
-the render's wall time.
+time over the render calls, summed over all of the process's threads: the work of the
+render, whatever else the machine runs) instead of the render's wall time. With ``--threads``
+above 1 it adds the threads' spinning and waiting too: compare CPU at one thread.
 
 A and B differ by environment settings (``--a``, ``--b``: ``NAME=VALUE`` words) and by
 ``PYTHONPATH`` (two checkouts) or cache folders (``WHITTED_CACHE_DIR``):
