@@ -14,7 +14,10 @@ The frame is the rotation of the flattened mesh object with the most triangles, 
 primitives' boxes turned into it are smaller (summed surface area) by
 :data:`MIN_GAIN`; otherwise the world frame (``bvh_frame`` empty, and the walks turn
 nothing). Each box in the frame is widened by :data:`FRAME_PAD` of the scene's size, far
-more than the rounding of the turned ray and far less than any geometry.
+more than the rounding of the turned ray and far less than any geometry. (The rounding of a
+turned ray origin grows with its distance: about 3e-16 of it, which reaches the pad only for
+an origin some 10^6-10^7 scene sizes away, where the band of rays it could misclassify is
+far narrower than a pixel's footprint.)
 """
 
 from __future__ import annotations
