@@ -27,7 +27,9 @@ def install() -> None:
     from numba import from_dtype, types
     from numba.extending import typeof_impl
 
-    numbas = typeof_impl.dispatch(np.ndarray)  # Numba's own, for every other case
+    # Numba's own, for every other case (typeof_impl is a functools.singledispatch function:
+    # ``dispatch`` is the standard library's documented look-up of its registered one)
+    numbas = typeof_impl.dispatch(np.ndarray)
 
     def typeof_array(value, context):
         if "numpy.ma" in sys.modules:  # masked arrays may exist: Numba's own typing
