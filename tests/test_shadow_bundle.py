@@ -21,9 +21,9 @@ from whitted.kernels.lighting import (
     SHADOW_LIST_CAP,
     ball_meets_bundle,
     list_bundle_occluders,
-    triangle_ball,
 )
 from whitted.kernels.shapes import INF
+from whitted.kernels.shapes.triangle import triangle_ball
 from whitted.kernels.traverse import cone_meets_box
 
 EPS = 1e-6  # the shadow rays' tmin

@@ -50,16 +50,19 @@ from .layout import (
     PRIM_TYPE,
     PRIM_XFORM,
     RAY_SHADOW,
-    SHAPE_SPHERE,
-    SHAPE_TRIANGLE,
 )
 from .light_buffer import cube_cell
 from .media import absorbed, media_enter, media_leave
 from .mesh import OPAQUE_KT
 from .sampling import SAMPLE_CHUNK, stratified_disk, stratum
 from .shapes import INF
-from .shapes.dispatch import crossed_twice, is_csg_object, is_extra, is_world_plane
-from .shapes.flat import EDGE_TOL
+from .shapes.dispatch import (
+    bounding_ball,
+    crossed_twice,
+    is_csg_object,
+    is_extra,
+    is_world_plane,
+)
 from .traverse import (
     box_entry,
     bvh_frame_point,
@@ -230,21 +233,6 @@ def ball_meets_bundle(c, r, p, axis, length, sin_a, cos_a, reach):
 
 
 @kernel
-def triangle_ball(P, i):
-    """(centre, radius) of a ball holding triangle row ``i`` and every point its hit test
-    can find (:func:`.shapes.triangle.intersect_triangle` allows EDGE_TOL past its edges)."""
-    v0 = vload(P, i, 0)
-    e1 = vload(P, i, 3)
-    e2 = vload(P, i, 6)
-    c = madd(v0, (e1[0] + e2[0], e1[1] + e2[1], e1[2] + e2[2]), 1.0 / 3.0)
-    a = sub(v0, c)
-    b = sub(madd(v0, e1, 1.0), c)
-    d = sub(madd(v0, e2, 1.0), c)
-    far = math.sqrt(max(dot(a, a), max(dot(b, b), dot(d, d))))  # the farthest corner
-    return c, far + 4.0 * EDGE_TOL * (math.sqrt(dot(e1, e1)) + math.sqrt(dot(e2, e2)))
-
-
-@kernel
 def _keep_bundle_occluders(geo, mats, p, centre, radius, listed, n):
     """Of ``listed[:n]`` (a bundle's list from its BVH leaves) keep, in order, those that a
     ray of the bundle could meet: spheres and triangles whose own bounding ball misses the
@@ -265,11 +253,8 @@ def _keep_bundle_occluders(geo, mats, p, centre, radius, listed, n):
         meets = True
         typ = geo.prim_info[i, PRIM_TYPE]
         if not near and geo.prim_info[i, PRIM_XFORM] < 0:  # its numbers are in world space
-            if typ == SHAPE_SPHERE:
-                meets = ball_meets_bundle(vload(P, i, 0), P[i, 3], p, axis, length, sin_a,
-                                           cos_a, reach)
-            elif typ == SHAPE_TRIANGLE:
-                c, r = triangle_ball(P, i)
+            has_ball, c, r = bounding_ball(typ, P, i)
+            if has_ball:
                 meets = ball_meets_bundle(c, r, p, axis, length, sin_a, cos_a, reach)
         if meets:
             listed[kept] = i

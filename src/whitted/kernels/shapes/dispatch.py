@@ -49,9 +49,9 @@ from .frustum import (
 )
 from .plane import intersect_plane, plane_normal, plane_uv
 from .rectangle import intersect_rectangle, rectangle_normal, rectangle_uv
-from .sphere import intersect_sphere, sphere_normal, sphere_span, sphere_uv
+from .sphere import intersect_sphere, sphere_ball, sphere_normal, sphere_span, sphere_uv
 from .torus import intersect_torus, torus_crossings, torus_normal, torus_uv
-from .triangle import intersect_triangle, triangle_normal, triangle_uv
+from .triangle import intersect_triangle, triangle_ball, triangle_normal, triangle_uv
 
 
 @kernel(inline="always")
@@ -240,3 +240,17 @@ def crossed_twice(typ, solid):
     """Whether a line through a row of shape ``typ`` (``solid``: its ``PRIM_SOLID``) crosses
     its surface twice: a closed core body, not a triangle of a flattened solid mesh."""
     return solid != 0 and typ != SHAPE_TRIANGLE
+
+
+@kernel(inline="always")
+def bounding_ball(typ, P, i):
+    """(whether it has one here, centre, radius): a ball holding row ``i`` of shape ``typ``
+    and every point its hit test can find, in the row's own numbers (world space where its
+    ``PRIM_XFORM`` is negative), for the spheres and triangles; other shapes: none."""
+    if typ == SHAPE_SPHERE:
+        c, r = sphere_ball(P, i)
+        return True, c, r
+    if typ == SHAPE_TRIANGLE:
+        c, r = triangle_ball(P, i)
+        return True, c, r
+    return False, (0.0, 0.0, 0.0), 0.0

@@ -54,3 +54,9 @@ def sphere_uv(P, i, p):
     z = dot(q, vload(P, i, SPHERE_FRAME + 6)) / r
     y = min(1.0, max(-1.0, y))
     return 0.5 + math.atan2(x, z) * INV_TWO_PI, 0.5 + math.asin(y) / math.pi
+
+
+@kernel(inline="always")
+def sphere_ball(P, i):
+    """(centre, radius): sphere row ``i`` is its own bounding ball."""
+    return vload(P, i, 0), P[i, 3]

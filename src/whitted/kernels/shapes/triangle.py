@@ -11,9 +11,11 @@ in mesh.py.
 
 from __future__ import annotations
 
+import math
+
 from ...jit import kernel
 from ..layout import TRIANGLE_NORMALS, TRIANGLE_UV
-from ..vec import cross, dot, normalize, sub, vload
+from ..vec import cross, dot, madd, normalize, sub, vload
 from . import INF
 from .flat import EDGE_TOL
 
@@ -91,3 +93,18 @@ def triangle_shading_normal(geo, i, p, fallback):
     if ns[0] == 0.0 and ns[1] == 0.0 and ns[2] == 0.0:
         return fallback
     return normalize(ns)
+
+
+@kernel
+def triangle_ball(P, i):
+    """(centre, radius) of a ball holding triangle row ``i`` and every point its hit test
+    can find (:func:`intersect_triangle` allows EDGE_TOL past its edges)."""
+    v0 = vload(P, i, 0)
+    e1 = vload(P, i, 3)
+    e2 = vload(P, i, 6)
+    c = madd(v0, (e1[0] + e2[0], e1[1] + e2[1], e1[2] + e2[2]), 1.0 / 3.0)
+    a = sub(v0, c)
+    b = sub(madd(v0, e1, 1.0), c)
+    d = sub(madd(v0, e2, 1.0), c)
+    far = math.sqrt(max(dot(a, a), max(dot(b, b), dot(d, d))))  # the farthest corner
+    return c, far + 4.0 * EDGE_TOL * (math.sqrt(dot(e1, e1)) + math.sqrt(dot(e2, e2)))
