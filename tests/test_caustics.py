@@ -760,3 +760,41 @@ def test_photons_are_the_same_compiled_cold_or_loaded_from_the_cache(tmp_path):
                              check=True)
         runs.append(tuple(run.stdout.split()))
     assert runs[0] == runs[1] == here
+
+
+def _general_caustics_scene(photons):
+    """A glass ball, a glass torus and a glass CSG lens over a floor, lit by a point light and
+    the sun: the general geometry's photon tracer (tori, CSG)."""
+    lights = [{"type": "point", "position": [-2.0, 6.0, 1.0], "intensity": 0.6},
+              {"type": "directional", "direction": [0.3, -1.0, -0.2], "intensity": 0.7}]
+    objects = [{"type": "sphere", "center": [-1.2, 1.2, 0.0], "radius": 0.8, "material": GLASS},
+               {"type": "torus", "major_radius": 0.7, "minor_radius": 0.25, "material": GLASS,
+                "transform": {"rotate": [20, 0, 0], "translate": [0.8, 0.6, 0.8]}},
+               {"type": "csg", "operation": "intersection", "material": GLASS,
+                "transform": {"translate": [1.0, 1.6, -0.8]},
+                "objects": [{"type": "sphere", "center": [0, 1.0, 0], "radius": 1.2},
+                            {"type": "sphere", "center": [0, -1.0, 0], "radius": 1.2}]}]
+    return scene_of(objects, photons=photons, lights=lights)
+
+
+def test_general_photon_tracer_computes_what_its_python_source_does():
+    # the tracer runs without fast-math (kernels/strict.py): every operation rounded as
+    # IEEE 754 prescribes, in source order, so the compiled general tracer (tori, CSG: both
+    # walks of a photon around one closest_hit, kernels/photons.py) stores the very bits
+    # the same kernels store run as Python (NUMBA_DISABLE_JIT), where every float
+    # operation is one IEEE double operation
+    import hashlib
+    import os
+    import subprocess
+    import sys
+
+    scene = _general_caustics_scene(300)
+    _, lights, stats = scene_photon_map(scene, threads=1)
+    compiled = (hashlib.sha256(lights.photons.tobytes()).hexdigest(), repr(stats.radius))
+    caustic = lights.photons[:, PHOTON_POWER] > 0
+    assert caustic.sum() > 20 and (~caustic).sum() > 20  # caustic and shadow photons
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
+    run = subprocess.run([sys.executable, "-c", DIGEST.replace("threads=2", "threads=1")],
+                         input=scene.model_dump_json(), capture_output=True, text=True,
+                         env=env, timeout=600, check=True)
+    assert tuple(run.stdout.split()) == compiled

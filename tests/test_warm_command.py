@@ -65,6 +65,37 @@ def test_each_tiny_scene_reaches_its_variant(geometry):
         assert (scene.render.antialias is not None) == (kind == "adaptive")
 
 
+def test_a_caustics_variant_compiles_the_photon_tracer_and_no_render_kernel(monkeypatch):
+    # a render with caustics runs its geometry's render kernel (the render variant): the
+    # caustics variant traces the tiny scene's photons and renders nothing, so two workers
+    # of ``whitted warm`` never compile the general render kernel at once
+    import importlib
+
+    from whitted.render.variants import warm_variant
+
+    photon_map = importlib.import_module("whitted.compile.photon_map")
+    api = importlib.import_module("whitted.render.api")
+
+    traced = []
+
+    def photon_lights(compiled, params, settings):
+        traced.append((compiled.geometry.inst_box.dtype, compiled.geometry.unbounded.dtype,
+                       settings.photons))
+
+    class NoRender:
+        def __init__(self, *args, **kwargs):
+            raise AssertionError("the caustics variant rendered")
+
+    monkeypatch.setattr(photon_map, "photon_lights", photon_lights)
+    monkeypatch.setattr(api, "RenderJob", NoRender)
+    assert warm_variant("general/caustics") >= 0
+    assert warm_variant("plain/caustics") >= 0
+    assert traced == [(np.float64, np.dtype(EXTRAS_DTYPE), 2000),
+                      (np.float32, np.int32, 2000)]
+    with pytest.raises(AssertionError, match="rendered"):  # the other kinds do render
+        warm_variant("plain/render")
+
+
 def test_a_variant_already_in_the_cache_loads(tmp_path):
     result = _whitted("warm", "--variant", "plain/render")
     assert result.returncode == 0, result.stderr

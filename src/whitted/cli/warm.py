@@ -8,8 +8,9 @@ the Stefan solver's kernels are handed out, one at a time, to ``--jobs`` worker 
 per core), each compiling into the same cache (jit/cache.py keeps it consistent). A kind of
 the general kernels that shares the render kernel's callees (adaptive anti-aliasing, AOVs) is
 handed out only once the general render kernel is in the cache: it then loads them instead of
-compiling them a second time in another process. The photon tracers (the caustics variants)
-share nothing with the render kernels and start at once. A variant already in the cache
+compiling them a second time in another process. The photon tracers (the caustics variants:
+the tracer only, the render with caustics is the render kernel's) share nothing with the
+render kernels and start at once. A variant already in the cache
 loads in a fraction of a second, so a second ``whitted warm`` is quick.
 """
 

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ..jit import kernel, numba_object
 from .accel import closest_hit, hit_material, surface_normals
 from .integrator import split_at_surface
@@ -64,6 +66,7 @@ SET_EPSILON = 3
 SET_SLOTS = 4  # records one photon may store
 N_SET = 5
 SHADOW_SLOTS = 2  # of which shadow photons (diffuse surfaces behind clear bodies) at most
+SHADOW_STEPS = 64  # surfaces a shadow walk passes at most
 
 
 
@@ -231,122 +234,112 @@ def _store(out, row, p, w, f, d, pass_index):
 
 
 @kernel
-def trace_photon(geo, mats, clear, table, j, o, d, power, directional, settings, photon,
-                 index, emitter, out, slot0, slots, stack, media, scratch):
-    """Follow one photon; store a record (layout.PHOTON_* columns) at each diffuse surface it
-    reaches after a specular bounce, at most ``slots`` into ``out[slot0:]``. Returns the
-    records stored. A refraction counts as specular at a clear material (``clear[m]``):
-    elsewhere shadow rays pass it and carry that light already."""
+def photon_bounce(geo, mats, clear, table, j, directional, settings, photon, index, emitter,
+                  out, slot0, slots, stored, media, n_media, scratch, bounce, hit, o, d, w,
+                  length, specular):
+    """One bounce of a photon's path (:func:`trace_photons`): the photon left ``o`` along
+    ``d`` with power ``w`` and met ``hit`` (closest_hit's answer, a primitive hit). Stores a
+    record (layout.PHOTON_* columns) if it reaches a diffuse surface after a specular bounce,
+    at most ``slots`` into ``out[slot0:]`` (``stored`` so far), and chooses between reflection
+    and refraction. Returns (whether the path goes on, o, d, w, length, stored, specular,
+    n_media). A refraction counts as specular at a clear material (``clear[m]``): elsewhere
+    shadow rays pass it and carry that light already."""
     seed = int(settings[SET_SEED])
     pass_index = int(settings[SET_PASS])
     eps = settings[SET_EPSILON]
-    w = power
-    n_media = 0
-    stored = 0
-    specular = False
-    length = 0.0
-    for bounce in range(int(settings[SET_DEPTH]) + 1):
-        t, prim, tri, b1, b2 = closest_hit(geo, o, d, 0.0, math.inf, stack)
-        if prim < 0:
-            break
-        if n_media > 0:  # Beer-Lambert absorption in the medium it crossed
-            cur = media[n_media - 1]
-            w = (absorbed(w[0], mats[cur, MAT_ATTEN], t),
-                 absorbed(w[1], mats[cur, MAT_ATTEN + 1], t),
-                 absorbed(w[2], mats[cur, MAT_ATTEN + 2], t))
-        length += t
-        m = hit_material(geo, prim, tri)
-        p = madd(o, d, t)
-        n_geo, n_shade = surface_normals(geo, prim, tri, b1, b2, p)
-        entering = dot(d, n_geo) < 0.0
-        if entering:
-            n = n_geo
-        else:
-            n = (-n_geo[0], -n_geo[1], -n_geo[2])
-            n_shade = (-n_shade[0], -n_shade[1], -n_shade[2])
-        if dot(n_shade, d) >= 0.0:
-            n_shade = n
-        if specular and mats[m, MAT_KD] > 0.0 and stored < slots:
-            f = 1.0 if directional else falloff_scale(table, j, length)
-            _store(out, slot0 + stored, p, w, f, d, pass_index)
-            stored += 1
-        kr = mats[m, MAT_KR]
-        kt = mats[m, MAT_KT]
-        if kr == 0.0 and kt == 0.0:
-            break
-        kr_eff = kr
-        bt = (0.0, 0.0, 0.0)
-        tdir = d
-        n_out = n_media
-        if kt > 0.0:
-            ok, tdir, kr_eff, kt_eff, n_out = split_at_surface(
-                geo, mats, prim, m, entering, media, n_media, scratch, d, n_shade, kr, kt)
-            if ok:
-                bt = (kt_eff * mats[m, MAT_COLOR], kt_eff * mats[m, MAT_COLOR + 1],
-                      kt_eff * mats[m, MAT_COLOR + 2])
-        b_mean = (bt[0] + bt[1] + bt[2]) / 3.0
-        total = kr_eff + b_mean
-        if total <= 0.0:
-            break
-        u = _choice(seed, photon, index, emitter, pass_index, bounce)
-        if u * total < b_mean:  # refracted, with probability b_mean / total
-            s = total / b_mean
-            w = (w[0] * bt[0] * s, w[1] * bt[1] * s, w[2] * bt[2] * s)
-            o = madd(p, n, -eps)
-            d = tdir
-            n_media = n_out
-            for k in range(n_out):
-                media[k] = scratch[k]
-            specular = specular or clear[m] != 0
-        else:  # reflected
-            w = (w[0] * total, w[1] * total, w[2] * total)
-            o = madd(p, n, eps)
-            d = madd(d, n_shade, -2.0 * dot(d, n_shade))
-            specular = True
-        if max(w[0], max(w[1], w[2])) < MIN_POWER:
-            break
-    return stored
+    t, prim, tri, b1, b2 = hit
+    if n_media > 0:  # Beer-Lambert absorption in the medium it crossed
+        cur = media[n_media - 1]
+        w = (absorbed(w[0], mats[cur, MAT_ATTEN], t),
+             absorbed(w[1], mats[cur, MAT_ATTEN + 1], t),
+             absorbed(w[2], mats[cur, MAT_ATTEN + 2], t))
+    length += t
+    m = hit_material(geo, prim, tri)
+    p = madd(o, d, t)
+    n_geo, n_shade = surface_normals(geo, prim, tri, b1, b2, p)
+    entering = dot(d, n_geo) < 0.0
+    if entering:
+        n = n_geo
+    else:
+        n = (-n_geo[0], -n_geo[1], -n_geo[2])
+        n_shade = (-n_shade[0], -n_shade[1], -n_shade[2])
+    if dot(n_shade, d) >= 0.0:
+        n_shade = n
+    if specular and mats[m, MAT_KD] > 0.0 and stored < slots:
+        f = 1.0 if directional else falloff_scale(table, j, length)
+        _store(out, slot0 + stored, p, w, f, d, pass_index)
+        stored += 1
+    kr = mats[m, MAT_KR]
+    kt = mats[m, MAT_KT]
+    if kr == 0.0 and kt == 0.0:
+        return False, o, d, w, length, stored, specular, n_media
+    kr_eff = kr
+    bt = (0.0, 0.0, 0.0)
+    tdir = d
+    n_out = n_media
+    if kt > 0.0:
+        ok, tdir, kr_eff, kt_eff, n_out = split_at_surface(
+            geo, mats, prim, m, entering, media, n_media, scratch, d, n_shade, kr, kt)
+        if ok:
+            bt = (kt_eff * mats[m, MAT_COLOR], kt_eff * mats[m, MAT_COLOR + 1],
+                  kt_eff * mats[m, MAT_COLOR + 2])
+    b_mean = (bt[0] + bt[1] + bt[2]) / 3.0
+    total = kr_eff + b_mean
+    if total <= 0.0:
+        return False, o, d, w, length, stored, specular, n_media
+    u = _choice(seed, photon, index, emitter, pass_index, bounce)
+    if u * total < b_mean:  # refracted, with probability b_mean / total
+        s = total / b_mean
+        w = (w[0] * bt[0] * s, w[1] * bt[1] * s, w[2] * bt[2] * s)
+        o = madd(p, n, -eps)
+        d = tdir
+        n_media = n_out
+        for k in range(n_out):
+            media[k] = scratch[k]
+        specular = specular or clear[m] != 0
+    else:  # reflected
+        w = (w[0] * total, w[1] * total, w[2] * total)
+        o = madd(p, n, eps)
+        d = madd(d, n_shade, -2.0 * dot(d, n_shade))
+        specular = True
+    go_on = not max(w[0], max(w[1], w[2])) < MIN_POWER  # a NaN power goes on
+    return go_on, o, d, w, length, stored, specular, n_media
 
 
 @kernel
-def shadow_photons(geo, mats, clear, table, j, o, d, power, directional, settings, out, slot0,
-                   slots, stack):
-    """The shadow photons of a photon leaving ``o`` along ``d``: where its straight path,
-    passing clear bodies as shadow rays do (as if they were not there), meets a diffuse
-    surface after crossing a clear body, a record of minus the power the direct term counts
-    there (layout.PHOTON_* columns, at most ``slots`` into ``out[slot0:]``). Other
-    transparent surfaces (unbounded planes) dim it by kt·colour as they dim shadow rays; an
-    opaque surface ends it. Returns the records stored."""
+def shadow_step(geo, mats, clear, table, j, directional, settings, out, slot0, slots, stored,
+                hit, o, d, w, length, crossed):
+    """One step of a photon's shadow walk (:func:`trace_photons`): its straight path, passing
+    clear bodies as shadow rays do (as if they were not there), from ``o`` along ``d`` met
+    ``hit`` (closest_hit's answer, a primitive hit). Where it meets a diffuse surface after
+    crossing a clear body, a record of minus the power the direct term counts there
+    (``w``, negative; layout.PHOTON_* columns, at most ``slots`` into ``out[slot0:]``).
+    Other transparent surfaces (unbounded planes) dim it by kt·colour as they dim shadow
+    rays; an opaque surface ends it. Returns (whether the walk goes on, o, w, length,
+    stored, crossed)."""
     pass_index = int(settings[SET_PASS])
     eps = settings[SET_EPSILON]
-    w = (-power[0], -power[1], -power[2])
-    stored = 0
-    crossed = False
-    length = 0.0
-    for _ in range(64):
-        t, prim, tri, b1, b2 = closest_hit(geo, o, d, 0.0, math.inf, stack)
-        if prim < 0:
-            break
-        length += t
-        m = hit_material(geo, prim, tri)
-        p = madd(o, d, t)
-        if crossed and mats[m, MAT_KD] > 0.0:
-            f = 1.0 if directional else falloff_scale(table, j, length)
-            _store(out, slot0 + stored, p, w, f, d, pass_index)
-            stored += 1
-            if stored >= slots:
-                break
-        if clear[m] != 0:
-            crossed = True
-        elif mats[m, MAT_KT] > 0.0:
-            kt = mats[m, MAT_KT]
-            w = (w[0] * kt * mats[m, MAT_COLOR], w[1] * kt * mats[m, MAT_COLOR + 1],
-                 w[2] * kt * mats[m, MAT_COLOR + 2])
-        else:
-            break
-        o = madd(p, d, eps)
-        length += eps
-    return stored
+    t, prim, tri, _, _ = hit
+    length += t
+    m = hit_material(geo, prim, tri)
+    p = madd(o, d, t)
+    if crossed and mats[m, MAT_KD] > 0.0:
+        f = 1.0 if directional else falloff_scale(table, j, length)
+        _store(out, slot0 + stored, p, w, f, d, pass_index)
+        stored += 1
+        if stored >= slots:
+            return False, o, w, length, stored, crossed
+    if clear[m] != 0:
+        crossed = True
+    elif mats[m, MAT_KT] > 0.0:
+        kt = mats[m, MAT_KT]
+        w = (w[0] * kt * mats[m, MAT_COLOR], w[1] * kt * mats[m, MAT_COLOR + 1],
+             w[2] * kt * mats[m, MAT_COLOR + 2])
+    else:
+        return False, o, w, length, stored, crossed
+    o = madd(p, d, eps)
+    length += eps
+    return True, o, w, length, stored, crossed
 
 
 @kernel(entry=True)  # called from Python, one call per lane
@@ -354,11 +347,21 @@ def trace_photons(geo, mats, clear, table, emitters, settings, first, last, out,
                   stack, media, scratch):
     """Photons ``first`` .. ``last - 1`` of a pass (``settings``: SET_* values): photon
     ``i`` writes its records into rows ``(i - first) * slots ...`` of ``out`` (the calls'
-    own rows, ``(last - first) * slots`` of them) and their number into ``counts[i]``."""
+    own rows, ``(last - first) * slots`` of them) and their number into ``counts[i]``: its
+    shadow photons first (at most SHADOW_SLOTS, :func:`shadow_step`), then the records of its
+    own path (:func:`photon_bounce`).
+
+    The two walks of a photon are one loop around one call of ``closest_hit``: every
+    function compiled above the intersection code optimises all of it again, and each call
+    site of the inlined ``closest_hit`` is a copy of it (the general geometry's torus and
+    CSG walk among it): one call site and no level between this kernel and the steps halve
+    what the compile of the general tracer optimises (docs/performance.md, the
+    general-tracer round)."""
     geo = geometry_ref_if_instances(geo)
     slots = int(settings[SET_SLOTS])
     seed = int(settings[SET_SEED])
     pass_index = int(settings[SET_PASS])
+    bounces = int(settings[SET_DEPTH]) + 1
     e = 0
     for i in range(first, last):
         while (e < emitters.shape[0] - 1
@@ -366,17 +369,57 @@ def trace_photons(geo, mats, clear, table, emitters, settings, first, last, out,
             e += 1
         while e > 0 and i < emitters[e, EMIT_FIRST]:
             e -= 1
-        o, d, power, directional = emit_photon(table, emitters, e,
-                                               i - int(emitters[e, EMIT_FIRST]), seed,
-                                               pass_index)
+        index = i - int(emitters[e, EMIT_FIRST])
+        o, d, power, directional = emit_photon(table, emitters, e, index, seed, pass_index)
         counts[i] = 0
         if max(power[0], max(power[1], power[2])) <= 0.0:
             continue
         j = int(emitters[e, EMIT_LIGHT])
         row = (i - first) * slots
-        n = shadow_photons(geo, mats, clear, table, j, o, d, power, directional, settings, out,
-                           row, SHADOW_SLOTS, stack)
-        counts[i] = n + trace_photon(geo, mats, clear, table, j, o, d, power, directional,
-                                     settings, i, i - int(emitters[e, EMIT_FIRST]), e, out,
-                                     row + n, slots - n, stack, media, scratch)
-
+        # the shadow walk first, then the photon's own path from the same start
+        shadow = True
+        ro = o
+        rd = d
+        w = (-power[0], -power[1], -power[2])
+        slot0 = row
+        room = SHADOW_SLOTS
+        stored = 0
+        # (typed bool, not the literal False: a step compiled for that type too otherwise)
+        flag = np.bool_(False)  # the shadow walk: a clear body crossed; the path: specular
+        length = 0.0
+        n_media = 0
+        step = 0
+        n_shadow = 0
+        while True:
+            go_on = step < (SHADOW_STEPS if shadow else bounces)
+            if go_on:
+                hit = closest_hit(geo, ro, rd, 0.0, math.inf, stack)
+                go_on = hit[1] >= 0
+            if go_on:
+                if shadow:
+                    go_on, ro, w, length, stored, flag = shadow_step(
+                        geo, mats, clear, table, j, directional, settings, out, slot0, room,
+                        stored, hit, ro, rd, w, length, flag)
+                else:
+                    go_on, ro, rd, w, length, stored, flag, n_media = photon_bounce(
+                        geo, mats, clear, table, j, directional, settings, i, index, e, out,
+                        slot0, room, stored, media, n_media, scratch, step, hit, ro, rd, w,
+                        length, flag)
+                step += 1
+            if go_on:
+                continue
+            if not shadow:
+                break
+            shadow = False  # the photon's own path
+            n_shadow = stored
+            ro = o
+            rd = d
+            w = power
+            slot0 = row + n_shadow
+            room = slots - n_shadow
+            stored = 0
+            flag = np.bool_(False)
+            length = 0.0
+            n_media = 0
+            step = 0
+        counts[i] = n_shadow + stored

@@ -5,9 +5,10 @@ The render kernels are specialised on a scene's arrays (kernels/features.py): *p
 instances, no tori or CSG objects) or *general* (either or both), and the render kernel has
 two kinds: plain and with *adaptive* anti-aliasing; the AOV kernel (depth, normal, id) is one
 more. Caustics need the photon tracer (compile/photon_map.py, its IEEE twins of the
-kernels, kernels/strict.py), one for each kind of geometry; their gather is a run-time choice
-of the render kernel (kernels/caustics.py), as are focal blur, area lights, textures and
-media, compiled with it.
+kernels, kernels/strict.py), one for each kind of geometry: the ``caustics`` variants compile
+only it. Their gather is a run-time choice of the render kernel (kernels/caustics.py), as are
+focal blur, area lights, textures and media, compiled with it: a render with caustics needs
+the ``render`` variant of its geometry and the ``caustics`` one, nothing else.
 """
 
 from __future__ import annotations
@@ -56,16 +57,19 @@ def warm_variant(name: str) -> float:
     start = time.perf_counter()
     if kind == "aovs" and not instances:
         render_aovs(scene)
+    elif kind == "caustics":
+        # the photon tracer only: a render with caustics runs the render kernel of its
+        # geometry (the gather is a run-time choice of it), which is that geometry's
+        # ``render`` variant; compiling it here too made two processes of ``whitted warm``
+        # compile the general render kernel at once
+        from ..compile.params import render_params
+        from ..compile.photon_map import photon_lights
+
+        compiled = compile_scene(scene, flatten_limit=0 if instances else 65_536)
+        photon_lights(compiled, render_params(scene, compiled, scene.render),
+                      scene.render.caustics)
     else:
         compiled = compile_scene(scene, flatten_limit=0 if instances else 65_536)
-        if kind == "caustics":
-            # the photon tracer first: its kernels are its own, so this process compiles
-            # them while another compiles the render kernel (which the render then loads)
-            from ..compile.params import render_params
-            from ..compile.photon_map import photon_lights
-
-            photon_lights(compiled, render_params(scene, compiled, scene.render),
-                          scene.render.caustics)
         RenderJob(scene, compiled=compiled, threads=1).run()
         if kind == "aovs":  # the AOV kernel of instanced scenes (after their render kernel)
             _aovs_of(scene, compiled)
