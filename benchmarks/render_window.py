@@ -1,0 +1,127 @@
+"""Where a bench render's wall time goes, thread by thread: fresh processes render a bench
+scene once, as ``whitted bench`` times it (``python -m whitted.bench.worker``: start, read,
+build, load the kernels, render, write), and the render's window is taken apart from the
+kernel's own accounting of every thread of the process (Linux ``/proc/self/task/*/schedstat``):
+
+- ``on_cpu``: the render threads' time running (all lanes together);
+- ``waiting``: their time runnable but waiting for a CPU (other processes, other threads);
+- ``blocked``: the rest of the lanes' wall time (sleeping on a lock, the GIL, a page from disk);
+- ``others``: CPU time of the process's other threads in the window (Embree's TBB workers,
+  helpers);
+- minor / major page faults and voluntary / involuntary switches of the process.
+
+On a loaded machine ``waiting`` takes up what the others run; ``on_cpu`` is the work of the
+render whatever the load. Threads alternate run by run (1, 2, 1, 2, ...):
+
+    python benchmarks/render_window.py bunny1m --threads 1,2 --runs 5
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+CHILD = r"""
+import contextlib, importlib, io, json, os, resource, sys, time
+api = importlib.import_module("whitted.render.api")
+
+
+def tasks():
+    out = {}
+    for t in os.listdir("/proc/self/task"):
+        try:
+            f = open(f"/proc/self/task/{t}/schedstat").read().split()
+        except FileNotFoundError:
+            continue
+        out[t] = (int(f[0]) / 1e9, int(f[1]) / 1e9)
+    return out
+
+
+window = {}
+run_lanes = api.run_lanes
+
+
+def timed_lanes(fn, lanes, pool):
+    lane_ids = set()
+
+    def lane(k, n):
+        lane_ids.add(str(__import__("threading").get_native_id()))
+        return fn(k, n)
+
+    a, r0, t0 = tasks(), resource.getrusage(resource.RUSAGE_SELF), time.perf_counter()
+    run_lanes(lane, lanes, pool)
+    wall, b, r1 = time.perf_counter() - t0, tasks(), resource.getrusage(resource.RUSAGE_SELF)
+    cpu = {k: b[k][0] - a.get(k, (0.0, 0.0))[0] for k in b}
+    wait = {k: b[k][1] - a.get(k, (0.0, 0.0))[1] for k in b}
+    on = sum(cpu[k] for k in lane_ids)
+    waiting = sum(wait[k] for k in lane_ids)
+    window.update(wall=wall, on_cpu=on, waiting=waiting,
+                  blocked=max(0.0, lanes * wall - on - waiting),
+                  others=sum(v for k, v in cpu.items() if k not in lane_ids),
+                  minflt=r1.ru_minflt - r0.ru_minflt, majflt=r1.ru_majflt - r0.ru_majflt,
+                  nvcsw=r1.ru_nvcsw - r0.ru_nvcsw, nivcsw=r1.ru_nivcsw - r0.ru_nivcsw)
+
+
+api.run_lanes = timed_lanes
+from whitted.bench import worker
+out = io.StringIO()
+with contextlib.redirect_stdout(out):
+    worker.main(sys.argv[1:])
+stats = json.loads(out.getvalue().strip().splitlines()[-1])
+window["render_s"] = stats["render_s"]
+print(json.dumps(window))
+"""
+
+FIGURES = ("render_s", "on_cpu", "waiting", "blocked", "others", "minflt", "majflt", "nvcsw",
+           "nivcsw")
+
+
+def cpu_name() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return "unknown CPU"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("scene", help="a bench scene's name (bunny1m, mesh1m, ...)")
+    parser.add_argument("--threads", default="1,2", help="thread counts, alternated")
+    parser.add_argument("--runs", type=int, default=3, help="processes per thread count")
+    args = parser.parse_args()
+    threads = [int(t) for t in args.threads.split(",")]
+    if args.runs < 1 or any(t < 1 for t in threads):
+        parser.error("--runs and every thread count must be at least 1")
+    from whitted.bench.scenes import load_bench_scene
+
+    rows: dict[int, list[dict]] = {t: [] for t in threads}
+    with tempfile.TemporaryDirectory(prefix="whitted-render-window-") as tmp:
+        scene_file = Path(tmp) / "scene.json"
+        load_bench_scene(args.scene).save(scene_file)
+        for _ in range(args.runs):
+            for t in threads:
+                run = subprocess.run([sys.executable, "-c", CHILD, str(scene_file),
+                                      str(Path(tmp) / "out.png"), "--threads", str(t)],
+                                     capture_output=True, text=True, check=True,
+                                     env=dict(os.environ))
+                rows[t].append(json.loads(run.stdout.strip().splitlines()[-1]))
+    print(f"{args.scene}, {cpu_name()}, {os.cpu_count()} CPUs; medians of {args.runs} "
+          "processes (s, counts)")
+    print("threads  " + "  ".join(f"{f:>9}" for f in FIGURES))
+    for t in threads:
+        med = [statistics.median(r[f] for r in rows[t]) for f in FIGURES]
+        print(f"{t:>7}  " + "  ".join(f"{v:9.4f}" if isinstance(v, float) and i < 5
+                                      else f"{v:9.0f}" for i, v in enumerate(med)))
+
+
+if __name__ == "__main__":
+    main()
