@@ -13,7 +13,7 @@ kernel's own accounting of every thread of the process (Linux ``/proc/self/task/
 On a loaded machine ``waiting`` takes up what the others run; ``on_cpu`` is the work of the
 render whatever the load. Threads alternate run by run (1, 2, 1, 2, ...):
 
-    python benchmarks/render_window.py bunny1m --threads 1,2 --runs 5
+    python benchmarks/render_window.py bunny1m --threads 1,2 --runs 5 [--size 640x360]
 """
 
 from __future__ import annotations
@@ -97,10 +97,17 @@ def main() -> None:
     parser.add_argument("scene", help="a bench scene's name (bunny1m, mesh1m, ...)")
     parser.add_argument("--threads", default="1,2", help="thread counts, alternated")
     parser.add_argument("--runs", type=int, default=3, help="processes per thread count")
+    parser.add_argument("--size", help="WxH instead of the scene's own image size")
     args = parser.parse_args()
-    threads = [int(t) for t in args.threads.split(",")]
-    if args.runs < 1 or any(t < 1 for t in threads):
-        parser.error("--runs and every thread count must be at least 1")
+    try:
+        threads = [int(t) for t in args.threads.split(",")]
+        size = [] if args.size is None else [int(v) for v in args.size.lower().split("x")]
+    except ValueError:
+        parser.error("--threads takes whole numbers (1,2) and --size WxH (640x360)")
+    if args.runs < 1 or any(t < 1 for t in threads) or len(size) not in (0, 2) or \
+            any(v < 1 for v in size):
+        parser.error("--runs, every thread count and both sides of --size must be at least 1")
+    extra = [] if not size else ["--width", str(size[0]), "--height", str(size[1])]
     from whitted.bench.scenes import load_bench_scene
 
     rows: dict[int, list[dict]] = {t: [] for t in threads}
@@ -110,7 +117,7 @@ def main() -> None:
         for _ in range(args.runs):
             for t in threads:
                 run = subprocess.run([sys.executable, "-c", CHILD, str(scene_file),
-                                      str(Path(tmp) / "out.png"), "--threads", str(t)],
+                                      str(Path(tmp) / "out.png"), "--threads", str(t), *extra],
                                      capture_output=True, text=True, check=True,
                                      env=dict(os.environ))
                 rows[t].append(json.loads(run.stdout.strip().splitlines()[-1]))

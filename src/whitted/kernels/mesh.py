@@ -45,7 +45,6 @@ embree_occluded = numba_object(f"{__package__}.embree", "embree_occluded")
 # Embree's closed float32 segment from whitted's open (tmin, tmax): the ends rounded inward
 float32_above = numba_object(f"{__package__}.embree", "float32_above")
 float32_below = numba_object(f"{__package__}.embree", "float32_below")
-prefetch_row = numba_object(f"{__package__}.prefetch", "prefetch_row")
 
 OPAQUE_KT = 0.01  # the lecture's rule: an occluder with kt below this blocks the light
 
@@ -110,11 +109,7 @@ def embree_closest_hit(geo, mesh, o, d, tmin, tmax):
                                        float32_above(tmin), float32_below(tmax))
     if prim < 0 or not (tmin < t < tmax):
         return INF, -1, 0.0, 0.0
-    tri = prim + geo.mesh_info[mesh, MESH_TRI_OFFSET]
-    # the hit's shading reads this triangle's corners (shapes/mesh.py, mesh_normals): their
-    # indices are fetched now, while the rest of the instance walk runs
-    prefetch_row(geo.mesh_faces, tri)
-    return t, tri, b1, b2
+    return t, prim + geo.mesh_info[mesh, MESH_TRI_OFFSET], b1, b2
 
 
 @kernel
