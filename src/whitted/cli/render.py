@@ -319,6 +319,8 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
         marks.note("render", stats.render_seconds)
         if stats.photons is not None:
             marks.note("photons", stats.photons.seconds)
+        for kind, traced in stats.rays.items():
+            marks.count(f"rays:{kind}", traced)
         marks.mark("written")
         marks.write()
     if interrupted.is_set():  # (a signal may have come during the write)
