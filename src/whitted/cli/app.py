@@ -98,9 +98,10 @@ def load_scene_argument(scene_path: Path | None, *, width: int | None = None,
         scene, name = default_scene(), "<default scene>"
     elif is_model_file(scene_path):
         size = {k: v for k, v in (("width", width), ("height", height)) if v is not None}
-        if len(size) == 1:  # keep the default picture's shape
-            size.setdefault("width", max(1, round(size["height"] * 4 / 3)))
-            size.setdefault("height", max(1, round(size["width"] * 3 / 4)))
+        if "width" not in size and "height" in size:  # keep the default picture's shape
+            size["width"] = max(1, round(size["height"] * 4 / 3))
+        elif "height" not in size and "width" in size:
+            size["height"] = max(1, round(size["width"] * 3 / 4))
         scene = model_scene(scene_path, **size, all_around=turntable is not None)
         name = str(scene_path)
     else:
