@@ -52,6 +52,26 @@ def test_the_wheel_carries_every_file_the_shipped_scenes_name():
                 assert scene.resolve_path(name).resolve() in carried, (path, name)
 
 
+def test_the_wheel_carries_every_file_the_examples_name_in_their_text():
+    """A scene's comment or the models' README names a file (``models/make_cones.py``, the
+    script that wrote the cones): an installed whitted's copy of the examples has it too."""
+    import re
+
+    base = ROOT / "examples"
+    carried = {p.resolve() for pattern in shipped_patterns()["examples"]
+               for p in base.glob(pattern)}
+    named = 0
+    for path in sorted(carried):
+        if path.suffix not in (".toml", ".md", ".obj", ".mtl", ".py"):
+            continue
+        text = path.read_text(encoding="utf-8", errors="replace")
+        for name in re.findall(r"(?<![\w/.])((?:models|textures)/[\w/.-]+\.[a-z]{2,4})\b",
+                               text):
+            named += 1
+            assert (base / name).resolve() in carried, (path.relative_to(base), name)
+    assert named >= 5
+
+
 def test_examples_by_short_name():
     names = example_names()
     assert "glass_cube" in names and "textured" in names and len(names) >= 10
