@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from cli_run import one_line_error, run_main
 from whitted.files.shipped import copy_examples, example_names, example_path, shipped_dir
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -89,6 +90,24 @@ def test_render_an_example_by_name_and_a_file_wins(tmp_path):
     assert done.returncode == 2 and "unknown scene format" in done.stderr
     done = run("render", "nonesuch", "-o", "n.png", cwd=tmp_path)
     assert done.returncode == 2 and done.stderr.count("\n") == 1 and "nonesuch" in done.stderr
+
+
+@pytest.mark.parametrize("command", ["render", "export", "sweep", "animate", "info"])
+def test_a_misspelt_example_name_gets_the_names_near_it(tmp_path, command):
+    line = one_line_error(run_main(command, "glass_cub", cwd=tmp_path), "glass_cub: ")
+    assert "did you mean 'glass_cube'?" in line and "`whitted examples` lists them" in line
+    line = one_line_error(run_main(command, "qqqq", cwd=tmp_path), "qqqq: no such file")
+    assert "did you mean" not in line and "`whitted examples` lists them" in line
+    one_line_error(run_main(command, "missing.toml", cwd=tmp_path),
+                   "missing.toml: no such file")
+    assert not list(tmp_path.iterdir())  # nothing written
+
+
+def test_a_misspelt_example_name_in_the_editor(tmp_path):
+    done = subprocess.run([sys.executable, "-m", "whitted", "gui", "glas_cube"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+    assert done.stderr.startswith("error: glas_cube: ") and "'glass_cube'" in done.stderr
 
 
 def test_copy_examples_never_replaces_a_file(tmp_path):
