@@ -1,5 +1,5 @@
 """Where a bench render's wall time goes, thread by thread: fresh processes render a bench
-scene once, as ``whitted bench`` times it (``python -m whitted.bench.worker``: start, read,
+scene once, as ``whitted bench`` times it (a ``whitted render`` process: start, read the scene,
 build, load the kernels, render, write), and the render's window is taken apart from the
 kernel's own accounting of every thread of the process (Linux ``/proc/self/task/*/schedstat``):
 
@@ -28,7 +28,7 @@ import tempfile
 from pathlib import Path
 
 CHILD = r"""
-import contextlib, importlib, io, json, os, resource, sys, time
+import importlib, json, os, resource, runpy, sys, threading, time
 api = importlib.import_module("whitted.render.api")
 
 
@@ -43,7 +43,6 @@ def tasks():
     return out
 
 
-window = {}
 run_lanes = api.run_lanes
 
 
@@ -51,7 +50,7 @@ def timed_lanes(fn, lanes, pool):
     lane_ids = set()
 
     def lane(k, n):
-        lane_ids.add(str(__import__("threading").get_native_id()))
+        lane_ids.add(str(threading.get_native_id()))
         return fn(k, n)
 
     a, r0, t0 = tasks(), resource.getrusage(resource.RUSAGE_SELF), time.perf_counter()
@@ -61,21 +60,18 @@ def timed_lanes(fn, lanes, pool):
     wait = {k: b[k][1] - a.get(k, (0.0, 0.0))[1] for k in b}
     on = sum(cpu[k] for k in lane_ids)
     waiting = sum(wait[k] for k in lane_ids)
-    window.update(wall=wall, on_cpu=on, waiting=waiting,
+    window = dict(wall=wall, on_cpu=on, waiting=waiting,
                   blocked=max(0.0, lanes * wall - on - waiting),
                   others=sum(v for k, v in cpu.items() if k not in lane_ids),
                   minflt=r1.ru_minflt - r0.ru_minflt, majflt=r1.ru_majflt - r0.ru_majflt,
                   nvcsw=r1.ru_nvcsw - r0.ru_nvcsw, nivcsw=r1.ru_nivcsw - r0.ru_nivcsw)
+    with open(os.environ["WHITTED_RENDER_WINDOW"], "w") as out:  # before the command's exit
+        out.write(json.dumps(window))
 
 
 api.run_lanes = timed_lanes
-from whitted.bench import worker
-out = io.StringIO()
-with contextlib.redirect_stdout(out):
-    worker.main(sys.argv[1:])
-stats = json.loads(out.getvalue().strip().splitlines()[-1])
-window["render_s"] = stats["render_s"]
-print(json.dumps(window))
+sys.argv = ["whitted", "render", *sys.argv[1:]]
+runpy.run_module("whitted", run_name="__main__", alter_sys=True)
 """
 
 FIGURES = ("render_s", "on_cpu", "waiting", "blocked", "others", "minflt", "majflt", "nvcsw",
@@ -109,6 +105,8 @@ def main() -> None:
         parser.error("--runs, every thread count and both sides of --size must be at least 1")
     extra = [] if not size else ["--width", str(size[0]), "--height", str(size[1])]
     from whitted.bench.scenes import load_bench_scene
+    from whitted.bench.startup import read_marks
+    from whitted.marks import ENV as MARKS_ENV
 
     rows: dict[int, list[dict]] = {t: [] for t in threads}
     with tempfile.TemporaryDirectory(prefix="whitted-render-window-") as tmp:
@@ -116,11 +114,16 @@ def main() -> None:
         load_bench_scene(args.scene).save(scene_file)
         for _ in range(args.runs):
             for t in threads:
-                run = subprocess.run([sys.executable, "-c", CHILD, str(scene_file),
-                                      str(Path(tmp) / "out.png"), "--threads", str(t), *extra],
-                                     capture_output=True, text=True, check=True,
-                                     env=dict(os.environ))
-                rows[t].append(json.loads(run.stdout.strip().splitlines()[-1]))
+                window, marks = Path(tmp) / "window.json", Path(tmp) / "marks.jsonl"
+                marks.unlink(missing_ok=True)
+                env = dict(os.environ, WHITTED_RENDER_WINDOW=str(window),
+                           **{MARKS_ENV: str(marks)})
+                subprocess.run([sys.executable, "-c", CHILD, str(scene_file), "-q", "-o",
+                                str(Path(tmp) / "out.png"), "--threads", str(t), *extra],
+                               capture_output=True, text=True, check=True, env=env)
+                row = json.loads(window.read_text())
+                row["render_s"] = read_marks(marks)["render:seconds"]
+                rows[t].append(row)
     print(f"{args.scene}, {cpu_name()}, {os.cpu_count()} CPUs; medians of {args.runs} "
           "processes (s, counts)")
     print("threads  " + "  ".join(f"{f:>9}" for f in FIGURES))
