@@ -108,6 +108,18 @@ def test_the_readme_shows_the_commands_this_test_runs():
     assert "VENV ?= .venv\n" in makefile and '@echo "    . $(VENV)/bin/activate"' in makefile
 
 
+def test_the_readme_table_lists_every_example():
+    """Each example `whitted examples` lists has its row in the README's table of them."""
+    from whitted.files.shipped import example_names
+
+    rows = re.findall(r"^\| `examples/([\w/]+)\.toml` \| (.+) \|$", README, re.MULTILINE)
+    described = {name: text for name, text in rows}
+    assert len(rows) == len(described)  # none twice
+    names = set(example_names())
+    assert names <= set(described), sorted(names - set(described))
+    assert set(described) <= names, sorted(set(described) - names)
+
+
 def run_commands(folder: Path, stefan: bool) -> list[str]:
     ran = []
     env = {**os.environ, "WHITTED_PROGRESS_DELAY": "1000"}
