@@ -64,7 +64,8 @@ _builders_ready = False
 HELPER_WAIT_SECONDS = 120.0  # a helper still busy after this is stopped (never expected)
 #: functions Numba compiles in a cold compile of each variant, this process and the helper
 #: together (counted on the 2-core VM, the helper on, an empty cache folder: 125 + 74 for the
-#: plain variant; 107 + 100 for the general one once the plain one is cached, as the render
+#: plain variant, 185-193 with the helper's share of docs/performance.md's two-process
+#: round; 107 + 100 for the general one once the plain one is cached, as the render
 #: API compiles the plain variant first; each kernel other kernels call counts once, as its
 #: twin). Only the progress shown depends on it: a count that drifted (kernels changed, a
 #: different split between the processes) makes the fraction approximate;
