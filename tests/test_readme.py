@@ -154,6 +154,10 @@ def test_the_python_snippets_run(folder):
     source = "\n".join(code_blocks("python"))
     source = re.sub(r"\bwidth=\d+", "width=32", source)
     source = re.sub(r"\bheight=\d+", "height=24", source)
+    # the job's state line shows how it ended, never "running"
+    assert "\njob.state, job.srgb()" in source
+    source = source.replace("\njob.state, job.srgb()", "\nassert job.state in ('cancelled', "
+                            "'finished'), job.state; job.srgb()")
     done = subprocess.run([sys.executable, "-c", source], cwd=folder, capture_output=True,
                           text=True, timeout=600)
     assert done.returncode == 0, done.stderr[-2000:]
