@@ -125,13 +125,17 @@ def render(
     if bit_depth not in (8, 16):
         raise fail(f"--bit-depth: must be 8 or 16 (got {bit_depth})")
     try:
-        check_bit_depth(bit_depth, image_format(output))
+        kind = image_format(output)
+    except ValueError as exc:
+        raise fail(f"{output}: {exc}") from None
+    try:
+        check_bit_depth(bit_depth, kind)
     except ValueError:
         raise fail(f"{output}: --bit-depth 16 is only supported for .png (a "
-                   f"{image_format(output)} file has 8 bits; .exr, .pfm and .npy store "
+                   f"{kind} file has 8 bits; .exr, .pfm and .npy store "
                    "float32)") from None
     try:
-        check_image_options(image_format(output), alpha=alpha)
+        check_image_options(kind, alpha=alpha)
     except ValueError as exc:
         raise fail(f"{output}: {exc}") from None
     try:
@@ -326,6 +330,8 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
         marks.note("render", stats.render_seconds)
         if stats.photons is not None:
             marks.note("photons", stats.photons.seconds)
+        for kind, traced in stats.rays.items():
+            marks.count(f"rays:{kind}", traced)
         marks.mark("written")
         marks.write()
     if interrupted.is_set():  # (a signal may have come during the write)
