@@ -106,6 +106,10 @@ def test_the_readme_shows_the_commands_this_test_runs():
     # the activation line the README shows is what `make demo` prints
     makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
     assert "VENV ?= .venv\n" in makefile and '@echo "    . $(VENV)/bin/activate"' in makefile
+    # the install, minutes of a quiet pip, says first what it is doing
+    recipe = makefile.split("$(BIN)/whitted: pyproject.toml\n", 1)[1].split("\n\n", 1)[0]
+    assert recipe.splitlines()[0].startswith("\t@echo \"installing whitted"), recipe
+    assert "--quiet -e '.[all]'" in recipe
 
 
 def test_the_readme_table_lists_every_example():
