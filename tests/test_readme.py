@@ -169,3 +169,13 @@ def test_the_python_snippets_run(folder):
 
     for made in ("ice.png", "cow.png"):
         assert Image.open(folder / made).size == (32, 24)
+
+
+def test_the_cache_files_the_readme_names_are_the_ones_whitted_writes():
+    """The kernel cache's marker files by the names the code gives them."""
+    source = (ROOT / "src/whitted/render/warm_up.py").read_text(encoding="utf-8")
+    written = set(re.findall(r'"(whitted-ready-\w+)"', source))
+    named = set(re.findall(r"`(whitted-ready-\w+)`", README))
+    assert named and written == named, (named, written)
+    assert "whitted-sums.json" in README and '"whitted-sums.json"' in "".join(
+        p.read_text(encoding="utf-8") for p in (ROOT / "src/whitted/jit").glob("*.py"))
