@@ -46,3 +46,21 @@ def test_a_frame_as_the_default_picture_is_whitted_s_too(tmp_path, examples_dir)
     assert written_by_whitted(tmp_path / "render.png")
     code, _, err = run_main("render", scene, *TINY, cwd=tmp_path)
     assert code == 0, err
+
+
+def test_the_default_sheet_of_a_sweep_replaces_only_its_own(tmp_path):
+    sweep = ("sweep", "--set", "render.max_depth=1,2", "-W", "8", "-H", "6", "-q")
+    code, _, err = run_main(*sweep, cwd=tmp_path)
+    assert code == 0, err
+    sheet = tmp_path / "sheet.png"
+    assert written_by_whitted(sheet)
+    assert all(written_by_whitted(p) for p in (tmp_path / "sheet_cells").iterdir())
+    code, _, err = run_main(*sweep, cwd=tmp_path)
+    assert code == 0, err  # its own sheet: replaced
+    PILImage.new("RGB", (3, 2)).save(sheet)
+    mine = sheet.read_bytes()
+    one_line_error(run_main(*sweep, cwd=tmp_path), "sheet.png: a file whitted did not write")
+    assert sheet.read_bytes() == mine
+    code, _, err = run_main(*sweep, "-o", "sheet.png", cwd=tmp_path)
+    assert code == 0, err
+    assert written_by_whitted(sheet)

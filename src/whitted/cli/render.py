@@ -19,6 +19,7 @@ from .app import (
     abandoned,
     app,
     apply_set_options,
+    check_default_output,
     ends_at_once,
     fail,
     is_dir,
@@ -124,7 +125,7 @@ def render(
     if is_dir(output):
         raise fail(f"{output}: is a directory (give a file name such as {output / 'render.png'})")
     if not named:
-        _check_default_output(output)
+        check_default_output(output)
     if bit_depth not in (8, 16):
         raise fail(f"--bit-depth: must be 8 or 16 (got {bit_depth})")
     try:
@@ -260,20 +261,6 @@ def _turntable_film(scene_path, output, frames, width, height, samples, max_dept
             height=height, samples=samples, max_depth=max_depth, threads=threads, seed=seed,
             set_values=set_values, crf=18, force=False, quiet=quiet, turntable=frames,
             cluster=cluster, scheduler=scheduler)
-
-
-def _check_default_output(output: Path) -> None:
-    """The picture's default name (no -o) replaces only a PNG whitted wrote: a file of the
-    user's at that name is kept, and the command ends in one line."""
-    from ..output.png import written_by_whitted
-
-    try:
-        there = output.exists() or output.is_symlink()
-    except OSError:
-        return  # check_outputs says what is wrong with the place
-    if there and not written_by_whitted(output):
-        raise fail(f"{output}: a file whitted did not write is there; it is kept (replace it "
-                   f"with -o {output}, or give another name)")
 
 
 def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,

@@ -289,14 +289,10 @@ def _write_png_alpha(tmp: str, pixels: np.ndarray, alpha: np.ndarray, transfer: 
     rgb = encode_ldr(pixels, bits=bits, transfer=transfer, tonemap=tonemap)
     a = quantize(np.clip(alpha, 0.0, 1.0), bits)
     rgba = np.concatenate([rgb, a[..., None]], axis=2)
-    from .png import SOFTWARE, software_chunk
+    from .png import software_chunk, software_text
 
     if bits == 8:
-        from PIL.PngImagePlugin import PngInfo
-
-        info = PngInfo()
-        info.add_text("Software", SOFTWARE.decode())
-        PILImage.fromarray(rgba, "RGBA").save(tmp, format="PNG", pnginfo=info,
+        PILImage.fromarray(rgba, "RGBA").save(tmp, format="PNG", pnginfo=software_text(),
                                              compress_level=PNG_COMPRESS_LEVEL)
         return
     import png as pypng  # 16-bit RGBA: Pillow has no such mode

@@ -65,6 +65,15 @@ def software_chunk() -> bytes:
     return _chunk(b"tEXt", b"Software\0" + SOFTWARE)
 
 
+def software_text():
+    """The same text for a PNG Pillow writes: its ``pnginfo``."""
+    from PIL.PngImagePlugin import PngInfo
+
+    info = PngInfo()
+    info.add_text("Software", SOFTWARE.decode())
+    return info
+
+
 def written_by_whitted(path) -> bool:
     """Whether ``path`` is a PNG file whose ``Software`` text (before its pixels) says whitted
     wrote it. False for anything else, a file that cannot be read included."""
