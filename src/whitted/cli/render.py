@@ -19,6 +19,7 @@ from .app import (
     abandoned,
     app,
     apply_set_options,
+    check_default_output,
     ends_at_once,
     fail,
     is_dir,
@@ -113,6 +114,7 @@ def render(
         _turntable_film(scene_path, output, turntable, width, height, samples, max_depth,
                         threads, seed, set_values, quiet, cluster, scheduler)
         return
+    named = output is not None
     output = output or Path("render.png")
 
     from ..output.formats import check_bit_depth, check_image_options, image_format
@@ -122,6 +124,8 @@ def render(
     aovs = _parse_aovs(aov)
     if is_dir(output):
         raise fail(f"{output}: is a directory (give a file name such as {output / 'render.png'})")
+    if not named:
+        check_default_output(output)
     if bit_depth not in (8, 16):
         raise fail(f"--bit-depth: must be 8 or 16 (got {bit_depth})")
     try:
