@@ -14,7 +14,8 @@ HERE = Path(__file__).resolve().parent
 #: folder of the checkout -> the files of it the wheel carries
 SHIPPED = {
     "examples": ("*.toml", "stefan/*.toml", "models/*.obj", "models/*.mtl", "models/README.md",
-                 "models/LICENSES/*", "models/cow/*", "textures/*.png"),
+                 "models/LICENSES/*", "models/cow/*", "textures/*.png",
+                 "models/make_cones.py", "textures/make_textures.py"),  # what made them
     "benchmarks": ("*.toml", "models/*.obj", "povray_checks/*.toml"),
 }
 

@@ -6,7 +6,7 @@ import numpy as np
 
 import whitted
 from whitted.animation import Track
-from whitted.animation.reuse import CompileCache
+from whitted.animation.reuse import CompileCache, ReuseStats
 from whitted.compile.reuse import BvhMemo
 from whitted.compile.scene import compile_scene
 from whitted.render.api import RenderJob
@@ -97,3 +97,14 @@ def test_a_mesh_keeps_its_bvh_when_another_object_moves(tmp_path):
     for name in fresh.geometry._fields:
         assert np.array_equal(getattr(second.geometry, name), getattr(fresh.geometry, name)), name
     assert not np.array_equal(first.geometry.node_box, second.geometry.node_box)
+
+
+def test_the_reuse_summary_says_in_words_what_each_frame_reused():
+    stats = ReuseStats(frames={"all": 11, "none": 1, "geometry": 2}, bvh_built=2,
+                       bvh_reused=22, primitives_built=30, primitives_reused=90,
+                       compile_seconds=0.1234)
+    assert stats.summary() == (
+        "scene compiles: 1 compiled in full, 2 kept the geometry (new lights), 11 reused the "
+        "frame before's whole; BVHs: 22 of 24 reused (75% of their primitives); 0.123 s")
+    assert ReuseStats().summary() == (
+        "scene compiles: none; BVHs: 0 of 0 reused (100% of their primitives); 0.000 s")

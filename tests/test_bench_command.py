@@ -256,12 +256,40 @@ def test_a_missing_source_model_skips_its_scene(monkeypatch):
 def test_a_failing_render_process_is_one_line(monkeypatch, tmp_path):
     from whitted.bench.timing import ProcessResult
 
-    monkeypatch.setattr(runner, "timed_process", lambda command: ProcessResult(
+    monkeypatch.setattr(runner, "timed_process", lambda command, env=None: ProcessResult(
         returncode=3, stdout="", stderr="a\nb\nc\nd\n", wall_s=1.0, peak_mib=1.0))
     with pytest.raises(BenchError) as info:
         runner._process_run(Scene(), 1, tmp_path)
     assert str(info.value) == "the render process failed (exit 3): b | c | d"
     assert (tmp_path / "scene.json").is_file()
+
+
+def test_a_timed_run_is_a_whitted_render_process_and_its_figures_are_the_jobs(tmp_path):
+    from whitted.bench.scenes import load_bench_scene
+    from whitted.render.api import RenderJob
+
+    scene = load_bench_scene("lecture", quick=True)
+    run = runner._process_run(scene, 1, tmp_path)
+    job = RenderJob(scene, threads=1)
+    job.run()
+    # the same rays as this process's render of the scene, kind by kind
+    assert run["rays"] == {kind: n for kind, n in job.stats.rays.items()}
+    assert sum(run["rays"].values()) > 0
+    assert run["wall_s"] >= run["compile_s"] + run["build_s"] + run["render_s"] > 0
+    assert run["startup_s"] == pytest.approx(
+        run["wall_s"] - run["compile_s"] - run["build_s"] - run["render_s"])
+    assert (tmp_path / "whitted.png").stat().st_size > 0
+
+
+def test_a_render_process_that_notes_no_figures_is_one_line(monkeypatch, tmp_path):
+    from whitted.bench.timing import ProcessResult
+
+    monkeypatch.setattr(runner, "timed_process", lambda command, env=None: ProcessResult(
+        returncode=0, stdout="", stderr="", wall_s=1.0, peak_mib=1.0))
+    with pytest.raises(BenchError) as info:
+        runner._process_run(Scene(), 1, tmp_path)
+    assert str(info.value) == ("the render process noted no kernels:seconds, build:seconds, "
+                               "render:seconds")
 
 
 def test_timed_process_reports_exit_output_and_memory(tmp_path):

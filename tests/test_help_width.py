@@ -33,3 +33,28 @@ def test_help_at_80_columns(command):
     for paragraph in paragraphs:
         for line in paragraph[:-1]:  # every line but a paragraph's last fills the width
             assert len(line) >= 60, (line, paragraph)
+
+
+@pytest.mark.parametrize("command", [[], ["stefan"]], ids=lambda c: " ".join(c) or "whitted")
+def test_command_list_summaries_are_whole_lines(command):
+    """The list of commands shows one sentence a command, wrapped to the column: no row but
+    an entry's last cut short (a docstring's own line break kept in mid-sentence)."""
+    env = {**os.environ, "COLUMNS": "80", "TERM": "dumb", "NO_COLOR": "1"}
+    env.pop("FORCE_COLOR", None)
+    run = subprocess.run([sys.executable, "-m", "whitted", *command, "--help"], env=env,
+                         capture_output=True, text=True, timeout=120, check=True)
+    lines = run.stdout.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("╭─ Commands"))
+    end = next(i for i in range(start, len(lines)) if lines[i].startswith("╰"))
+    rows = [line[1:-1] for line in lines[start + 1:end]]
+    column = len(rows[0]) - len(rows[0][1:].split(" ", 1)[1].lstrip()) - 1
+    width = len(rows[0]) - column - 1
+    entries: list[list[str]] = []
+    for row in rows:
+        if row[1] != " ":
+            entries.append([])
+        entries[-1].append(row[column:].rstrip())
+    assert len(entries) >= 4, rows
+    for entry in entries:
+        assert all(len(row) >= 0.6 * width for row in entry[:-1]), entry
+        assert entry[-1].endswith("."), entry  # one whole sentence

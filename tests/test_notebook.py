@@ -303,6 +303,22 @@ def test_viewer_bad_slider_is_one_line(scene):
 
 
 # ------------------------------------------------------------------ Stefan
+def test_stefan_run_without_a_folder_is_titled_with_the_case(tmp_path, monkeypatch,
+                                                              examples_dir):
+    """No output folder: a temporary one, named after the case file, which titles the plot
+    (not the temporary folder's random name)."""
+    import tempfile
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    results = whitted.run_stefan(examples_dir / "stefan" / "hollow_ice.toml",
+                                 grid={"cells": 16}, time={"end": 60.0, "save_every": 60.0},
+                                 live=False)
+    assert results.folder.name == "hollow_ice"
+    assert results.folder.parent.parent == tmp_path
+    assert list(results.time_s) == [0.0, 60.0]
+    assert results.figure().get_suptitle() == "hollow_ice"
+
+
 def test_stefan_results_plot_and_balance(tmp_path, shown, examples_dir):
     results = whitted.run_stefan(examples_dir / "stefan" / "hollow_ice.toml",
                                  tmp_path / "melt", grid={"cells": 16},

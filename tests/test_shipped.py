@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from cli_run import one_line_error, run_main
 from whitted.files.shipped import copy_examples, example_names, example_path, shipped_dir
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -52,6 +53,26 @@ def test_the_wheel_carries_every_file_the_shipped_scenes_name():
                 assert scene.resolve_path(name).resolve() in carried, (path, name)
 
 
+def test_the_wheel_carries_every_file_the_examples_name_in_their_text():
+    """A scene's comment or the models' README names a file (``models/make_cones.py``, the
+    script that wrote the cones): an installed whitted's copy of the examples has it too."""
+    import re
+
+    base = ROOT / "examples"
+    carried = {p.resolve() for pattern in shipped_patterns()["examples"]
+               for p in base.glob(pattern)}
+    named = 0
+    for path in sorted(carried):
+        if path.suffix not in (".toml", ".md", ".obj", ".mtl", ".py"):
+            continue
+        text = path.read_text(encoding="utf-8", errors="replace")
+        for name in re.findall(r"(?<![\w/.])((?:models|textures)/[\w/.-]+\.[a-z]{2,4})\b",
+                               text):
+            named += 1
+            assert (base / name).resolve() in carried, (path.relative_to(base), name)
+    assert named >= 5
+
+
 def test_examples_by_short_name():
     names = example_names()
     assert "glass_cube" in names and "textured" in names and len(names) >= 10
@@ -69,6 +90,24 @@ def test_render_an_example_by_name_and_a_file_wins(tmp_path):
     assert done.returncode == 2 and "unknown scene format" in done.stderr
     done = run("render", "nonesuch", "-o", "n.png", cwd=tmp_path)
     assert done.returncode == 2 and done.stderr.count("\n") == 1 and "nonesuch" in done.stderr
+
+
+@pytest.mark.parametrize("command", ["render", "export", "sweep", "animate", "info"])
+def test_a_misspelt_example_name_gets_the_names_near_it(tmp_path, command):
+    line = one_line_error(run_main(command, "glass_cub", cwd=tmp_path), "glass_cub: ")
+    assert "did you mean 'glass_cube'?" in line and "`whitted examples` lists them" in line
+    line = one_line_error(run_main(command, "qqqq", cwd=tmp_path), "qqqq: no such file")
+    assert "did you mean" not in line and "`whitted examples` lists them" in line
+    one_line_error(run_main(command, "missing.toml", cwd=tmp_path),
+                   "missing.toml: no such file")
+    assert not list(tmp_path.iterdir())  # nothing written
+
+
+def test_a_misspelt_example_name_in_the_editor(tmp_path):
+    done = subprocess.run([sys.executable, "-m", "whitted", "gui", "glas_cube"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+    assert done.stderr.startswith("error: glas_cube: ") and "'glass_cube'" in done.stderr
 
 
 def test_copy_examples_never_replaces_a_file(tmp_path):

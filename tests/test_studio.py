@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import whitted
+from cli_run import run_main
 from whitted.errors import ArgumentError, SceneError
 from whitted.studio.bounds import world_points
 from whitted.studio.framing import AZIMUTH, ELEVATION, MARGIN, view_direction
@@ -210,6 +211,19 @@ def test_render_a_model_file_from_the_command_line(tmp_path):
     assert done.returncode == 2 and "--turntable" in done.stderr
     done = run_cli("render", "pyramid.obj", "--turntable", "3", "-o", "t.png", cwd=tmp_path)
     assert done.returncode == 2 and "film" in done.stderr and done.stderr.count("\n") == 1
+
+
+def test_one_side_of_a_model_picture_keeps_the_default_shape(tmp_path):
+    """-W alone or -H alone: the other side follows the default 4:3 picture."""
+    from PIL import Image
+
+    write(tmp_path, "pyramid.obj", PYRAMID)
+    for option, value, size in (("-W", 40, (40, 30)), ("-H", 30, (40, 30)),
+                                ("-W", 1, (1, 1))):
+        code, _, err = run_main("render", "pyramid.obj", option, value, "-o", "p.png", "-q",
+                                cwd=tmp_path)
+        assert code == 0, err
+        assert Image.open(tmp_path / "p.png").size == size
 
 
 def test_turntable_film_from_the_command_line(tmp_path):

@@ -124,3 +124,36 @@ def test_a_worker_answers_each_name_it_reads_with_one_line():
     lines = [json.loads(line) for line in result.stdout.splitlines()]
     assert [entry["name"] for entry in lines] == ["plain/render", "plain/render"]
     assert all(entry["seconds"] >= 0 for entry in lines)
+
+
+@pytest.mark.parametrize("cached, names, lines", [
+    (True, [], ["loading the default scene's kernels (compiled before)"]),
+    (False, ["plain/aovs"], ["compiling the default scene's kernels (the first time)",
+                             "1 more variant in 1 process, each compiled unless the cache "
+                             "has it"]),
+])
+def test_warm_says_whether_it_compiles_or_loads(tmp_path, monkeypatch, cached, names, lines):
+    """What `whitted warm` says before its work: loading kernels compiled before, or
+    compiling them (never 'the first time' on a warm cache, nor a count of cores)."""
+    import importlib
+
+    from cli_run import run_main
+    from whitted.cli import warm
+
+    warm_up = importlib.import_module("whitted.render.warm_up")
+
+    monkeypatch.setattr(warm_up, "kernels_cached", lambda instances=False: cached)
+    monkeypatch.setattr(warm_up, "warm_up_kernels", lambda: 0.25)
+    monkeypatch.setattr(warm, "_all_names", lambda: names)
+
+    def work(queue, procs):  # a worker that had every variant in the cache
+        while (name := queue.take()) is not None:
+            queue.finish(name, 0.5)
+
+    monkeypatch.setattr(warm, "_work", work)
+    code, out, err = run_main("warm", cwd=tmp_path)
+    assert code == 0, err
+    assert err.splitlines() == lines
+    assert out.splitlines()[:1 + len(names)] == [f"{'plain/render':28}    0.25 s"] + [
+        f"{name:28}    0.50 s" for name in names]
+    assert out.splitlines()[-1].startswith("every kernel is in the cache: ")

@@ -33,6 +33,12 @@ def note(name: str, seconds: float) -> None:
         _marks.append((f"{name}:seconds", seconds))
 
 
+def count(name: str, value: int) -> None:
+    """Note a count (the rays of each kind a render traced)."""
+    if os.environ.get(ENV):
+        _marks.append((f"{name}:count", value))
+
+
 def write() -> None:
     """Append the marks to the file ``WHITTED_STARTUP_MARKS`` names (nothing when unset)."""
     path = os.environ.get(ENV)

@@ -10,7 +10,7 @@ from typing import Annotated
 
 import typer
 
-from .cli.app import app, fail
+from .cli.app import app, fail, no_such_example
 from .cli.main import main as _cli_main
 from .errors import WhittedError
 
@@ -49,6 +49,8 @@ def gui(
             raise fail(str(exc)) from None
         if example is not None:  # untitled: a save never writes into whitted's own examples
             scene_path = None
+    elif scene_path is not None and not scene_path.suffix:  # meant as an example's name
+        raise fail(f"{scene_path}: {no_such_example(str(scene_path))}")
     elif scene_path is not None and scene_path.suffix.lower() not in (".toml", ".json"):
         raise fail(f"{scene_path}: unknown scene format {scene_path.suffix!r} (use .toml or .json)")
     # Qt is imported by the editor only, after its check of the system libraries Qt needs

@@ -46,13 +46,30 @@ class ReuseStats:
     compile_seconds: float = 0.0
 
     def summary(self) -> str:
-        levels = ", ".join(f"{n} {k}" for k, n in sorted(self.frames.items()))
+        """One line in words: how many frames' scenes were compiled in full, or reused the
+        frame before's in part or whole; the BVHs reused; the time the compiles took."""
+        levels = ", ".join(f"{self.frames[k]} {LEVEL_WORDS.get(k, k)}"
+                           for k in sorted(self.frames, key=_level_order))
         total_bvh = self.bvh_built + self.bvh_reused
         prims = self.primitives_built + self.primitives_reused
         share = self.primitives_reused / prims if prims else 1.0
-        return (f"compiles: {levels or 'none'}; BVHs: {self.bvh_reused} of {total_bvh} builds "
-                f"reused ({share:.0%} of their primitives); compile time "
-                f"{self.compile_seconds:.3f} s")
+        return (f"scene compiles: {levels or 'none'}; BVHs: {self.bvh_reused} of {total_bvh} "
+                f"reused ({share:.0%} of their primitives); {self.compile_seconds:.3f} s")
+
+
+#: each level of reuse in words, for :meth:`ReuseStats.summary` (in this order)
+LEVEL_WORDS = {
+    REUSE_NONE: "compiled in full",
+    REUSE_BVH: "compiled again keeping unchanged BVHs",
+    REUSE_GEOMETRY: "kept the geometry (new lights)",
+    REUSE_LIGHT_BUFFERS: "kept all but the lights' values",
+    REUSE_ALL: "reused the frame before's whole",
+}
+
+
+def _level_order(level: str) -> int:
+    order = list(LEVEL_WORDS)
+    return order.index(level) if level in order else len(order)
 
 
 def _geometry_part(scene: Scene) -> tuple:

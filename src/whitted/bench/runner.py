@@ -2,8 +2,8 @@
 
 Each (scene, thread count) is rendered once as a warm-up (fills the kernel cache and the
 operating system's file cache; not counted), then ``runs`` times; every number reported is the
-median over those runs. By default every run is a fresh process (:mod:`whitted.bench.worker`,
-which does what ``whitted render`` does), so the wall time is a user's wall time; ``--quick``
+median over those runs. By default every run is a fresh ``whitted render`` process, started as
+a user starts it, so the wall time is a user's wall time; ``--quick``
 and ``in_process`` render inside this process instead (start-up is then just the scene load).
 Beside POV-Ray (``--compare povray``) the two renderers' runs alternate, and each ratio is the
 median of the ratios of the pairs (a run of whitted and the POV-Ray run after it).
@@ -24,6 +24,7 @@ The columns (also the JSON keys, see docs/performance.md):
 from __future__ import annotations
 
 import json
+import os
 import resource
 import statistics
 import sys
@@ -34,10 +35,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..marks import ENV as MARKS_ENV
 from ..render.api import RAY_KIND_NAMES, RenderJob, available_threads
 from ..scene.scene import Scene
 from .models import MissingSourceModel
 from .scenes import BenchScene, has_meshes, load_bench_scene, pick_scenes
+from .startup import read_marks
 from .timing import timed_process
 
 RAY_KINDS = tuple(RAY_KIND_NAMES.values())  # primary, shadow, reflection, refraction
@@ -214,22 +217,34 @@ def _in_process_run(scene: Scene, threads: int, folder: Path) -> dict[str, Any]:
 
 
 def _process_run(scene: Scene, threads: int, folder: Path) -> dict[str, Any]:
+    """One ``whitted render`` process, as a user starts it (its own early exit and collector
+    settings included), timed from outside; the job's figures from its marks
+    (whitted/marks.py)."""
     scene_file = folder / "scene.json"
     if not scene_file.exists():
         scene.save(scene_file)
-    command = [sys.executable, "-m", "whitted.bench.worker", str(scene_file),
-               str(folder / "whitted.png"), "--threads", str(threads)]
-    run = timed_process(command)
+    marks_file = folder / "marks.jsonl"
+    marks_file.unlink(missing_ok=True)
+    command = [sys.executable, "-m", "whitted", "render", str(scene_file), "-q",
+               "-o", str(folder / "whitted.png"), "--threads", str(threads)]
+    run = timed_process(command, env=dict(os.environ, **{MARKS_ENV: str(marks_file)}))
     if run.returncode != 0:
         tail = " | ".join(run.stderr.strip().splitlines()[-3:])
         raise BenchError(f"the render process failed (exit {run.returncode}): {tail}")
-    stats = json.loads(run.stdout.strip().splitlines()[-1])
-    work = stats["compile_s"] + stats["build_s"] + stats["render_s"]
+    marks = read_marks(marks_file)
+    missing = [f"{name}:seconds" for name in ("kernels", "build", "render")
+               if f"{name}:seconds" not in marks]
+    if missing:
+        raise BenchError(f"the render process noted no {', '.join(missing)}")
+    compile_s, build_s, render_s = (marks["kernels:seconds"], marks["build:seconds"],
+                                    marks["render:seconds"])
+    rays = {name[len("rays:"):-len(":count")]: int(value) for name, value in marks.items()
+            if name.startswith("rays:") and name.endswith(":count")}
     return {
-        "rays": stats["rays"], "compile_s": stats["compile_s"], "build_s": stats["build_s"],
-        "render_s": stats["render_s"], "wall_s": run.wall_s,
-        "photon_s": stats.get("photon_s", 0.0),
-        "startup_s": max(0.0, run.wall_s - work), "peak_mib": run.peak_mib,
+        "rays": rays, "compile_s": compile_s, "build_s": build_s, "render_s": render_s,
+        "wall_s": run.wall_s, "photon_s": marks.get("photons:seconds", 0.0),
+        "startup_s": max(0.0, run.wall_s - compile_s - build_s - render_s),
+        "peak_mib": run.peak_mib,
     }
 
 

@@ -7,12 +7,13 @@ modules (render, info, export, bench, animate, sweep, stefan), which register on
 from __future__ import annotations
 
 import gc
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from ..errors import WhittedError, shorten
+from ..errors import SceneError, WhittedError, shorten
 from .console import Text, err, out
 
 if TYPE_CHECKING:
@@ -98,18 +99,55 @@ def load_scene_argument(scene_path: Path | None, *, width: int | None = None,
         scene, name = default_scene(), "<default scene>"
     elif is_model_file(scene_path):
         size = {k: v for k, v in (("width", width), ("height", height)) if v is not None}
-        if len(size) == 1:  # keep the default picture's shape
-            size.setdefault("width", max(1, round(size["height"] * 4 / 3)))
-            size.setdefault("height", max(1, round(size["width"] * 3 / 4)))
+        if "width" not in size and "height" in size:  # keep the default picture's shape
+            size["width"] = max(1, round(size["height"] * 4 / 3))
+        elif "height" not in size and "width" in size:
+            size["height"] = max(1, round(size["width"] * 3 / 4))
         scene = model_scene(scene_path, **size, all_around=turntable is not None)
         name = str(scene_path)
     else:
         example = None if _exists(scene_path) else example_path(str(scene_path))
+        if example is None and _bare_name(scene_path):
+            raise SceneError(no_such_example(str(scene_path)), file=str(scene_path))
         scene = load_scene(example or scene_path)
         name = str(example or scene_path)
     if turntable is not None:
         scene = turntable_of(scene, turntable)
     return scene, name
+
+
+def _bare_name(path: Path) -> bool:
+    """A name with no folder and no suffix that is not a file here: meant as an example."""
+    text = str(path)
+    return bool(text) and "/" not in text and os.sep not in text and not path.suffix \
+        and not _exists(path)
+
+
+def no_such_example(name: str) -> str:
+    """Neither a file nor an example: the examples' names nearest to ``name``."""
+    import difflib
+
+    from ..files.shipped import example_names
+
+    names = list(example_names())
+    near = difflib.get_close_matches(name, names, n=3, cutoff=0.6)
+    hint = f"did you mean {' or '.join(repr(n) for n in near)}? " if near else ""
+    return (f"no such file, nor an example of that name ({hint}`whitted examples` lists "
+            f"them)" if names else "no such file")
+
+
+def check_default_output(output: Path) -> None:
+    """An output at a default name (no -o) replaces only a PNG whitted wrote: a file of the
+    user's at that name is kept, and the command ends in one line."""
+    from ..output.png import written_by_whitted
+
+    try:
+        there = output.exists() or output.is_symlink()
+    except OSError:
+        return  # check_outputs says what is wrong with the place
+    if there and not written_by_whitted(output):
+        raise fail(f"{output}: a file whitted did not write is there; it is kept (replace it "
+                   f"with -o {output}, or give another name)")
 
 
 def _exists(path: Path) -> bool:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import os
+import re
 import signal
 import sys
 
@@ -69,6 +70,7 @@ def main() -> None:
     show_compile_bar(False)  # the commands show a first compile in their own progress bars
     abandoned.clear()
     ends_at_once.clear()
+    _summaries()  # after every command registered (program.py adds gui)
     try:
         with only_the_command_named(sys.argv):
             code = app(standalone_mode=False)
@@ -111,6 +113,28 @@ def main() -> None:
     finally:
         resume_collector()  # a render that ended before its job (a usage error), a caller
     sys.exit(code if isinstance(code, int) else 0)
+
+
+def _first_sentence(text: str) -> str:
+    """The first sentence of a docstring, its lines joined."""
+    joined = " ".join(text.split())
+    return re.split(r"(?<=[.!?])\s+(?=[A-Z])", joined, maxsplit=1)[0]
+
+
+def _summaries() -> None:
+    """Give every command a one-sentence summary for the list ``whitted --help`` shows:
+    typer shows a command's first paragraph there with its docstring's line breaks kept (a
+    line cut short in mid-sentence), and a whole paragraph is too long for a list."""
+    groups = [app]
+    while groups:
+        group = groups.pop()
+        groups.extend(g.typer_instance for g in group.registered_groups if g.typer_instance)
+        for info in group.registered_commands:
+            if info.short_help is None:
+                doc = info.help or (info.callback.__doc__ if info.callback else None)
+                if doc:
+                    info.short_help = _first_sentence(doc)
+
 
 
 def _command_name(info: typer.models.CommandInfo) -> str:

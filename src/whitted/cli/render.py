@@ -20,6 +20,7 @@ from .app import (
     abandoned,
     app,
     apply_set_options,
+    check_default_output,
     ends_at_once,
     fail,
     is_dir,
@@ -114,6 +115,7 @@ def render(
         _turntable_film(scene_path, output, turntable, width, height, samples, max_depth,
                         threads, seed, set_values, quiet, cluster, scheduler)
         return
+    named = output is not None
     output = output or Path("render.png")
 
     from ..output.formats import check_bit_depth, check_image_options, image_format
@@ -124,9 +126,22 @@ def render(
     aovs = _parse_aovs(aov)
     if is_dir(output):
         raise fail(f"{output}: is a directory (give a file name such as {output / 'render.png'})")
+    if not named:
+        check_default_output(output)
+    if bit_depth not in (8, 16):
+        raise fail(f"--bit-depth: must be 8 or 16 (got {bit_depth})")
     try:
-        check_bit_depth(bit_depth, image_format(output))
-        check_image_options(image_format(output), alpha=alpha)
+        kind = image_format(output)
+    except ValueError as exc:
+        raise fail(f"{output}: {exc}") from None
+    try:
+        check_bit_depth(bit_depth, kind)
+    except ValueError:
+        raise fail(f"{output}: --bit-depth 16 is only supported for .png (a "
+                   f"{kind} file has 8 bits; .exr, .pfm and .npy store "
+                   "float32)") from None
+    try:
+        check_image_options(kind, alpha=alpha)
     except ValueError as exc:
         raise fail(f"{output}: {exc}") from None
     try:
@@ -326,6 +341,8 @@ def _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet,
         marks.note("render", stats.render_seconds)
         if stats.photons is not None:
             marks.note("photons", stats.photons.seconds)
+        for kind, traced in stats.rays.items():
+            marks.count(f"rays:{kind}", traced)
         marks.mark("written")
         marks.write()
     if interrupted.is_set():  # (a signal may have come during the write)

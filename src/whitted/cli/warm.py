@@ -181,20 +181,23 @@ def warm(
         _warm_here(variants)
         return
     from ..render.api import available_threads
-    from ..render.warm_up import warm_up_kernels
+    from ..render.warm_up import kernels_cached, warm_up_kernels
 
     if jobs < 0 or jobs > 1024:
         raise fail(f"--jobs: must be 0 (one per core) to 1024 (got {jobs})")
     jobs = jobs or available_threads()
     start = time.perf_counter()
-    err.echo("compiling the default scene's kernels (the first time: both cores)")
+    err.echo("loading the default scene's kernels (compiled before)" if kernels_cached()
+             else "compiling the default scene's kernels (the first time)")
     first = warm_up_kernels()
     names = _all_names()
     queue = _Queue(names)
     queue.times["plain/render"] = first
     workers = min(jobs, len(names))
-    err.echo(f"compiling {len(names)} more variants in {workers} process"
-             f"{'es' * (workers > 1)}")
+    if names:
+        err.echo(f"{len(names)} more variant{'s' * (len(names) > 1)} in {workers} "
+                 f"process{'es' * (workers > 1)}, "
+                 "each compiled unless the cache has it")
     procs: list[subprocess.Popen] = []
     threads = [threading.Thread(target=_work, args=(queue, procs), daemon=True,
                                 name=f"whitted-warm-{i}") for i in range(workers)]

@@ -64,8 +64,9 @@ def run_stefan(
     **changes: Any,
 ) -> StefanResults:
     """Solve a Stefan case (a :class:`~whitted.stefan.Case`, a case file or a dict) into the
-    folder ``out`` (None: a new temporary folder), as ``whitted stefan run`` does (resumes
-    when ``resume``), and return its results, which plot inline in a notebook. Keyword
+    folder ``out`` (None: a folder named after the case file in a new temporary folder), as
+    ``whitted stefan run`` does (resumes when ``resume``), and return its results, which plot
+    inline in a notebook (titled with the folder's name). Keyword
     ``changes`` replace tables of the case: ``grid={"cells": 16}``, ``time={"end": 600}``.
     In a notebook a bar shows the simulated time; the interrupt stops at the next step and
     keeps every saved time (run it again to resume). One-line :class:`CaseError` for a case
@@ -75,7 +76,10 @@ def run_stefan(
     from ..stefan.run import run_case
 
     the_case, text, path = _case(case, changes)
-    out = Path(tempfile.mkdtemp(prefix="whitted-stefan-")) if out is None else Path(out)
+    if out is None:  # named after the case: the folder's name titles the results' plot
+        out = Path(tempfile.mkdtemp(prefix="whitted-stefan-")) / (
+            path.stem if path is not None else "stefan")
+    out = Path(out)
     cancel = CancelToken()
     live = live_view(live)
     view = None
