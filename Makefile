@@ -8,6 +8,8 @@ BIN := $(VENV)/bin
 .PHONY: demo test test-oldest-numba test-timing check-wheel coverage lint install install-test bench clean
 
 $(BIN)/whitted: pyproject.toml
+	@echo "installing whitted and every extra into $(VENV)/ (about 1.3 GB: minutes on a first"
+	@echo "download; pip is quiet meanwhile)"
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[all]'

@@ -114,11 +114,16 @@ def test_no_library_to_load(monkeypatch):
 
 def test_candidates(monkeypatch, tmp_path):
     monkeypatch.setenv("WHITTED_EMBREE_LIBRARY", "none")
-    assert E.library_candidates() == []
+    assert list(E.library_candidates()) == []
     monkeypatch.setenv("WHITTED_EMBREE_LIBRARY", str(tmp_path / "my.so"))
-    assert E.library_candidates()[0] == str(tmp_path / "my.so")
-    monkeypatch.setattr(E.ctypes.util, "find_library", lambda name: "libembree4.so.4")
-    assert E.library_candidates()[-1] == "libembree4.so.4"
+    asked = []
+    monkeypatch.setattr(E.ctypes.util, "find_library",
+                        lambda name: asked.append(name) or "libembree4.so.4")
+    candidates = E.library_candidates()
+    assert next(candidates) == str(tmp_path / "my.so")
+    assert asked == []  # the system's search waits until the candidates before it failed
+    assert list(candidates)[-1] == "libembree4.so.4"
+    assert asked == ["embree4"]
 
 
 def test_auto_made_concrete(monkeypatch):

@@ -64,8 +64,8 @@ def test_without_dask_the_farm_says_what_to_install(tmp_path):
     assert result.returncode == 2
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in result.stderr
-    assert lines[0].startswith("error: the render farm needs dask.distributed: "
-                               "pip install 'whitted[farm]'")
+    assert lines[0] == ("error: the render farm needs dask.distributed, which is not "
+                        "installed: install whitted[farm] (pip install 'whitted[farm]')")
 
 
 FILM = """

@@ -84,3 +84,51 @@ def test_a_result_to_run_again_with_no_ready_worker_goes_to_any_worker():
 
     assert run_tasks(watch, {Future("a"): 7}, submit, on_done) is True
     assert submitted == [(7, None)] and calls == ["a", "again"]
+
+
+class ClosedClient:
+    """A Dask client the scheduler's loss has closed: it has no scheduler left to ask, and
+    its questions fail with AttributeError ('NoneType' object has no attribute ...)."""
+
+    status = "running"  # not yet updated: the race the watch must survive
+    scheduler = None
+
+    def get_events(self, topic):
+        return []
+
+    def subscribe_topic(self, topic, handler):
+        pass
+
+    def _gone(self, *args, **kwargs):
+        return None.processing  # what Dask's client does with no scheduler
+
+    scheduler_info = processing = who_has = _gone
+
+
+class WaitingFuture:
+    key = "frame-0"
+
+    def result(self, timeout=None):
+        raise TimeoutError
+
+
+def test_a_client_closed_by_the_scheduler_s_loss_is_cluster_lost():
+    from whitted.farm.watch import Watch as ClusterWatch
+
+    watch = ClusterWatch(ClosedClient(), stall_floor=5.0)
+    with pytest.raises(ClusterLost, match="^lost the connection to the scheduler at "
+                                          "the scheduler$"):
+        watch.check({"frame-0"})
+    with pytest.raises(ClusterLost):
+        watch.result(WaitingFuture())
+    assert watch.give_up_on(WaitingFuture()) == []
+
+
+def test_an_attribute_error_of_a_connected_client_is_not_hidden():
+    from whitted.farm.watch import Watch as ClusterWatch
+
+    client = ClosedClient()
+    client.scheduler = type("S", (), {"address": "tcp://h:1"})()
+    watch = ClusterWatch(client, stall_floor=5.0)
+    with pytest.raises(AttributeError):
+        watch.check({"frame-0"})

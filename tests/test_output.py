@@ -575,3 +575,38 @@ def test_8bit_srgb_table_gives_the_exact_curves_codes():
     hdr = (rng.random((64, 48, 3)) * 9).astype(np.float32)
     for mode in ("clamp", "reinhard", "aces"):
         assert np.array_equal(e.encode_ldr(hdr, bits=8, tonemap=mode), reference(hdr, mode))
+
+
+@pytest.mark.parametrize("bits, with_alpha", [(8, False), (16, False), (8, True), (16, True)])
+def test_every_png_whitted_writes_says_so(tmp_path, bits, with_alpha):
+    """Each PNG writer (whitted's own RGB one, Pillow's RGBA, pypng's 16-bit RGBA) adds the
+    text 'Software: whitted', which written_by_whitted finds; the pixels are unchanged."""
+    from whitted.output.png import written_by_whitted
+
+    pixels = ramp_image()
+    alpha = np.linspace(0, 1, 42, dtype=np.float32).reshape(6, 7) if with_alpha else None
+    path = Image(pixels).save(tmp_path / "a.png", bit_depth=bits, alpha=alpha)
+    assert written_by_whitted(path)
+    _w, _h, rows, info = png.Reader(filename=str(path)).read()  # a valid PNG (CRCs checked)
+    got = np.array(list(rows), dtype=np.int64).reshape(6, 7, 4 if with_alpha else 3)
+    assert info["bitdepth"] == bits
+    np.testing.assert_array_equal(got[..., :3], encode_ldr(pixels, bits=bits))
+    if with_alpha:
+        np.testing.assert_array_equal(got[..., 3], quantize(alpha, bits))
+    assert dict(png.Reader(filename=str(path)).chunks()).get(b"tEXt") == b"Software\0whitted"
+
+
+def test_other_files_are_not_whitted_s(tmp_path):
+    from whitted.output.png import written_by_whitted
+
+    PILImage.new("RGB", (4, 3)).save(tmp_path / "theirs.png")
+    (tmp_path / "notes.png").write_text("not a picture")
+    (tmp_path / "short.png").write_bytes(b"\x89PNG\r\n\x1a\n\0\0")
+    other = PILImage.new("RGB", (4, 3))
+    from PIL.PngImagePlugin import PngInfo
+
+    info = PngInfo()
+    info.add_text("Software", "whitted-like")
+    other.save(tmp_path / "like.png", pnginfo=info)
+    for name in ("theirs.png", "notes.png", "short.png", "like.png", "missing.png", "."):
+        assert not written_by_whitted(tmp_path / name), name

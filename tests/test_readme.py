@@ -106,6 +106,10 @@ def test_the_readme_shows_the_commands_this_test_runs():
     # the activation line the README shows is what `make demo` prints
     makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
     assert "VENV ?= .venv\n" in makefile and '@echo "    . $(VENV)/bin/activate"' in makefile
+    # the install, minutes of a quiet pip, says first what it is doing
+    recipe = makefile.split("$(BIN)/whitted: pyproject.toml\n", 1)[1].split("\n\n", 1)[0]
+    assert recipe.splitlines()[0].startswith("\t@echo \"installing whitted"), recipe
+    assert "--quiet -e '.[all]'" in recipe
 
 
 def test_the_readme_table_lists_every_example():
@@ -154,6 +158,10 @@ def test_the_python_snippets_run(folder):
     source = "\n".join(code_blocks("python"))
     source = re.sub(r"\bwidth=\d+", "width=32", source)
     source = re.sub(r"\bheight=\d+", "height=24", source)
+    # the job's state line shows how it ended, never "running"
+    assert "\njob.state, job.srgb()" in source
+    source = source.replace("\njob.state, job.srgb()", "\nassert job.state in ('cancelled', "
+                            "'finished'), job.state; job.srgb()")
     done = subprocess.run([sys.executable, "-c", source], cwd=folder, capture_output=True,
                           text=True, timeout=600)
     assert done.returncode == 0, done.stderr[-2000:]
@@ -161,3 +169,13 @@ def test_the_python_snippets_run(folder):
 
     for made in ("ice.png", "cow.png"):
         assert Image.open(folder / made).size == (32, 24)
+
+
+def test_the_cache_files_the_readme_names_are_the_ones_whitted_writes():
+    """The kernel cache's marker files by the names the code gives them."""
+    source = (ROOT / "src/whitted/render/warm_up.py").read_text(encoding="utf-8")
+    written = set(re.findall(r'"(whitted-ready-\w+)"', source))
+    named = set(re.findall(r"`(whitted-ready-\w+)`", README))
+    assert named and written == named, (named, written)
+    assert "whitted-sums.json" in README and '"whitted-sums.json"' in "".join(
+        p.read_text(encoding="utf-8") for p in (ROOT / "src/whitted/jit").glob("*.py"))

@@ -12,7 +12,7 @@ import pytest
 from whitted.compile.params import render_params
 from whitted.jit import kernel
 from whitted.kernels import integrator, tiles
-from whitted.kernels.callees import render_callees
+from whitted.kernels.callees import callees_here_first, render_callees
 from whitted.kernels.layout import N_RAY_KINDS
 from whitted.render import warm_up
 from whitted.scene.scene import RenderSettings, Scene
@@ -37,6 +37,9 @@ def test_helper_compiles_the_signatures_render_tiles_calls(monkeypatch, instance
                        np.zeros((1, N_RAY_KINDS), np.int64), tiles.lane_workspace(1), 0, 1)
     delegated = render_callees(stand_in.geometry, stand_in.materials, stand_in.lights, params)
     assert delegated
+    # and what the render process compiles first meanwhile
+    delegated += callees_here_first(stand_in.geometry, stand_in.materials, stand_in.lights,
+                                    params)
     for dispatcher, argument_types in delegated:
         assert tuple(argument_types) in dispatcher.callee.overloads, (
             f"{dispatcher.py_func.__name__}: render_tiles compiled "
@@ -135,3 +138,72 @@ def test_the_expected_compile_count_is_the_real_one(tmp_path):
     compiled = int(result.stdout.split()[-1])
     expected = warm_up.EXPECTED_COMPILES[False]
     assert abs(compiled - expected) <= 0.1 * expected, (compiled, expected)
+
+
+def _started_helpers(monkeypatch) -> list:
+    """The helpers warm_up starts from now on (their Popen objects)."""
+    started = []
+    start = warm_up._start_helper
+
+    def recording(instances):
+        helper = start(instances)
+        if helper is not None:
+            started.append(helper)
+        return helper
+
+    monkeypatch.setattr(warm_up, "_start_helper", recording)
+    return started
+
+
+def test_the_helper_started_ahead_is_adopted_by_the_compile(monkeypatch, tmp_path):
+    """``whitted render`` starts the helper before its output checks (which compile the OBJ
+    reader on a cold cache); the render's warm-up then uses that helper and that lock, and
+    releases the lock when done. Cold here as far as the warm-up knows (no marker), the
+    kernels themselves load from the test cache."""
+    warm_up.warm_up_kernels()  # the kernels in the cache, and the plain variant loaded here
+    marker = tmp_path / "whitted-ready-plain"
+    monkeypatch.setattr(warm_up, "_marker", lambda instances: marker)
+    monkeypatch.setattr(warm_up, "_ready", set())
+    started = _started_helpers(monkeypatch)
+    assert warm_up.start_cold_compile_ahead()
+    assert warm_up.start_cold_compile_ahead()  # once: the same helper
+    assert len(started) == 1
+    cache = warm_up.prepare()
+    assert cache.take_compile_lock("plain") is None  # held ahead
+    warm_up.warm_up_kernels()
+    assert len(started) == 1 and started[0].poll() is not None  # adopted, waited for
+    assert warm_up._ahead is None and marker.exists()
+    lock = cache.take_compile_lock("plain")
+    assert lock is not None  # released
+    lock.release()
+
+
+def test_a_command_that_ends_before_its_render_stops_the_helper_started_ahead(
+        monkeypatch, tmp_path):
+    """A user mistake found by the output checks (a folder that does not exist): exit 2,
+    and the helper started ahead is stopped and the lock released, not left running."""
+    from typer.testing import CliRunner
+
+    from whitted.cli.main import app
+
+    monkeypatch.setattr(warm_up, "kernels_cached", lambda instances=False: False)
+    monkeypatch.setattr(warm_up, "_ready", set())
+    started = _started_helpers(monkeypatch)
+    scene = tmp_path / "s.toml"
+    scene.write_text('[[objects]]\ntype = "sphere"\nradius = 1.0\n')
+    out = tmp_path / "no such folder" / "x.png"
+    result = CliRunner().invoke(app, ["render", str(scene), "-o", str(out)])
+    assert result.exit_code == 2, result.output
+    assert result.stderr.startswith("error:") and "no such folder" in result.stderr
+    assert len(started) == 1 and started[0].poll() is not None
+    assert warm_up._ahead is None
+    lock = warm_up.prepare().take_compile_lock("plain")
+    assert lock is not None
+    lock.release()
+
+
+def test_no_helper_ahead_on_a_warm_cache(monkeypatch):
+    warm_up.warm_up_kernels()
+    started = _started_helpers(monkeypatch)
+    assert not warm_up.start_cold_compile_ahead()
+    assert started == []

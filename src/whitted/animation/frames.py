@@ -186,9 +186,11 @@ def _write_frame_png(path: Path, image: Any, digest: str, frame: int) -> None:
 
     from ..files import atomic_write
     from ..fingerprint import FINGERPRINT_KEY, renderer_fingerprint
+    from ..output.png import SOFTWARE
 
     data = image.to_srgb8()
     info = PngInfo()
+    info.add_text("Software", SOFTWARE.decode())  # as every PNG whitted writes (output/png.py)
     info.add_text(FRAME_HASH_KEY, digest)
     info.add_text(FRAME_NUMBER_KEY, str(int(frame)))
     info.add_text(FINGERPRINT_KEY, renderer_fingerprint())  # the renderer that made it

@@ -84,13 +84,14 @@ class ContactSheet:
 
         from ..errors import OutputError
         from ..files import atomic_write
+        from ..output.png import software_text
 
         path = Path(path)
         if path.suffix.lower() != ".png":
             raise OutputError(f"{path}: the sheet is a PNG (use a .png name)")
         try:
             return atomic_write(path, lambda tmp: PILImage.fromarray(self.pixels).save(
-                tmp, format="PNG"))
+                tmp, format="PNG", pnginfo=software_text()))
         except OSError as exc:
             raise OutputError(f"{path}: cannot write: {exc.strerror or exc}") from None
 

@@ -136,6 +136,20 @@ def no_such_example(name: str) -> str:
             f"them)" if names else "no such file")
 
 
+def check_default_output(output: Path) -> None:
+    """An output at a default name (no -o) replaces only a PNG whitted wrote: a file of the
+    user's at that name is kept, and the command ends in one line."""
+    from ..output.png import written_by_whitted
+
+    try:
+        there = output.exists() or output.is_symlink()
+    except OSError:
+        return  # check_outputs says what is wrong with the place
+    if there and not written_by_whitted(output):
+        raise fail(f"{output}: a file whitted did not write is there; it is kept (replace it "
+                   f"with -o {output}, or give another name)")
+
+
 def _exists(path: Path) -> bool:
     try:
         return path.exists()

@@ -32,7 +32,8 @@ ClusterOption = Annotated[
                              "worker processes (needs whitted\\[farm])")]
 SchedulerOption = Annotated[
     str | None, typer.Option("--scheduler", help="Render on the Dask cluster at "
-                             "tcp://HOST:PORT (workers need whitted installed)")]
+                             "tls://HOST:PORT (tcp:// on a trusted network only; workers need "
+                             "whitted installed)")]
 
 
 def farm_module():

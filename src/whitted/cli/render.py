@@ -3,6 +3,7 @@ the tiles finished (cli/interrupt.py), AOVs beside it, or bands on a farm (cli/f
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import threading
@@ -19,6 +20,7 @@ from .app import (
     abandoned,
     app,
     apply_set_options,
+    check_default_output,
     ends_at_once,
     fail,
     is_dir,
@@ -113,15 +115,19 @@ def render(
         _turntable_film(scene_path, output, turntable, width, height, samples, max_depth,
                         threads, seed, set_values, quiet, cluster, scheduler)
         return
+    named = output is not None
     output = output or Path("render.png")
 
     from ..output.formats import check_bit_depth, check_image_options, image_format
     from ..render.api import DEFAULT_TILE, RenderJob
+    from ..render.warm_up import cold_compile_ahead
 
     process_start = time.perf_counter()
     aovs = _parse_aovs(aov)
     if is_dir(output):
         raise fail(f"{output}: is a directory (give a file name such as {output / 'render.png'})")
+    if not named:
+        check_default_output(output)
     if bit_depth not in (8, 16):
         raise fail(f"--bit-depth: must be 8 or 16 (got {bit_depth})")
     try:
@@ -168,40 +174,45 @@ def render(
         except ValueError as exc:
             raise fail(f"--region: {exc}") from None
     outputs = [output] + [output.with_name(f"{output.stem}.{a}.npy") for a in aovs]
-    try:
-        from ..output.safety import check_memory, check_outputs
-
-        check_outputs(outputs, scene, scene_path)
-        check_memory(scene.render.width, scene.render.height, image_format(output), bit_depth)
-    except WhittedError as exc:
-        raise fail(str(exc)) from None
-    resume_collector()  # set-up done: the job (or the farm's client) runs with it
     farm = cluster is not None or scheduler is not None
-    if farm and (region is not None or alpha or resume or exposure or quality is not None):
-        raise fail("--region, --alpha, --exposure, --quality and --continue render here, not "
-                   "on a cluster (leave out --cluster/--scheduler)")
-    if farm:  # bands on a Dask cluster (cli/farm.py)
-        render_still_on_farm(scene, output, cluster=cluster, scheduler=scheduler,
-                             threads=threads, quiet=quiet, bit_depth=bit_depth, aovs=aovs,
-                             frame=frame)
+    # a cold kernel cache: the compile helper starts now and compiles its share of the
+    # render kernel while the output checks read the scene's models (compiling the OBJ
+    # reader in this process); stopped if the command ends before its render adopts it
+    with contextlib.nullcontext() if farm else cold_compile_ahead():
+        try:
+            from ..output.safety import check_memory, check_outputs
 
-    from .tile_state import job_digest, state_path
+            check_outputs(outputs, scene, scene_path)
+            check_memory(scene.render.width, scene.render.height, image_format(output),
+                         bit_depth)
+        except WhittedError as exc:
+            raise fail(str(exc)) from None
+        resume_collector()  # set-up done: the job (or the farm's client) runs with it
+        if farm and (region is not None or alpha or resume or exposure or quality is not None):
+            raise fail("--region, --alpha, --exposure, --quality and --continue render here, not "
+                       "on a cluster (leave out --cluster/--scheduler)")
+        if farm:  # bands on a Dask cluster (cli/farm.py)
+            render_still_on_farm(scene, output, cluster=cluster, scheduler=scheduler,
+                                 threads=threads, quiet=quiet, bit_depth=bit_depth, aovs=aovs,
+                                 frame=frame)
 
-    kept = state_path(output)
-    digest = job_digest(scene, frame or 0, pixels_region, DEFAULT_TILE)
-    earlier = _kept_tiles(kept, digest, scene) if resume else None
-    try:
-        job = RenderJob(scene, region=pixels_region, resume=earlier)
-    except WhittedError as exc:
-        raise fail(str(exc)) from None
-    ends_at_once.append(True)
-    finish = StillFinish(pixels_region, alpha, exposure, quality, kept, digest)
-    # Ctrl-C, SIGTERM: stop after the tiles in flight (cli/interrupt.py); the handlers stay
-    # until the image is written: a signal during the write lets it finish
-    with InterruptGuard() as guard:
-        guard.on_interrupt(job.cancel)
-        _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet, guard,
-                          process_start, frame, finish)
+        from .tile_state import job_digest, state_path
+
+        kept = state_path(output)
+        digest = job_digest(scene, frame or 0, pixels_region, DEFAULT_TILE)
+        earlier = _kept_tiles(kept, digest, scene) if resume else None
+        try:
+            job = RenderJob(scene, region=pixels_region, resume=earlier)
+        except WhittedError as exc:
+            raise fail(str(exc)) from None
+        ends_at_once.append(True)
+        finish = StillFinish(pixels_region, alpha, exposure, quality, kept, digest)
+        # Ctrl-C, SIGTERM: stop after the tiles in flight (cli/interrupt.py); the handlers stay
+        # until the image is written: a signal during the write lets it finish
+        with InterruptGuard() as guard:
+            guard.on_interrupt(job.cancel)
+            _render_and_write(job, scene, name, output, outputs, aovs, bit_depth, quiet, guard,
+                              process_start, frame, finish)
 
 
 #: the widest --exposure, in stops (2^64 times brighter or darker is far beyond any use)

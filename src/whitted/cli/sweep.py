@@ -13,6 +13,7 @@ from ..errors import WhittedError
 from .app import (
     SceneArgument,
     app,
+    check_default_output,
     fail,
     load_scene_argument,
     out,
@@ -39,8 +40,8 @@ def sweep(
             "--set", help="PATH=VALUES to sweep (START:STOP:STEP or a,b,c; one or two), "
                           "or PATH=VALUE to fix")
     ] = None,
-    output: Annotated[Path, typer.Option("-o", "--output", help="The sheet (PNG)")] = Path(
-        "sheet.png"),
+    output: Annotated[Path | None, typer.Option(
+        "-o", "--output", help="The sheet (PNG; default: sheet.png)")] = None,
     columns: Annotated[
         int | None, typer.Option("--columns", help="Cells per row (one swept value)")
     ] = None,
@@ -68,8 +69,12 @@ def sweep(
     from ..render.api import CancelToken
 
     started = time.perf_counter()
+    named = output is not None
+    output = output or Path("sheet.png")
     if output.suffix.lower() != ".png":
         raise fail(f"{output}: the sheet is a PNG (use a .png name)")
+    if not named:
+        check_default_output(output)
     try:
         scene, name = load_scene_argument(scene_path)
         axes, fixed = [], []
@@ -154,12 +159,14 @@ def _write_sheet(output, paths, cells, axes, ncols, title, guard, atomic_write) 
     from PIL import Image as PILImage
 
     from ..animation.sweep import contact_sheet
+    from ..output.png import software_text
 
     images = [np.asarray(PILImage.open(p).convert("RGB")) for p in paths]
     heading = title if title is not None else " / ".join(path for path, _ in axes)
     sheet = contact_sheet(images, [c.label for c in cells], ncols, heading)
     try:
-        atomic_write(output, lambda tmp: PILImage.fromarray(sheet).save(tmp, format="PNG"))
+        atomic_write(output, lambda tmp: PILImage.fromarray(sheet).save(
+            tmp, format="PNG", pnginfo=software_text()))
     except OSError as exc:
         raise fail(f"{output}: cannot write: {exc.strerror or exc}") from None
     if guard.interrupted:

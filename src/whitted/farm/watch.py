@@ -238,9 +238,9 @@ class Watch:
                 if now - start > self.result_seconds:
                     raise
                 key = future.key
-                held = self.client.who_has([future]).get(key)
+                held = self.ask(self.client.who_has, [future]).get(key)
                 running = any(str(key) in map(str, keys)
-                              for keys in self.client.processing().values())
+                              for keys in self.ask(self.client.processing).values())
                 if held or running:
                     orphan_since = None
                     continue
@@ -251,8 +251,8 @@ class Watch:
     def give_up_on(self, future: Future) -> list[str]:
         """Exclude the workers holding ``future``'s result (it did not come back)."""
         try:
-            holders = list(self.client.who_has([future]).get(future.key, ()))
-        except (OSError, TimeoutError):
+            holders = list(self.ask(self.client.who_has, [future]).get(future.key, ()))
+        except (ClusterLost, TimeoutError):
             holders = []
         for worker in holders:
             if worker not in self.excluded:
@@ -287,6 +287,20 @@ class Watch:
         ``RuntimeError('ConnectionPool is closed')``)."""
         return self.client.status not in ("running", "newly-created")
 
+    def ask(self, call, *args, **kwargs):
+        """``call(*args, **kwargs)``, a question to the scheduler through the client;
+        :class:`ClusterLost` when the connection is gone: a broken connection, or the client
+        already closed by the loss (Dask's client then has no scheduler to ask, and its
+        methods fail with AttributeError)."""
+        try:
+            return call(*args, **kwargs)
+        except (OSError, distributed.comm.CommClosedError) as exc:
+            raise self.lost(exc) from None
+        except AttributeError:
+            if getattr(self.client, "scheduler", True) is None:
+                raise self.lost() from None
+            raise
+
     def lost(self, exc: BaseException | None = None) -> ClusterLost:
         """The one line for a scheduler gone: where it was, not Dask's text of the broken
         connection (its local and remote sockets, its stream's state)."""
@@ -312,9 +326,9 @@ class Watch:
         if self.client.status not in ("running", "connecting", "newly-created"):
             raise self.lost()
         try:
-            info = self.client.scheduler_info(n_workers=-1)
-            processing = self.client.processing()
-        except (OSError, distributed.comm.CommClosedError, TimeoutError) as exc:
+            info = self.ask(self.client.scheduler_info, n_workers=-1)
+            processing = self.ask(self.client.processing)
+        except TimeoutError as exc:
             raise self.lost(exc) from None
         now = time.monotonic()
         workers = info.get("workers", {})

@@ -241,12 +241,12 @@ class KernelCache:
     def _acquire(self) -> None:
         self._file_lock = self._take(LOCK)
 
-    def _take(self, name: str):
+    def _take(self, name: str, wait: float = LOCK_WAIT_SECONDS):
         """The lock file ``name`` in the folder, acquired (None: not waited for longer, or
         it cannot be made)."""
         from filelock import Timeout
 
-        lock = _file_lock(os.path.join(self.folder, name), LOCK_WAIT_SECONDS)
+        lock = _file_lock(os.path.join(self.folder, name), wait)
         try:
             lock.acquire(poll_interval=0.05)
         except Timeout:
@@ -271,6 +271,14 @@ class KernelCache:
         finally:
             if lock is not None:
                 lock.release()
+
+    def take_compile_lock(self, variant: str):
+        """The lock of :meth:`compile_lock`, taken only if no other process holds it (not
+        waited for): the acquired lock, to ``release()`` when the compile is done, or None
+        (another process compiles ``variant``, or no lock can be made here)."""
+        if self.folder is None or self.helper or self.read_only:
+            return None
+        return self._take(f"{COMPILE_LOCK}{variant}", wait=0)
 
     def _release(self) -> None:
         lock, self._file_lock = self._file_lock, None

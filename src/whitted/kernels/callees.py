@@ -11,11 +11,14 @@ exactly the ones the callers ask for, or the helper's work is wasted: ``tests/te
 checks them. Integers are int64 everywhere (``dispatcher.KernelDispatcher`` widens them); what is
 compiled is each kernel's twin for calls from kernels (``callee``).
 
-The share is chosen by measured compile times (docs/performance.md): for scenes without mesh
-instances the helper also compiles all the builders and the OBJ loader, so it takes only
-``surface_normals``, the first callee ``render_tiles`` reaches after ``closest_hit``; for
-scenes with mesh instances (the builders are already cached) it takes the direct light with
-its shadow rays (``direct_light``, one function down to the shadow rays' walks): what remains
+The share is chosen by measured compile times (docs/performance.md, "the first compile's two
+processes"): for scenes without mesh instances the helper takes ``hit_analytic`` (the
+analytic shapes' intersections, which ``closest_hit`` reaches late), ``surface_normals``
+(the direct light's shadow rays call both: compiled once, by the helper) and then the
+direct light with its shadow rays (``direct_light``, one function down to the shadow rays'
+walks, which the render kernel reaches after the hit's normals and colour), then compiles
+the builders and the OBJ reader; for scenes with mesh
+instances (the builders are already cached) it takes ``direct_light`` alone. What remains
 here is ``closest_hit``, normals, colour, the caustics and ``render_tiles``, which inlines
 them all (work only this process can do, as it needs everything below it).
 """
@@ -24,9 +27,11 @@ from __future__ import annotations
 
 from numba import typeof, types
 
-from .accel import surface_normals
+from .accel import hit_analytic, surface_normals
+from .caustics import add_caustic
 from .features import instances_possible
 from .geometry_ref import GeometryRef
+from .integrator import split_at_surface
 from .layout import GeometryArrays
 from .lighting import direct_light
 
@@ -50,4 +55,23 @@ def render_callees(geometry: GeometryArrays, materials, lights, params):
         return [(direct_light, (geo, mats, typeof(lights), typeof(params), VEC3, VEC3, VEC3,
                                 INT, VEC3, INT32S, INT, INT32S, INT32S, REALS, INT32S, INT64S,
                                 types.UniTuple(INT, 3)))]
-    return [(surface_normals, (geo, INT, INT, REAL, REAL, VEC3))]
+    return [(hit_analytic, (geo, INT, VEC3, VEC3, REAL, REAL)),
+            (surface_normals, (geo, INT, INT, REAL, REAL, VEC3)),
+            (direct_light, (geo, mats, typeof(lights), typeof(params), VEC3, VEC3, VEC3,
+                            INT, VEC3, INT32S, INT, INT32S, INT32S, REALS, INT32S, INT64S,
+                            types.UniTuple(INT, 3)))]
+
+
+def callees_here_first(geometry: GeometryArrays, materials, lights, params):
+    """(kernel, argument types) pairs the render process compiles before ``render_tiles``
+    while the helper compiles its share (scenes without mesh instances): the callees the
+    render kernel reaches after ``direct_light`` (the caustic term and the refraction), so
+    that it reaches ``direct_light`` later, when the helper has it ready, instead of waiting
+    for it with those still to do."""
+    geo = typeof(geometry)
+    if instances_possible(geo):
+        return []
+    mats = typeof(materials)
+    return [(add_caustic, (typeof(lights), mats, INT, VEC3, VEC3, VEC3, VEC3)),
+            (split_at_surface, (geo, mats, INT, INT, types.boolean, INT32S, INT, INT32S, VEC3,
+                                VEC3, REAL, REAL))]

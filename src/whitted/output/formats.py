@@ -16,6 +16,7 @@ Every file is written atomically (see :func:`atomic_write`): a reader never sees
 
 from __future__ import annotations
 
+import io
 import os
 import pathlib
 
@@ -288,16 +289,22 @@ def _write_png_alpha(tmp: str, pixels: np.ndarray, alpha: np.ndarray, transfer: 
     rgb = encode_ldr(pixels, bits=bits, transfer=transfer, tonemap=tonemap)
     a = quantize(np.clip(alpha, 0.0, 1.0), bits)
     rgba = np.concatenate([rgb, a[..., None]], axis=2)
+    from .png import software_chunk, software_text
+
     if bits == 8:
-        PILImage.fromarray(rgba, "RGBA").save(tmp, format="PNG",
+        PILImage.fromarray(rgba, "RGBA").save(tmp, format="PNG", pnginfo=software_text(),
                                              compress_level=PNG_COMPRESS_LEVEL)
         return
     import png as pypng  # 16-bit RGBA: Pillow has no such mode
 
+    encoded = io.BytesIO()
+    writer = pypng.Writer(pixels.shape[1], pixels.shape[0], bitdepth=16, greyscale=False,
+                          alpha=True)
+    writer.write(encoded, rgba.reshape(pixels.shape[0], -1))
+    data = encoded.getvalue()
+    ihdr_end = 8 + 8 + 13 + 4  # the signature, then IHDR: length, type, 13 bytes, CRC
     with open(tmp, "wb") as f:
-        writer = pypng.Writer(pixels.shape[1], pixels.shape[0], bitdepth=16, greyscale=False,
-                              alpha=True)
-        writer.write(f, rgba.reshape(pixels.shape[0], -1))
+        f.write(data[:ihdr_end] + software_chunk() + data[ihdr_end:])
 
 
 # --------------------------------------------------------------------------------------------

@@ -53,6 +53,50 @@ def _chunk(kind: bytes, data: bytes) -> bytes:
             + struct.pack(">I", zlib.crc32(data, zlib.crc32(kind)) & 0xFFFFFFFF))
 
 
+#: PNG's standard "Software" text: what wrote the file. A PNG whitted wrote carries it, and a
+#: command may replace such a file at a name the user did not give (``whitted render``'s
+#: render.png); any other file there is kept (:func:`written_by_whitted`).
+SOFTWARE = b"whitted"
+
+
+def software_chunk() -> bytes:
+    """The tEXt chunk ``Software: whitted``, written after the IHDR of every PNG whitted
+    writes."""
+    return _chunk(b"tEXt", b"Software\0" + SOFTWARE)
+
+
+def software_text():
+    """The same text for a PNG Pillow writes: its ``pnginfo``."""
+    from PIL.PngImagePlugin import PngInfo
+
+    info = PngInfo()
+    info.add_text("Software", SOFTWARE.decode())
+    return info
+
+
+def written_by_whitted(path) -> bool:
+    """Whether ``path`` is a PNG file whose ``Software`` text (before its pixels) says whitted
+    wrote it. False for anything else, a file that cannot be read included."""
+    try:
+        with open(path, "rb") as f:
+            if f.read(len(SIGNATURE)) != SIGNATURE:
+                return False
+            for _ in range(64):  # the chunks before the first IDAT
+                head = f.read(8)
+                if len(head) < 8:
+                    return False
+                length, kind = struct.unpack(">I4s", head)
+                if kind in (b"IDAT", b"IEND") or length > 1 << 20:
+                    return False
+                data = f.read(length)
+                f.read(4)  # the CRC
+                if kind == b"tEXt" and data.partition(b"\0")[::2] == (b"Software", SOFTWARE):
+                    return True
+    except OSError:
+        return False
+    return False
+
+
 def unit_rows(height: int, width: int, bits: int) -> list[tuple[int, int]]:
     """The row ranges deflated as units: about DEFLATE_UNIT_BYTES of filtered rows each."""
     row_bytes = 1 + width * 3 * bits // 8
@@ -102,6 +146,7 @@ def write_png(file: BinaryIO, height: int, width: int, bits: int,
     file.write(SIGNATURE)
     file.write(_chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, bits, COLOR_TYPE_RGB,
                                            0, 0, 0)))
+    file.write(software_chunk())
     if threads is None:
         threads = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (
             os.cpu_count() or 1)

@@ -14,6 +14,11 @@ loads what it made. Whatever the
 helper did not finish is compiled here, so the result never depends on the helper: it only
 saves time. The AOV kernel (depth, normal and object-id images) is compiled when first used.
 
+``whitted render`` starts the helper earlier (:func:`start_cold_compile_ahead`), before its
+output checks: they read the scene's models, which compiles the OBJ reader in this process
+(the default scene has one), and the helper compiles its share meanwhile; the helper compiles
+the OBJ reader last, by when it is usually in the cache.
+
 A marker file in the cache folder (``whitted-ready-plain`` / ``whitted-ready-general``)
 records that a variant is complete there, so a warm start starts no helper.
 
@@ -59,7 +64,8 @@ _builders_ready = False
 HELPER_WAIT_SECONDS = 120.0  # a helper still busy after this is stopped (never expected)
 #: functions Numba compiles in a cold compile of each variant, this process and the helper
 #: together (counted on the 2-core VM, the helper on, an empty cache folder: 125 + 74 for the
-#: plain variant; 107 + 100 for the general one once the plain one is cached, as the render
+#: plain variant, 185-193 with the helper's share of docs/performance.md's two-process
+#: round; 107 + 100 for the general one once the plain one is cached, as the render
 #: API compiles the plain variant first; each kernel other kernels call counts once, as its
 #: twin). Only the progress shown depends on it: a count that drifted (kernels changed, a
 #: different split between the processes) makes the fraction approximate;
@@ -117,10 +123,12 @@ def _compile_builders() -> None:
     """The kernels that load models and build a scene's arrays."""
     global _builders_ready
     if not _builders_ready:
-        load_obj_bytes(TINY_OBJ, "warm-up.obj", Path("."))
         scene = _builders_scene()
         compile_scene(scene)  # the mesh flattened into the scene BVH
         compile_scene(scene, flatten_limit=0)  # the mesh instanced
+        # last: a render of a scene with OBJ files has compiled the reader already (its
+        # output checks read the models before the render), so the helper loads it
+        load_obj_bytes(TINY_OBJ, "warm-up.obj", Path("."))
         _builders_ready = True
 
 
@@ -393,7 +401,7 @@ def warm_up_kernels(compiled: CompiledScene | None = None,
                                     else stand_in_scene(instances), aovs=False)
         else:
             # a second cold render of the variant waits here, then loads
-            with cache.compile_lock("general" if instances else "plain"):
+            with _compile_lock(cache, instances):
                 if marker is not None and marker.exists():  # another process compiled it
                     _compile_render_kernels(compiled if compiled is not None
                                             else stand_in_scene(instances), aovs=False)
@@ -405,6 +413,94 @@ def warm_up_kernels(compiled: CompiledScene | None = None,
             cache.seal()
         _ready.add(key)
         return time.perf_counter() - start
+
+
+#: (the plain variant's compile lock, the helper) started ahead of the cold compile by
+#: :func:`start_cold_compile_ahead`, until the compile adopts them
+_ahead: tuple[object, subprocess.Popen] | None = None
+_ahead_lock = threading.Lock()  # not _lock: a compile holds that until it ends
+
+
+def start_cold_compile_ahead() -> bool:
+    """On a cold cache, start the compile helper now, before the work a command does ahead
+    of its render: ``whitted render``'s output checks read the scene's models, which
+    compiles the OBJ reader (3 s of CPU), and the helper compiles its share of the render
+    kernel meanwhile instead of starting after it. The compile lock of the plain variant is
+    taken without waiting (another process compiling it: nothing is started, the render
+    waits for it as before) and held until the render's warm-up adopts both
+    (:func:`warm_up_kernels`) or :func:`stop_cold_compile_ahead` ends them. True when the
+    helper was started."""
+    global _ahead
+    with _ahead_lock:
+        if _ahead is not None or (False, False) in _ready or kernels_cached(False):
+            return _ahead is not None
+        from ..jit import load_numba
+
+        load_numba()
+        lock = prepare().take_compile_lock("plain")
+        if lock is None:
+            return False
+        helper = _start_helper(False)
+        if helper is None:
+            lock.release()
+            return False
+        _ahead = (lock, helper)
+        return True
+
+
+def stop_cold_compile_ahead() -> None:
+    """End what :func:`start_cold_compile_ahead` started and no compile adopted (the
+    command stopped before its render: a user mistake, Ctrl-C): the helper is stopped (what
+    it cached stays, unsealed, for the next compile to check) and the lock released."""
+    global _ahead
+    with _ahead_lock:
+        ahead, _ahead = _ahead, None
+    if ahead is not None:
+        _stop_helper(ahead[1])
+        ahead[0].release()
+
+
+@contextlib.contextmanager
+def cold_compile_ahead():
+    """:func:`start_cold_compile_ahead` for the block, :func:`stop_cold_compile_ahead` after
+    it (nothing to stop once the block's render has adopted the helper)."""
+    start_cold_compile_ahead()
+    try:
+        yield
+    finally:
+        stop_cold_compile_ahead()
+
+
+def _take_ahead(instances: bool):
+    """The lock and helper started ahead for this variant (the plain one), or None."""
+    global _ahead
+    with _ahead_lock:
+        if instances or _ahead is None:
+            return None
+        ahead, _ahead = _ahead, None
+        return ahead
+
+
+@contextlib.contextmanager
+def _compile_lock(cache, instances: bool):
+    """The variant's compile lock: the one taken ahead, or taken now (waiting for another
+    process that holds it)."""
+    global _ahead
+    ahead = None if instances else _ahead
+    if ahead is not None:
+        try:
+            yield
+        finally:
+            with _ahead_lock:
+                unused = _ahead is ahead  # not adopted: another process had compiled it
+                if unused:
+                    _ahead = None
+            if unused:
+                _stop_helper(ahead[1])
+            ahead[0].release()
+        return
+    with cache.compile_lock("general" if instances else "plain"):
+        yield
 
 
 @contextlib.contextmanager
@@ -428,21 +524,23 @@ def _interrupt_at_safe_points(count: _CompileCount):
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
-def _delegated(instances: bool) -> list:
-    """The helper's share of the render kernel's callees: (twin dispatcher, types) pairs;
-    none with stock Numba (no twins to compile, nothing to wait for: jit/dispatcher.py)."""
+def _delegated(instances: bool, here: bool = False) -> list:
+    """The helper's share of the render kernel's callees (``here``: what this process
+    compiles first meanwhile): (twin dispatcher, types) pairs; none with stock Numba (no
+    twins to compile, nothing to wait for: jit/dispatcher.py)."""
     from ..jit import load_numba
     from ..jit.dispatcher import tuned
 
     load_numba()
     if not tuned():
         return []
-    from ..kernels.callees import render_callees
+    from ..kernels.callees import callees_here_first, render_callees
 
     stand_in = stand_in_scene(instances)
+    chosen = callees_here_first if here else render_callees
     return [(dispatcher.callee, argument_types) for dispatcher, argument_types
-            in render_callees(stand_in.geometry, stand_in.materials, stand_in.lights,
-                              _stand_in_params(stand_in))]
+            in chosen(stand_in.geometry, stand_in.materials, stand_in.lights,
+                      _stand_in_params(stand_in))]
 
 
 def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
@@ -455,7 +553,8 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
 
     load_numba()  # Numba, with whitted's settings
     KernelCache = kernel_cache_class()  # noqa: N806 - None with stock Numba
-    helper = _start_helper(instances)
+    ahead = _take_ahead(instances)
+    helper = ahead[1] if ahead is not None else _start_helper(instances)
     delegated = ()
     if helper is not None and helper.stdout is not None:
         delegated = tuple(d.py_func.__qualname__ for d, _ in _delegated(instances))
@@ -471,6 +570,9 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
                            compile_progress)
     try:
         with report, _CountCompiles(count), _interrupt_at_safe_points(count):
+            if delegated:  # this process's first share, while the helper compiles its own
+                for dispatcher, argument_types in _delegated(instances, here=True):
+                    dispatcher.compile(argument_types)
             _compile_render_kernels(compiled if compiled is not None
                                     else stand_in_scene(instances))
             if KernelCache is not None:
