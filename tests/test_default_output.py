@@ -24,7 +24,8 @@ def test_the_default_picture_replaces_only_its_own(tmp_path):
     PILImage.new("RGB", (3, 2), "red").save(picture)  # the user's own picture
     mine = picture.read_bytes()
     one_line_error(run_main("render", *TINY, cwd=tmp_path),
-                   "render.png: a file whitted did not write is there; it is kept",
+                   "render.png: a file not marked as whitted's is there (someone else's, or "
+                   "an older whitted's); it is kept",
                    "-o render.png")
     assert picture.read_bytes() == mine
     picture.write_text("my notes")
@@ -59,7 +60,7 @@ def test_the_default_sheet_of_a_sweep_replaces_only_its_own(tmp_path):
     assert code == 0, err  # its own sheet: replaced
     PILImage.new("RGB", (3, 2)).save(sheet)
     mine = sheet.read_bytes()
-    one_line_error(run_main(*sweep, cwd=tmp_path), "sheet.png: a file whitted did not write")
+    one_line_error(run_main(*sweep, cwd=tmp_path), "sheet.png: a file not marked as whitted's")
     assert sheet.read_bytes() == mine
     code, _, err = run_main(*sweep, "-o", "sheet.png", cwd=tmp_path)
     assert code == 0, err

@@ -132,3 +132,22 @@ def test_an_attribute_error_of_a_connected_client_is_not_hidden():
     watch = ClusterWatch(client, stall_floor=5.0)
     with pytest.raises(AttributeError):
         watch.check({"frame-0"})
+
+
+def test_a_slow_answer_of_the_scheduler_is_a_timeout_not_a_lost_cluster():
+    """A question that times out (TimeoutError is an OSError) stays a timeout: the task
+    loop then gives up on that result and submits the task again, instead of ending the
+    whole render as if the scheduler were gone; a broken connection is a lost cluster."""
+    from whitted.farm.watch import Watch as ClusterWatch
+
+    def slow(*args, **kwargs):
+        raise TimeoutError
+
+    def broken(*args, **kwargs):
+        raise ConnectionResetError("reset by peer")
+
+    watch = ClusterWatch(ClosedClient(), stall_floor=5.0)
+    with pytest.raises(TimeoutError):
+        watch.ask(slow, [WaitingFuture()])
+    with pytest.raises(ClusterLost):
+        watch.ask(broken)

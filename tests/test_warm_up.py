@@ -140,6 +140,20 @@ def test_the_expected_compile_count_is_the_real_one(tmp_path):
     assert abs(compiled - expected) <= 0.1 * expected, (compiled, expected)
 
 
+#: a compile helper is started only with two cores or more and the helper not switched off
+helpers_start = pytest.mark.skipif(
+    len(os.sched_getaffinity(0)) < 2 or os.environ.get("WHITTED_COMPILE_HELPER") == "0"
+    or os.environ.get("NUMBA_DISABLE_JIT") == "1",
+    reason="no compile helper is started here (one core, or switched off)")
+
+
+@pytest.fixture
+def ahead_stopped():
+    """Whatever a test leaves started ahead (a failed assertion) is stopped after it."""
+    yield
+    warm_up.stop_cold_compile_ahead()
+
+
 def _started_helpers(monkeypatch) -> list:
     """The helpers warm_up starts from now on (their Popen objects)."""
     started = []
@@ -155,7 +169,9 @@ def _started_helpers(monkeypatch) -> list:
     return started
 
 
-def test_the_helper_started_ahead_is_adopted_by_the_compile(monkeypatch, tmp_path):
+@helpers_start
+def test_the_helper_started_ahead_is_adopted_by_the_compile(monkeypatch, tmp_path,
+                                                            ahead_stopped):
     """``whitted render`` starts the helper before its output checks (which compile the OBJ
     reader on a cold cache); the render's warm-up then uses that helper and that lock, and
     releases the lock when done. Cold here as far as the warm-up knows (no marker), the
@@ -178,8 +194,9 @@ def test_the_helper_started_ahead_is_adopted_by_the_compile(monkeypatch, tmp_pat
     lock.release()
 
 
+@helpers_start
 def test_a_command_that_ends_before_its_render_stops_the_helper_started_ahead(
-        monkeypatch, tmp_path):
+        monkeypatch, tmp_path, ahead_stopped):
     """A user mistake found by the output checks (a folder that does not exist): exit 2,
     and the helper started ahead is stopped and the lock released, not left running."""
     from typer.testing import CliRunner
@@ -207,3 +224,18 @@ def test_no_helper_ahead_on_a_warm_cache(monkeypatch):
     started = _started_helpers(monkeypatch)
     assert not warm_up.start_cold_compile_ahead()
     assert started == []
+
+
+def test_no_helper_ahead_when_the_kernels_were_finished_while_the_lock_was_taken(
+        monkeypatch, ahead_stopped):
+    """Another process may finish the compile (and free the lock) between the first look
+    at the cache and the lock: then nothing is started and the lock is not kept."""
+    answers = iter([False, True])
+    monkeypatch.setattr(warm_up, "kernels_cached", lambda instances=False: next(answers))
+    monkeypatch.setattr(warm_up, "_ready", set())
+    started = _started_helpers(monkeypatch)
+    assert not warm_up.start_cold_compile_ahead()
+    assert started == [] and warm_up._ahead is None
+    lock = warm_up.prepare().take_compile_lock("plain")
+    assert lock is not None  # not held
+    lock.release()

@@ -146,8 +146,9 @@ def check_default_output(output: Path) -> None:
     except OSError:
         return  # check_outputs says what is wrong with the place
     if there and not written_by_whitted(output):
-        raise fail(f"{output}: a file whitted did not write is there; it is kept (replace it "
-                   f"with -o {output}, or give another name)")
+        raise fail(f"{output}: a file not marked as whitted's is there (someone else's, or "
+                   f"an older whitted's); it is kept (replace it with -o {output}, or give "
+                   "another name)")
 
 
 def _exists(path: Path) -> bool:

@@ -136,7 +136,6 @@ def _summaries() -> None:
                     info.short_help = _first_sentence(doc)
 
 
-
 def _command_name(info: typer.models.CommandInfo) -> str:
     return info.name or typer.main.get_command_name(info.callback.__name__)
 

@@ -137,9 +137,8 @@ def render(
     try:
         check_bit_depth(bit_depth, kind)
     except ValueError:
-        raise fail(f"{output}: --bit-depth 16 is only supported for .png (a "
-                   f"{kind} file has 8 bits; .exr, .pfm and .npy store "
-                   "float32)") from None
+        raise fail(f"{output}: --bit-depth 16 is only for .png output (got {kind}: .jpg, "
+                   ".tif and .webp have 8 bits, .exr, .pfm and .npy store float32)") from None
     try:
         check_image_options(kind, alpha=alpha)
     except ValueError as exc:

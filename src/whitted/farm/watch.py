@@ -294,6 +294,8 @@ class Watch:
         methods fail with AttributeError)."""
         try:
             return call(*args, **kwargs)
+        except TimeoutError:  # a slow answer (an OSError too): the caller decides
+            raise
         except (OSError, distributed.comm.CommClosedError) as exc:
             raise self.lost(exc) from None
         except AttributeError:

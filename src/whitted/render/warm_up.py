@@ -440,6 +440,9 @@ def start_cold_compile_ahead() -> bool:
         lock = prepare().take_compile_lock("plain")
         if lock is None:
             return False
+        if kernels_cached(False):  # finished by another process before the lock was free
+            lock.release()
+            return False
         helper = _start_helper(False)
         if helper is None:
             lock.release()
