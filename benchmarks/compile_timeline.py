@@ -190,26 +190,25 @@ def summarise(run: dict, detail: bool) -> None:
               f"CPU {end[1]:.2f} s, {len(compiles)} compiles"
               + (f" from {first_c[0] - t0:.2f} to {last_c[0] - t0:.2f} s" if last_c else ""))
         stack = []
+
+        def close(label, ts, cpu):
+            """Print the span that ``label`` opened last, ended at (ts, cpu)."""
+            for i in range(len(stack) - 1, -1, -1):
+                if stack[i][2] == label:
+                    bts, bcpu, _ = stack.pop(i)
+                    print(f"    {bts - t0:7.2f} {ts - t0:7.2f}  {ts - bts:6.2f} s wall "
+                          f"{cpu - bcpu:6.2f} s CPU  {label}")
+                    return
+
         for ts, cpu, kind, name, depth in rows:
             if kind == "begin":
                 stack.append((ts, cpu, name))
             elif kind == "end":
-                for i in range(len(stack) - 1, -1, -1):
-                    if stack[i][2] == name:
-                        bts, bcpu, _ = stack.pop(i)
-                        print(f"    {bts - t0:7.2f} {ts - t0:7.2f}  {ts - bts:6.2f} s wall "
-                              f"{cpu - bcpu:6.2f} s CPU  {name}")
-                        break
+                close(name, ts, cpu)
             elif kind == "cstart" and depth <= (2 if detail else 0):
                 stack.append((ts, cpu, "compile " + "  " * depth + name))
             elif kind == "cend" and depth <= (2 if detail else 0):
-                label = "compile " + "  " * depth + name
-                for i in range(len(stack) - 1, -1, -1):
-                    if stack[i][2] == label:
-                        bts, bcpu, _ = stack.pop(i)
-                        print(f"    {bts - t0:7.2f} {ts - t0:7.2f}  {ts - bts:6.2f} s wall "
-                              f"{cpu - bcpu:6.2f} s CPU  {label}")
-                        break
+                close("compile " + "  " * depth + name, ts, cpu)
     main, helper = run["logs"].get("main"), run["logs"].get("helper")
     if main and helper:
         names_m = {r[3] for r in main["rows"] if r[2] == "cend"}
