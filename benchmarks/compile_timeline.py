@@ -173,6 +173,16 @@ def one_run(args, src: Path, keep: Path | None) -> dict:
         shutil.rmtree(work, ignore_errors=True)
 
 
+def _close(stack: list, label: str, ts: float, cpu: float, t0: float) -> None:
+    """Print the span that ``label`` opened last (popped from ``stack``), ended at (ts, cpu)."""
+    for i in range(len(stack) - 1, -1, -1):
+        if stack[i][2] == label:
+            bts, bcpu, _ = stack.pop(i)
+            print(f"    {bts - t0:7.2f} {ts - t0:7.2f}  {ts - bts:6.2f} s wall "
+                  f"{cpu - bcpu:6.2f} s CPU  {label}")
+            return
+
+
 def summarise(run: dict, detail: bool) -> None:
     t0 = run["t0"]
     print(f"\nprocess: {run['wall']:.2f} s wall, {run['cpu']:.2f} s CPU (both processes)")
@@ -190,25 +200,15 @@ def summarise(run: dict, detail: bool) -> None:
               f"CPU {end[1]:.2f} s, {len(compiles)} compiles"
               + (f" from {first_c[0] - t0:.2f} to {last_c[0] - t0:.2f} s" if last_c else ""))
         stack = []
-
-        def close(label, ts, cpu):
-            """Print the span that ``label`` opened last, ended at (ts, cpu)."""
-            for i in range(len(stack) - 1, -1, -1):
-                if stack[i][2] == label:
-                    bts, bcpu, _ = stack.pop(i)
-                    print(f"    {bts - t0:7.2f} {ts - t0:7.2f}  {ts - bts:6.2f} s wall "
-                          f"{cpu - bcpu:6.2f} s CPU  {label}")
-                    return
-
         for ts, cpu, kind, name, depth in rows:
             if kind == "begin":
                 stack.append((ts, cpu, name))
             elif kind == "end":
-                close(name, ts, cpu)
+                _close(stack, name, ts, cpu, t0)
             elif kind == "cstart" and depth <= (2 if detail else 0):
                 stack.append((ts, cpu, "compile " + "  " * depth + name))
             elif kind == "cend" and depth <= (2 if detail else 0):
-                close("compile " + "  " * depth + name, ts, cpu)
+                _close(stack, "compile " + "  " * depth + name, ts, cpu, t0)
     main, helper = run["logs"].get("main"), run["logs"].get("helper")
     if main and helper:
         names_m = {r[3] for r in main["rows"] if r[2] == "cend"}
