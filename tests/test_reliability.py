@@ -669,7 +669,8 @@ def test_d8_bit_depth_16_png_from_the_command_line(tmp_path: Path):
     _w, _h, _rows, info = png.Reader(filename=str(tmp_path / "deep.png")).read()
     assert info["bitdepth"] == 16 and (_w, _h) == (16, 12)
     one_line_error(run_main("render", "scene.toml", "-o", "x.jpg", "--bit-depth", "16",
-                            cwd=tmp_path), "x.jpg: --bit-depth 16 is only for .png output (got jpeg")
+                            cwd=tmp_path),
+                   "x.jpg: --bit-depth 16 is only for .png output (got jpeg")
 
 
 # ============================================================================ E. Python API
