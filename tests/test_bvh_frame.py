@@ -13,6 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import whitted
+from scattered import scattered_shapes
 from whitted.bench.models import rounded_box_mesh
 from whitted.compile import bvh_frame
 from whitted.compile.scene import compile_scene
@@ -100,17 +101,8 @@ def _scene(seed, scale, n_spheres, n_tris, rotate):
     around and through it, all clear (so walks gather every crossing), and a plane."""
     rng = np.random.default_rng(seed)
     objects = [_mesh(rotate, (0.3, -0.2, 0.1), scale)]
-    for r in rng.uniform(0.05, 0.6, n_spheres):
-        objects.append(whitted.Sphere(center=tuple(rng.uniform(-2, 2, 3) * scale),
-                                      radius=float(r) * scale, material=_glass()))
-    for _ in range(n_tris):
-        a = rng.uniform(-2, 2, 3)
-        b = a + rng.normal(0, 0.5, 3)
-        c = a + rng.normal(0, 0.5, 3)
-        if np.linalg.norm(np.cross(b - a, c - a)) < 1e-3:
-            continue
-        objects.append(whitted.Triangle(vertices=(tuple(a * scale), tuple(b * scale),
-                                                  tuple(c * scale)), material=_glass()))
+    objects += scattered_shapes(rng, n_spheres, n_tris, half=2.0, radius_max=0.6, spread=0.5,
+                                scale=scale, material=_glass)
     objects.append(whitted.Plane(point=(0, -3 * scale, 0), normal=(0, 1, 0), material=_glass()))
     return compile_scene(whitted.Scene(objects=objects))
 

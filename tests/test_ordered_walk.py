@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import whitted
+from scattered import scattered_shapes
 from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import closest_hit, hit_analytic
 from whitted.kernels.layout import BVH_STACK
@@ -45,18 +46,8 @@ def _scene(seed, n_spheres, n_tris, scale):
     """Spheres and triangles scattered in a cube of half-side 4·scale, clustered so boxes
     overlap and nest, and a plane (unbounded)."""
     rng = np.random.default_rng(seed)
-    objects = []
-    for r in rng.uniform(0.05, 0.8, n_spheres):
-        objects.append(whitted.Sphere(center=tuple(rng.uniform(-4, 4, 3) * scale),
-                                      radius=float(r) * scale))
-    for _ in range(n_tris):
-        a = rng.uniform(-4, 4, 3)
-        b = a + rng.normal(0, 0.7, 3)
-        c = a + rng.normal(0, 0.7, 3)
-        if np.linalg.norm(np.cross(b - a, c - a)) < 1e-3:
-            continue
-        objects.append(whitted.Triangle(vertices=(tuple(a * scale), tuple(b * scale),
-                                                  tuple(c * scale))))
+    objects = scattered_shapes(rng, n_spheres, n_tris, half=4.0, radius_max=0.8, spread=0.7,
+                               scale=scale)
     objects.append(whitted.Plane(point=(0, -5 * scale, 0), normal=(0, 1, 0)))
     return compile_scene(whitted.Scene(objects=objects)).geometry
 
