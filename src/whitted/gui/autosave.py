@@ -58,6 +58,11 @@ class Autosave(QObject):
     def path(self) -> Path:
         return autosave_path(self.doc.path, self.folder)
 
+    @property
+    def current(self) -> bool:
+        """Whether the autosave holds the document's present edits."""
+        return self.doc.revision == self._saved_revision
+
     def save_now(self) -> Path | None:
         """Write the autosave if there are unsaved edits not autosaved yet."""
         if not self.doc.dirty or self.doc.revision == self._saved_revision:
