@@ -21,6 +21,7 @@ tells what its own last words say (the editor keeps unsaved edits in its autosav
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import os
 import signal
@@ -63,10 +64,25 @@ def last_signal() -> int | None:
 
 def install_process_handlers() -> None:
     """SIGINT and SIGTERM end the process at once (one line, 130 or 143) while no guard is
-    set: the ``whitted`` program calls this before it imports anything else."""
+    set: the ``whitted`` program calls this before it imports anything else. Once the
+    interpreter shuts down they are ignored (:func:`_ignore_while_exiting`)."""
     if threading.current_thread() is threading.main_thread():
         for sig in SIGNALS:
             signal.signal(sig, _end_at_once)
+        # registered before the command runs: after the exit hooks its libraries register
+        atexit.register(_ignore_while_exiting)
+
+
+def _ignore_while_exiting() -> None:
+    """An exit hook, run once every thread has ended and the command's files are closed:
+    Python's shutdown then puts back the system's default for a signal with a Python handler
+    (death by the signal, no line, while it frees its modules: some 0.1 s), never for an
+    ignored one. A SIGINT or SIGTERM that late changes nothing: the process ends with the
+    command's own status."""
+    if threading.current_thread() is threading.main_thread():
+        for sig in SIGNALS:
+            with contextlib.suppress(OSError, ValueError):
+                signal.signal(sig, signal.SIG_IGN)
 
 
 def command_finished() -> None:
