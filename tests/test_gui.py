@@ -358,6 +358,31 @@ def test_declined_recovery_removes_the_autosave(make_window, tmp_path):
     assert not auto.exists()
 
 
+def test_a_file_of_someone_else_s_at_the_autosave_name_is_kept(make_window, tmp_path):
+    """The autosave's name is whitted's choice: a file there that whitted did not write is
+    neither written over nor removed, and the status bar says so."""
+    path = tmp_path / "work.toml"
+    small_scene().save(path)
+    theirs = autosave_path(path, tmp_path)
+    theirs.write_text("my own notes\n")
+    window = make_window(scene=whitted.load_scene(path), path=path)
+    said = []
+    window.autosave.saved.connect(said.append)
+    window.object_actions["disk"].trigger()
+    assert window.autosave.save_now() is None
+    assert theirs.read_text() == "my own notes\n"
+    assert said == [f"Autosave off: {theirs.name} is there and whitted did not write it "
+                    "(it is kept)"]
+    window.autosave.discard()
+    assert theirs.read_text() == "my own notes\n"
+    theirs.unlink()
+    assert window.autosave.save_now() == theirs  # whitted's own from now on: replaced
+    window.object_actions["box"].trigger()
+    assert window.autosave.save_now() == theirs
+    window.autosave.discard()
+    assert not theirs.exists()
+
+
 def test_camera_position_rotation_and_mouse(window, qtbot):
     window.select(CAMERA)
     assert set_text(window, ("position",), "1") == ""

@@ -152,3 +152,27 @@ def test_a_foreign_file_at_the_tile_state_name_is_not_taken_for_whitted_s(tmp_pa
         np.save(buffer, np.array("not whitted"))
         z.writestr("magic.npy", buffer.getvalue())
     assert foreign(path)
+
+
+def test_the_default_study_plot_replaces_only_whitted_s_own(tmp_path):
+    """``whitted bench --study`` without --plot writes bench-study-KIND.png here: a file of
+    someone else's there stops it in one line before the (long) study runs."""
+    from whitted.bench.studies import plot_study
+
+    plot = tmp_path / "bench-study-threads.png"
+    PILImage.new("RGB", (3, 2)).save(plot)
+    mine = plot.read_bytes()
+    one_line_error(run_main("bench", "--study", "threads", "--quick", cwd=tmp_path),
+                   f"bench-study-threads.png: {FOREIGN}")
+    assert plot.read_bytes() == mine
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bench-study-threads.png"]
+    rows = [{"scene": "seed000", "width": 8, "height": 8, "threads": t, "render_s": 1.0 / t,
+             "wall_s": 1.2 / t, "mrays_per_s": 1.0} for t in (1, 2)]
+    plot_study("threads", rows, plot, with_seed=False)  # the plot the study writes
+    assert written_by_whitted(plot)
+
+
+def test_two_bench_results_never_go_to_one_file(tmp_path):
+    one_line_error(run_main("bench", "--quick", "--json", "out.txt", "--markdown", "out.txt",
+                            cwd=tmp_path), "--markdown: out.txt is the file --json names too")
+    assert not any(tmp_path.iterdir())

@@ -68,6 +68,17 @@ def bench(
                        f"(known: {', '.join(SCENES)})")
     from ..output.safety import check_output_place
 
+    if study in ("threads", "size") and plot is None:  # a name not given: only whitted's
+        from .app import check_default_output
+
+        plot = Path(f"bench-study-{study}.png")
+        check_default_output(plot)
+    named = [(o, p) for o, p in (("--json", json_path), ("--plot", plot),
+                                 ("--markdown", markdown)) if p is not None]
+    for k, (option, path) in enumerate(named):  # two results never go to one file
+        for other, earlier in named[:k]:
+            if path.resolve() == earlier.resolve():
+                raise fail(f"{option}: {path} is the file {other} names too")
     for option, path in (("--json", json_path), ("--plot", plot), ("--markdown", markdown)):
         try:
             if path is not None:

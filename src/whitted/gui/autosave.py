@@ -1,6 +1,8 @@
 """Periodic autosave beside the scene file (``.NAME.autosave.toml`` next to ``NAME.toml``;
 untitled scenes in the editor's data folder), offered back for recovery after a crash. A clean
-save or a deliberate discard removes it."""
+save or a deliberate discard removes it. The name is whitted's choice, not the user's: a file
+there that whitted did not write (its record, :mod:`whitted.output.ownership`) is neither
+written over nor removed; the status bar says the autosave is off for it."""
 
 from __future__ import annotations
 
@@ -9,6 +11,7 @@ from pathlib import Path
 
 from PySide6.QtCore import QObject, QStandardPaths, QTimer, Signal
 
+from ..output.ownership import exists, record_written, recorded_by_whitted
 from ..scene import load_scene, save_scene
 from .document import SceneDocument
 
@@ -68,12 +71,17 @@ class Autosave(QObject):
         if not self.doc.dirty or self.doc.revision == self._saved_revision:
             return None
         target = self.path
+        if exists(target) and not recorded_by_whitted(target):
+            self.saved.emit(f"Autosave off: {target.name} is there and whitted did not write "
+                            "it (it is kept)")
+            return None
         try:
             target.parent.mkdir(parents=True, exist_ok=True)
             save_scene(self.doc.scene, target)
         except OSError as exc:  # a read-only folder: nothing to do but say so
             self.saved.emit(f"Autosave failed: {exc.strerror or exc}")
             return None
+        record_written(target)
         self._saved_revision = self.doc.revision
         self.saved.emit(f"Autosaved to {target.name}")
         return target
@@ -83,6 +91,8 @@ class Autosave(QObject):
         target = autosave_path(scene_path if scene_path is not None else self.doc.path,
                                self.folder)
         self._saved_revision = -1
+        if not recorded_by_whitted(target):  # not whitted's (or gone): kept
+            return
         try:
             os.remove(target)
         except FileNotFoundError:
