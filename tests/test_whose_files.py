@@ -176,3 +176,15 @@ def test_two_bench_results_never_go_to_one_file(tmp_path):
     one_line_error(run_main("bench", "--quick", "--json", "out.txt", "--markdown", "out.txt",
                             cwd=tmp_path), "--markdown: out.txt is the file --json names too")
     assert not any(tmp_path.iterdir())
+
+
+def test_the_default_melt_film_replaces_only_whitted_s_own(tmp_path, examples_dir):
+    """``whitted stefan film`` without -o writes melt.mp4 here: someone else's melt.mp4
+    stops it in one line before the solve, and nothing is written."""
+    case = examples_dir / "stefan" / "hollow_ice.toml"
+    film = tmp_path / "melt.mp4"
+    mine = _foreign_mp4(film)
+    one_line_error(run_main("stefan", "film", case, "-W", "8", "-H", "6", cwd=tmp_path),
+                   f"melt.mp4: {FOREIGN}")
+    assert film.read_bytes() == mine
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["melt.mp4"]
