@@ -9,6 +9,9 @@ import shutil
 
 import imageio_ffmpeg
 import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from PIL import Image as PILImage
 
 from cli_run import one_line_error, run_main
@@ -19,6 +22,14 @@ from whitted.output.video import encode_film, film_written_by_whitted
 TINY = ("-W", "8", "-H", "6", "-q")
 FOREIGN = "a file not marked as whitted's is there (someone else's, or an older whitted's); " \
           "it is kept"
+
+
+@pytest.fixture(autouse=True)
+def _own_records(tmp_path, monkeypatch):
+    """The records of the files whitted wrote kept beside the test's folder (the kernel
+    cache, and so the cache folder, stays the one the tests share)."""
+    records = tmp_path.with_name(tmp_path.name + "-records")
+    monkeypatch.setattr(ownership, "_records", lambda: records)
 
 
 def _frames(n: int = 2) -> list[np.ndarray]:
@@ -188,3 +199,40 @@ def test_the_default_melt_film_replaces_only_whitted_s_own(tmp_path, examples_di
                    f"melt.mp4: {FOREIGN}")
     assert film.read_bytes() == mine
     assert sorted(p.name for p in tmp_path.iterdir()) == ["melt.mp4"]
+
+
+@settings(max_examples=30, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(head=st.sampled_from([b"", b"GIF89a", b"\0\0\0\x18ftypisom", b"\x89PNG\r\n\x1a\n"]),
+       body=st.binary(max_size=400))
+def test_no_bytes_at_a_default_name_pass_for_whitted_s(tmp_path, head, body):
+    """Whatever someone else's file holds (a film's or a PNG's first bytes, then anything), it
+    is never taken for whitted's, and reading it never raises."""
+    path = tmp_path / "film.mp4"
+    path.write_bytes(head + body)
+    assert not written_by_whitted(path)
+    record = ownership._records() / f"{ownership._key(path)}.json"
+    if not record.exists():  # a damaged record is no record
+        record.parent.mkdir(parents=True, exist_ok=True)
+        record.write_bytes(body)
+        try:
+            assert not recorded_by_whitted(path)
+        finally:
+            record.unlink()
+
+
+def test_records_of_files_gone_are_swept_past_the_limit(tmp_path, monkeypatch):
+    monkeypatch.setattr(ownership, "RECORDS_KEPT", 3)
+    files = [tmp_path / f"{k}.npy" for k in range(4)]
+    for path in files:
+        np.save(path, np.zeros(2))
+        record_written(path)
+    files[0].unlink()
+    files[1].write_bytes(b"changed")
+    np.save(files[2], np.ones(2))  # the same size: kept, yet no longer whitted's
+    kept = tmp_path / "4.npy"
+    np.save(kept, np.zeros(2))
+    record_written(kept)
+    assert len(list(ownership._records().iterdir())) == 3
+    assert recorded_by_whitted(kept) and recorded_by_whitted(files[3])
+    assert not recorded_by_whitted(files[2])

@@ -28,6 +28,8 @@ __all__ = ["check_replaceable", "record_written", "recorded_by_whitted", "writte
 RECORDS = "written"
 #: A record's version (its first key).
 RECORD_KIND = "whitted written file 1"
+#: Records kept before those of files gone or changed since are swept away.
+RECORDS_KEPT = 2000
 
 
 def _records() -> Path:
@@ -65,6 +67,22 @@ def record_written(path: str | os.PathLike[str]) -> None:
                            "sha256": digest})
         atomic_write(folder / f"{_key(path)}.json",
                      lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+        _sweep(folder)
+
+
+def _sweep(folder: Path) -> None:
+    """Past :data:`RECORDS_KEPT` records, remove those whose file is gone or has another
+    size now (it is no longer what whitted wrote)."""
+    entries = list(os.scandir(folder))
+    if len(entries) <= RECORDS_KEPT:
+        return
+    for entry in entries:
+        with contextlib.suppress(OSError, ValueError, KeyError, TypeError):
+            record = json.loads(Path(entry.path).read_bytes()[:4096])
+            if os.stat(record["path"]).st_size == record["size"]:
+                continue
+        with contextlib.suppress(OSError):
+            os.unlink(entry.path)
 
 
 def recorded_by_whitted(path: str | os.PathLike[str]) -> bool:
