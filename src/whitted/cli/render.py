@@ -178,7 +178,7 @@ def render(
     # a cold kernel cache: the compile helper starts now and compiles its share of the
     # render kernel while the output checks read the scene's models (compiling the OBJ
     # reader in this process); stopped if the command ends before its render adopts it
-    with contextlib.nullcontext() if farm else cold_compile_ahead():
+    with contextlib.nullcontext() if farm else cold_compile_ahead(scene):
         try:
             from ..output.safety import check_memory, check_outputs
 

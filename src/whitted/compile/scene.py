@@ -67,6 +67,33 @@ class CompiledScene:
     prim_hi: np.ndarray | None = None
 
 
+def scene_needs_builders(scene: Scene) -> bool:
+    """Whether compiling ``scene`` runs a builder on an input too large for its Python twin
+    (jit/python_twins.py), judged before reading any model: more bounded objects than the
+    BVH's limit, an inline mesh with more triangles, or a model file larger than the OBJ
+    reader's limit (its triangle count unknown until read). A first render of such a scene
+    has its compile helper compile the builders too."""
+    from ..assets.obj_scan import PYTHON_LIMIT_BYTES
+    from .bvh import PYTHON_LIMIT
+
+    if len(scene.objects) > PYTHON_LIMIT:
+        return True
+    for shape in scene.objects:
+        if not isinstance(shape, Mesh):
+            continue
+        if shape.file is None:
+            if shape.faces is not None and len(shape.faces) > PYTHON_LIMIT:
+                return True
+            continue
+        try:
+            size = scene.resolve_path(shape.file).stat().st_size
+        except OSError:
+            continue  # reported where the model is read
+        if size > PYTHON_LIMIT_BYTES:
+            return True
+    return False
+
+
 #: scene BVHs of this many bounded primitives are built with the SAH on all three axes
 ALL_AXES_FROM = 4096
 ALL_AXES_UP_TO = 1 << 20  # past this the build's time matters more (three times the binning)
