@@ -64,6 +64,26 @@ def test_whitted_s_films_carry_the_mark_and_others_do_not(tmp_path):
     assert not written_by_whitted(tmp_path / "dir.mp4")
 
 
+def test_a_user_s_remux_or_copy_of_whitted_s_film_is_theirs(tmp_path):
+    """The mark survives a remux (ffmpeg ``-c copy``, which keeps the metadata) and a copy;
+    only the very bytes whitted wrote at that place are whitted's."""
+    import subprocess
+
+    from whitted.output.video import ffmpeg_exe
+
+    film = encode_film(_frames(), tmp_path / "film.mp4", fps=10)
+    cut = tmp_path / "cut.mp4"
+    subprocess.run([ffmpeg_exe(), "-nostdin", "-loglevel", "error", "-i", str(film),
+                    "-c", "copy", "-t", "0.1", str(cut)], check=True)
+    assert film_written_by_whitted(film) and not film_written_by_whitted(cut)
+    cut.replace(film)  # the user's cut saved over whitted's film
+    assert not film_written_by_whitted(film) and not written_by_whitted(film)
+    copy = tmp_path / "copy.gif"
+    gif = encode_film(_frames(), tmp_path / "a.gif", fps=10)
+    copy.write_bytes(gif.read_bytes())  # whitted's bytes, but not written there by whitted
+    assert film_written_by_whitted(gif) and not film_written_by_whitted(copy)
+
+
 def test_an_npy_is_whitted_s_while_it_holds_the_bytes_recorded(tmp_path):
     path = tmp_path / "x.depth.npy"
     np.save(path, np.arange(6, dtype=np.float32))
@@ -187,6 +207,10 @@ def test_two_bench_results_never_go_to_one_file(tmp_path):
     one_line_error(run_main("bench", "--quick", "--json", "out.txt", "--markdown", "out.txt",
                             cwd=tmp_path), "--markdown: out.txt is the file --json names too")
     assert not any(tmp_path.iterdir())
+    (tmp_path / "loop").symlink_to("loop")  # a link to itself: one line too, no traceback
+    code, _, err = run_main("bench", "--quick", "--json", "loop", "--markdown", "out.md",
+                            cwd=tmp_path)
+    assert code == 2 and err.strip().count("\n") == 0 and "loop" in err, err
 
 
 def test_the_default_melt_film_replaces_only_whitted_s_own(tmp_path, examples_dir):

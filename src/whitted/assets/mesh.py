@@ -351,7 +351,8 @@ def _convert_hard_numbers(
         return
     starts, ends, lines, kinds, flat = (hard_numbers[:, k] for k in range(5))
     buffer = np.empty(int((ends - starts).sum()) + len(hard_numbers), np.uint8)
-    obj_scan.gather_tokens(text, hard_numbers, buffer)
+    gather = for_size(obj_scan.gather_tokens, len(buffer), obj_scan.PYTHON_LIMIT_BYTES)
+    gather(text, hard_numbers, buffer)
     values = np.array(buffer.tobytes().split(), dtype=np.float64)
     bad = ~np.isfinite(values)
     if bad.any():

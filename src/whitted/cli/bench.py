@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Annotated
 
@@ -77,7 +78,7 @@ def bench(
                                  ("--markdown", markdown)) if p is not None]
     for k, (option, path) in enumerate(named):  # two results never go to one file
         for other, earlier in named[:k]:
-            if path.resolve() == earlier.resolve():
+            if os.path.realpath(path) == os.path.realpath(earlier):  # loops too
                 raise fail(f"{option}: {path} is the file {other} names too")
     for option, path in (("--json", json_path), ("--plot", plot), ("--markdown", markdown)):
         try:

@@ -104,8 +104,10 @@ def _centroid(rows, j, k):
 
 @builder
 def _bin_of(rows, j, axis, cmin, scale, nb):
-    b = int((_centroid(rows, j, axis) - cmin) * scale)
-    return nb - 1 if b >= nb else b
+    x = (_centroid(rows, j, axis) - cmin) * scale
+    if not x >= 0.0:  # NaN: an infinite spread of centroids (coordinates near 1e308)
+        return 0
+    return nb - 1 if x >= nb else int(x)
 
 
 @builder

@@ -35,6 +35,7 @@ BUILDERS_MARKER = "whitted-ready-builders"
 
 _lock = threading.Lock()
 _twins: dict = {}  # Python function -> its twin
+_quiet: dict = {}  # Python function -> its twin, called with NumPy's warnings off
 _namespaces: dict[int, dict] = {}  # id(a module's globals) -> the twins' copy of them
 _forced = threading.local()  # compiled() and as_python() blocks on this thread
 #: the mode outside such blocks: None chooses by size and cache (:func:`for_size`);
@@ -144,9 +145,26 @@ def for_size(kernel, size: int, limit: int):
     if _jit_disabled():
         return kernel  # a Python function already
     mode = getattr(_forced, "mode", None) or default_mode
-    if mode == "python":
-        return python_twin(kernel)
-    if (mode == "compiled" or size > limit or _compiled_here(kernel)
-            or builders_cached()):
+    if mode != "python" and (mode == "compiled" or size > limit or _compiled_here(kernel)
+                             or builders_cached()):
         return kernel
-    return python_twin(kernel)
+    return _quiet_twin(kernel)
+
+
+def _quiet_twin(kernel):
+    """The twin, run with NumPy's floating-point warnings off: an overflow to inf (a model's
+    coordinates near 1e308) is a value, as in the compiled builder, not a warning line."""
+    function = _python_function(kernel)
+    made = _quiet.get(function)
+    if made is None:
+        twin = python_twin(kernel)
+
+        def made(*args):
+            import numpy as np
+
+            with np.errstate(all="ignore"):
+                return twin(*args)
+
+        made.__wrapped__ = twin
+        _quiet[function] = made
+    return made

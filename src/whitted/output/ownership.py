@@ -3,9 +3,10 @@ give (a default output such as render.png, film.mp4 or sheet.png; the AOVs writt
 a picture, ``NAME.depth.npy``). Anything else there is someone else's, and is kept.
 
 A file proves itself whitted's by what it carries: a PNG its ``Software: whitted`` text
-(:mod:`.png`), an MP4 or GIF its ``whitted`` comment (:mod:`.video`). A format that holds no
-such mark (NPY: its header is exactly three keys, and NumPy refuses any other) is recorded
-instead when whitted writes it (:func:`record_written`): its path, size and SHA-256 in the
+(:mod:`.png`). A film's ``whitted`` comment (:mod:`.video`) survives a user's remux or
+re-encode, so a film must also be recorded; a format that holds no mark at all (NPY: its
+header is exactly three keys, and NumPy refuses any other) is recorded only. Recorded
+(:func:`record_written`) when whitted writes it: its path, size and SHA-256 in the
 per-user cache (``$WHITTED_CACHE_DIR/written/``, default ``~/.cache/whitted/written/``). Such
 a file is whitted's while its bytes are those recorded; one copied in from elsewhere, changed
 since, or written when the record could not be kept is treated as someone else's (the safe
@@ -53,7 +54,8 @@ def _digest(path: Path) -> tuple[int, str]:
 
 
 def record_written(path: str | os.PathLike[str]) -> None:
-    """Note that whitted has just written ``path`` (a file whose format holds no mark). A
+    """Note that whitted has just written ``path`` (a film, or a file whose format holds no
+    mark). A
     record that cannot be kept (no cache folder) is skipped: the file then counts as
     someone else's."""
     path = Path(path)

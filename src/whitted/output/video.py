@@ -17,8 +17,11 @@ reaches whitted only); it is stopped when the encode is cancelled (``cancel``) o
 Every film whitted encodes says so, as its PNGs do (``Software: whitted``): an MP4 carries the
 comment ``whitted`` in its metadata (ffmpeg's ``-metadata comment=``), a GIF a comment
 extension ``whitted`` (Pillow's ``comment``). :func:`film_written_by_whitted` reads it back
-(ffmpeg's own metadata dump, ``-f ffmetadata``; Pillow for a GIF): a command may replace a
-film at a name the user did not give (``whitted animate``'s film.mp4) only when it carries it.
+(ffmpeg's own metadata dump, ``-f ffmetadata``; Pillow for a GIF). A remux or re-encode
+keeps such a comment, so whitted also records each film's bytes when it writes it
+(output/ownership.py): a command may replace a film at a name the user did not give
+(``whitted animate``'s film.mp4) only when it carries the mark and is byte for byte the film
+whitted wrote there.
 """
 
 from __future__ import annotations
@@ -157,8 +160,14 @@ def encode_film(
     if not items:
         raise ValueError("no frames to encode")
     if fmt == "gif":
-        return atomic_write(path, lambda tmp: _write_gif(tmp, _frames(items), fps, cancel))
-    return atomic_write(path, lambda tmp: _write_mp4(tmp, _frames(items), fps, crf, cancel))
+        written = atomic_write(path, lambda tmp: _write_gif(tmp, _frames(items), fps, cancel))
+    else:
+        written = atomic_write(path, lambda tmp: _write_mp4(tmp, _frames(items), fps, crf,
+                                                            cancel))
+    from .ownership import record_written
+
+    record_written(written)  # the mark alone survives a user's remux or re-encode
+    return written
 
 
 def _check(cancel: Cancel | None) -> None:
@@ -246,8 +255,9 @@ def _write_gif(tmp: str, frames: Iterator[np.ndarray], fps: float,
 
 def film_written_by_whitted(path: str | os.PathLike[str]) -> bool:
     """Whether ``path`` is a film whitted encoded: an MP4 whose metadata comment, or a GIF
-    whose comment, is :data:`FILM_MARK`. False for anything else: another file, one that
-    cannot be read, an MP4 when no ffmpeg is there to read it."""
+    whose comment, is :data:`FILM_MARK`, with the very bytes whitted recorded when it wrote
+    it (output/ownership.py). False for anything else: another file, one changed since, one
+    that cannot be read, an MP4 when no ffmpeg is there to read it."""
     path = Path(path)
     try:
         if not path.is_file():
@@ -256,11 +266,15 @@ def film_written_by_whitted(path: str | os.PathLike[str]) -> bool:
             head = f.read(12)
     except (OSError, ValueError):
         return False
+    from .ownership import recorded_by_whitted
+
+    # the mark and whitted's record of the very bytes: a user's edit of a film whitted made
+    # (a remux, a cut, a re-encode) keeps the mark, and is the user's
     if head[:6] in (b"GIF87a", b"GIF89a"):
-        return _gif_comment(path) == FILM_MARK.encode()
+        return _gif_comment(path) == FILM_MARK.encode() and recorded_by_whitted(path)
     if head[4:8] != b"ftyp":  # not an MP4 (ISO base media) file: ffmpeg is not asked
         return False
-    return _mp4_comment(path) == FILM_MARK
+    return recorded_by_whitted(path) and _mp4_comment(path) == FILM_MARK
 
 
 def _gif_comment(path: Path) -> bytes | None:
