@@ -106,14 +106,12 @@ def recorded_by_whitted(path: str | os.PathLike[str]) -> bool:
 
 
 def written_by_whitted(path: str | os.PathLike[str]) -> bool:
-    """Whether ``path`` is a file whitted wrote: it carries whitted's mark (PNG, MP4, GIF) or
-    is one whitted recorded (:func:`recorded_by_whitted`). False for anything else, a file
-    that cannot be read included."""
+    """Whether ``path`` is a file whitted wrote: a PNG with whitted's mark, or a file whitted
+    recorded (:func:`recorded_by_whitted`: its films and its NPY files, the very bytes it
+    wrote there). False for anything else, a file that cannot be read included."""
     from .png import written_by_whitted as png_is_whitteds
-    from .video import film_written_by_whitted
 
-    return (png_is_whitteds(path) or film_written_by_whitted(path)
-            or recorded_by_whitted(path))
+    return png_is_whitteds(path) or recorded_by_whitted(path)
 
 
 def exists(path: Path) -> bool:
