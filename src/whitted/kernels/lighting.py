@@ -120,10 +120,14 @@ def _instances_occlusion_if_instances(geo, mats, o, d, inv, tmin, tmax, stack):
 @kernel
 def listed_occlusion(geo, mats, occluders, first, count, o, d, tmin, tmax, stack):
     """:func:`any_occluder` over a light-buffer cell's list ``occluders[first:][:count]``
-    instead of the BVHs: an entry ``i`` >= 0 is an analytic primitive, ``-1 - node`` a leaf
-    of the instance BVH (its box tested as the walk tests it, then each of its instances).
-    The answer does not depend on the order: 1 when any listed surface blocks opaquely, else
-    2 when any transparent one is met."""
+    instead of the BVHs (the walk itself when ``count`` is negative: no list): an entry
+    ``i`` >= 0 is an analytic primitive, ``-1 - node`` a leaf of the instance BVH (its box
+    tested as the walk tests it, then each of its instances). The answer does not depend on
+    the order: 1 when any listed surface blocks opaquely, else 2 when any transparent one is
+    met. (One call for both, so the shadow code inlined into the lighting stays small.)
+    Called only for scenes with instances (:func:`_shadow_through_instances`)."""
+    if count < 0:
+        return any_occluder(geo, mats, o, d, tmin, tmax, stack)
     seen_transparent = 0
     inv = inverse_direction(d)
     for k in range(first, first + count):
@@ -131,8 +135,7 @@ def listed_occlusion(geo, mats, occluders, first, count, o, d, tmin, tmax, stack
         if i >= 0:
             state = occludes(geo, mats, i, o, d, tmin, tmax)
         else:
-            state = instance_leaf_occlusion_if_instances(geo, mats, -1 - i, o, d, inv, tmin,
-                                                         tmax, stack)
+            state = _instance_leaf_occlusion(geo, mats, -1 - i, o, d, inv, tmin, tmax, stack)
         if state == 1:
             return 1
         seen_transparent = max(seen_transparent, state)
@@ -154,19 +157,6 @@ def _instance_leaf_occlusion(geo, mats, node, o, d, inv, tmin, tmax, stack):
             return 1
         seen_transparent = max(seen_transparent, state)
     return seen_transparent
-
-
-def instance_leaf_occlusion_if_instances(geo, mats, node, o, d, inv, tmin, tmax, stack):
-    """:func:`_instance_leaf_occlusion`, never compiled for scenes without instances."""
-    return _instance_leaf_occlusion(geo, mats, node, o, d, inv, tmin, tmax, stack)
-
-
-@overload(instance_leaf_occlusion_if_instances)
-def _instance_leaf_occlusion_if_instances(geo, mats, node, o, d, inv, tmin, tmax, stack):
-    if not instances_possible(geo):
-        return lambda geo, mats, node, o, d, inv, tmin, tmax, stack: 0
-    return lambda geo, mats, node, o, d, inv, tmin, tmax, stack: _instance_leaf_occlusion(
-        geo, mats, node, o, d, inv, tmin, tmax, stack)
 
 
 @kernel
@@ -450,11 +440,8 @@ def _shadow_through_instances(geo, mats, params, o, d, dist, media, n_media, scr
     count = n_media
     trans = (1.0, 1.0, 1.0)
     t_from = params.epsilon
-    if n_listed >= 0:
-        state = listed_occlusion(geo, mats, occluders, list_first, n_listed, o, d,
-                                 params.epsilon, dist, stack)
-    else:
-        state = any_occluder(geo, mats, o, d, params.epsilon, dist, stack)
+    state = listed_occlusion(geo, mats, occluders, list_first, n_listed, o, d, params.epsilon,
+                             dist, stack)
     if state == 0:  # only the medium the point is in, if any, dims the light
         return _absorb(mats, media, n_media, dist - params.epsilon, (1.0, 1.0, 1.0)), -1
     if state == 1:
