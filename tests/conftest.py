@@ -8,6 +8,8 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
+from whitted.jit import python_twins
+
 # Property tests draw the same cases on every run (CI and here): a failure is reproducible,
 # and a run never fails on a case no earlier run drew. Explore with HYPOTHESIS_PROFILE=explore.
 settings.register_profile("whitted", derandomize=True, database=None, deadline=None)
@@ -15,6 +17,12 @@ settings.register_profile("explore", deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "whitted"))
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
+
+# The tests' own processes run the compiled builders on every input, as a warmed cache does;
+# small inputs would otherwise run their Python twins until the builders are compiled
+# (jit/python_twins.py). tests/test_python_twins.py holds the twins to the compiled results,
+# and the command tests (processes of their own) meet the twins on an empty cache.
+python_twins.default_mode = "compiled"
 
 
 @pytest.fixture(scope="session")

@@ -358,6 +358,54 @@ def test_declined_recovery_removes_the_autosave(make_window, tmp_path):
     assert not auto.exists()
 
 
+def test_a_file_of_someone_else_s_at_the_autosave_name_is_kept(make_window, tmp_path):
+    """The autosave's name is whitted's choice: a file there that whitted did not write is
+    neither written over nor removed, and the status bar says so."""
+    path = tmp_path / "work.toml"
+    small_scene().save(path)
+    theirs = autosave_path(path, tmp_path)
+    theirs.write_text("my own notes\n")
+    window = make_window(scene=whitted.load_scene(path), path=path)
+    said = []
+    window.autosave.saved.connect(said.append)
+    window.object_actions["disk"].trigger()
+    assert window.autosave.save_now() is None
+    assert theirs.read_text() == "my own notes\n"
+    assert said == [f"Autosave off: {theirs.name} is there and whitted did not write it "
+                    "(it is kept)"]
+    window.autosave.discard()
+    assert theirs.read_text() == "my own notes\n"
+    theirs.unlink()
+    assert window.autosave.save_now() == theirs  # whitted's own from now on: replaced
+    window.object_actions["box"].trigger()
+    assert window.autosave.save_now() == theirs
+    window.autosave.discard()
+    assert not theirs.exists()
+
+
+def test_the_autosave_is_whitted_s_by_its_first_line(make_window, tmp_path, monkeypatch):
+    """An autosave carries its proof in its first line: with nowhere to record what whitted
+    wrote (a cleared or read-only cache), every later autosave still replaces it and a
+    discard still removes it."""
+    from whitted.gui.autosave import AUTOSAVE_MARK
+    from whitted.output import ownership
+
+    (tmp_path / "a-file").write_text("")  # records "under" a file: none can be kept
+    monkeypatch.setattr(ownership, "_records", lambda: tmp_path / "a-file" / "written")
+    path = tmp_path / "work.json"  # a JSON scene's autosave is TOML too
+    small_scene().save(path)
+    window = make_window(scene=whitted.load_scene(path), path=path)
+    window.object_actions["disk"].trigger()
+    auto = window.autosave.save_now()
+    assert auto == tmp_path / ".work.autosave.toml"
+    assert auto.read_text().startswith(AUTOSAVE_MARK)
+    assert len(whitted.load_scene(auto).objects) == len(window.doc.scene.objects)
+    window.object_actions["box"].trigger()
+    assert window.autosave.save_now() == auto  # replaced, not "Autosave off"
+    window.autosave.discard()
+    assert not auto.exists()
+
+
 def test_camera_position_rotation_and_mouse(window, qtbot):
     window.select(CAMERA)
     assert set_text(window, ("position",), "1") == ""

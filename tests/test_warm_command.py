@@ -129,7 +129,8 @@ def test_the_queue_hands_a_general_kind_out_only_after_the_general_render_kernel
             break
         assert queue.take() == name
         taken.append(name)
-    assert sorted(taken) == ["plain/adaptive", "plain/aovs", "plain/caustics", "stefan"]
+    assert sorted(taken) == ["builders", "plain/adaptive", "plain/aovs", "plain/caustics",
+                             "stefan"]
     assert queue.todo == ["general/adaptive", "general/aovs"]
     queue.finish("general/render", 12.5)
     assert queue.take() == "general/adaptive"

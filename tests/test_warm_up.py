@@ -159,8 +159,8 @@ def _started_helpers(monkeypatch) -> list:
     started = []
     start = warm_up._start_helper
 
-    def recording(instances):
-        helper = start(instances)
+    def recording(instances, builders=False):
+        helper = start(instances, builders)
         if helper is not None:
             started.append(helper)
         return helper

@@ -62,7 +62,10 @@ def gui(
     except ImportError as exc:
         raise fail(f"the editor needs PySide6 ({exc}): install whitted[gui] "
                    "(pip install 'whitted[gui]')") from None
-    raise typer.Exit(run_editor(scene, scene_path))
+    from .cli.interrupt import command_began
+
+    # a SIGTERM or Ctrl-C while the window is open: the editor autosaves and says so
+    raise typer.Exit(run_editor(scene, scene_path, on_running=command_began))
 
 
 def main() -> None:

@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SceneError
+from ..jit.python_twins import for_size
 from ..scene.materials import Material
 from . import obj_scan
 from .mesh_data import MeshData
@@ -228,9 +229,10 @@ def check_obj(text: np.ndarray, name: str) -> np.ndarray:
     empty2 = np.zeros((0, 2), np.float64)
     empty3 = np.zeros((0, 3), np.float64)
     no_corners = np.zeros((0, 3), np.int32)
-    obj_scan.scan_obj(text, False, info, empty3, empty2, empty3, no_corners, no_corners,
-                      no_corners, np.zeros((0, 4), np.int64), np.zeros((0, 3), np.int64),
-                      np.zeros((0, 5), np.int64))
+    scan = for_size(obj_scan.scan_obj, len(text), obj_scan.PYTHON_LIMIT_BYTES)
+    scan(text, False, info, empty3, empty2, empty3, no_corners, no_corners,
+         no_corners, np.zeros((0, 4), np.int64), np.zeros((0, 3), np.int64),
+         np.zeros((0, 5), np.int64))
     if info[obj_scan.INFO_CODE] != obj_scan.OK:
         raise _obj_error(info, text, name)
     return info
@@ -264,8 +266,9 @@ def load_obj_bytes(data: bytes, name: str, folder: Path) -> MeshData:
     mtllib_spans = np.empty((int(info[obj_scan.INFO_MTLLIB]), 3), np.int64)
     hard_numbers = np.empty((int(info[obj_scan.INFO_HARD_NUMBERS]), 5), np.int64)
     filled = np.zeros(obj_scan.INFO_SIZE, np.int64)
-    obj_scan.scan_obj(text, True, filled, positions, texcoords, normals, corner_v, corner_vt,
-                      corner_vn, usemtl_spans, mtllib_spans, hard_numbers)
+    scan = for_size(obj_scan.scan_obj, len(text), obj_scan.PYTHON_LIMIT_BYTES)
+    scan(text, True, filled, positions, texcoords, normals, corner_v, corner_vt, corner_vn,
+         usemtl_spans, mtllib_spans, hard_numbers)
     if filled[obj_scan.INFO_CODE] != obj_scan.OK:  # cannot happen after a clean check
         raise _obj_error(filled, text, name)
     _convert_hard_numbers(text, hard_numbers, (positions, texcoords, normals), name)
@@ -348,7 +351,8 @@ def _convert_hard_numbers(
         return
     starts, ends, lines, kinds, flat = (hard_numbers[:, k] for k in range(5))
     buffer = np.empty(int((ends - starts).sum()) + len(hard_numbers), np.uint8)
-    obj_scan.gather_tokens(text, hard_numbers, buffer)
+    gather = for_size(obj_scan.gather_tokens, len(buffer), obj_scan.PYTHON_LIMIT_BYTES)
+    gather(text, hard_numbers, buffer)
     values = np.array(buffer.tobytes().split(), dtype=np.float64)
     bad = ~np.isfinite(values)
     if bad.any():

@@ -150,6 +150,11 @@ def plot_study(kind: str, rows: list[dict[str, Any]], path: Path,
     ax.legend(fontsize=7)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
+    from ..files import atomic_write
+    from ..output.png import SOFTWARE
+
+    # the PNG says whitted wrote it (Software): the default name is replaced only then
+    atomic_write(path, lambda tmp: fig.savefig(tmp, format="png",
+                                               metadata={"Software": SOFTWARE.decode()}))
     plt.close(fig)
     return path

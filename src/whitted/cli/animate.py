@@ -14,6 +14,7 @@ from .app import (
     SceneArgument,
     app,
     apply_set_options,
+    check_default_output,
     err,
     fail,
     load_scene_argument,
@@ -31,9 +32,9 @@ if TYPE_CHECKING:
 @app.command()
 def animate(
     scene_path: SceneArgument = None,
-    output: Annotated[
-        Path, typer.Option("-o", "--output", help="film.mp4, film.gif, or a folder (frames only)")
-    ] = Path("film.mp4"),
+    output: Annotated[Path | None, typer.Option(
+        "-o", "--output", help="film.mp4, film.gif, or a folder (frames only) "
+        "[default: film.mp4]")] = None,
     frames: Annotated[
         str | None, typer.Option("--frames", help="A:B, both included (default: all)")
     ] = None,
@@ -60,13 +61,17 @@ def animate(
     """Render every frame of SCENE to numbered PNGs (FILM_frames/0000.png ...), then encode
     the film (H.264 MP4 or GIF). Frames already rendered from the same scene and settings are
     kept, so an interrupted run continues where it stopped (Ctrl-C or SIGTERM keeps finished
-    frames). Files in the way that whitted did not write are never written over."""
+    frames). Files in the way that whitted did not write are never written over: without
+    -o, a film.mp4 already there is replaced only when whitted encoded it."""
     from pydantic import ValidationError
 
     from ..animation.film import parse_frame_range, prepare_film, render_film
     from ..render.api import CancelToken
 
     started = time.perf_counter()
+    if output is None:  # a name the user did not give: it replaces only whitted's film
+        output = Path("film.mp4")
+        check_default_output(output)
     try:
         scene, name = load_scene_argument(scene_path, width=width, height=height,
                                           turntable=turntable)

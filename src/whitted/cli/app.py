@@ -137,18 +137,15 @@ def no_such_example(name: str) -> str:
 
 
 def check_default_output(output: Path) -> None:
-    """An output at a default name (no -o) replaces only a PNG whitted wrote: a file of the
-    user's at that name is kept, and the command ends in one line."""
-    from ..output.png import written_by_whitted
+    """An output at a default name (no -o) replaces only a file whitted wrote (a PNG, MP4 or
+    GIF marked as whitted's, output/ownership.py): a file of the user's at that name is kept,
+    and the command ends in one line."""
+    from ..output.ownership import check_replaceable
 
     try:
-        there = output.exists() or output.is_symlink()
-    except OSError:
-        return  # check_outputs says what is wrong with the place
-    if there and not written_by_whitted(output):
-        raise fail(f"{output}: a file not marked as whitted's is there (someone else's, or "
-                   f"an older whitted's); it is kept (replace it with -o {output}, or give "
-                   "another name)")
+        check_replaceable(output, f"replace it with -o {output}, or give another name")
+    except WhittedError as exc:
+        raise fail(str(exc)) from None
 
 
 def _exists(path: Path) -> bool:
@@ -197,11 +194,28 @@ def with_scene_key(exc: WhittedError, scene: Scene, name: str) -> str:
 
 
 def save_npy(path: Path, array: np.ndarray) -> None:
+    """An AOV beside the picture: written atomically, and recorded as whitted's (an NPY
+    holds no mark; output/ownership.py) so that the next render may replace it."""
     import numpy as np
 
     from ..files import atomic_write
+    from ..output.ownership import record_written
 
     atomic_write(path, lambda tmp: np.save(tmp, array))
+    record_written(path)
+
+
+def check_side_files(paths: list[Path]) -> None:
+    """Files a command writes beside its output under derived names (the AOVs,
+    ``NAME.depth.npy``): each may replace only a file whitted wrote; anything else there
+    ends the command in one line before any work."""
+    from ..output.ownership import check_replaceable
+
+    for path in paths:
+        try:
+            check_replaceable(path, "move it, or give -o another name")
+        except WhittedError as exc:
+            raise fail(str(exc)) from None
 
 
 def override_error(exc: ValidationError, given: dict[str, object] | None = None) -> str:

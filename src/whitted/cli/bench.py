@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Annotated
 
@@ -68,6 +69,17 @@ def bench(
                        f"(known: {', '.join(SCENES)})")
     from ..output.safety import check_output_place
 
+    if study in ("threads", "size") and plot is None:  # a name not given: only whitted's
+        from .app import check_default_output
+
+        plot = Path(f"bench-study-{study}.png")
+        check_default_output(plot)
+    named = [(o, p) for o, p in (("--json", json_path), ("--plot", plot),
+                                 ("--markdown", markdown)) if p is not None]
+    for k, (option, path) in enumerate(named):  # two results never go to one file
+        for other, earlier in named[:k]:
+            if os.path.realpath(path) == os.path.realpath(earlier):  # loops too
+                raise fail(f"{option}: {path} is the file {other} names too")
     for option, path in (("--json", json_path), ("--plot", plot), ("--markdown", markdown)):
         try:
             if path is not None:

@@ -14,11 +14,14 @@ wait for the safe point; the program ends with one line and the same status.
 Outside a guard (while the program imports its modules and reads its input, or after the
 command is done) :func:`install_process_handlers`, set first thing by the ``whitted``
 program, ends the process at once with one line and the same status: nothing is being
-written then, and no temporary file or child process exists.
+written then, and no temporary file or child process exists. A command that runs its work
+without a guard (the editor's event loop) says so with :func:`command_began`: the line then
+tells what its own last words say (the editor keeps unsaved edits in its autosave first).
 """
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import os
 import signal
@@ -33,14 +36,16 @@ from .console import err
 if TYPE_CHECKING:
     import typer
 
-__all__ = ["EXIT_INTERRUPTED", "EXIT_TERMINATED", "InterruptGuard", "command_finished",
-           "exit_code_of", "install_process_handlers", "last_signal"]
+__all__ = ["EXIT_INTERRUPTED", "EXIT_TERMINATED", "InterruptGuard", "command_began",
+           "command_finished", "exit_code_of", "install_process_handlers", "last_signal"]
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT
 EXIT_TERMINATED = 143  # 128 + SIGTERM
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 _received: list[int] = []  # every signal a guard or the process handler took, in order
 _finished: list[bool] = []  # set when the command is done (only the exit is left)
+#: set by a command running its work without a guard: what a signal then says (and does)
+_running: list[Callable[[], str]] = []
 
 
 def exit_code_of(signum: int | None) -> int:
@@ -59,10 +64,25 @@ def last_signal() -> int | None:
 
 def install_process_handlers() -> None:
     """SIGINT and SIGTERM end the process at once (one line, 130 or 143) while no guard is
-    set: the ``whitted`` program calls this before it imports anything else."""
+    set: the ``whitted`` program calls this before it imports anything else. Once the
+    interpreter shuts down they are ignored (:func:`_ignore_while_exiting`)."""
     if threading.current_thread() is threading.main_thread():
         for sig in SIGNALS:
             signal.signal(sig, _end_at_once)
+        # registered before the command runs: after the exit hooks its libraries register
+        atexit.register(_ignore_while_exiting)
+
+
+def _ignore_while_exiting() -> None:
+    """An exit hook, run once every thread has ended and the command's files are closed:
+    Python's shutdown then puts back the system's default for a signal with a Python handler
+    (death by the signal, no line, while it frees its modules: some 0.1 s), never for an
+    ignored one. A SIGINT or SIGTERM that late changes nothing: the process ends with the
+    command's own status."""
+    if threading.current_thread() is threading.main_thread():
+        for sig in SIGNALS:
+            with contextlib.suppress(OSError, ValueError):
+                signal.signal(sig, signal.SIG_IGN)
 
 
 def command_finished() -> None:
@@ -70,10 +90,24 @@ def command_finished() -> None:
     _finished.append(True)
 
 
+def command_began(last_words: Callable[[], str]) -> None:
+    """Say the command's work has begun outside a guard (the editor's window is open): a
+    SIGINT or SIGTERM then calls ``last_words()``, which may save what it can, and prints
+    the sentence it returns (``terminated: <it>``) before the process ends."""
+    _running.append(last_words)
+
+
 def _end_at_once(signum: int, frame: FrameType | None) -> None:
     _received.append(signum)
-    what = ("the command had finished" if _finished else
-            "stopped before the command began its work: nothing was written")
+    if _finished:
+        what = "the command had finished"
+    elif _running:
+        try:
+            what = _running[-1]()
+        except Exception:  # noqa: BLE001 - the process ends whatever its last words do
+            what = "stopped while the command was running"
+    else:
+        what = "stopped before the command began its work: nothing was written"
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(Exception):
             stream.flush()

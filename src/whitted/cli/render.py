@@ -21,6 +21,7 @@ from .app import (
     app,
     apply_set_options,
     check_default_output,
+    check_side_files,
     ends_at_once,
     fail,
     is_dir,
@@ -177,7 +178,7 @@ def render(
     # a cold kernel cache: the compile helper starts now and compiles its share of the
     # render kernel while the output checks read the scene's models (compiling the OBJ
     # reader in this process); stopped if the command ends before its render adopts it
-    with contextlib.nullcontext() if farm else cold_compile_ahead():
+    with contextlib.nullcontext() if farm else cold_compile_ahead(scene):
         try:
             from ..output.safety import check_memory, check_outputs
 
@@ -186,6 +187,7 @@ def render(
                          bit_depth)
         except WhittedError as exc:
             raise fail(str(exc)) from None
+        check_side_files(outputs[1:])  # the AOVs: names the user did not give
         resume_collector()  # set-up done: the job (or the farm's client) runs with it
         if farm and (region is not None or alpha or resume or exposure or quality is not None):
             raise fail("--region, --alpha, --exposure, --quality and --continue render here, not "
@@ -256,9 +258,10 @@ def _turntable_film(scene_path, output, frames, width, height, samples, max_dept
     """``render --turntable N``: the film ``whitted animate --turntable N`` makes."""
     from .animate import animate
 
-    if output is None:
+    if output is None:  # a name the user did not give: it replaces only whitted's film
         stem = scene_path.stem if scene_path is not None else "render"
         output = Path(f"{stem}_turntable.mp4")
+        check_default_output(output)
     elif output.suffix.lower() in (".png", ".exr", ".pfm", ".npy", ".jpg", ".jpeg", ".tif",
                                    ".tiff", ".webp"):
         raise fail(f"{output}: --turntable makes a film: name an .mp4 or .gif file, or a "

@@ -107,8 +107,9 @@ def foreign(path: Path) -> bool:
             head = f.read(4096)
     except OSError:
         return True
-    # a zip (np.savez) whose first member is the magic string's array
-    return not (head.startswith(b"PK") and b"magic.npy" in head)
+    # a zip (np.savez, stored) whose first member is the magic string's array (UTF-32)
+    return not (head.startswith(b"PK") and b"magic.npy" in head
+                and MAGIC.encode("utf-32-le") in head)
 
 
 def remove_state(path: Path) -> None:

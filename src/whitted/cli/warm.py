@@ -2,9 +2,10 @@
 ahead of use (``make demo`` runs it), so no later render, film or Stefan run stops for a first
 compile.
 
-The default scene's kernels (with the scene builders and the OBJ reader) come first, in this
-process and its compile helper (both cores); then the other variants (render/variants.py) and
-the Stefan solver's kernels are handed out, one at a time, to ``--jobs`` worker processes (one
+The default scene's kernels come first, in this process and its compile helper (both
+cores); then the other variants (render/variants.py), the scene builders with the OBJ reader
+(which a small scene runs as Python until they are compiled: jit/python_twins.py) and the
+Stefan solver's kernels are handed out, one at a time, to ``--jobs`` worker processes (one
 per core), each compiling into the same cache (jit/cache.py keeps it consistent). A kind of
 the general kernels that shares the render kernel's callees (adaptive anti-aliasing, AOVs) is
 handed out only once the general render kernel is in the cache: it then loads them instead of
@@ -30,12 +31,13 @@ from .app import app, fail
 from .console import err, out
 
 STEFAN = "stefan"
+BUILDERS = "builders"
 
 
 def _all_names() -> list[str]:
     from ..render.variants import variant_names
 
-    return [n for n in variant_names() if n != "plain/render"] + [STEFAN]
+    return [n for n in variant_names() if n != "plain/render"] + [BUILDERS, STEFAN]
 
 
 def _first(name: str) -> str | None:
@@ -43,8 +45,9 @@ def _first(name: str) -> str | None:
     of its geometry, whose callees it shares (plain/render is compiled before any; the
     photon tracer of the caustics variants shares none)."""
     geometry, _, kind = name.partition("/")
-    return None if name == STEFAN or kind in ("render", "caustics") or geometry == "plain" \
-        else f"{geometry}/render"
+    if name in (STEFAN, BUILDERS) or kind in ("render", "caustics") or geometry == "plain":
+        return None
+    return f"{geometry}/render"
 
 
 def _order(names: list[str]) -> list[str]:
@@ -53,7 +56,7 @@ def _order(names: list[str]) -> list[str]:
     def rank(name: str) -> tuple[int, int]:
         geometry, _, kind = name.partition("/")
         kinds = ("render", "caustics", "adaptive", "aovs")
-        return (0 if geometry not in ("plain", STEFAN) else 1,
+        return (0 if geometry not in ("plain", STEFAN, BUILDERS) else 1,
                 kinds.index(kind) if kind in kinds else len(kinds))
     return sorted(names, key=rank)
 
@@ -63,6 +66,12 @@ def _warm_one(name: str) -> float:
         from ..stefan.warm import warm_stefan_kernels
 
         return warm_stefan_kernels()
+    if name == BUILDERS:
+        from ..render.warm_up import compile_builders
+
+        start = time.perf_counter()
+        compile_builders()
+        return time.perf_counter() - start
     from ..render.variants import warm_variant
 
     return warm_variant(name)

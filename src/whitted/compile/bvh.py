@@ -28,10 +28,14 @@ from typing import NamedTuple
 import numpy as np
 
 from ..jit import builder as _builder
+from ..jit.python_twins import for_size
 
 #: the builders here allocate nothing (build_bvh hands them every array), so they run without
 #: Numba's runtime: loading them needs neither the runtime's functions nor NumPy's array code
 builder = _builder(_nrt=False)
+#: until the builders are compiled, trees of at most this many primitives are built by the
+#: same routines run as Python (jit/python_twins.py): about 0.04 s for the default scene
+PYTHON_LIMIT = 1024
 
 LEAF_HARD_CAP = 16  # a node with more primitives than this is always split
 MAX_DEPTH = 60  # root has depth 0; no leaf is deeper than this
@@ -100,8 +104,10 @@ def _centroid(rows, j, k):
 
 @builder
 def _bin_of(rows, j, axis, cmin, scale, nb):
-    b = int((_centroid(rows, j, axis) - cmin) * scale)
-    return nb - 1 if b >= nb else b
+    x = (_centroid(rows, j, axis) - cmin) * scale
+    if not x >= 0.0:  # NaN: an infinite spread of centroids (coordinates near 1e308)
+        return 0
+    return nb - 1 if x >= nb else int(x)
 
 
 @builder
@@ -523,7 +529,8 @@ def build_bvh(
 
     rows = np.empty((n, _NCOL), np.float64)
     prim_order = np.empty(n, np.int32)
-    _pack(bmin, bmax, rows, prim_order)
+    _pack_ = for_size(_pack, n, PYTHON_LIMIT)
+    _pack_(bmin, bmax, rows, prim_order)
     m_cap = 2 * n - 1
     node_min = np.empty((m_cap, 3), np.float64)
     node_max = np.empty((m_cap, 3), np.float64)
@@ -531,7 +538,7 @@ def build_bvh(
     node_count = np.empty(m_cap, np.int32)
     node_axis = np.empty(m_cap, np.int8)
     leaf_cap = max(int(max_leaf_size), LEAF_HARD_CAP)
-    m = _build(
+    m = for_size(_build, n, PYTHON_LIMIT)(
         rows,
         prim_order,
         int(n_bins),

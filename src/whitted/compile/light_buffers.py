@@ -109,16 +109,6 @@ def list_cell_occluders(geo, mats, light, reach, res, lists, counts, opaque, sta
         opaque[cell] = 1 if (n >= 0 and all_opaque) else 0
 
 
-@kernel(entry=True)  # called from Python
-def pack_cell_lists(lists, counts, offsets, prims):
-    """Copy each cell's list (``lists[cell, :counts[cell]]``, none when the count is -1) to
-    ``prims[offsets[cell]:]``, one after another."""
-    for cell in range(lists.shape[0]):
-        at = offsets[cell]
-        for k in range(counts[cell]):
-            prims[at + k] = lists[cell, k]
-
-
 def _reach(geo: GeometryArrays, light: np.ndarray) -> float:
     """Distance from ``light`` to the farthest corner of the scene BVH's root box and of the
     instance BVH's, widened."""
@@ -192,8 +182,8 @@ def build_light_buffers(geo: GeometryArrays, materials: np.ndarray, table: np.nd
     listed = np.maximum(counts, 0)
     offsets = np.zeros(len(listed), np.int64)
     np.cumsum(listed[:-1], out=offsets[1:])
-    prims = np.empty(int(listed.sum()), np.int32)
-    pack_cell_lists(lists, counts, offsets, prims)
+    # each cell's list (none where the count is -1), one after another: row by row
+    prims = lists[np.arange(lists.shape[1])[None, :] < counts[:, None]]
     cells = np.empty((len(counts), 3), np.int32)
     cells[:, CELL_FIRST] = offsets
     cells[:, CELL_COUNT] = counts

@@ -14,6 +14,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import builder
+from ..jit.python_twins import for_size
+
+#: meshes of at most this many triangles get their normals from the Python twin until the
+#: builders are compiled (jit/python_twins.py)
+PYTHON_LIMIT = 4096
 
 
 @builder(_nrt=False)  # allocates nothing: no Numba runtime
@@ -73,5 +78,6 @@ def smooth_corner_normals(vertices: np.ndarray, faces: np.ndarray,
     out = np.zeros((len(f), 3, 3), np.float32)
     cos_crease = float(np.cos(np.radians(min(max(crease_angle, 0.0), 180.0))))
     # a hair of slack so faces exactly at the crease angle (a cube's 90 deg at 90) join
-    _corner_normals(angle, unit, order, starts, cos_crease - 1e-9, out)
+    corner_normals = for_size(_corner_normals, len(f), PYTHON_LIMIT)
+    corner_normals(angle, unit, order, starts, cos_crease - 1e-9, out)
     return out

@@ -67,6 +67,39 @@ class CompiledScene:
     prim_hi: np.ndarray | None = None
 
 
+#: a model file's typical bytes per triangle (the default scene's OBJ has 58, with normals;
+#: binary PLY 13-20, binary STL 50): scene_needs_builders' estimate of a model's triangles
+#: before reading it. An estimate: a wrong one costs time, never a different result
+_BYTES_PER_TRIANGLE = {".obj": 40, ".ply": 20, ".stl": 50, ".off": 30, ".gltf": 20, ".glb": 20}
+
+
+def scene_needs_builders(scene: Scene) -> bool:
+    """Whether compiling ``scene`` may run a builder on an input too large for its Python
+    twin (jit/python_twins.py), judged before reading any model: the objects, the inline
+    meshes' triangles and each model file's triangles estimated from its size together over
+    the BVH builder's limit, or a model file over the OBJ reader's. A first render of such a
+    scene has its compile helper compile the builders too."""
+    from ..assets.obj_scan import PYTHON_LIMIT_BYTES
+    from .bvh import PYTHON_LIMIT
+
+    primitives = len(scene.objects)
+    for shape in scene.objects:
+        if not isinstance(shape, Mesh):
+            continue
+        if shape.file is None:
+            primitives += len(shape.faces) if shape.faces is not None else 0
+            continue
+        path = scene.resolve_path(shape.file)
+        try:
+            size = path.stat().st_size
+        except OSError:
+            continue  # reported where the model is read
+        if size > PYTHON_LIMIT_BYTES:
+            return True
+        primitives += size // _BYTES_PER_TRIANGLE.get(path.suffix.lower(), 20)
+    return primitives > PYTHON_LIMIT
+
+
 #: scene BVHs of this many bounded primitives are built with the SAH on all three axes
 ALL_AXES_FROM = 4096
 ALL_AXES_UP_TO = 1 << 20  # past this the build's time matters more (three times the binning)

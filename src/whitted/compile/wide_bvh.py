@@ -25,12 +25,16 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import builder as _builder
+from ..jit.python_twins import for_size
 from ..kernels.layout import WIDE, WIDE_COUNT, WIDE_LINK, WIDE_ROWS
 
 EXACT_FLOAT32 = 1 << 24  # whole numbers below this are exact in float32
 
 #: the collapse allocates nothing (wide_nodes hands it every array): no Numba runtime
 builder = _builder(_nrt=False)
+#: binary trees of at most this many nodes are collapsed by the Python twin until the
+#: builders are compiled (jit/python_twins.py)
+PYTHON_LIMIT = 2048
 
 
 @builder
@@ -123,7 +127,8 @@ def wide_nodes(bvh) -> np.ndarray:
     if m == 0 or len(bvh.prim_order) >= EXACT_FLOAT32:
         return np.zeros((0, WIDE_ROWS, WIDE), np.float32)
     box = np.empty((m, WIDE_ROWS, WIDE), np.float32)
-    made = _collapse(np.ascontiguousarray(bvh.node_min, np.float64),
+    collapse = for_size(_collapse, m, PYTHON_LIMIT)
+    made = collapse(np.ascontiguousarray(bvh.node_min, np.float64),
                      np.ascontiguousarray(bvh.node_max, np.float64),
                      np.ascontiguousarray(bvh.node_offset, np.int64),
                      np.ascontiguousarray(bvh.node_count, np.int64), box,

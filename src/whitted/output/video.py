@@ -13,6 +13,15 @@ atomically, as every output of whitted: ffmpeg writes a temporary file that repl
 only when ffmpeg says it succeeded, so a failed or cancelled encode never replaces a good
 film. ffmpeg runs as a child process in a session of its own (a Ctrl-C on the terminal
 reaches whitted only); it is stopped when the encode is cancelled (``cancel``) or fails.
+
+Every film whitted encodes says so, as its PNGs do (``Software: whitted``): an MP4 carries the
+comment ``whitted`` in its metadata (ffmpeg's ``-metadata comment=``), a GIF a comment
+extension ``whitted`` (Pillow's ``comment``). :func:`film_written_by_whitted` reads it back
+(ffmpeg's own metadata dump, ``-f ffmetadata``; Pillow for a GIF). A remux or re-encode
+keeps such a comment, so whitted also records each film's bytes when it writes it
+(output/ownership.py): a command may replace a film at a name the user did not give
+(``whitted animate``'s film.mp4) only when it carries the mark and is byte for byte the film
+whitted wrote there.
 """
 
 from __future__ import annotations
@@ -34,8 +43,9 @@ import numpy as np
 from ..errors import ArgumentError, RenderCancelled
 from ..files import atomic_write
 
-__all__ = ["DEFAULT_CRF", "FPS_MAX", "FPS_MIN", "VIDEO_FORMATS", "check_crf", "check_fps",
-           "encode_film", "even_size", "pad_to_even", "video_format"]
+__all__ = ["DEFAULT_CRF", "FILM_MARK", "FPS_MAX", "FPS_MIN", "VIDEO_FORMATS", "check_crf",
+           "check_fps", "encode_film", "even_size", "film_written_by_whitted", "pad_to_even",
+           "video_format"]
 
 DEFAULT_CRF = 18
 VIDEO_FORMATS = {".mp4": "mp4", ".gif": "gif"}
@@ -43,6 +53,10 @@ VIDEO_FORMATS = {".mp4": "mp4", ".gif": "gif"}
 FPS_MIN = 0.01
 #: The fastest film of each format (a GIF's delays are hundredths of a second, 2 at least).
 FPS_MAX = {"mp4": 1000.0, "gif": 50.0}
+#: What every film whitted encodes says of itself: an MP4's metadata comment, a GIF's comment.
+FILM_MARK = "whitted"
+#: Seconds ffmpeg may take to read a film's metadata (it reads the head only).
+PROBE_SECONDS = 20
 
 
 class Cancel(Protocol):
@@ -146,8 +160,14 @@ def encode_film(
     if not items:
         raise ValueError("no frames to encode")
     if fmt == "gif":
-        return atomic_write(path, lambda tmp: _write_gif(tmp, _frames(items), fps, cancel))
-    return atomic_write(path, lambda tmp: _write_mp4(tmp, _frames(items), fps, crf, cancel))
+        written = atomic_write(path, lambda tmp: _write_gif(tmp, _frames(items), fps, cancel))
+    else:
+        written = atomic_write(path, lambda tmp: _write_mp4(tmp, _frames(items), fps, crf,
+                                                            cancel))
+    from .ownership import record_written
+
+    record_written(written)  # the mark alone survives a user's remux or re-encode
+    return written
 
 
 def _check(cancel: Cancel | None) -> None:
@@ -176,7 +196,7 @@ def _ffmpeg_command(tmp: str, width: int, height: int, fps: float, crf: int) -> 
             "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{width}x{height}", "-r", str(rate),
             "-i", "-", "-an", "-vcodec", "libx264", "-pix_fmt", "yuv420p",
             "-crf", str(int(crf)), "-preset", "medium", "-movflags", "+faststart",
-            "-f", "mp4", tmp]
+            "-metadata", f"comment={FILM_MARK}", "-f", "mp4", tmp]
 
 
 def _write_mp4(tmp: str, frames: Iterator[np.ndarray], fps: float, crf: int,
@@ -230,4 +250,62 @@ def _write_gif(tmp: str, frames: Iterator[np.ndarray], fps: float,
             colors=256, method=PILImage.Quantize.MEDIANCUT, dither=PILImage.Dither.FLOYDSTEINBERG))
     duration = max(20, round(1000 / fps / 10) * 10)  # GIF delays are in 1/100 s
     images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], loop=0,
-                   duration=duration, optimize=True, disposal=1)
+                   duration=duration, optimize=True, disposal=1, comment=FILM_MARK.encode())
+
+
+def film_written_by_whitted(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` is a film whitted encoded: an MP4 whose metadata comment, or a GIF
+    whose comment, is :data:`FILM_MARK`, with the very bytes whitted recorded when it wrote
+    it (output/ownership.py). False for anything else: another file, one changed since, one
+    that cannot be read, an MP4 when no ffmpeg is there to read it."""
+    path = Path(path)
+    try:
+        if not path.is_file():
+            return False
+        with open(path, "rb") as f:
+            head = f.read(12)
+    except (OSError, ValueError):
+        return False
+    from .ownership import recorded_by_whitted
+
+    # the mark and whitted's record of the very bytes: a user's edit of a film whitted made
+    # (a remux, a cut, a re-encode) keeps the mark, and is the user's
+    if head[:6] in (b"GIF87a", b"GIF89a"):
+        return _gif_comment(path) == FILM_MARK.encode() and recorded_by_whitted(path)
+    if head[4:8] != b"ftyp":  # not an MP4 (ISO base media) file: ffmpeg is not asked
+        return False
+    return recorded_by_whitted(path) and _mp4_comment(path) == FILM_MARK
+
+
+def _gif_comment(path: Path) -> bytes | None:
+    from PIL import Image as PILImage
+
+    try:
+        with PILImage.open(path) as im:
+            comment = im.info.get("comment")
+    except (OSError, ValueError, PILImage.DecompressionBombError):
+        return None  # UnidentifiedImageError is an OSError
+    return comment if isinstance(comment, bytes) else None
+
+
+def _mp4_comment(path: Path) -> str | None:
+    """The ``comment`` of the film's global metadata, as ffmpeg's ``ffmetadata`` dump
+    gives it (None: no ffmpeg, or ffmpeg could not read the file)."""
+    try:
+        exe = ffmpeg_exe()
+    except ArgumentError:
+        return None
+    command = [exe, "-nostdin", "-hide_banner", "-loglevel", "error", "-i", os.fspath(path),
+               "-vn", "-an", "-sn", "-dn", "-f", "ffmetadata", "-"]
+    try:
+        done = subprocess.run(command, stdin=subprocess.DEVNULL, capture_output=True,
+                              timeout=PROBE_SECONDS, start_new_session=True)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    if done.returncode != 0:
+        return None
+    for line in done.stdout.decode("utf-8", "replace").splitlines():
+        key, sep, value = line.partition("=")
+        if sep and key == "comment":
+            return value
+    return None

@@ -19,7 +19,7 @@ from enum import StrEnum
 import numpy as np
 
 from ..compile.params import render_params
-from ..compile.scene import CompiledScene, compile_scene
+from ..compile.scene import CompiledScene, compile_scene, scene_needs_builders
 from ..errors import ArgumentError, JobStateError
 from ..kernels.layout import (
     N_RAY_KINDS,
@@ -421,8 +421,10 @@ class RenderJob:
         # runs a kind of its own, loaded in its stage below
         plain_kernel = self.settings.antialias is None
         stats.compile_seconds = 0.0
-        if not kernels_cached():  # a first run: the default variant, builders and the OBJ
-            stats.compile_seconds = warm_up_kernels()  # reader, compiled on both cores
+        if not kernels_cached():  # a first run: the default variant (and the builders, for
+            # a scene too large for their Python twins), compiled on both cores
+            stats.compile_seconds = warm_up_kernels(
+                builders=self.compiled is None and scene_needs_builders(self.scene))
         compiled: CompiledScene = (self.compiled if self.compiled is not None
                                    else compile_scene(self.scene, threads=self.threads))
         stats.compile_seconds += warm_up_kernels(compiled, render_kernel=plain_kernel)

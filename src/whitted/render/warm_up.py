@@ -5,19 +5,22 @@ Numba compiles one function at a time in a process, so on a cold cache the first
 shared with a second process (``python -m whitted.render.warm_up``) when there are two cores
 or more. While this process compiles ``render_tiles`` (and its callees on the way, depth
 first), the helper compiles a share of the render kernel's callees (``kernels/callees.py``),
-then the scene builders and the OBJ loader, into the cache. When this process reaches one of
-the helper's callees it waits for it (``KernelCache.wait_for_helper``, jit/dispatcher.py)
-and loads it instead of compiling it a second time (with stock Numba, which has neither the
-twins nor the wait, the helper compiles only the builders and the loader). Then it waits for the
-helper (which by then is on the builders and loader, work this process would do next) and
-loads what it made. Whatever the
-helper did not finish is compiled here, so the result never depends on the helper: it only
-saves time. The AOV kernel (depth, normal and object-id images) is compiled when first used.
+then the light-buffer kernels, into the cache. When this process reaches one of the helper's
+callees it waits for it (``KernelCache.wait_for_helper``, jit/dispatcher.py) and loads it
+instead of compiling it a second time (with stock Numba, which has neither the twins nor the
+wait, the helper compiles only the light buffers). Then it waits for the helper and loads
+what it made. Whatever the helper did not finish is compiled here, so the result never
+depends on the helper: it only saves time. The AOV kernel (depth, normal and object-id
+images) is compiled when first used.
+
+The scene builders and the OBJ reader are not part of a cold compile: on a small scene (the
+default one) they run as Python until they are compiled (jit/python_twins.py), which
+``whitted warm`` does, and so does the first scene too large for that
+(:func:`~whitted.compile.scene.scene_needs_builders`): its helper compiles them after the
+light buffers.
 
 ``whitted render`` starts the helper earlier (:func:`start_cold_compile_ahead`), before its
-output checks: they read the scene's models, which compiles the OBJ reader in this process
-(the default scene has one), and the helper compiles its share meanwhile; the helper compiles
-the OBJ reader last, by when it is usually in the cache.
+output checks, which read the scene's models.
 
 A marker file in the cache folder (``whitted-ready-plain`` / ``whitted-ready-general``)
 records that a variant is complete there, so a warm start starts no helper.
@@ -48,9 +51,11 @@ import numpy as np
 
 from ..assets.mesh import load_obj_bytes
 from ..compile.params import render_params
-from ..compile.scene import CompiledScene, compile_scene
+from ..compile.scene import CompiledScene, compile_scene, scene_needs_builders
 from ..jit.cache import HELPER_ENV, prepare
 from ..jit.progress import CompileReport
+from ..jit.python_twins import builders_cached, mark_builders_cached
+from ..jit.python_twins import compiled as compiled_builders
 from ..kernels.features import EXTRAS_DTYPE
 from ..kernels.layout import N_RAY_KINDS
 from ..scene.lights import PointLight
@@ -63,15 +68,16 @@ _ready: set[tuple[bool, bool]] = set()
 _builders_ready = False
 HELPER_WAIT_SECONDS = 120.0  # a helper still busy after this is stopped (never expected)
 #: functions Numba compiles in a cold compile of each variant, this process and the helper
-#: together (counted on the 2-core VM, the helper on, an empty cache folder: 125 + 74 for the
-#: plain variant, 185-193 with the helper's share of docs/performance.md's two-process
-#: round; 107 + 100 for the general one once the plain one is cached, as the render
-#: API compiles the plain variant first; each kernel other kernels call counts once, as its
-#: twin). Only the progress shown depends on it: a count that drifted (kernels changed, a
-#: different split between the processes) makes the fraction approximate;
-#: tests/test_warm_up.py holds the plain one to a real cold compile within 10 %.
-EXPECTED_COMPILES = {False: 199, True: 207}
-TINY_OBJ = b"""v 0 0 0
+#: together (counted on the 2-core VM, an empty cache folder: 162 for the plain variant in one
+#: process, a few more with the helper; 107 + 100 for the general one once the plain one is
+#: cached, as the render API compiles the plain variant first; each kernel other kernels call
+#: counts once, as its twin). Only the progress shown depends on it: a count that drifted
+#: (kernels changed, a different split between the processes) makes the fraction
+#: approximate; tests/test_warm_up.py holds the plain one to a real cold compile within 10 %.
+EXPECTED_COMPILES = {False: 165, True: 207}
+#: the builders' and the OBJ reader's compiles, added where a cold compile makes them too
+EXPECTED_BUILDER_COMPILES = 39
+TINY_OBJ = b"""v 0.12345678901234567890 0 0
 v 1 0 0
 v 0 1 0
 vt 0 0
@@ -119,17 +125,26 @@ def _builders_scene() -> Scene:
                  lights=[PointLight(position=(0, 5, 0))])
 
 
-def _compile_builders() -> None:
-    """The kernels that load models and build a scene's arrays."""
+def compile_builders() -> None:
+    """The kernels that load models and build a scene's arrays, compiled whatever the size
+    of their inputs (small ones otherwise run as Python until this has run:
+    jit/python_twins.py), and marked as compiled in the cache folder."""
     global _builders_ready
     if not _builders_ready:
         scene = _builders_scene()
-        compile_scene(scene)  # the mesh flattened into the scene BVH
-        compile_scene(scene, flatten_limit=0)  # the mesh instanced
-        # last: a render of a scene with OBJ files has compiled the reader already (its
-        # output checks read the models before the render), so the helper loads it
-        load_obj_bytes(TINY_OBJ, "warm-up.obj", Path("."))
+        with compiled_builders():
+            compile_scene(scene)  # the mesh flattened into the scene BVH
+            compile_scene(scene, flatten_limit=0)  # the mesh instanced
+            load_obj_bytes(TINY_OBJ, "warm-up.obj", Path("."))
+        if os.environ.get(HELPER_ENV) != "1":  # the helper's files are sealed, and the
+            mark_builders_cached()  # marker written, by the process that started it
         _builders_ready = True
+
+
+def _compile_light_buffers() -> None:
+    """The light-buffer kernels a scene with a point light runs (fast-math kernels that have
+    no Python twin): what the helper compiles after its share of the render kernel."""
+    compile_scene(Scene(objects=[Sphere(radius=1.0)], lights=[PointLight(position=(0, 5, 0))]))
 
 
 def _stand_in_params(compiled: CompiledScene):
@@ -336,7 +351,7 @@ def _report_of(count: _CompileCount, label: str) -> CompileReport:
     return report
 
 
-def _start_helper(instances: bool) -> subprocess.Popen | None:
+def _start_helper(instances: bool, builders: bool = False) -> subprocess.Popen | None:
     from numba import config
 
     folder = prepare().folder
@@ -349,7 +364,8 @@ def _start_helper(instances: bool) -> subprocess.Popen | None:
     try:
         return subprocess.Popen(
             [sys.executable, "-m", "whitted.render.warm_up",
-             "instances" if instances else "plain", str(os.getpid())],
+             "instances" if instances else "plain", str(os.getpid())]
+            + (["builders"] if builders else []),
             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
             text=True, env=env)
     except OSError:  # no interpreter to start (frozen app, exotic platform): compile alone
@@ -357,8 +373,8 @@ def _start_helper(instances: bool) -> subprocess.Popen | None:
 
 
 def _finish_helper(helper: subprocess.Popen | None) -> None:
-    """Wait for the helper (stopping it if it hangs): its last work, the builders and the
-    loader, is what this process needs next."""
+    """Wait for the helper (stopping it if it hangs): its last work, the light buffers (and
+    the builders where the scene needs them compiled), is what this process needs next."""
     if helper is None:
         return
     try:
@@ -375,14 +391,15 @@ def _stop_helper(helper: subprocess.Popen | None) -> None:
 
 
 def warm_up_kernels(compiled: CompiledScene | None = None,
-                    render_kernel: bool = True) -> float:
+                    render_kernel: bool = True, builders: bool = False) -> float:
     """Compile (first run) or load from the on-disk cache (later runs) the render kernels for
     scenes like ``compiled`` (kernels are specialised for scenes with and without mesh
     instances; without when None); on the first run also the builders and the AOV kernel.
     ``render_kernel=False``: a render that runs another kind of the render kernel (caustics,
     adaptive anti-aliasing, loaded in its own stage) does not load the plain one when the
-    cache holds the variant. Returns the seconds it took; 0 when all of it was already loaded
-    in this process (or nothing had to be)."""
+    cache holds the variant. ``builders``: a cold compile compiles the builders too (a scene
+    too large for their Python twins: :func:`scene_needs_builders`). Returns the seconds it
+    took; 0 when all of it was already loaded in this process (or nothing had to be)."""
     with _lock:
         key = _loaded_key(compiled)
         if key in _ready:
@@ -406,7 +423,7 @@ def warm_up_kernels(compiled: CompiledScene | None = None,
                     _compile_render_kernels(compiled if compiled is not None
                                             else stand_in_scene(instances), aovs=False)
                 else:
-                    _cold_compile(instances, compiled)
+                    _cold_compile(instances, compiled, builders)
                 cache.seal()
                 _mark(marker)
         if cache.unsealed:
@@ -421,7 +438,7 @@ _ahead: tuple[object, subprocess.Popen] | None = None
 _ahead_lock = threading.Lock()  # not _lock: a compile holds that until it ends
 
 
-def start_cold_compile_ahead() -> bool:
+def start_cold_compile_ahead(builders: bool = False) -> bool:
     """On a cold cache, start the compile helper now, before the work a command does ahead
     of its render: ``whitted render``'s output checks read the scene's models, which
     compiles the OBJ reader (3 s of CPU), and the helper compiles its share of the render
@@ -443,7 +460,7 @@ def start_cold_compile_ahead() -> bool:
         if kernels_cached(False):  # finished by another process before the lock was free
             lock.release()
             return False
-        helper = _start_helper(False)
+        helper = _start_helper(False, builders and not builders_cached())
         if helper is None:
             lock.release()
             return False
@@ -464,10 +481,11 @@ def stop_cold_compile_ahead() -> None:
 
 
 @contextlib.contextmanager
-def cold_compile_ahead():
-    """:func:`start_cold_compile_ahead` for the block, :func:`stop_cold_compile_ahead` after
-    it (nothing to stop once the block's render has adopted the helper)."""
-    start_cold_compile_ahead()
+def cold_compile_ahead(scene: Scene | None = None):
+    """:func:`start_cold_compile_ahead` for the block (the helper compiles the builders too
+    when ``scene`` needs them compiled), :func:`stop_cold_compile_ahead` after it (nothing to
+    stop once the block's render has adopted the helper)."""
+    start_cold_compile_ahead(scene is not None and scene_needs_builders(scene))
     try:
         yield
     finally:
@@ -546,10 +564,12 @@ def _delegated(instances: bool, here: bool = False) -> list:
                       _stand_in_params(stand_in))]
 
 
-def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
-    """Compile the variant here while the helper compiles its share of the callees and the
-    builders, counting both for :func:`compile_progress`; on any exception (Ctrl-C) the
-    helper is stopped at once rather than waited for."""
+def _cold_compile(instances: bool, compiled: CompiledScene | None,
+                  builders: bool = False) -> None:
+    """Compile the variant here while the helper compiles its share of the callees, the
+    light buffers and (``builders``) the builders, counting both for
+    :func:`compile_progress`; on any exception (Ctrl-C) the helper is stopped at once rather
+    than waited for."""
     global _progress
     from ..jit import load_numba
     from ..jit.dispatcher import kernel_cache_class
@@ -557,11 +577,13 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
     load_numba()  # Numba, with whitted's settings
     KernelCache = kernel_cache_class()  # noqa: N806 - None with stock Numba
     ahead = _take_ahead(instances)
-    helper = ahead[1] if ahead is not None else _start_helper(instances)
+    builders = builders and not builders_cached()
+    helper = ahead[1] if ahead is not None else _start_helper(instances, builders)
     delegated = ()
     if helper is not None and helper.stdout is not None:
         delegated = tuple(d.py_func.__qualname__ for d, _ in _delegated(instances))
-    count = _CompileCount(EXPECTED_COMPILES[instances], delegated)
+    count = _CompileCount(EXPECTED_COMPILES[instances] + EXPECTED_BUILDER_COMPILES * builders,
+                          delegated)
     if helper is not None and helper.stdout is not None:
         threading.Thread(target=count.read_helper, args=(helper.stdout,),
                          name="whitted-compile-helper-output", daemon=True).start()
@@ -581,7 +603,9 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
             if KernelCache is not None:
                 KernelCache.wait_for_helper = None
             _finish_helper(helper)
-            _compile_builders()
+            _compile_light_buffers()  # loaded from the cache where the helper compiled them
+            if builders:
+                compile_builders()
     except BaseException:
         _stop_helper(helper)
         raise
@@ -591,13 +615,16 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None) -> None:
         _progress = None
 
 
-def precompile_for_render(instances: bool) -> None:
+def precompile_for_render(instances: bool, builders: bool = False) -> None:
     """The helper's work: its share of the render kernel's callees (a line ``done <name>``
-    after each), then the builders, into the on-disk cache."""
+    after each), then the light buffers and (``builders``) the builders, into the on-disk
+    cache."""
     for dispatcher, argument_types in _delegated(instances):
         dispatcher.compile(argument_types)
         print("done", dispatcher.py_func.__qualname__, flush=True)
-    _compile_builders()
+    _compile_light_buffers()
+    if builders:
+        compile_builders()
 
 
 def _end_with_parent(parent: int) -> None:
@@ -611,6 +638,7 @@ def _end_with_parent(parent: int) -> None:
 
 def _helper_main(argv: list[str]) -> None:
     instances = bool(argv) and argv[0] == "instances"
+    builders = "builders" in argv[2:]
     if len(argv) > 1:
         threading.Thread(target=_end_with_parent, args=(int(argv[1]),), daemon=True).start()
 
@@ -635,7 +663,7 @@ def _helper_main(argv: list[str]) -> None:
 
     try:
         with Report():
-            precompile_for_render(instances)
+            precompile_for_render(instances, builders)
     except BrokenPipeError:  # the parent stopped reading: it has gone
         os._exit(1)
 
