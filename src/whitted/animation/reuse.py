@@ -140,9 +140,7 @@ class CompileCache:
                 if kept is not None:  # only colours or intensities changed
                     return dataclasses.replace(compiled, lights=kept, ambient=ambient,
                                                build_seconds=0.0), REUSE_LIGHT_BUFFERS
-                lights = build_light_buffers(geo, compiled.materials, table,
-                                             has_instances=len(geo.inst_prims) > 0,
-                                             threads=threads)
+                lights = build_light_buffers(geo, compiled.materials, table, threads=threads)
                 return dataclasses.replace(compiled, lights=lights, ambient=ambient,
                                            build_seconds=0.0), REUSE_GEOMETRY
         built, reused = self.memo.built, self.memo.reused

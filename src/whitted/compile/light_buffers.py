@@ -4,8 +4,10 @@ shadow ray through that cell could hit.
 
 The list of a cell is conservative: a primitive is listed when its BVH leaf box meets a cone
 that holds the cell's whole pyramid of rays out to the far side of the scene's bounds, and an
-unbounded plane unless every ray of the cell runs away from it. Scenes with mesh instances
-get no light buffers (their shadow rays walk both BVH levels as before).
+unbounded plane unless every ray of the cell runs away from it. In scenes with mesh instances
+a cell lists, after its analytic primitives, the leaves of the instance BVH whose boxes meet
+the same cone, each as ``-1 - node`` (the shadow ray tests the leaf's box, then each of its
+instances: kernels/lighting.py ``listed_occlusion``).
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import kernel
+from ..kernels.features import has_instances
 from ..kernels.layout import (
     BVH_STACK,
     CELL_COUNT,
@@ -38,7 +41,7 @@ from ..kernels.light_buffer import (
     cell_cone,
     cell_direction,
 )
-from ..kernels.lighting import list_cone_leaves
+from ..kernels.lighting import list_cone_instance_leaves, list_cone_leaves
 from ..kernels.mesh import OPAQUE_KT
 
 CONE_SLACK = 1e-6  # relative widening of each cell's cone (rounding of the ray directions)
@@ -74,8 +77,9 @@ def list_cell_occluders(geo, mats, light, reach, res, lists, counts, opaque, sta
     """For cells ``first`` to ``last - 1``: fill ``lists[cell, :counts[cell]]`` with the
     primitives that may block rays leaving ``light`` through the cell (``counts[cell]`` = -1
     when there are more than the row holds) and ``opaque[cell]`` with whether they are all
-    opaque. ``reach`` is at least the distance from the light to the farthest corner of the
-    scene BVH's root box. Cells do not depend on each other: ranges may run on threads of
+    opaque (a cell that lists instance leaves, ``-1 - node``, never is). ``reach`` is at
+    least the distance from the light to the farthest corner of the scene BVH's and the
+    instance BVH's root boxes. Cells do not depend on each other: ranges may run on threads of
     their own (``stack`` is the thread's)."""
     cap = lists.shape[1]
     for cell in range(first, last):
@@ -94,23 +98,32 @@ def list_cell_occluders(geo, mats, light, reach, res, lists, counts, opaque, sta
             all_opaque = all_opaque and mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT
         if n >= 0:
             c, tan_half = cell_cone(cell, res)
-            n, all_opaque = list_cone_leaves(
-                geo, mats, light, (c[0] * reach, c[1] * reach, c[2] * reach),
-                reach * tan_half * (1.0 + CONE_SLACK) + reach * CONE_SLACK, stack, lists[cell],
-                n, cap, all_opaque)
+            axis = (c[0] * reach, c[1] * reach, c[2] * reach)
+            radius = reach * tan_half * (1.0 + CONE_SLACK) + reach * CONE_SLACK
+            n, all_opaque = list_cone_leaves(geo, mats, light, axis, radius, stack, lists[cell],
+                                             n, cap, all_opaque)
+            if n >= 0 and has_instances(geo):
+                n, all_opaque = list_cone_instance_leaves(geo, light, axis, radius, stack,
+                                                          lists[cell], n, cap, all_opaque)
         counts[cell] = n
         opaque[cell] = 1 if (n >= 0 and all_opaque) else 0
 
 
 def _reach(geo: GeometryArrays, light: np.ndarray) -> float:
-    """Distance from ``light`` to the farthest corner of the scene BVH's root box, widened."""
-    if geo.node_box.shape[0] == 0:
+    """Distance from ``light`` to the farthest corner of the scene BVH's root box and of the
+    instance BVH's, widened."""
+    far = 0.0
+    if geo.node_box.shape[0]:
+        lo, hi = geo.node_box[0]
+        # the root box is in the BVH's frame (compile/bvh_frame.py)
+        seen = geo.bvh_frame @ light if geo.bvh_frame.shape[0] else light
+        far = float(np.linalg.norm(np.maximum(np.abs(lo - seen), np.abs(hi - seen))))
+    if geo.inst_box.shape[0]:
+        lo, hi = geo.inst_box[0].astype(np.float64)
+        far = max(far, float(np.linalg.norm(np.maximum(np.abs(lo - light), np.abs(hi - light)))))
+    if far == 0.0:
         return 1.0
-    lo, hi = geo.node_box[0]
-    if geo.bvh_frame.shape[0]:  # the root box is in the BVH's frame (compile/bvh_frame.py)
-        light = geo.bvh_frame @ light
-    far = np.maximum(np.abs(lo - light), np.abs(hi - light))
-    return float(np.linalg.norm(far)) * (1.0 + 1e-6) + 1e-9
+    return far * (1.0 + 1e-6) + 1e-9
 
 
 def buffer_side(n_point_lights: int, n_prims: int, res: int = LIGHT_BUFFER_RES) -> int:
@@ -125,17 +138,17 @@ def buffer_side(n_point_lights: int, n_prims: int, res: int = LIGHT_BUFFER_RES) 
 
 
 def build_light_buffers(geo: GeometryArrays, materials: np.ndarray, table: np.ndarray,
-                        has_instances: bool, res: int = LIGHT_BUFFER_RES,
-                        cap: int = LIGHT_BUFFER_CAP, threads: int = 1) -> LightArrays:
+                        res: int = LIGHT_BUFFER_RES, cap: int = LIGHT_BUFFER_CAP,
+                        threads: int = 1) -> LightArrays:
     """The light table with a light buffer for each point light (its LIGHT_BUFFER column set
-    to its first cell; -1 for other lights, and for every light when the scene has mesh
-    instances or ``res`` is 0). The cells are listed on ``threads`` threads, each taking an
-    equal run of every light's cells: the same buffers on any number."""
+    to its first cell; -1 for other lights, and for every light when ``res`` is 0). The
+    cells are listed on ``threads`` threads, each taking an equal run of every light's cells:
+    the same buffers on any number."""
     table = table.copy()
     res = buffer_side(int(np.sum(table[:, LIGHT_TYPE] == LIGHT_POINT)), len(geo.prim_info), res)
     table[:, LIGHT_BUFFER] = -1.0
     lights = [j for j in range(table.shape[0])
-              if not (has_instances or res <= 0 or table[j, LIGHT_TYPE] != LIGHT_POINT)]
+              if not (res <= 0 or table[j, LIGHT_TYPE] != LIGHT_POINT)]
     n_cells = 6 * res * res if lights else 0
     lists = np.empty((len(lights) * n_cells, cap), np.int32)
     counts = np.empty(len(lights) * n_cells, np.int32)

@@ -254,8 +254,8 @@ class LightArrays(NamedTuple):
 
     A light buffer (see light_buffer.py) divides the directions leaving a point light into the
     cells of a cube map, LIGHT_BUFFER_RES x LIGHT_BUFFER_RES per face, and lists for each cell
-    the analytic primitives that could block a shadow ray travelling through it: a shadow ray
-    tests those instead of walking the BVH.
+    the analytic primitives that could block a shadow ray travelling through it, then the
+    instance BVH's leaves it could meet: a shadow ray tests those instead of walking the BVHs.
 
     The photon map (compile/photon_map.py, docs/caustics.md) is empty in renders without
     caustics, and its ``photon_grid`` holds no pass: the render kernel skips its gather
@@ -269,7 +269,8 @@ class LightArrays(NamedTuple):
 
     table: np.ndarray  # (L, N_LIGHT_PARAMS) float64
     buffer_cells: np.ndarray  # (C, 3) int32: CELL_FIRST, CELL_COUNT, CELL_OPAQUE
-    buffer_prims: np.ndarray  # (N,) int32 primitive indices
+    # (N,) int32 primitive indices, and -1 - node for a leaf of the instance BVH
+    buffer_prims: np.ndarray
     photons: np.ndarray = _NO_PHOTONS  # (N, PHOTON_WIDTH) float32
     photon_cells: np.ndarray = _NO_CELLS  # (H + 1,) int32
     photon_grid: np.ndarray = _NO_GRID  # (GRID_PASS + 2 passes,) float64

@@ -3,8 +3,9 @@
 The directions leaving a point light are divided into the cells of a cube map around it,
 ``LIGHT_BUFFER_RES`` x ``LIGHT_BUFFER_RES`` per face. For every cell the compiler lists the
 analytic primitives whose boxes meet the pyramid of rays through that cell (and the unbounded
-ones those rays can reach); a shadow ray toward the light lies inside the pyramid of the cell
-its direction falls in, so it needs to test only that cell's list instead of walking the BVH.
+ones those rays can reach), then the leaves of the instance BVH whose boxes meet it; a shadow
+ray toward the light lies inside the pyramid of the cell its direction falls in, so it needs
+to test only that cell's list instead of walking the BVHs.
 Seen from a light most cells hold nothing or a primitive or two: the shadow ray's cost is then
 a handful of arithmetic. POV-Ray calls the same idea a light buffer.
 

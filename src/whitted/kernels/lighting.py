@@ -118,6 +118,48 @@ def _instances_occlusion_if_instances(geo, mats, o, d, inv, tmin, tmax, stack):
 
 
 @kernel
+def listed_occlusion(geo, mats, occluders, first, count, o, d, tmin, tmax, stack):
+    """:func:`any_occluder` over a light-buffer cell's list ``occluders[first:][:count]``
+    instead of the BVHs (the walk itself when ``count`` is negative: no list): an entry
+    ``i`` >= 0 is an analytic primitive, ``-1 - node`` a leaf of the instance BVH (its box
+    tested as the walk tests it, then each of its instances). The answer does not depend on
+    the order: 1 when any listed surface blocks opaquely, else 2 when any transparent one is
+    met. (One call for both, so the shadow code inlined into the lighting stays small.)
+    Called only for scenes with instances (:func:`_shadow_through_instances`)."""
+    if count < 0:
+        return any_occluder(geo, mats, o, d, tmin, tmax, stack)
+    seen_transparent = 0
+    inv = inverse_direction(d)
+    for k in range(first, first + count):
+        i = occluders[k]
+        if i >= 0:
+            state = occludes(geo, mats, i, o, d, tmin, tmax)
+        else:
+            state = _instance_leaf_occlusion(geo, mats, -1 - i, o, d, inv, tmin, tmax, stack)
+        if state == 1:
+            return 1
+        seen_transparent = max(seen_transparent, state)
+    return seen_transparent
+
+
+@kernel
+def _instance_leaf_occlusion(geo, mats, node, o, d, inv, tmin, tmax, stack):
+    """:func:`instance_occludes` over the instances of leaf ``node`` of the instance BVH
+    when the ray's segment meets its box."""
+    if box_entry(geo.inst_box, node, o, inv, tmin, tmax) == INF:
+        return 0
+    seen_transparent = 0
+    first = geo.inst_link[node, 0]
+    for j in range(first, first + geo.inst_link[node, 1]):
+        state = instance_occludes(geo, mats, geo.inst_prims[j], o, d, inv, tmin, tmax,
+                                  stack)
+        if state == 1:
+            return 1
+        seen_transparent = max(seen_transparent, state)
+    return seen_transparent
+
+
+@kernel
 def any_occluder(geo, mats, o, d, tmin, tmax, stack):
     """0: nothing on the segment (tmin, tmax) of the ray; 1: an opaque occluder (the search
     stops at the first one); 2: only transparent ones. Analytic shapes first (one call site
@@ -300,6 +342,34 @@ def list_cone_leaves(geo, mats, apex, axis, radius, stack, out, n, cap, opaque):
 
 
 @kernel
+def list_cone_instance_leaves(geo, apex, axis, radius, stack, out, n, cap, opaque):
+    """Append to ``out[n:]``, as ``-1 - node``, the leaves of the instance BVH whose boxes
+    meet the cone of :func:`list_cone_leaves` (world space: the instance boxes are not in
+    the scene BVH's frame). Returns (the new count, whether all listed are opaque: False once
+    a leaf is listed, the instances' triangles may have materials of their own); the count
+    is -1 when they would be more than ``cap``."""
+    top = 0
+    stack[0] = 0
+    while top >= 0:
+        node = stack[top]
+        top -= 1
+        if not cone_meets_box(geo.inst_box, node, apex, axis, radius):
+            continue
+        if geo.inst_link[node, 1] == 0:
+            top += 1
+            stack[top] = node + 1
+            top += 1
+            stack[top] = geo.inst_link[node, 0]
+            continue
+        if n == cap:
+            return -1, False
+        out[n] = -1 - node
+        n += 1
+        opaque = False
+    return n, opaque
+
+
+@kernel
 def gather_extra_hits(geo, i, o, d, inv, tmin, tmax, step, hits, n, full):
     """A shadow ray's walk (:func:`direct_light`) at a torus or CSG object ``i``: its crossings in
     (tmin, tmax), a CSG object's as (t, leaf) pairs from one walk (:func:`.csg.csg_surfaces`),
@@ -360,15 +430,18 @@ def _absorb(mats, scratch, count, length, trans):
 
 
 @kernel(inline="always")  # as when it was written inside the shadow ray's code
-def _shadow_through_instances(geo, mats, params, o, d, dist, media, n_media, scratch, stack):
+def _shadow_through_instances(geo, mats, params, o, d, dist, media, n_media, scratch, stack,
+                              occluders, list_first, n_listed):
     """A shadow ray's transmittance (:func:`direct_light`) in scenes with mesh instances, from
-    ``epsilon`` to ``dist`` along unit ``d``: an any-hit walk first,
-    then, only when it met transparent surfaces, the crossings one nearest hit at a time.
-    ``scratch[:n_media]`` already holds a copy of ``media[:n_media]``."""
+    ``epsilon`` to ``dist`` along unit ``d``: an any-hit test first (over the light-buffer
+    cell's list ``occluders[list_first:][:n_listed]`` when ``n_listed`` >= 0, else a walk of
+    both BVHs), then, only when it met transparent surfaces, the crossings one nearest hit at
+    a time. ``scratch[:n_media]`` already holds a copy of ``media[:n_media]``."""
     count = n_media
     trans = (1.0, 1.0, 1.0)
     t_from = params.epsilon
-    state = any_occluder(geo, mats, o, d, params.epsilon, dist, stack)
+    state = listed_occlusion(geo, mats, occluders, list_first, n_listed, o, d, params.epsilon,
+                             dist, stack)
     if state == 0:  # only the medium the point is in, if any, dims the light
         return _absorb(mats, media, n_media, dist - params.epsilon, (1.0, 1.0, 1.0)), -1
     if state == 1:
@@ -390,22 +463,23 @@ def _shadow_through_instances(geo, mats, params, o, d, dist, media, n_media, scr
 
 
 def shadow_through_instances_if_instances(geo, mats, params, o, d, dist, media, n_media,
-                                          scratch, stack):
+                                          scratch, stack, occluders, list_first, n_listed):
     """:func:`_shadow_through_instances`, never compiled for scenes without instances (see
     features.py)."""
     return _shadow_through_instances(geo, mats, params, o, d, dist, media, n_media, scratch,
-                                     stack)
+                                     stack, occluders, list_first, n_listed)
 
 
 @overload(shadow_through_instances_if_instances, inline="always")
 def _shadow_through_instances_if_instances(geo, mats, params, o, d, dist, media, n_media,
-                                           scratch, stack):
+                                           scratch, stack, occluders, list_first, n_listed):
     if not instances_possible(geo):
-        return (lambda geo, mats, params, o, d, dist, media, n_media, scratch, stack:
-                ((1.0, 1.0, 1.0), -1))
-    return (lambda geo, mats, params, o, d, dist, media, n_media, scratch, stack:
-            _shadow_through_instances(geo, mats, params, o, d, dist, media, n_media, scratch,
-                                      stack))
+        return (lambda geo, mats, params, o, d, dist, media, n_media, scratch, stack,
+                occluders, list_first, n_listed: ((1.0, 1.0, 1.0), -1))
+    return (lambda geo, mats, params, o, d, dist, media, n_media, scratch, stack, occluders,
+            list_first, n_listed: _shadow_through_instances(
+                geo, mats, params, o, d, dist, media, n_media, scratch, stack, occluders,
+                list_first, n_listed))
 
 
 @kernel
@@ -659,7 +733,7 @@ def direct_light(
                        weight * radiance[2] * f[2])) < NEGLIGIBLE_LIGHT:
                     continue
             buffer = int(table[j, LIGHT_BUFFER])
-            if buffer >= 0 and not has_instances(geo):
+            if buffer >= 0:
                 cell = buffer + cube_cell((-to_light[0], -to_light[1], -to_light[2]),
                                           int(table[j, LIGHT_BUFFER_SIDE]))
                 occluders = lights.buffer_prims
@@ -673,6 +747,7 @@ def direct_light(
             if blocker >= 0 and hit_analytic(geo, blocker, p, ldir, eps, tmax) < INF:
                 continue
             opaque = -1  # an opaque primitive found on the ray
+            # (a cell listing instance leaves is never ``listed_opaque``)
             if n_listed >= 0 and listed_opaque:
                 for k in range(list_first, list_first + n_listed):
                     if hit_analytic(geo, occluders[k], p, ldir, eps, tmax) < INF:
@@ -687,7 +762,8 @@ def direct_light(
                     scratch[k] = media[k]
                 if has_instances(geo):
                     vis, _ = shadow_through_instances_if_instances(
-                        geo, mats, params, p, ldir, tmax, media, n_media, scratch, stack)
+                        geo, mats, params, p, ldir, tmax, media, n_media, scratch, stack,
+                        occluders, list_first, n_listed)
                 else:
                     # walks gather the surfaces on the segment, sorted, a buffer-full at a
                     # time; one closer than ``epsilon`` to the previous crossing is the same
