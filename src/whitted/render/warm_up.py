@@ -141,10 +141,16 @@ def compile_builders() -> None:
         _builders_ready = True
 
 
-def _compile_light_buffers() -> None:
+def _compile_light_buffers(instances: bool = False) -> None:
     """The light-buffer kernels a scene with a point light runs (fast-math kernels that have
-    no Python twin): what the helper compiles after its share of the render kernel."""
-    compile_scene(Scene(objects=[Sphere(radius=1.0)], lights=[PointLight(position=(0, 5, 0))]))
+    no Python twin), for the variant's arrays (``instances``: a scene with a mesh instance,
+    whose buffers list instance leaves too): what the helper compiles after its share of the
+    render kernel."""
+    if instances:
+        compile_scene(_builders_scene(), flatten_limit=0)
+    else:
+        compile_scene(Scene(objects=[Sphere(radius=1.0)],
+                            lights=[PointLight(position=(0, 5, 0))]))
 
 
 def _stand_in_params(compiled: CompiledScene):
@@ -603,7 +609,7 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None,
             if KernelCache is not None:
                 KernelCache.wait_for_helper = None
             _finish_helper(helper)
-            _compile_light_buffers()  # loaded from the cache where the helper compiled them
+            _compile_light_buffers(instances)  # loaded where the helper compiled them
             if builders:
                 compile_builders()
     except BaseException:
@@ -622,7 +628,7 @@ def precompile_for_render(instances: bool, builders: bool = False) -> None:
     for dispatcher, argument_types in _delegated(instances):
         dispatcher.compile(argument_types)
         print("done", dispatcher.py_func.__qualname__, flush=True)
-    _compile_light_buffers()
+    _compile_light_buffers(instances)
     if builders:
         compile_builders()
 
