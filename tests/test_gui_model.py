@@ -28,8 +28,8 @@ def test_gui_opens_the_models_scene_untitled(tmp_path, monkeypatch):
     seen = []
     import whitted.gui.app as gui_app
 
-    monkeypatch.setattr(gui_app, "run_editor", lambda scene, path: seen.append((scene, path))
-                        or 0)
+    monkeypatch.setattr(gui_app, "run_editor",
+                        lambda scene, path, **options: seen.append((scene, path)) or 0)
     monkeypatch.chdir(tmp_path)
     result = CliRunner().invoke(cli_app, ["gui", "tetra.obj"])
     assert result.exit_code == 0, result.output
