@@ -12,8 +12,8 @@ import pytest
 
 import whitted
 from meshgen import uv_sphere
+from one_lane import render_one_lane
 from whitted.compile.light_buffers import build_light_buffers
-from whitted.compile.params import render_params
 from whitted.compile.scene import compile_scene
 from whitted.kernels.layout import (
     CELL_COUNT,
@@ -21,11 +21,8 @@ from whitted.kernels.layout import (
     CELL_OPAQUE,
     LIGHT_BUFFER,
     LIGHT_BUFFER_SIDE,
-    N_RAY_KINDS,
 )
 from whitted.kernels.light_buffer import cube_cell
-from whitted.kernels.tiles import lane_workspace, render_tiles
-from whitted.render.api import tile_grid
 
 EPS = 1e-6
 
@@ -130,16 +127,6 @@ def test_every_instance_a_shadow_segment_meets_is_listed(light_position):
     assert len(sizes) > 2900 and np.median(sizes) <= 3 and max(sizes) < 16
 
 
-def _render(compiled, scene):
-    params = render_params(scene, compiled, scene.render)
-    tiles = tile_grid(params.width, params.height)
-    fb = np.zeros((params.height, params.width, 3), np.float32)
-    counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
-    render_tiles(tiles, fb, compiled.geometry, compiled.materials, compiled.lights, params,
-                 counters, lane_workspace(params.max_depth), 0, 1)
-    return fb
-
-
 def test_an_instance_scene_renders_the_same_with_and_without_its_light_buffer():
     """Opaque and glass instances, a ground plane, the light among the balls' heights and
     above them: the image through the cells' lists is the walk's, bit for bit, in both
@@ -150,10 +137,10 @@ def test_an_instance_scene_renders_the_same_with_and_without_its_light_buffer():
             "camera": whitted.Camera(position=(0, 9, 12), look_at=(0, 0, 0), fov=55)})
         compiled = compile_scene(scene, flatten_limit=0)
         assert compiled.lights.table[0, LIGHT_BUFFER] == 0
-        listed = _render(compiled, scene)
+        listed = render_one_lane(compiled, scene)
         table = compiled.lights.table.copy()
         table[:, LIGHT_BUFFER] = -1.0
-        walked = _render(dataclasses.replace(
+        walked = render_one_lane(dataclasses.replace(
             compiled, lights=compiled.lights._replace(table=table)), scene)
         assert np.array_equal(listed, walked)
         # lists of at most two entries: many cells overflow, and their rays walk
@@ -161,7 +148,7 @@ def test_an_instance_scene_renders_the_same_with_and_without_its_light_buffer():
                                     compiled.lights.table, cap=2)
         assert (short.buffer_cells[:, CELL_COUNT] < 0).any()
         assert (short.buffer_cells[:, CELL_COUNT] > 0).any()
-        assert np.array_equal(listed, _render(dataclasses.replace(compiled, lights=short),
+        assert np.array_equal(listed, render_one_lane(dataclasses.replace(compiled, lights=short),
                                               scene))
         assert listed.mean() > 0.05
         # shadows are there: the floor under the balls is darker than the floor in the open

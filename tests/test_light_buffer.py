@@ -14,8 +14,8 @@ from numba import njit
 
 import whitted
 from meshgen import uv_sphere
+from one_lane import render_one_lane
 from whitted.compile.light_buffers import buffer_side
-from whitted.compile.params import render_params
 from whitted.compile.scene import compile_scene
 from whitted.kernels.accel import hit_analytic
 from whitted.kernels.layout import (
@@ -24,12 +24,9 @@ from whitted.kernels.layout import (
     CELL_OPAQUE,
     LIGHT_BUFFER,
     LIGHT_BUFFER_SIDE,
-    N_RAY_KINDS,
 )
 from whitted.kernels.light_buffer import LIGHT_BUFFER_CELLS, cell_cone, cube_cell
 from whitted.kernels.shapes import INF
-from whitted.kernels.tiles import lane_workspace, render_tiles
-from whitted.render.api import tile_grid
 
 EPS = 1e-6  # the shadow rays' tmin
 
@@ -194,26 +191,16 @@ def test_a_direction_lies_in_the_cone_of_its_cell(w, side):
     assert tan_w <= tan_half * (1 + 1e-9) + 1e-12
 
 
-def _render(compiled, scene):
-    params = render_params(scene, compiled, scene.render)
-    tiles = tile_grid(params.width, params.height)
-    fb = np.zeros((params.height, params.width, 3), np.float32)
-    counters = np.zeros((len(tiles), N_RAY_KINDS), np.int64)
-    render_tiles(tiles, fb, compiled.geometry, compiled.materials, compiled.lights, params,
-                 counters, lane_workspace(params.max_depth), 0, 1)
-    return fb
-
-
 def test_light_buffers_give_the_image_the_bvh_walk_gives():
     scene = _cluttered_scene(LIGHTS).model_copy(update={
         "render": whitted.RenderSettings(width=96, height=72),
         "camera": whitted.Camera(position=(0, 4, 10), look_at=(0, 1, 0), fov=50)})
     compiled = compile_scene(scene)
-    with_buffers = _render(compiled, scene)
+    with_buffers = render_one_lane(compiled, scene)
     table = compiled.lights.table.copy()
     table[:, LIGHT_BUFFER] = -1.0
     compiled.lights = compiled.lights._replace(table=table)
-    walked = _render(compiled, scene)
+    walked = render_one_lane(compiled, scene)
     assert np.array_equal(with_buffers, walked)
     assert with_buffers.mean() > 0.05  # lit, not black
 
@@ -229,7 +216,7 @@ def test_compile_without_light_buffers_builds_none_and_gives_the_same_image():
     assert (buffered.lights.table[:, LIGHT_BUFFER] >= 0).any()
     assert (bare.lights.table[:, LIGHT_BUFFER] == -1).all()
     assert len(bare.lights.buffer_prims) == 0
-    assert np.array_equal(_render(buffered, scene), _render(bare, scene))
+    assert np.array_equal(render_one_lane(buffered, scene), render_one_lane(bare, scene))
 
 
 def test_buffers_built_on_threads_equal_the_one_thread_build():
