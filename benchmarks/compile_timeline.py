@@ -74,13 +74,15 @@ def _watch():
     wrapped = set()
     targets = [("whitted.render.warm_up", "_start_helper", "start helper"),
                ("whitted.render.warm_up", "_finish_helper", "wait: helper's end"),
-               ("whitted.render.warm_up", "_compile_builders", "builders"),
+               ("whitted.render.warm_up", "compile_builders", "builders"),
+               ("whitted.render.warm_up", "_compile_light_buffers", "light buffers"),
                ("whitted.render.warm_up", "_compile_render_kernels", "render kernels"),
                ("whitted.render.warm_up", "_delegated", "delegated list"),
                ("whitted.render.warm_up", "stand_in_scene", "stand-in scene"),
                ("whitted.render.api", "compile_scene", "scene compiled"),
                ("__main__", "precompile_for_render", "helper's work"),
-               ("__main__", "_compile_builders", "builders")]
+               ("__main__", "compile_builders", "builders"),
+               ("__main__", "_compile_light_buffers", "light buffers")]
     deadline = _t() + 120
     while _t() < deadline:
         if not registered and "numba.core.event" in sys.modules:
