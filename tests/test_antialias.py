@@ -1,5 +1,6 @@
 """Adaptive anti-aliasing: worked pixel values at an edge, smooth regions traced at the
-corners only, the same image on any number of threads, settings checked."""
+corners only, the same image on any number of threads, settings checked, and no compile of
+its own after a uniform render."""
 
 from __future__ import annotations
 
@@ -80,26 +81,23 @@ def test_samples_and_antialias_do_not_mix():
         Scene.model_validate({"render": {"samples": 4, "antialias": {}}})
 
 
-def test_the_adaptive_kernel_loads_before_the_render_clock_starts(monkeypatch):
-    """The adaptive kernel is its own function: it is compiled (the first time) or loaded
-    by an empty call before the render starts, counted as compile time, never inside the
-    first tile (whose render time it would swell: 8.7 s for a cold compile)."""
-    import time
+def test_an_adaptive_render_after_a_uniform_one_compiles_nothing():
+    """Adaptive anti-aliasing is a run-time choice of the one render kernel (its levels and
+    threshold are arguments): once a uniform render of a kind of geometry has run, an
+    adaptive one of the same kind compiles and loads nothing, and its render kernel has the
+    same signatures as before."""
+    from numba.core.event import install_recorder
 
-    from whitted.kernels import adaptive
-    from whitted.render import RenderJob
+    from whitted.kernels.tiles import render_tiles
 
-    real = adaptive.render_tiles_adaptive
-    calls = []
-
-    def recording(tiles, *args):
-        start = time.perf_counter()
-        result = real(tiles, *args)
-        calls.append((len(tiles), time.perf_counter() - start))
-        return result
-
-    monkeypatch.setattr(adaptive, "render_tiles_adaptive", recording)
-    job = RenderJob(_edge_scene(threshold=0.1, max_samples=9))
-    job.run()
-    assert calls[0][0] == 0 and all(n > 0 for n, _ in calls[1:]) and len(calls) > 1
-    assert job.stats.compile_seconds >= calls[0][1]
+    adaptive = _edge_scene(threshold=0.1, max_samples=81)
+    uniform = adaptive.model_copy(update={"render": adaptive.render.model_copy(
+        update={"antialias": None})})
+    assert whitted.render(uniform).pixels[1, 3, 0] == 0.0  # its centre, x = 3.5: black
+    signatures = list(render_tiles.signatures)
+    with install_recorder("numba:compile") as compiles:
+        image = whitted.render(adaptive)
+    assert compiles.buffer == []
+    assert list(render_tiles.signatures) == signatures
+    assert image.meta["stats"].compile_seconds == 0.0
+    assert image.pixels[1, 3, 0] == pytest.approx(0.3125, abs=1e-12)  # adaptive indeed

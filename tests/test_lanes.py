@@ -15,7 +15,13 @@ import whitted
 from whitted.compile.params import render_params
 from whitted.compile.scene import compile_scene
 from whitted.kernels.layout import N_RAY_KINDS, RAY_PRIMARY, RAY_SHADOW
-from whitted.kernels.tiles import CACHE_LINE, lane_workspace, own_lines, render_tiles
+from whitted.kernels.tiles import (
+    CACHE_LINE,
+    adaptive_workspace,
+    lane_workspace,
+    own_lines,
+    render_tiles,
+)
 from whitted.render.api import run_lanes, tile_grid
 
 
@@ -73,7 +79,7 @@ def _counted(lanes: int) -> tuple[np.ndarray, np.ndarray]:
     works = [lane_workspace(params.max_depth) for _ in range(lanes)]
     for lane in range(lanes):
         render_tiles(tiles, fb, compiled.geometry, compiled.materials, compiled.lights, params,
-                     counters, works[lane], lane, lanes)
+                     counters, works[lane], adaptive_workspace(), 0.0, -1, lane, lanes)
     return fb, counters
 
 

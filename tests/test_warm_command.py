@@ -28,7 +28,7 @@ def _whitted(*args: str) -> subprocess.CompletedProcess:
 
 def test_every_variant_is_named_once():
     names = variant_names()
-    assert len(names) == len(set(names)) == len(GEOMETRY) * len(KINDS) == 8
+    assert len(names) == len(set(names)) == len(GEOMETRY) * len(KINDS) == 6
 
 
 def test_instances_and_extras_share_the_general_kernels():
@@ -62,7 +62,7 @@ def test_each_tiny_scene_reaches_its_variant(geometry):
         assert (geo.inst_box.dtype == np.float64) == instances, kind
         assert (geo.unbounded.dtype == np.dtype(EXTRAS_DTYPE)) == extras, kind
         assert (scene.render.caustics.photons > 0) == (kind == "caustics")
-        assert (scene.render.antialias is not None) == (kind == "adaptive")
+        assert scene.render.antialias is None  # a run-time choice of the render kernel
 
 
 def test_a_caustics_variant_compiles_the_photon_tracer_and_no_render_kernel(monkeypatch):
@@ -129,11 +129,20 @@ def test_the_queue_hands_a_general_kind_out_only_after_the_general_render_kernel
             break
         assert queue.take() == name
         taken.append(name)
-    assert sorted(taken) == ["builders", "plain/adaptive", "plain/aovs", "plain/caustics",
-                             "stefan"]
-    assert queue.todo == ["general/adaptive", "general/aovs"]
+    assert sorted(taken) == ["builders", "plain/aovs", "plain/caustics", "stefan"]
+    assert queue.todo == ["general/aovs"]
     queue.finish("general/render", 12.5)
-    assert queue.take() == "general/adaptive"
+    assert queue.take() == "general/aovs"
+
+
+def test_no_variant_is_adaptive_anti_aliasing():
+    # adaptive anti-aliasing is a run-time choice of the render kernel: its geometry's
+    # ``render`` variant serves it, no kind of its own is compiled
+    from whitted.cli.warm import _all_names
+
+    assert _all_names() == ["plain/caustics", "plain/aovs", "general/render",
+                            "general/caustics", "general/aovs", "builders", "stefan"]
+    assert KINDS == ("render", "caustics", "aovs")
 
 
 def test_a_failed_general_render_kernel_fails_its_kinds_without_compiling_them():

@@ -34,7 +34,8 @@ def test_helper_compiles_the_signatures_render_tiles_calls(monkeypatch, instance
     params = render_params(Scene(), stand_in, RenderSettings(width=1, height=1))
     fresh_render_tiles(np.zeros((0, 4), np.int32), np.zeros((1, 1, 3), np.float32),
                        stand_in.geometry, stand_in.materials, stand_in.lights, params,
-                       np.zeros((1, N_RAY_KINDS), np.int64), tiles.lane_workspace(1), 0, 1)
+                       np.zeros((1, N_RAY_KINDS), np.int64), tiles.lane_workspace(1),
+                       tiles.adaptive_workspace(), 0.0, -1, 0, 1)
     delegated = render_callees(stand_in.geometry, stand_in.materials, stand_in.lights, params)
     assert delegated
     # and what the render process compiles first meanwhile

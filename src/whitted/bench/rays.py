@@ -12,9 +12,9 @@ import math
 
 from ..jit import kernel
 from ..kernels.accel import closest_hit
+from ..kernels.camera import camera_ray
 from ..kernels.geometry_ref import geometry_ref_if_instances
 from ..kernels.lighting import any_occluder
-from ..kernels.tiles import camera_ray
 
 TILE = 16  # the render's tile size: rays in the order a render lane traces them
 

@@ -7,9 +7,10 @@ cores); then the other variants (render/variants.py), the scene builders with th
 (which a small scene runs as Python until they are compiled: jit/python_twins.py) and the
 Stefan solver's kernels are handed out, one at a time, to ``--jobs`` worker processes (one
 per core), each compiling into the same cache (jit/cache.py keeps it consistent). A kind of
-the general kernels that shares the render kernel's callees (adaptive anti-aliasing, AOVs) is
-handed out only once the general render kernel is in the cache: it then loads them instead of
-compiling them a second time in another process. The photon tracers (the caustics variants:
+the general kernels that shares the render kernel's callees (the AOV kernel) is handed out
+only once the general render kernel is in the cache: it then loads them instead of compiling
+them a second time in another process. Adaptive anti-aliasing is a run-time choice of the
+render kernel: the ``render`` variants serve it. The photon tracers (the caustics variants:
 the tracer only, the render with caustics is the render kernel's) share nothing with the
 render kernels and start at once. A variant already in the cache
 loads in a fraction of a second, so a second ``whitted warm`` is quick.
@@ -55,7 +56,7 @@ def _order(names: list[str]) -> list[str]:
     then its kinds, caustics the biggest) first, the rest filling the other cores."""
     def rank(name: str) -> tuple[int, int]:
         geometry, _, kind = name.partition("/")
-        kinds = ("render", "caustics", "adaptive", "aovs")
+        kinds = ("render", "caustics", "aovs")
         return (0 if geometry not in ("plain", STEFAN, BUILDERS) else 1,
                 kinds.index(kind) if kind in kinds else len(kinds))
     return sorted(names, key=rank)
@@ -177,9 +178,9 @@ def warm(
     serve: Annotated[bool, typer.Option(
         "--serve", hidden=True, help="A worker of the command: names on stdin")] = False,
 ) -> None:
-    """Compile every kernel variant (CSG and tori, mesh instances, caustics, adaptive
-    anti-aliasing, AOVs, the Stefan solver, the OBJ reader) into the kernel cache, so that
-    no later command waits for a first compile."""
+    """Compile every kernel variant (CSG and tori, mesh instances, caustics, AOVs, the Stefan
+    solver, the OBJ reader; adaptive anti-aliasing is part of the render kernel) into the
+    kernel cache, so that no later command waits for a first compile."""
     if serve:
         _serve()
         return

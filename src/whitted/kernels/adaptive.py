@@ -13,178 +13,205 @@ with the point's index in the grid as the "pixel". Neighbouring pixels share the
 (traced once per tile) and their split edges (traced by each pixel that needs them, to the
 same value), so no tile depends on another, and the image is the same whatever the thread
 count or the order of the tiles.
+
+The render kernel (:func:`.tiles.render_tiles`) traces the samples: it has one call of the
+path tracer, for the uniform samples and these alike, so that the tracer is compiled into it
+once. This module only says which sample it traces next (:func:`next_sample`) and keeps
+what it traced (:func:`put_sample`): the algorithm above as a walk that stops at each
+sample it still needs and resumes where it stopped, its state in the lane's scratch memory
+(:func:`.tiles.adaptive_workspace`).
 """
 
 from __future__ import annotations
 
-import numpy as np
+from ..jit import kernel
+from .camera import camera_ray, lens_ray
 
-from ..jit import kernel, numba_object
-from .integrator import trace_path
-from .layout import N_RAY_KINDS, RAY_PRIMARY
-from .tiles import camera_ray, lens_ray, own_lines
-
-geometry_ref_if_instances = numba_object(f"{__package__}.geometry_ref",
-                                         "geometry_ref_if_instances")
-def adaptive_workspace(tile_width: int, tile_height: int, levels: int):
-    """Scratch memory of one lane: the corners of a tile's pixels, one pixel's sample grid
-    and its marks, and the stack of squares to visit (three per level and the first)."""
-    side = (1 << levels) + 1
-    return (own_lines((tile_height + 1, tile_width + 1, 3)), own_lines((side, side, 3)),
-            own_lines((side, side), np.int8), own_lines((3 * levels + 2, 3), np.int32))
-
-
-@kernel  # one call site of trace_path (which Numba inlines into it)
-def _sample(geo, mats, lights, params, gx, gy, fine, work, cnt):
-    """Radiance through the point (gx, gy) of the image's finest grid."""
-    st_f, st_i, media, scratch, stack, hits, listed, _ = work
-    key = gy * (params.width * fine + 1) + gx
-    o, d = camera_ray(params, gx / fine, gy / fine)
-    if params.focal_distance > 0.0:
-        o, d = lens_ray(params, o, d, key, 0)
-    cnt[RAY_PRIMARY] += 1
-    return trace_path(geo, mats, lights, params, o, d, key, 0, st_f, st_i, media, scratch,
-                      stack, hits, listed, cnt)
-
-
-@kernel
-def _clamp01(x):
-    return min(max(x, 0.0), 1.0)
-
-
-@kernel
-def _distance(a0, a1, a2, b0, b1, b2):
-    """POV-Ray's colour distance of two samples (clamped to displayable values)."""
-    return (abs(_clamp01(a0) - _clamp01(b0)) + abs(_clamp01(a1) - _clamp01(b1))
-            + abs(_clamp01(a2) - _clamp01(b2)))
+# the walk's state, st[...] of the scratch memory: which pass (0: the tile's corners, 1: its
+# pixels), the corner or pixel it is at, whether that pixel's squares are being split (their
+# stack then holds them), the stack's top, and the grid point (i, j) whose sample is awaited
+# (the corner pass: the corner's column and row in the tile)
+ST_PASS = 0
+ST_INDEX = 1
+ST_SPLITTING = 2
+ST_TOP = 3
+ST_I = 4
+ST_J = 5
+N_STATE = 6
 
 
 @kernel
 def corners_differ(g, i0, j0, i1, j1, threshold):
     """Do the four corners (i0|i1, j0|j1) of the sample grid ``g`` differ by more than
-    ``threshold`` (any pair)?"""
+    ``threshold`` (any pair)? The distance of two samples is POV-Ray's (clamped to
+    displayable values)."""
     for a in range(4):
         ia = i0 if a % 2 == 0 else i1
         ja = j0 if a < 2 else j1
         for b in range(a + 1, 4):
             ib = i0 if b % 2 == 0 else i1
             jb = j0 if b < 2 else j1
-            if _distance(g[ja, ia, 0], g[ja, ia, 1], g[ja, ia, 2],
-                         g[jb, ib, 0], g[jb, ib, 1], g[jb, ib, 2]) > threshold:
+            if (abs(min(max(g[ja, ia, 0], 0.0), 1.0) - min(max(g[jb, ib, 0], 0.0), 1.0))
+                    + abs(min(max(g[ja, ia, 1], 0.0), 1.0) - min(max(g[jb, ib, 1], 0.0), 1.0))
+                    + abs(min(max(g[ja, ia, 2], 0.0), 1.0)
+                          - min(max(g[jb, ib, 2], 0.0), 1.0))) > threshold:
                 return True
     return False
 
 
-@kernel(inline="always")
-def _known(geo, mats, lights, params, grid, known, gx0, gy0, i, j, fine, work, cnt):
-    """Make sure point (i, j) of the pixel's sample grid is traced."""
-    if known[j, i] == 0:
-        c = _sample(geo, mats, lights, params, gx0 + i, gy0 + j, fine, work, cnt)
+@kernel
+def next_sample(params, x0, y0, x1, y1, levels, threshold, framebuffer, aa):
+    """The camera ray (o, d) of the sample the tile (x0, y0, x1, y1) needs next and its
+    sampler's "pixel" (the point's index in the image's finest grid), or a key of -1 once
+    every pixel of the tile is in ``framebuffer``. ``aa``: the lane's scratch memory
+    (:func:`.tiles.adaptive_workspace`), its state zeroed at the tile's start; the sample
+    traced is handed back with :func:`put_sample` before the next call.
+
+    The ray is made here, after the walk's loops, as the kernel that traced each sample made
+    it before the render kernel traced them: made inside a loop whose divisors do not
+    change, LLVM may multiply by a reciprocal instead (fast-math's ``arcp``), and a ray
+    through the image's centre (x exactly half the width) would no longer be exactly
+    straight ahead.
+    """
+    gx, gy = _next_point(x0, y0, x1, y1, levels, threshold, framebuffer, aa)
+    fine = 1 << levels
+    o = params.camera_origin
+    d = params.camera_forward
+    if gx < 0:
+        return o, d, -1
+    key = gy * (params.width * fine + 1) + gx
+    o, d = camera_ray(params, gx / fine, gy / fine)
+    if params.focal_distance > 0.0:  # focal blur (0: a pinhole)
+        o, d = lens_ray(params, o, d, key, 0)
+    return o, d, key
+
+
+@kernel
+def _next_point(x0, y0, x1, y1, levels, threshold, framebuffer, aa):
+    """The point (gx, gy) of the image's finest grid whose sample the tile needs next, or
+    (-1, -1) once every pixel of it is in ``framebuffer``.
+
+    First the corners of every pixel, row by row; then pixel by pixel: a pixel whose corners
+    differ has its squares split (a stack of squares, depth first: a square's four corners,
+    then its four quarters while they differ) until no square needs a sample not yet traced;
+    its colour is then the squares' area-weighted mean."""
+    corners, grid, known, squares, st, acc = aa
+    fine = 1 << levels
+    if st[ST_PASS] == 0:
+        cols = x1 - x0 + 1
+        k = st[ST_INDEX]
+        if k < (y1 - y0 + 1) * cols:
+            cy = k // cols
+            cx = k - cy * cols
+            st[ST_I] = cx
+            st[ST_J] = cy
+            return (x0 + cx) * fine, (y0 + cy) * fine
+        st[ST_PASS] = 1
+        st[ST_INDEX] = 0
+        st[ST_SPLITTING] = 0
+    w = x1 - x0
+    while st[ST_INDEX] < (y1 - y0) * w:
+        cy = st[ST_INDEX] // w
+        cx = st[ST_INDEX] - cy * w
+        px = x0 + cx
+        py = y0 + cy
+        if st[ST_SPLITTING] == 0:
+            for k in range(3):  # the pixel's corners into its sample grid
+                grid[0, 0, k] = corners[cy, cx, k]
+                grid[0, fine, k] = corners[cy, cx + 1, k]
+                grid[fine, 0, k] = corners[cy + 1, cx, k]
+                grid[fine, fine, k] = corners[cy + 1, cx + 1, k]
+            if levels > 0 and corners_differ(grid, 0, 0, fine, fine, threshold):
+                for j in range(fine + 1):
+                    for i in range(fine + 1):
+                        known[j, i] = 0
+                known[0, 0] = 1
+                known[0, fine] = 1
+                known[fine, 0] = 1
+                known[fine, fine] = 1
+                squares[0, 0] = 0
+                squares[0, 1] = 0
+                squares[0, 2] = fine
+                st[ST_TOP] = 0
+                st[ST_SPLITTING] = 1
+                for k in range(3):
+                    acc[k] = 0.0
+            else:
+                col = (
+                    0.25 * (grid[0, 0, 0] + grid[0, fine, 0] + grid[fine, 0, 0]
+                            + grid[fine, fine, 0]),
+                    0.25 * (grid[0, 0, 1] + grid[0, fine, 1] + grid[fine, 0, 1]
+                            + grid[fine, fine, 1]),
+                    0.25 * (grid[0, 0, 2] + grid[0, fine, 2] + grid[fine, 0, 2]
+                            + grid[fine, fine, 2]),
+                )
+                framebuffer[py, px, 0] = col[0]
+                framebuffer[py, px, 1] = col[1]
+                framebuffer[py, px, 2] = col[2]
+                st[ST_INDEX] += 1
+                continue
+        # the pixel's squares: the one on top of the stack stays there until its four
+        # corners are traced, then it is split or counted
+        r = acc[0]
+        g = acc[1]
+        b = acc[2]
+        top = st[ST_TOP]
+        while top >= 0:
+            i = squares[top, 0]
+            j = squares[top, 1]
+            size = squares[top, 2]
+            for c in range(4):
+                ci = i + (size if c % 2 else 0)
+                cj = j + (size if c >= 2 else 0)
+                if known[cj, ci] == 0:  # this corner's sample first
+                    st[ST_TOP] = top
+                    st[ST_I] = ci
+                    st[ST_J] = cj
+                    acc[0] = r
+                    acc[1] = g
+                    acc[2] = b
+                    return px * fine + ci, py * fine + cj
+            top -= 1
+            if size > 1 and corners_differ(grid, i, j, i + size, j + size, threshold):
+                half = size // 2
+                for c in range(4):
+                    top += 1
+                    squares[top, 0] = i + (half if c % 2 else 0)
+                    squares[top, 1] = j + (half if c >= 2 else 0)
+                    squares[top, 2] = half
+                continue
+            w4 = 0.25 * size * size
+            for k in range(3):
+                s = (grid[j, i, k] + grid[j, i + size, k] + grid[j + size, i, k]
+                     + grid[j + size, i + size, k]) * w4
+                if k == 0:
+                    r += s
+                elif k == 1:
+                    g += s
+                else:
+                    b += s
+        inv = 1.0 / (fine * fine)
+        framebuffer[py, px, 0] = r * inv
+        framebuffer[py, px, 1] = g * inv
+        framebuffer[py, px, 2] = b * inv
+        st[ST_SPLITTING] = 0
+        st[ST_INDEX] += 1
+    return -1, -1
+
+
+@kernel
+def put_sample(aa, c):
+    """Keep the sample ``c`` (r, g, b) that :func:`next_sample` asked for last."""
+    corners, grid, known, squares, st, acc = aa
+    i = st[ST_I]
+    j = st[ST_J]
+    if st[ST_PASS] == 0:  # a corner of the tile's pixels
+        corners[j, i, 0] = c[0]
+        corners[j, i, 1] = c[1]
+        corners[j, i, 2] = c[2]
+        st[ST_INDEX] += 1
+    else:  # a point of the pixel's sample grid
         grid[j, i, 0] = c[0]
         grid[j, i, 1] = c[1]
         grid[j, i, 2] = c[2]
         known[j, i] = 1
-
-
-@kernel
-def refine_pixel(geo, mats, lights, params, px, py, levels, threshold, grid, known, squares,
-                 work, cnt):
-    """The colour of pixel (px, py) whose corners (already in ``grid``'s corners, marked in
-    ``known``) differ: its squares split while their corners differ, ``levels`` deep."""
-    fine = 1 << levels
-    gx0 = px * fine
-    gy0 = py * fine
-    r = 0.0
-    g = 0.0
-    b = 0.0
-    top = 0
-    squares[0, 0] = 0
-    squares[0, 1] = 0
-    squares[0, 2] = fine
-    while top >= 0:
-        i = squares[top, 0]
-        j = squares[top, 1]
-        size = squares[top, 2]
-        top -= 1
-        for c in range(4):
-            ci = i + (size if c % 2 else 0)
-            cj = j + (size if c >= 2 else 0)
-            _known(geo, mats, lights, params, grid, known, gx0, gy0, ci, cj, fine, work, cnt)
-        if size > 1 and corners_differ(grid, i, j, i + size, j + size, threshold):
-            half = size // 2
-            for c in range(4):
-                top += 1
-                squares[top, 0] = i + (half if c % 2 else 0)
-                squares[top, 1] = j + (half if c >= 2 else 0)
-                squares[top, 2] = half
-            continue
-        w = 0.25 * size * size
-        for k in range(3):
-            s = (grid[j, i, k] + grid[j, i + size, k] + grid[j + size, i, k]
-                 + grid[j + size, i + size, k]) * w
-            if k == 0:
-                r += s
-            elif k == 1:
-                g += s
-            else:
-                b += s
-    inv = 1.0 / (fine * fine)
-    return r * inv, g * inv, b * inv
-
-
-@kernel(entry=True)  # called from Python
-def render_tiles_adaptive(tiles, framebuffer, geo, mats, lights, params, counters, work, aa,
-                          threshold, levels, lane, lanes):
-    """:func:`.tiles.render_tiles` with adaptive anti-aliasing (see the module docstring).
-    ``aa`` is the lane's scratch memory from :func:`adaptive_workspace`."""
-    geo = geometry_ref_if_instances(geo)
-    corners, grid, known, squares = aa
-    fine = 1 << levels
-    cnt = work[7]  # the lane's own counts, stored in counters[t] once a tile (render_tiles)
-    for t in range(lane, tiles.shape[0], lanes):
-        for k in range(N_RAY_KINDS):
-            cnt[k] = 0
-        x0 = tiles[t, 0]
-        y0 = tiles[t, 1]
-        x1 = tiles[t, 2]
-        y1 = tiles[t, 3]
-        for cy in range(y1 - y0 + 1):
-            for cx in range(x1 - x0 + 1):
-                c = _sample(geo, mats, lights, params, (x0 + cx) * fine, (y0 + cy) * fine,
-                            fine, work, cnt)
-                corners[cy, cx, 0] = c[0]
-                corners[cy, cx, 1] = c[1]
-                corners[cy, cx, 2] = c[2]
-        for py in range(y0, y1):
-            for px in range(x0, x1):
-                cy = py - y0
-                cx = px - x0
-                for k in range(3):  # the pixel's corners into its sample grid
-                    grid[0, 0, k] = corners[cy, cx, k]
-                    grid[0, fine, k] = corners[cy, cx + 1, k]
-                    grid[fine, 0, k] = corners[cy + 1, cx, k]
-                    grid[fine, fine, k] = corners[cy + 1, cx + 1, k]
-                if levels > 0 and corners_differ(grid, 0, 0, fine, fine, threshold):
-                    for j in range(fine + 1):
-                        for i in range(fine + 1):
-                            known[j, i] = 0
-                    known[0, 0] = 1
-                    known[0, fine] = 1
-                    known[fine, 0] = 1
-                    known[fine, fine] = 1
-                    col = refine_pixel(geo, mats, lights, params, px, py, levels, threshold,
-                                       grid, known, squares, work, cnt)
-                else:
-                    col = (
-                        0.25 * (grid[0, 0, 0] + grid[0, fine, 0] + grid[fine, 0, 0]
-                                + grid[fine, fine, 0]),
-                        0.25 * (grid[0, 0, 1] + grid[0, fine, 1] + grid[fine, 0, 1]
-                                + grid[fine, fine, 1]),
-                        0.25 * (grid[0, 0, 2] + grid[0, fine, 2] + grid[fine, 0, 2]
-                                + grid[fine, fine, 2]),
-                    )
-                framebuffer[py, px, 0] = col[0]
-                framebuffer[py, px, 1] = col[1]
-                framebuffer[py, px, 2] = col[2]
-        for k in range(N_RAY_KINDS):
-            counters[t, k] = cnt[k]

@@ -15,6 +15,8 @@ import numpy as np
 
 from ..jit import kernel, numba_object
 from .accel import closest_hit, surface_normals
+from .adaptive import N_STATE, next_sample, put_sample
+from .camera import camera_ray, lens_ray
 from .integrator import N_STACK_F, N_STACK_I, trace_path
 from .layout import (
     BVH_STACK,
@@ -24,8 +26,8 @@ from .layout import (
     RAY_PRIMARY,
 )
 from .lighting import HITS_BUFFER, SHADOW_LIST_CAP
-from .sampling import concentric_disk, random_pair, stratum
-from .vec import dot, madd, normalize, sub
+from .sampling import random_pair, stratum
+from .vec import madd
 
 # kernels/geometry_ref.py is a Numba extension: imported with Numba (jit/decorators.py)
 geometry_ref_if_instances = numba_object(f"{__package__}.geometry_ref",
@@ -68,80 +70,99 @@ def lane_workspace(max_depth: int):
     )
 
 
-@kernel
-def camera_ray(params, x, y):
-    """Ray through image-plane position (x, y) in pixels from the top-left corner."""
-    sx = 2.0 * x / params.width - 1.0
-    sy = 1.0 - 2.0 * y / params.height
-    right = params.camera_right
-    up = params.camera_up
-    fwd = params.camera_forward
-    offset = (sx * right[0] + sy * up[0], sx * right[1] + sy * up[1], sx * right[2] + sy * up[2])
-    if params.orthographic:
-        return madd(params.camera_origin, offset, 1.0), fwd
-    return params.camera_origin, normalize(
-        (fwd[0] + offset[0], fwd[1] + offset[1], fwd[2] + offset[2])
-    )
-
-
-@kernel
-def lens_ray(params, o, d, pixel, sample):
-    """The camera ray (o, d) through a thin lens (focal blur): from a point of the lens
-    drawn by the pixel's sampler (dimension 1, concentric disk), toward the point where (o, d)
-    meets the plane in focus. Points on that plane stay as sharp as through a pinhole."""
-    u, v = random_pair(params.seed, pixel, sample, 1)
-    lx, ly = concentric_disk(u, v)
-    lu = params.lens_u
-    lv = params.lens_v
-    start = (o[0] + lx * lu[0] + ly * lv[0], o[1] + lx * lu[1] + ly * lv[1],
-             o[2] + lx * lu[2] + ly * lv[2])
-    f = params.focal_distance / dot(d, params.camera_forward)
-    focus = madd(o, d, f)
-    return start, normalize(sub(focus, start))
+def adaptive_workspace(tile_width: int = 0, tile_height: int = 0, levels: int = 0):
+    """Scratch memory of one lane for adaptive anti-aliasing (kernels/adaptive.py): the
+    corners of a tile's pixels, one pixel's sample grid and its marks, the stack of squares
+    to visit (three per level and the first), the walk's state and a pixel's sums so far.
+    With no arguments: the few bytes a render of uniform samples passes in its place."""
+    side = (1 << levels) + 1
+    return (own_lines((tile_height + 1, tile_width + 1, 3)), own_lines((side, side, 3)),
+            own_lines((side, side), np.int8), own_lines((3 * levels + 2, 3), np.int32),
+            own_lines(N_STATE, np.int64), own_lines(3))
 
 
 @kernel(entry=True)  # called from Python
-def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, lane, lanes):
+def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, aa, threshold,
+                 levels, lane, lanes):
     """Render this lane's share of ``tiles`` (rows of x0, y0, x1, y1) into ``framebuffer``
     (H, W, 3 float32); ``counters[t]`` receives the rays traced for tile t by kind. ``work`` is
     the lane's scratch memory from :func:`lane_workspace`; rays are counted there, in the
     lane's own memory, and stored in ``counters`` once a tile (rows of neighbouring tiles
-    share cache lines, and lanes render neighbouring tiles)."""
+    share cache lines, and lanes render neighbouring tiles).
+
+    ``levels`` < 0: ``params.samples`` stratified samples a pixel; ``levels`` >= 0: adaptive
+    anti-aliasing (kernels/adaptive.py) with ``threshold``, splitting a pixel ``levels``
+    times at most, ``aa`` the lane's scratch memory from :func:`adaptive_workspace` (any of
+    them for uniform samples). Both trace their samples at the one call of the path tracer
+    below, so that it is compiled into this kernel once: the next sample is picked (a pixel's
+    next stratum, or what adaptive.next_sample asks for), traced, then accounted for."""
     n_tiles = tiles.shape[0]
     spp = params.samples
+    uniform = levels < 0
     geo = geometry_ref_if_instances(geo)  # one pointer for every call, not 28 arrays
     st_f, st_i, media, scratch, stack, hits, listed, cnt = work
+    state = aa[4]
     for t in range(lane, n_tiles, lanes):
         for k in range(N_RAY_KINDS):
             cnt[k] = 0
-        for py in range(tiles[t, 1], tiles[t, 3]):
-            for px in range(tiles[t, 0], tiles[t, 2]):
+        x0 = tiles[t, 0]
+        y0 = tiles[t, 1]
+        x1 = tiles[t, 2]
+        y1 = tiles[t, 3]
+        px = x0  # uniform samples: the pixel, its sample and their sums
+        py = y0
+        s = 0
+        r = 0.0
+        g = 0.0
+        b = 0.0
+        for k in range(N_STATE):  # adaptive: the walk from the tile's first corner
+            state[k] = 0
+        while True:
+            if uniform:
+                if py >= y1 or px >= x1:
+                    break
                 pixel = py * params.width + px
-                r = 0.0
-                g = 0.0
-                b = 0.0
-                for s in range(spp):
-                    if spp == 1:
-                        jx = 0.5
-                        jy = 0.5
-                    else:
-                        cx, cy, m, rows = stratum(s, spp)
-                        ux, uy = random_pair(params.seed, pixel, s, 0)
-                        jx = (cx + ux) / m
-                        jy = (cy + uy) / rows
-                    o, d = camera_ray(params, px + jx, py + jy)
-                    if params.focal_distance > 0.0:  # focal blur (0: a pinhole)
-                        o, d = lens_ray(params, o, d, pixel, s)
-                    cnt[RAY_PRIMARY] += 1
-                    c = trace_path(geo, mats, lights, params, o, d, pixel, s, st_f, st_i,
-                                   media, scratch, stack, hits, listed, cnt)
-                    r += c[0]
-                    g += c[1]
-                    b += c[2]
+                if spp == 1:
+                    jx = 0.5
+                    jy = 0.5
+                else:
+                    cx, cy, m, rows = stratum(s, spp)
+                    ux, uy = random_pair(params.seed, pixel, s, 0)
+                    jx = (cx + ux) / m
+                    jy = (cy + uy) / rows
+                o, d = camera_ray(params, px + jx, py + jy)
+                if params.focal_distance > 0.0:  # focal blur (0: a pinhole)
+                    o, d = lens_ray(params, o, d, pixel, s)
+                sample = s
+            else:  # a point of the finest grid: its index there is its sampler's "pixel"
+                o, d, pixel = next_sample(params, x0, y0, x1, y1, levels, threshold,
+                                          framebuffer, aa)
+                if pixel < 0:
+                    break
+                sample = 0
+            cnt[RAY_PRIMARY] += 1
+            c = trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media,
+                           scratch, stack, hits, listed, cnt)
+            if not uniform:
+                put_sample(aa, c)
+                continue
+            r += c[0]
+            g += c[1]
+            b += c[2]
+            s += 1
+            if s >= spp:  # the pixel's last sample
                 inv = 1.0 / spp
                 framebuffer[py, px, 0] = r * inv
                 framebuffer[py, px, 1] = g * inv
                 framebuffer[py, px, 2] = b * inv
+                r = 0.0
+                g = 0.0
+                b = 0.0
+                s = 0
+                px += 1
+                if px == x1:
+                    px = x0
+                    py += 1
         for k in range(N_RAY_KINDS):
             counters[t, k] = cnt[k]
 

@@ -413,13 +413,10 @@ class RenderJob:
         return image
 
     def _run(self) -> Image:
-        from ..kernels.tiles import lane_workspace, render_tiles
+        from ..kernels.tiles import adaptive_workspace, lane_workspace, render_tiles
 
         wall_start = time.perf_counter()
         stats = self.stats
-        # the plain render kernel only where this render runs it: adaptive anti-aliasing
-        # runs a kind of its own, loaded in its stage below
-        plain_kernel = self.settings.antialias is None
         stats.compile_seconds = 0.0
         if not kernels_cached():  # a first run: the default variant (and the builders, for
             # a scene too large for their Python twins), compiled on both cores
@@ -427,7 +424,7 @@ class RenderJob:
                 builders=self.compiled is None and scene_needs_builders(self.scene))
         compiled: CompiledScene = (self.compiled if self.compiled is not None
                                    else compile_scene(self.scene, threads=self.threads))
-        stats.compile_seconds += warm_up_kernels(compiled, render_kernel=plain_kernel)
+        stats.compile_seconds += warm_up_kernels(compiled)
         stats.build_seconds = compiled.build_seconds
         stats.warnings = list(compiled.warnings)
         stats.triangles = compiled.triangles
@@ -443,21 +440,10 @@ class RenderJob:
         stats.tiles_total = self.tiles_total = len(tiles)
         lanes = self.threads
         antialias = self.settings.antialias
-        levels = 0
-        if antialias is not None:
-            from ..kernels.adaptive import adaptive_workspace, render_tiles_adaptive
-
-            levels = antialias.levels
-            # its kernel compiled (the first time) or loaded here, not in the first tile:
-            # that time is compile time, not render time
-            start = time.perf_counter()
-            render_tiles_adaptive(np.zeros((0, 4), np.int32), self.framebuffer,
-                                  compiled.geometry, compiled.materials, lights, params,
-                                  np.zeros((0, N_RAY_KINDS), np.int64),
-                                  lane_workspace(params.max_depth),
-                                  adaptive_workspace(self.tile_size, self.tile_size, levels),
-                                  float(antialias.threshold), levels, 0, 1)
-            stats.compile_seconds += time.perf_counter() - start
+        # uniform samples (levels -1) or adaptive anti-aliasing: a run-time choice of the
+        # one render kernel (kernels/tiles.py), which warm_up_kernels loaded above
+        levels = -1 if antialias is None else antialias.levels
+        threshold = 0.0 if antialias is None else float(antialias.threshold)
         render_start = time.perf_counter() - photon_seconds  # shooting photons is rendering
         done = len(tiles) - len(todo)
         self.tiles_done = done
@@ -503,8 +489,8 @@ class RenderJob:
         def render_runs(n: int) -> None:
             nonlocal done
             work = lane_workspace(params.max_depth)
-            aa = None if antialias is None else adaptive_workspace(
-                self.tile_size, self.tile_size, levels)
+            aa = (adaptive_workspace() if antialias is None
+                  else adaptive_workspace(self.tile_size, self.tile_size, levels))
             while True:
                 if self.cancel_token.cancelled or failed.is_set():
                     return
@@ -514,14 +500,8 @@ class RenderJob:
                 part = np.ascontiguousarray(tiles[idx])
                 part_counters = np.zeros((len(idx), N_RAY_KINDS), np.int64)
                 run_start = time.perf_counter()
-                if aa is None:
-                    render_tiles(part, self.framebuffer, compiled.geometry, compiled.materials,
-                                 lights, params, part_counters, work, 0, 1)
-                else:  # adaptive anti-aliasing (kernels/adaptive.py)
-                    render_tiles_adaptive(part, self.framebuffer, compiled.geometry,
-                                          compiled.materials, lights, params,
-                                          part_counters, work, aa, float(antialias.threshold),
-                                          levels, 0, 1)
+                render_tiles(part, self.framebuffer, compiled.geometry, compiled.materials,
+                             lights, params, part_counters, work, aa, threshold, levels, 0, 1)
                 with lock:
                     tile_seconds[0] = (time.perf_counter() - run_start) / len(idx)
                     counters[idx] = part_counters

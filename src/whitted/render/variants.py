@@ -2,13 +2,14 @@
 rendering a tiny scene that needs it: what ``whitted warm`` compiles ahead of use.
 
 The render kernels are specialised on a scene's arrays (kernels/features.py): *plain* (no mesh
-instances, no tori or CSG objects) or *general* (either or both), and the render kernel has
-two kinds: plain and with *adaptive* anti-aliasing; the AOV kernel (depth, normal, id) is one
-more. Caustics need the photon tracer (compile/photon_map.py, its IEEE twins of the
-kernels, kernels/strict.py), one for each kind of geometry: the ``caustics`` variants compile
-only it. Their gather is a run-time choice of the render kernel (kernels/caustics.py), as are
-focal blur, area lights, textures and media, compiled with it: a render with caustics needs
-the ``render`` variant of its geometry and the ``caustics`` one, nothing else.
+instances, no tori or CSG objects) or *general* (either or both); the AOV kernel (depth,
+normal, id) is one more. Caustics need the photon tracer (compile/photon_map.py, its IEEE
+twins of the kernels, kernels/strict.py), one for each kind of geometry: the ``caustics``
+variants compile only it. Their gather is a run-time choice of the render kernel
+(kernels/caustics.py), as are adaptive anti-aliasing (kernels/adaptive.py), focal blur, area
+lights, textures and media, compiled with it: a render with caustics needs the ``render``
+variant of its geometry and the ``caustics`` one, a render with adaptive anti-aliasing the
+``render`` one alone.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from collections.abc import Callable
 #: the tiny scene of each kind of geometry: (with a mesh instance, with a torus); compile/
 #: scene.py gives either or both the general kernels
 GEOMETRY = {"plain": (False, False), "general": (True, True)}
-KINDS = ("render", "caustics", "adaptive", "aovs")
+KINDS = ("render", "caustics", "aovs")
 
 
 def variant_names() -> list[str]:
@@ -31,7 +32,7 @@ def tiny_scene(extras: bool, kind: str):
     light (caustics: the sphere focuses its photons), a torus for the extras, a small mesh
     (instanced when the variant asks for instances)."""
     from ..scene import Mesh, Plane, PointLight, RenderSettings, Scene, Sphere, Torus
-    from ..scene.scene import Antialias, CausticsSettings
+    from ..scene.scene import CausticsSettings
 
     objects = [Sphere(center=(0, 1, 0), radius=1.0, material={"preset": "glass"}),
                Plane(), Mesh(vertices=[[2, 0, 0], [3, 0, 0], [2, 1, 0]], faces=[[0, 1, 2]])]
@@ -40,8 +41,6 @@ def tiny_scene(extras: bool, kind: str):
     render = RenderSettings(width=4, height=3, threads=1, max_depth=3)
     if kind == "caustics":
         render = render.model_copy(update={"caustics": CausticsSettings(photons=2000)})
-    elif kind == "adaptive":
-        render = render.model_copy(update={"antialias": Antialias()})
     return Scene(objects=objects, lights=[PointLight(position=(0, 5, 0))], render=render)
 
 

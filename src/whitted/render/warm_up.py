@@ -160,14 +160,15 @@ def _stand_in_params(compiled: CompiledScene):
 
 
 def _compile_render_kernels(compiled: CompiledScene, aovs: bool = False) -> None:
-    from ..kernels.tiles import lane_workspace, render_aovs, render_tiles
+    from ..kernels.tiles import adaptive_workspace, lane_workspace, render_aovs, render_tiles
 
     params = _stand_in_params(compiled)
     fb = np.zeros((1, 1, 3), np.float32)
     counters = np.zeros((1, N_RAY_KINDS), np.int64)
     no_tiles = np.zeros((0, 4), np.int32)  # compiles (or loads) without rendering
     render_tiles(no_tiles, fb, compiled.geometry, compiled.materials, compiled.lights,
-                 params, counters, lane_workspace(params.max_depth), 0, 1)
+                 params, counters, lane_workspace(params.max_depth), adaptive_workspace(), 0.0,
+                 -1, 0, 1)
     if not aovs:
         return
     render_aovs(compiled.geometry, params._replace(height=0), np.zeros((1, 1), np.float32),
@@ -396,22 +397,18 @@ def _stop_helper(helper: subprocess.Popen | None) -> None:
         helper.wait()
 
 
-def warm_up_kernels(compiled: CompiledScene | None = None,
-                    render_kernel: bool = True, builders: bool = False) -> float:
+def warm_up_kernels(compiled: CompiledScene | None = None, builders: bool = False) -> float:
     """Compile (first run) or load from the on-disk cache (later runs) the render kernels for
     scenes like ``compiled`` (kernels are specialised for scenes with and without mesh
     instances; without when None); on the first run also the builders and the AOV kernel.
-    ``render_kernel=False``: a render that runs another kind of the render kernel (caustics,
-    adaptive anti-aliasing, loaded in its own stage) does not load the plain one when the
-    cache holds the variant. ``builders``: a cold compile compiles the builders too (a scene
-    too large for their Python twins: :func:`scene_needs_builders`). Returns the seconds it
-    took; 0 when all of it was already loaded in this process (or nothing had to be)."""
+    The render kernel serves uniform samples and adaptive anti-aliasing alike (a run-time
+    choice). ``builders``: a cold compile compiles the builders too (a scene too large for
+    their Python twins: :func:`scene_needs_builders`). Returns the seconds it took; 0 when
+    all of it was already loaded in this process (or nothing had to be)."""
     with _lock:
         key = _loaded_key(compiled)
         if key in _ready:
             return 0.0
-        if not render_kernel and kernels_cached(key[0]):
-            return 0.0  # the render's own kind loads in its stage
         instances = key[0]
         start = time.perf_counter()
         cache = prepare()
