@@ -15,7 +15,7 @@ import numpy as np
 
 from ..jit import kernel, numba_object
 from .accel import closest_hit, surface_normals
-from .adaptive import N_STATE, next_sample
+from .adaptive import N_STATE, next_sample, put_sample
 from .camera import camera_ray, lens_ray
 from .integrator import N_STACK_F, N_STACK_I, trace_path
 from .layout import (
@@ -111,13 +111,12 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
         y1 = tiles[t, 3]
         px = x0  # uniform samples: the pixel, its sample and their sums
         py = y0
-        s = 0
+        s = np.int64(0)  # typed int64 from the start: see trace_path's call below
         r = 0.0
         g = 0.0
         b = 0.0
         for k in range(N_STATE):  # adaptive: the walk from the tile's first corner
             state[k] = 0
-        c = (0.0, 0.0, 0.0)  # adaptive: the sample traced last, for next_sample to keep
         while True:
             if uniform:
                 if py >= y1 or px >= x1:
@@ -134,17 +133,19 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
                 o, d = camera_ray(params, px + jx, py + jy)
                 if params.focal_distance > 0.0:  # focal blur (0: a pinhole)
                     o, d = lens_ray(params, o, d, pixel, s)
-                sample = s
             else:  # a point of the finest grid: its index there is its sampler's "pixel"
                 o, d, pixel = next_sample(params, x0, y0, x1, y1, levels, threshold,
-                                          framebuffer, aa, c)
+                                          framebuffer, aa)
                 if pixel < 0:
                     break
-                sample = 0
             cnt[RAY_PRIMARY] += 1
-            c = trace_path(geo, mats, lights, params, o, d, pixel, sample, st_f, st_i, media,
+            # s: the sample's number (adaptive: always 0), never typed as a literal 0, for
+            # which Numba would compile direct_light a second time (the tuple (pixel, 0, ...)
+            # that trace_path hands it is typed with its items' types, literals included)
+            c = trace_path(geo, mats, lights, params, o, d, pixel, s, st_f, st_i, media,
                            scratch, stack, hits, listed, cnt)
             if not uniform:
+                put_sample(aa, c)
                 continue
             r += c[0]
             g += c[1]
@@ -158,7 +159,7 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
                 r = 0.0
                 g = 0.0
                 b = 0.0
-                s = 0
+                s = np.int64(0)
                 px += 1
                 if px == x1:
                     px = x0
