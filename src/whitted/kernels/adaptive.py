@@ -16,8 +16,8 @@ count or the order of the tiles.
 
 The render kernel (:func:`.tiles.render_tiles`) traces the samples: it has one call of the
 path tracer, for the uniform samples and these alike, so that the tracer is compiled into it
-once. This module says which sample it traces next (:func:`next_sample`) and keeps what
-it traced (:func:`put_sample`): the algorithm above as a walk that stops at each sample it still
+once. This module says which sample it traces next and keeps what it traced
+(:func:`next_sample`): the algorithm above as a walk that stops at each sample it still
 needs and resumes where it stopped, its state in the lane's scratch memory
 (:func:`.tiles.adaptive_workspace`).
 """
@@ -30,17 +30,18 @@ from .camera import camera_ray, lens_ray
 # the walk's state, st[...] of the scratch memory: which pass (0: the tile's corners, 1: its
 # pixels), the corner or pixel it is at, whether that pixel's squares are being split (their
 # stack then holds them), the stack's top, and the grid point (i, j) whose sample is awaited
-# (the corner pass: the corner's column and row in the tile)
+# (the corner pass: the corner's column and row in the tile), and whether it is awaited
 ST_PASS = 0
 ST_INDEX = 1
 ST_SPLITTING = 2
 ST_TOP = 3
 ST_I = 4
 ST_J = 5
-N_STATE = 6
+ST_PENDING = 6
+N_STATE = 7
 
 
-@kernel
+@kernel(numba_inline=True)  # Numba inlines it into next_sample: one compile fewer
 def corners_differ(g, i0, j0, i1, j1, threshold):
     """Do the four corners (i0|i1, j0|j1) of the sample grid ``g`` differ by more than
     ``threshold`` (any pair)? The distance of two samples is POV-Ray's (clamped to
@@ -60,12 +61,13 @@ def corners_differ(g, i0, j0, i1, j1, threshold):
 
 
 @kernel
-def next_sample(params, x0, y0, x1, y1, levels, threshold, framebuffer, aa):
+def next_sample(params, x0, y0, x1, y1, levels, threshold, framebuffer, aa, c):
     """The camera ray (o, d) of the sample the tile (x0, y0, x1, y1) needs next and its
     sampler's "pixel" (the point's index in the image's finest grid), or a key of -1 once
-    every pixel of the tile is in ``framebuffer``. ``aa``: the lane's scratch memory
-    (:func:`.tiles.adaptive_workspace`), its state zeroed at the tile's start; the sample
-    traced for the ray is handed back with :func:`put_sample` before the next call.
+    every pixel of the tile is in ``framebuffer``. ``c``: the sample (r, g, b) traced for
+    the ray of the call before (not read at the tile's first call). ``aa``: the lane's
+    scratch memory (:func:`.tiles.adaptive_workspace`), its state zeroed at the tile's
+    start.
 
     First the corners of every pixel, row by row; then pixel by pixel: a pixel whose corners
     differ has its squares split (a stack of squares, depth first: a square's four corners,
@@ -80,6 +82,17 @@ def next_sample(params, x0, y0, x1, y1, levels, threshold, framebuffer, aa):
     """
     corners, grid, known, squares, st, acc = aa
     fine = 1 << levels
+    if st[ST_PENDING] != 0:  # keep the sample asked for last
+        i = st[ST_I]
+        j = st[ST_J]
+        if st[ST_PASS] == 0:  # a corner of the tile's pixels
+            for k in range(3):
+                corners[j, i, k] = c[k]
+            st[ST_INDEX] += 1
+        else:  # a point of the pixel's sample grid
+            for k in range(3):
+                grid[j, i, k] = c[k]
+            known[j, i] = 1
     gx = -1
     gy = -1
     cols = x1 - x0 + 1
@@ -168,6 +181,7 @@ def next_sample(params, x0, y0, x1, y1, levels, threshold, framebuffer, aa):
                 acc[k] += (grid[j, i, k] + grid[j, i + size, k] + grid[j + size, i, k]
                            + grid[j + size, i + size, k]) * w4
         st[ST_TOP] = top
+    st[ST_PENDING] = gx >= 0
     if gx < 0:
         return params.camera_origin, params.camera_forward, -1
     key = gy * (params.width * fine + 1) + gx
@@ -176,20 +190,3 @@ def next_sample(params, x0, y0, x1, y1, levels, threshold, framebuffer, aa):
         o, d = lens_ray(params, o, d, key, 0)
     return o, d, key
 
-
-@kernel
-def put_sample(aa, c):
-    """Keep the sample ``c`` (r, g, b) traced for the ray :func:`next_sample` made last."""
-    corners, grid, known, squares, st, acc = aa
-    i = st[ST_I]
-    j = st[ST_J]
-    if st[ST_PASS] == 0:  # a corner of the tile's pixels
-        corners[j, i, 0] = c[0]
-        corners[j, i, 1] = c[1]
-        corners[j, i, 2] = c[2]
-        st[ST_INDEX] += 1
-    else:  # a point of the pixel's sample grid
-        grid[j, i, 0] = c[0]
-        grid[j, i, 1] = c[1]
-        grid[j, i, 2] = c[2]
-        known[j, i] = 1

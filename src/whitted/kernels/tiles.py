@@ -15,7 +15,7 @@ import numpy as np
 
 from ..jit import kernel, numba_object
 from .accel import closest_hit, surface_normals
-from .adaptive import N_STATE, next_sample, put_sample
+from .adaptive import N_STATE, next_sample
 from .camera import camera_ray, lens_ray
 from .integrator import N_STACK_F, N_STACK_I, trace_path
 from .layout import (
@@ -117,6 +117,7 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
         b = 0.0
         for k in range(N_STATE):  # adaptive: the walk from the tile's first corner
             state[k] = 0
+        c = (0.0, 0.0, 0.0)  # adaptive: the sample traced last, kept by next_sample
         while True:
             if uniform:
                 if py >= y1 or px >= x1:
@@ -135,7 +136,7 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
                     o, d = lens_ray(params, o, d, pixel, s)
             else:  # a point of the finest grid: its index there is its sampler's "pixel"
                 o, d, pixel = next_sample(params, x0, y0, x1, y1, levels, threshold,
-                                          framebuffer, aa)
+                                          framebuffer, aa, c)
                 if pixel < 0:
                     break
             cnt[RAY_PRIMARY] += 1
@@ -145,7 +146,6 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
             c = trace_path(geo, mats, lights, params, o, d, pixel, s, st_f, st_i, media,
                            scratch, stack, hits, listed, cnt)
             if not uniform:
-                put_sample(aa, c)
                 continue
             r += c[0]
             g += c[1]
