@@ -193,8 +193,8 @@ def advect_enthalpy(H, box0, u, v, w, frac, heat, dt, dx, flat, out):
     heat ``heat`` (J/m³, per cell of the box) of the cell the flow comes from, through a face
     open by the lesser liquid fraction ``frac`` of its two cells), added to the padded
     enthalpy ``H`` whose cell (i, j, k) of the box is ``box0`` + (i, j, k). ``out`` is scratch
-    (the change per cell). Each face's flux is added to one cell and taken from the other:
-    the total enthalpy does not change."""
+    (the change per cell, added to ``H`` as it is computed: no term reads ``H``). Each face's
+    flux is added to one cell and taken from the other: the total enthalpy does not change."""
     n0, n1, n2 = frac.shape
     g = dt / dx
     for i in prange(n0):
@@ -223,9 +223,6 @@ def advect_enthalpy(H, box0, u, v, w, frac, heat, dt, dx, flat, out):
                         a = w[i, j, k + 1] * min(fc, frac[i, j, k + 1])
                         s -= a * (hc if a > 0.0 else heat[i, j, k + 1])
                 out[i, j, k] = g * s
-    for i in prange(n0):
-        for j in range(n1):
-            for k in range(n2):
                 H[box0[0] + i, box0[1] + j, box0[2] + k] += out[i, j, k]
 
 

@@ -324,19 +324,6 @@ def _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain
 
 
 @builder(entry=False)
-def _surface_cells(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain, air_h,
-                   air_ice, air_t, surface, order, e0, e1, scale, out, rescale, occ,
-                   is_surface):
-    """:func:`_surface_cell` for the list's cells ``order[e0:e1]``, in that order: its one
-    inlined copy, which both step kernels call (a call per slab or step, not per cell)."""
-    for e in range(e0, e1):
-        m = order[e]
-        _surface_cell(H, kind, Hn, p, dt, dx, face_h, face_inv_h, face_t, face_drain, air_h,
-                      air_ice, air_t, surface[m, 0], surface[m, 1], surface[m, 2], scale, out,
-                      m, rescale, occ, is_surface)
-
-
-@builder(entry=False)
 def _air_coefficients(air_h, p, dx):
     """Per face direction, the air film's conductance to an ice cell's centre,
     1 / (1/h + dx / 2 k_i) (0 where h is 0; 2 k_i / dx where h is infinite)."""
@@ -439,6 +426,12 @@ def _copy(a, b):
                 b[i, j, k] = a[i, j, k]
 
 
+@builder(entry=False)
+def _zeros_rows(n):
+    """An (n, 4) array of zeros: ``np.zeros`` compiled without the parallel option."""
+    return np.zeros((n, 4))
+
+
 @builder(parallel=True)
 def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
                        air_t, surface, scale, n_surface, is_surface, n_steps, totals,
@@ -448,7 +441,7 @@ def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h
     drained cells; ``n_surface[0]`` is the surface list's length (grows as cells drain).
     Returns the steps done: fewer when a breach is signalled and ``stop_on_breach``."""
     nx = H.shape[0] - 2
-    out = np.zeros((surface.shape[0], 4))
+    out = _zeros_rows(surface.shape[0])  # (np.zeros here would be a parallel loop of its own)
     face_inv_h = np.empty(6)
     for f in range(6):
         face_inv_h[f] = _inverse(face_h[f])
@@ -472,10 +465,13 @@ def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h
             rw = rows[c]
             _conduct_slab(src, kind, dst, p, g, i0, i1, pl[0], pl[1], pl[2], pl[3], pl[4],
                           pl[5], rw[0], rw[1], rw[2])
-            _surface_cells(src, kind, dst, p, dt, dx, face_h, face_inv_h, face_t,
-                           face_drain, air_h, air_ice, air_t, surface, plane_cells,
-                           plane_start[i0 - 1], plane_start[i1 - 1], scale, out, rescale,
-                           occs[c], is_surface)
+            occ = occs[c]
+            for e in range(plane_start[i0 - 1], plane_start[i1 - 1]):
+                m = plane_cells[e]
+                _surface_cell(src, kind, dst, p, dt, dx, face_h, face_inv_h, face_t,
+                              face_drain, air_h, air_ice, air_t, surface[m, 0],
+                              surface[m, 1], surface[m, 2], scale, out, m, rescale, occ,
+                              is_surface)
         breach = 0.0
         drains = 0.0
         for m in range(ns):  # in list order: no dependence on the thread count
@@ -519,14 +515,15 @@ def run_steps_serial(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
         planes[0, 4], planes[0, 5]
     fya, fyb, fz = rows[0, 0], rows[0, 1], rows[0, 2]
     occ = occs[0]
-    order = np.arange(surface.shape[0])  # the list in its own order
     for step in range(n_steps):
         _conduct_slab(src, kind, dst, p, g, 1, nx + 1, ta, ka, tb, kb, fxa, fxb, fya, fyb, fz)
         ns = n_surface[0]
         rescale = (first_step + step) % rescale_every == 0
-        _surface_cells(src, kind, dst, p, dt, dx, face_h, face_inv_h, face_t, face_drain,
-                       air_h, air_ice, air_t, surface, order, 0, ns, scale, out, rescale, occ,
-                       is_surface)
+        for m in range(ns):
+            _surface_cell(src, kind, dst, p, dt, dx, face_h, face_inv_h,
+                          face_t, face_drain, air_h, air_ice, air_t, surface[m, 0],
+                          surface[m, 1], surface[m, 2], scale, out, m, rescale, occ,
+                              is_surface)
         breach = 0.0
         drains = 0.0
         for m in range(ns):
@@ -552,7 +549,7 @@ def run_steps_serial(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
 def total_enthalpy(H, kind):
     """Sum of H over body cells (J/m³ times cells), in a fixed order."""
     nx, ny, nz = H.shape
-    rows = np.zeros(nx * ny)
+    rows = np.empty(nx * ny)  # every row written below (np.zeros: a parallel loop of its own)
     for q in prange(nx * ny):
         i = q // ny
         j = q - i * ny
