@@ -42,6 +42,9 @@ COARSEST_SWEEPS = 24
 #: than the work of a small level)
 PARALLEL_MIN_CELLS = 4096
 
+# Each level kernel below calls its plane function from its parallel loop and from its serial
+# one: a call, not Numba's inlining, so each plane function is compiled once (inlined, it was
+# compiled into both loops; the solve within 2 % of its speed, docs/performance.md).
 
 @builder(entry=False, error_model="numpy")
 def _apply_plane(wx, wy, wz, d, x, out, o, n0, n1, n2, i):
