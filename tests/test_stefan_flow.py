@@ -331,6 +331,31 @@ def test_the_coupled_flow_has_the_same_bits_on_one_thread_and_two():
         assert np.array_equal(a, b)
 
 
+def test_the_total_enthalpy_has_the_same_bits_on_one_thread_and_two():
+    # a block whose rows' sums round differently when added in another grouping
+    import numba
+
+    from whitted.stefan import kernels
+
+    rng = np.random.default_rng(7)
+    H = rng.uniform(-1e6, 1e9, (48, 48, 5)) * 10.0 ** rng.integers(-8, 8, (48, 48, 5))
+    kind = np.full(H.shape, kernels.BODY, np.int8)
+    kind[rng.random(H.shape) < 0.2] = kernels.BODY + 1  # not all cells are body cells
+    in_order = 0.0
+    for i in range(48):
+        for j in range(48):
+            in_order += sum(H[i, j, k] for k in range(5) if kind[i, j, k] == kernels.BODY)
+    found = []
+    before = numba.get_num_threads()
+    try:
+        for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+            numba.set_num_threads(threads)
+            found.append(kernels.total_enthalpy(H, kind))
+    finally:
+        numba.set_num_threads(before)
+    assert found[0] == found[1] == in_order
+
+
 def test_gallium_in_a_cell_of_finite_depth():
     # the same cavity 3.81 cm deep between no-slip adiabatic walls (3-D, 9 cells deep at
     # 4 mm): the fronts on its middle plane; measured at 2 min top/middle/bottom

@@ -558,4 +558,7 @@ def total_enthalpy(H, kind):
             if kind[i, j, k] == BODY:
                 s += H[i, j, k]
         rows[q] = s
-    return rows.sum()
+    total = 0.0  # the rows' sums added in order (rows.sum() would be a parallel reduction,
+    for q in range(nx * ny):  # its order, so its last bits, the thread count's)
+        total += rows[q]
+    return total
