@@ -13,10 +13,9 @@ from .accel import (
     hit_analytic,
     hit_material,
     instance_occludes,
-    occludes,
 )
 from .csg import csg_surfaces
-from .extras import body_medium
+from .extras import body_medium, extra_hit
 from .features import extras_possible, has_extras, has_instances, instances_possible
 from .hit_list import MAX_SHADOW_HITS, keep_nearest
 from .layout import (
@@ -132,8 +131,10 @@ def listed_occlusion(geo, mats, occluders, first, count, o, d, tmin, tmax, stack
     inv = inverse_direction(d)
     for k in range(first, first + count):
         i = occluders[k]
-        if i >= 0:
-            state = occludes(geo, mats, i, o, d, tmin, tmax)
+        if i >= 0:  # an analytic primitive: no hit, opaque (1) or transparent (2)
+            if hit_analytic(geo, i, o, d, tmin, tmax) == INF:
+                continue
+            state = 1 if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT else 2
         else:
             state = _instance_leaf_occlusion(geo, mats, -1 - i, o, d, inv, tmin, tmax, stack)
         if state == 1:
@@ -173,10 +174,12 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
                                                          leaf, leaf_end, top, False)
         if i < 0:
             break
-        state = occludes(geo, mats, i, o, d, tmin, tmax)
-        if state == 1:
+        if hit_analytic(geo, i, o, d, tmin, tmax) == INF:
+            continue
+        if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT:
             return 1
-        seen_transparent = max(seen_transparent, state)
+        seen_transparent = 2  # a transparent surface (written here, not a call: the
+        # intersection code is optimised once per separately compiled level)
     if has_instances(geo):
         state = instances_occlusion_if_instances(geo, mats, o, d, inv, tmin, tmax, stack)
         if state == 1:
@@ -376,12 +379,14 @@ def gather_extra_hits(geo, i, o, d, inv, tmin, tmax, step, hits, n, full):
     a torus's each found from past the one before (up to four)."""
     if is_csg_object(geo.prim_info[i, PRIM_TYPE]):
         return csg_surfaces(geo, i, o, d, inv, tmin, tmax, hits, n, full)
-    t = hit_analytic(geo, i, o, d, tmin, tmax)
+    # the torus straight through extras.py's test (hit_analytic would bring every core
+    # shape's test in twice)
+    t, _ = extra_hit(geo, i, o, d, inv, tmin, tmax)
     for _ in range(4):
         if t == INF:
             break
         n, full = keep_nearest(hits, n, t, i, full)
-        t = hit_analytic(geo, i, o, d, t * (1.0 + 1e-12) + step, tmax)
+        t, _ = extra_hit(geo, i, o, d, inv, t * (1.0 + 1e-12) + step, tmax)
     return n, full
 
 
