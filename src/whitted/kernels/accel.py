@@ -20,6 +20,7 @@ from .extras import (
 )
 from .features import has_extras, has_instances, instances_possible
 from .layout import (
+    MAT_KT,
     MESH_NORMALS,
     MESH_STACK_BASE,
     PRIM_MATERIAL,
@@ -27,6 +28,7 @@ from .layout import (
     PRIM_XFORM,
 )
 from .mesh import (
+    OPAQUE_KT,
     embree_closest_hit,
     embree_occlusion,
     mesh_closest_hit,
@@ -87,8 +89,7 @@ def hit_instance(geo, i, o, d, inv, tmin, tmax, stack):
 
 @kernel
 def instance_occludes(geo, mats, i, o, d, inv, tmin, tmax, stack):
-    """Does mesh instance ``i`` block the segment (tmin, tmax)? 0: no; 1: opaquely; 2: only
-    through a transparent surface (``inv`` as in :func:`hit_instance`)."""
+    """:func:`occludes` for a mesh instance (``inv`` as in :func:`hit_instance`)."""
     xf = geo.prim_info[i, PRIM_XFORM]
     mesh = int(geo.prim_params[i, 0])
     material = geo.prim_info[i, PRIM_MATERIAL]
@@ -101,6 +102,15 @@ def instance_occludes(geo, mats, i, o, d, inv, tmin, tmax, stack):
         inv = inverse_direction(d)
     return mesh_occlusion(geo, mats, mesh, material, o, d, inv, tmin, tmax, stack,
                           MESH_STACK_BASE)
+
+
+@kernel
+def occludes(geo, mats, i, o, d, tmin, tmax):
+    """Does analytic primitive ``i`` block the segment (tmin, tmax)? 0: no; 1: opaquely;
+    2: only through a transparent surface."""
+    if hit_analytic(geo, i, o, d, tmin, tmax) == INF:
+        return 0
+    return 1 if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT else 2
 
 
 @kernel

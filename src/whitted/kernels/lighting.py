@@ -13,6 +13,7 @@ from .accel import (
     hit_analytic,
     hit_material,
     instance_occludes,
+    occludes,
 )
 from .csg import csg_surfaces
 from .extras import body_medium, extra_hit
@@ -131,10 +132,8 @@ def listed_occlusion(geo, mats, occluders, first, count, o, d, tmin, tmax, stack
     inv = inverse_direction(d)
     for k in range(first, first + count):
         i = occluders[k]
-        if i >= 0:  # an analytic primitive: no hit, opaque (1) or transparent (2)
-            if hit_analytic(geo, i, o, d, tmin, tmax) == INF:
-                continue
-            state = 1 if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT else 2
+        if i >= 0:
+            state = occludes(geo, mats, i, o, d, tmin, tmax)
         else:
             state = _instance_leaf_occlusion(geo, mats, -1 - i, o, d, inv, tmin, tmax, stack)
         if state == 1:
@@ -174,12 +173,10 @@ def any_occluder(geo, mats, o, d, tmin, tmax, stack):
                                                          leaf, leaf_end, top, False)
         if i < 0:
             break
-        if hit_analytic(geo, i, o, d, tmin, tmax) == INF:
-            continue
-        if mats[geo.prim_info[i, PRIM_MATERIAL], MAT_KT] < OPAQUE_KT:
+        state = occludes(geo, mats, i, o, d, tmin, tmax)
+        if state == 1:
             return 1
-        seen_transparent = 2  # a transparent surface (written here, not a call: the
-        # intersection code is optimised once per separately compiled level)
+        seen_transparent = max(seen_transparent, state)
     if has_instances(geo):
         state = instances_occlusion_if_instances(geo, mats, o, d, inv, tmin, tmax, stack)
         if state == 1:
