@@ -59,7 +59,8 @@ def main() -> None:
         setattr(obj, name, timed)
 
     if not args.whole:
-        for name in ("predict", "divergence", "correct", "advect_enthalpy", "kell_buoyancy"):
+        for name in ("predict", "predict_inner", "divergence", "correct", "advect_enthalpy",
+                     "kell_buoyancy"):
             if hasattr(flow_kernels, name):
                 wrap(flow_kernels, name, name)
         masked = solver.flow.flow._masked

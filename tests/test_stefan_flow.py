@@ -34,6 +34,35 @@ def test_the_projection_leaves_no_divergence(shape):
     np.testing.assert_allclose(p.solve(lap), phi, atol=1e-10)
 
 
+@pytest.mark.parametrize("shape, axes", [((7, 6, 5), (2, 1, 0)), ((7, 6, 1), (1, 0, 2))])
+def test_the_two_predictor_loop_orders_give_the_same_bits(shape, axes):
+    # predict_inner (the loop along the views' axis 0 innermost: a 3-D box's w, a flat box's
+    # v, on Fortran-ordered views) against predict (the loop along axis 2 innermost) on
+    # C-ordered copies of the same views: the same operations per face, so the same bits
+    from whitted.stefan import flow_kernels as fk
+
+    rng = np.random.default_rng(7)
+    flat = shape[2] == 1
+    n0, n1, n2 = shape
+    u, v = rng.normal(size=(n0 + 1, n1, n2)), rng.normal(size=(n0, n1 + 1, n2))
+    w = rng.normal(size=(n0, n1, n2 + 1))
+    force, sink = rng.normal(size=shape), np.abs(rng.normal(size=shape))
+    if flat:  # v's equation; u stands in for w, which a flat box never reads
+        q, p, r = v.transpose(axes), u.transpose(axes), u.transpose(axes)
+        out = np.zeros_like(v).transpose(axes)
+    else:  # w's equation
+        q, p, r = w.transpose(axes), v.transpose(axes), u.transpose(axes)
+        out = np.zeros_like(w).transpose(axes)
+    views = [q, p, r, force.transpose(axes), sink.transpose(axes)]
+    assert all(a.flags.f_contiguous and not a.flags.c_contiguous for a in views + [out])
+    fk.predict_inner(q, p, r, 0.3, 1e-3, 0.1, views[3], views[4], out, flat)
+    copies = [np.ascontiguousarray(a) for a in views]
+    reference = np.full(out.shape, np.nan)
+    fk.predict(*copies[:3], 0.3, 1e-3, 0.1, copies[3], copies[4], reference, flat)
+    assert np.array_equal(out, reference)
+    assert np.count_nonzero(reference) > 0.5 * reference.size
+
+
 @pytest.mark.parametrize("ra, nu_tol, vel_tol", [(1e3, 0.005, 0.006), (1e4, 0.015, 0.01)])
 def test_de_vahl_davis_square_cavity_at_32_cells(ra, nu_tol, vel_tol):
     # measured at 32²: Ra 1e3 Nu 1.1199 (+0.17 %), u_max 3.663 (+0.39 %), v_max 3.711
@@ -300,6 +329,31 @@ def test_the_coupled_flow_has_the_same_bits_on_one_thread_and_two():
     assert solver.flow.speed() > 0.0
     for a, b in zip(found[0], found[1], strict=True):
         assert np.array_equal(a, b)
+
+
+def test_the_total_enthalpy_has_the_same_bits_on_one_thread_and_two():
+    # a block whose rows' sums round differently when added in another grouping
+    import numba
+
+    from whitted.stefan import kernels
+
+    rng = np.random.default_rng(7)
+    H = rng.uniform(-1e6, 1e9, (48, 48, 5)) * 10.0 ** rng.integers(-8, 8, (48, 48, 5))
+    kind = np.full(H.shape, kernels.BODY, np.int8)
+    kind[rng.random(H.shape) < 0.2] = kernels.BODY + 1  # not all cells are body cells
+    in_order = 0.0
+    for i in range(48):
+        for j in range(48):
+            in_order += sum(H[i, j, k] for k in range(5) if kind[i, j, k] == kernels.BODY)
+    found = []
+    before = numba.get_num_threads()
+    try:
+        for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+            numba.set_num_threads(threads)
+            found.append(kernels.total_enthalpy(H, kind))
+    finally:
+        numba.set_num_threads(before)
+    assert found[0] == found[1] == in_order
 
 
 def test_gallium_in_a_cell_of_finite_depth():

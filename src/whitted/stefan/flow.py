@@ -224,18 +224,22 @@ class Flow:
     def _predict(self, dt: float, buoyancy: np.ndarray, sink: np.ndarray) -> None:
         dx, nu, flat = self.dx, self.nu, self.flat
         t = (1, 0, 2)
-        fk.predict(self.u, self.v, self.w, nu, dt, dx, self._zero, sink, self._u, flat, False)
-        # a flat box's views along v are Fortran-ordered (a length-1 last axis), those of
-        # its two-face-deep w are not; w is not read there (flat), so u's view stands in
-        # for it and the kernel is the one compiled for the last component of a 3-D box
+        fk.predict(self.u, self.v, self.w, nu, dt, dx, self._zero, sink, self._u, flat)
+        # a flat box's views along v are Fortran-ordered (a length-1 last axis), its axis 0
+        # the contiguous one: the kernel of a 3-D box's last component, whose inner loop runs
+        # along axis 0; w is not read there (flat), so u's view stands in for it (the
+        # two-face-deep w's view would not be Fortran-ordered)
         p = self.u.transpose(t)
-        fk.predict(self.v.transpose(t), p, p if flat else self.w.transpose(t), nu, dt, dx,
-                   buoyancy.transpose(t), sink.transpose(t), self._v.transpose(t), flat, False)
-        if not flat:
+        if flat:
+            fk.predict_inner(self.v.transpose(t), p, p, nu, dt, dx, buoyancy.transpose(t),
+                             sink.transpose(t), self._v.transpose(t), True)
+        else:
+            fk.predict(self.v.transpose(t), p, self.w.transpose(t), nu, dt, dx,
+                       buoyancy.transpose(t), sink.transpose(t), self._v.transpose(t), False)
             t = (2, 1, 0)
-            fk.predict(self.w.transpose(t), self.v.transpose(t), self.u.transpose(t), nu, dt,
-                       dx, self._zero.transpose(t), sink.transpose(t), self._w.transpose(t),
-                       False, True)
+            fk.predict_inner(self.w.transpose(t), self.v.transpose(t), self.u.transpose(t),
+                             nu, dt, dx, self._zero.transpose(t), sink.transpose(t),
+                             self._w.transpose(t), False)
         self.u, self._u = self._u, self.u
         self.v, self._v = self._v, self.v
         self.w, self._w = self._w, self.w

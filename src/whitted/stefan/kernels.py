@@ -426,6 +426,12 @@ def _copy(a, b):
                 b[i, j, k] = a[i, j, k]
 
 
+@builder(entry=False)
+def _zeros_rows(n):
+    """An (n, 4) array of zeros: ``np.zeros`` compiled without the parallel option."""
+    return np.zeros((n, 4))
+
+
 @builder(parallel=True)
 def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
                        air_t, surface, scale, n_surface, is_surface, n_steps, totals,
@@ -435,7 +441,7 @@ def run_steps_parallel(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h
     drained cells; ``n_surface[0]`` is the surface list's length (grows as cells drain).
     Returns the steps done: fewer when a breach is signalled and ``stop_on_breach``."""
     nx = H.shape[0] - 2
-    out = np.zeros((surface.shape[0], 4))
+    out = _zeros_rows(surface.shape[0])  # (np.zeros here would be a parallel loop of its own)
     face_inv_h = np.empty(6)
     for f in range(6):
         face_inv_h[f] = _inverse(face_h[f])
@@ -543,7 +549,7 @@ def run_steps_serial(H, kind, Hn, p, dt, dx, face_h, face_t, face_drain, air_h,
 def total_enthalpy(H, kind):
     """Sum of H over body cells (J/m³ times cells), in a fixed order."""
     nx, ny, nz = H.shape
-    rows = np.zeros(nx * ny)
+    rows = np.empty(nx * ny)  # every row written below (np.zeros: a parallel loop of its own)
     for q in prange(nx * ny):
         i = q // ny
         j = q - i * ny
@@ -552,4 +558,7 @@ def total_enthalpy(H, kind):
             if kind[i, j, k] == BODY:
                 s += H[i, j, k]
         rows[q] = s
-    return rows.sum()
+    total = 0.0  # the rows' sums added in order (rows.sum() would be a parallel reduction,
+    for q in range(nx * ny):  # its order, so its last bits, the thread count's)
+        total += rows[q]
+    return total

@@ -42,8 +42,11 @@ COARSEST_SWEEPS = 24
 #: than the work of a small level)
 PARALLEL_MIN_CELLS = 4096
 
+# Each level kernel below calls its plane function from its parallel loop and from its serial
+# one: a call, not Numba's inlining, so each plane function is compiled once (inlined, it was
+# compiled into both loops; the solve within 2 % of its speed, docs/performance.md).
 
-@builder(entry=False, error_model="numpy", numba_inline=True)
+@builder(entry=False, error_model="numpy")
 def _apply_plane(wx, wy, wz, d, x, out, o, n0, n1, n2, i):
     s1 = n1 * n2
     for j in range(n1):
@@ -72,14 +75,14 @@ def _apply_plane(wx, wy, wz, d, x, out, o, n0, n1, n2, i):
 def _apply(wx, wy, wz, d, x, out, o, n0, n1, n2):
     """out = A x on level (o, n0, n1, n2)."""
     if n0 * n1 * n2 >= PARALLEL_MIN_CELLS:
-        for i in prange(n0):
+        for i in prange(0, n0):  # an int64 index (prange(n0)'s is unsigned)
             _apply_plane(wx, wy, wz, d, x, out, o, n0, n1, n2, i)
     else:
         for i in range(n0):
             _apply_plane(wx, wy, wz, d, x, out, o, n0, n1, n2, i)
 
 
-@builder(entry=False, error_model="numpy", numba_inline=True)
+@builder(entry=False, error_model="numpy")
 def _sweep_plane(wx, wy, wz, d, b, x, o, n0, n1, n2, color, i):
     s1 = n1 * n2
     for j in range(n1):
@@ -108,14 +111,14 @@ def _sweep(wx, wy, wz, d, b, x, o, n0, n1, n2, color):
     """One Gauss-Seidel pass over the cells with (i + j + k) % 2 == color (their neighbours
     all of the other colour: the order within a pass does not matter)."""
     if n0 * n1 * n2 >= PARALLEL_MIN_CELLS:
-        for i in prange(n0):
+        for i in prange(0, n0):  # an int64 index (prange(n0)'s is unsigned)
             _sweep_plane(wx, wy, wz, d, b, x, o, n0, n1, n2, color, i)
     else:
         for i in range(n0):
             _sweep_plane(wx, wy, wz, d, b, x, o, n0, n1, n2, color, i)
 
 
-@builder(entry=False, error_model="numpy", numba_inline=True)
+@builder(entry=False, error_model="numpy")
 def _restrict_plane(wx, wy, wz, d, b, x, bc, fo, n0, n1, n2, co, m1, m2, c0, c1, c2, ci):
     s1 = n1 * n2
     base = co + ci * m1 * m2
@@ -148,7 +151,7 @@ def _restrict_plane(wx, wy, wz, d, b, x, bc, fo, n0, n1, n2, co, m1, m2, c0, c1,
 def _restrict(wx, wy, wz, d, b, x, bc, fo, n0, n1, n2, co, m0, m1, m2, c0, c1, c2):
     """bc (coarse) = the sum over each block of the fine residual b - A x."""
     if n0 * n1 * n2 >= PARALLEL_MIN_CELLS:
-        for ci in prange(m0):
+        for ci in prange(0, m0):  # an int64 index (prange(m0)'s is unsigned)
             _restrict_plane(wx, wy, wz, d, b, x, bc, fo, n0, n1, n2, co, m1, m2, c0, c1, c2,
                             ci)
     else:
@@ -157,7 +160,7 @@ def _restrict(wx, wy, wz, d, b, x, bc, fo, n0, n1, n2, co, m0, m1, m2, c0, c1, c
                             ci)
 
 
-@builder(entry=False, error_model="numpy", numba_inline=True)
+@builder(entry=False, error_model="numpy")
 def _prolong_plane(d, x, fo, n1, n2, co, m1, m2, c0, c1, c2, i):
     s1 = n1 * n2
     for j in range(n1):
@@ -171,7 +174,7 @@ def _prolong_plane(d, x, fo, n1, n2, co, m1, m2, c0, c1, c2, i):
 def _prolong(d, x, fo, n0, n1, n2, co, m1, m2, c0, c1, c2):
     """x (fine) += the coarse x of each fluid cell's block."""
     if n0 * n1 * n2 >= PARALLEL_MIN_CELLS:
-        for i in prange(n0):
+        for i in prange(0, n0):  # an int64 index (prange(n0)'s is unsigned)
             _prolong_plane(d, x, fo, n1, n2, co, m1, m2, c0, c1, c2, i)
     else:
         for i in range(n0):
