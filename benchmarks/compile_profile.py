@@ -66,7 +66,7 @@ def llvm_passes(buffer, top: int) -> None:
             if (id(disp), sig) in seen:
                 continue
             seen.add((id(disp), sig))
-            timings = cres.metadata.get("llvm_pass_timings")
+            timings = (cres.metadata or {}).get("llvm_pass_timings")
             if timings is None:
                 continue
             function = module = 0.0

@@ -14,9 +14,8 @@ import numpy as np
 
 from ..jit import kernel, overload
 from .extras import (
-    csg_hit_if_extras,
+    extra_hit_if_extras,
     extra_normal_if_extras,
-    extra_t_if_extras,
     flipped_if_extras,
 )
 from .features import has_extras, has_instances, instances_possible
@@ -40,7 +39,6 @@ from .shapes import INF
 from .shapes.dispatch import (
     has_shading_normal,
     intersect_local,
-    is_csg_object,
     is_extra,
     normal_local,
 )
@@ -63,22 +61,14 @@ def hit_analytic(geo, i, o, d, tmin, tmax):
     """t of the ray with analytic primitive ``i`` (INF on a miss). Inlined into the traversal
     loops (in kernels for scenes with tori or CSG it would otherwise be a call per candidate,
     and the torus and the CSG walk stay calls behind it, made only for them)."""
+    typ = geo.prim_info[i, PRIM_TYPE]
+    if has_extras(geo) and is_extra(typ):  # tori, CSG (compiled only where used)
+        t, _ = extra_hit_if_extras(geo, i, o, d, inverse_direction(d), tmin, tmax)
+        return t
     xf = geo.prim_info[i, PRIM_XFORM]
     if xf >= 0:
         o, d = to_object(geo.xforms, xf, o, d)
-    typ = geo.prim_info[i, PRIM_TYPE]
-    if has_extras(geo) and is_extra(typ):  # tori, CSG (compiled only where used)
-        return extra_t_if_extras(geo, i, o, d, tmin, tmax)
     return intersect_local(typ, geo.prim_params, i, o, d, tmin, tmax)
-
-
-@kernel(inline="always")
-def hit_part(geo, i, o, d, inv, tmin, tmax):
-    """(t, the primitive whose surface it is) for analytic primitive ``i``: ``i`` itself, or
-    for a CSG object the leaf whose surface shows (``inv``: the ray's inverse direction)."""
-    if has_extras(geo) and is_csg_object(geo.prim_info[i, PRIM_TYPE]):
-        return csg_hit_if_extras(geo, i, o, d, inv, tmin, tmax)
-    return hit_analytic(geo, i, o, d, tmin, tmax), np.int64(i)
 
 
 @kernel
@@ -266,7 +256,14 @@ def closest_hit(geo, o, d, tmin, tmax, stack):
                                                          j, leaf, leaf_end, top, True)
         if i < 0:
             break
-        t, part = hit_part(geo, i, o, d, inv, tmin, best_t)
+        # (t, the primitive whose surface it is): ``i`` itself, or for a CSG object the leaf
+        # whose surface shows; tori and CSG objects through the call hit_analytic makes, so
+        # their code is linked in once
+        if has_extras(geo) and is_extra(geo.prim_info[i, PRIM_TYPE]):
+            t, part = extra_hit_if_extras(geo, i, o, d, inv, tmin, best_t)
+        else:
+            t = hit_analytic(geo, i, o, d, tmin, best_t)
+            part = np.int64(i)
         if t < best_t:
             best_t = t
             best = part

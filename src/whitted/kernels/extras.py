@@ -13,43 +13,38 @@ import numpy as np
 from ..jit import kernel, overload
 from .csg import csg_hit
 from .features import extras_possible
-from .layout import PRIM_FLIP, PRIM_MEDIUM, PRIM_TYPE
+from .layout import PRIM_FLIP, PRIM_MEDIUM, PRIM_TYPE, PRIM_XFORM
 from .shapes import INF
 from .shapes.dispatch import extra_shape_normal, extra_shape_t, extra_shape_uv, is_csg_object
-from .traverse import inverse_direction
+from .xform import to_object
 
 
 @kernel
-def extra_t(geo, i, o, d, tmin, tmax):
-    """Nearest visible crossing in (tmin, tmax) of extra shape ``i`` (``o``, ``d`` in its
-    row's space)."""
+def extra_hit(geo, i, o, d, inv, tmin, tmax):
+    """(t, the primitive whose surface it is) of the nearest visible crossing in
+    (tmin, tmax) of extra shape ``i``, or (INF, -1) for a CSG object the ray misses: a
+    torus (the world ray mapped into its row's space here) or a CSG object (the leaf whose
+    surface shows; a CSG root row has no transform of its own, and ``inv`` is the ray's
+    inverse direction). The one call site of the CSG walk and the torus's quartic for both
+    the closest hit and the shadow rays' tests (accel.py ``closest_hit``, ``hit_analytic``)."""
     typ = geo.prim_info[i, PRIM_TYPE]
     if is_csg_object(typ):
-        t, _ = csg_hit(geo, i, o, d, inverse_direction(d), tmin, tmax)
-        return t
-    return extra_shape_t(typ, geo.prim_params, i, o, d, tmin, tmax)
+        return csg_hit(geo, i, o, d, inv, tmin, tmax)
+    xf = geo.prim_info[i, PRIM_XFORM]
+    if xf >= 0:
+        o, d = to_object(geo.xforms, xf, o, d)
+    return extra_shape_t(typ, geo.prim_params, i, o, d, tmin, tmax), np.int64(i)
 
 
-def extra_t_if_extras(geo, i, o, d, tmin, tmax):
-    return extra_t(geo, i, o, d, tmin, tmax)
+def extra_hit_if_extras(geo, i, o, d, inv, tmin, tmax):
+    return extra_hit(geo, i, o, d, inv, tmin, tmax)
 
 
-@overload(extra_t_if_extras)
-def _extra_t_if_extras(geo, i, o, d, tmin, tmax):
-    if not extras_possible(geo):
-        return lambda geo, i, o, d, tmin, tmax: INF
-    return lambda geo, i, o, d, tmin, tmax: extra_t(geo, i, o, d, tmin, tmax)
-
-
-def csg_hit_if_extras(geo, i, o, d, inv, tmin, tmax):
-    return csg_hit(geo, i, o, d, inv, tmin, tmax)
-
-
-@overload(csg_hit_if_extras)
-def _csg_hit_if_extras(geo, i, o, d, inv, tmin, tmax):
+@overload(extra_hit_if_extras)
+def _extra_hit_if_extras(geo, i, o, d, inv, tmin, tmax):
     if not extras_possible(geo):
         return lambda geo, i, o, d, inv, tmin, tmax: (INF, np.int64(-1))
-    return lambda geo, i, o, d, inv, tmin, tmax: csg_hit(geo, i, o, d, inv, tmin, tmax)
+    return lambda geo, i, o, d, inv, tmin, tmax: extra_hit(geo, i, o, d, inv, tmin, tmax)
 
 
 @kernel

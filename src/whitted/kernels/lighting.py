@@ -16,7 +16,7 @@ from .accel import (
     occludes,
 )
 from .csg import csg_surfaces
-from .extras import body_medium
+from .extras import body_medium, extra_hit
 from .features import extras_possible, has_extras, has_instances, instances_possible
 from .hit_list import MAX_SHADOW_HITS, keep_nearest
 from .layout import (
@@ -376,12 +376,14 @@ def gather_extra_hits(geo, i, o, d, inv, tmin, tmax, step, hits, n, full):
     a torus's each found from past the one before (up to four)."""
     if is_csg_object(geo.prim_info[i, PRIM_TYPE]):
         return csg_surfaces(geo, i, o, d, inv, tmin, tmax, hits, n, full)
-    t = hit_analytic(geo, i, o, d, tmin, tmax)
+    # the torus straight through extras.py's test (hit_analytic would bring every core
+    # shape's test in twice)
+    t, _ = extra_hit(geo, i, o, d, inv, tmin, tmax)
     for _ in range(4):
         if t == INF:
             break
         n, full = keep_nearest(hits, n, t, i, full)
-        t = hit_analytic(geo, i, o, d, t * (1.0 + 1e-12) + step, tmax)
+        t, _ = extra_hit(geo, i, o, d, inv, t * (1.0 + 1e-12) + step, tmax)
     return n, full
 
 
