@@ -86,6 +86,26 @@ def llvm_passes(buffer, top: int) -> None:
         print(f"{module:8.2f} {function:10.2f} {lines:9d}  {name}")
 
 
+def print_compiles(rows, wall: float, cpu: float, top: int, signature_width=None) -> None:
+    """The compiles' totals, the ``top`` longest by exclusive time, and the functions
+    compiled for more than one signature (each signature cut to ``signature_width``)."""
+    by_name = collections.defaultdict(list)
+    for name, sig, inc, exc in rows:
+        by_name[name].append((sig, inc, exc))
+    total_exc = sum(r[3] for r in rows)
+    print(f"compiles: {len(rows)} ({len(by_name)} functions); exclusive total {total_exc:.1f} s;"
+          f" job {wall:.1f} s wall, {cpu:.1f} s CPU")
+    print(f"\n{'exclusive s':>11} {'inclusive s':>11}  function")
+    for name, _sig, inc, exc in sorted(rows, key=lambda r: -r[3])[:top]:
+        print(f"{exc:11.2f} {inc:11.2f}  {name}")
+    dups = {n: v for n, v in by_name.items() if len(v) > 1}
+    print(f"\nfunctions compiled for more than one signature: {len(dups)}")
+    for name, variants in sorted(dups.items(), key=lambda kv: -sum(v[2] for v in kv[1])):
+        print(f"  {name}: {len(variants)} variants, {sum(v[2] for v in variants):.2f} s")
+        for sig, _inc, exc in variants:
+            print(f"      {exc:6.2f} s  {str(sig)[:signature_width]}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("scene", nargs="?", help="a scene file (default: the default scene)")
@@ -111,21 +131,7 @@ def main() -> None:
     wall = time.perf_counter() - wall0
 
     rows = compile_times(rec.buffer)
-    by_name = collections.defaultdict(list)
-    for name, sig, inc, exc in rows:
-        by_name[name].append((sig, inc, exc))
-    total_exc = sum(r[3] for r in rows)
-    print(f"compiles: {len(rows)} ({len(by_name)} functions); exclusive total {total_exc:.1f} s;"
-          f" job {wall:.1f} s wall, {cpu:.1f} s CPU")
-    print(f"\n{'exclusive s':>11} {'inclusive s':>11}  function")
-    for name, _sig, inc, exc in sorted(rows, key=lambda r: -r[3])[:args.top]:
-        print(f"{exc:11.2f} {inc:11.2f}  {name}")
-    dups = {n: v for n, v in by_name.items() if len(v) > 1}
-    print(f"\nfunctions compiled for more than one signature: {len(dups)}")
-    for name, variants in sorted(dups.items(), key=lambda kv: -sum(v[2] for v in kv[1])):
-        print(f"  {name}: {len(variants)} variants, {sum(v[2] for v in variants):.2f} s")
-        for sig, _inc, exc in variants:
-            print(f"      {exc:6.2f} s  {sig}")
+    print_compiles(rows, wall, cpu, args.top)
 
     # exclusive time per compiler pass, over all compiles, and inside the top function
     events = sorted([(ts, 0, ev) for ts, ev in rec.buffer]
