@@ -68,6 +68,21 @@ def test_the_same_image_on_any_number_of_threads():
     assert np.array_equal(one, two)
 
 
+@pytest.mark.parametrize("tile_size", [1, 3, 5, 4096])
+def test_the_same_image_whatever_the_tile_size(tile_size):
+    # a sample's value depends only on its point of the finest grid: tiles of one pixel,
+    # of odd sizes cut at the image's edges, and one tile bigger than the image (its lane's
+    # corner memory then sized by the image) all give the 16-pixel tiles' image
+    from whitted.render.api import RenderJob
+
+    scene = whitted.load_scene("examples/soft_shadows.toml").with_settings(
+        width=11, height=7, samples=1, antialias={"threshold": 0.05, "max_samples": 25})
+    reference = RenderJob(scene, threads=1, tile_size=16).run().pixels
+    image = RenderJob(scene, threads=1, tile_size=tile_size).run().pixels
+    assert np.array_equal(image, reference)
+    assert len(np.unique(reference.reshape(-1, 3), axis=0)) > 10  # not a blank picture
+
+
 @pytest.mark.parametrize("antialias", [{"threshold": -0.1}, {"threshold": float("nan")},
                                        {"max_samples": 3}, {"max_samples": 10**6},
                                        {"max_samples": 2.5}, {"colour": 1}])

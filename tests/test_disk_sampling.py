@@ -98,3 +98,42 @@ def test_the_benchmark_light_walks_its_whole_grid():
             a = -r * (-math.pi / 2 - phi) / (math.pi / 4)
         cells.append((int((a + 1) / 2 * 8), int((b + 1) / 2 * 8)))
     assert cells == [(k % 8, k // 8) for k in range(64)]
+
+
+def _lowbias32(x):
+    x &= 0xFFFFFFFF
+    x ^= x >> 16
+    x = (x * 0x7FEB352D) & 0xFFFFFFFF
+    x ^= x >> 15
+    x = (x * 0x846CA68B) & 0xFFFFFFFF
+    x ^= x >> 16
+    return x
+
+
+def _hash_below_2_32(seed, pixel, sample, dim):
+    # the hash of a key below 2**32, written out in plain Python integers
+    h = _lowbias32(sample * 0x27D4EB2F + dim)
+    h = _lowbias32(pixel * 0x85EBCA77 + h)
+    return _lowbias32(seed * 0x9E3779B1 + h)
+
+
+@given(st.integers(0, 2**31), st.integers(0, 2**32 - 1), st.integers(0, 4095),
+       st.integers(0, 8))
+@settings(max_examples=60, deadline=None)
+def test_keys_below_32_bits_draw_the_numbers_of_the_worked_hash(seed, pixel, sample, dim):
+    from whitted.kernels.sampling import random01
+
+    assert random01(seed, pixel, sample, dim) == _hash_below_2_32(seed, pixel, sample, dim) \
+        / 2.0**32
+
+
+@given(st.integers(0, 2**31), st.integers(0, 2**32 - 1), st.integers(1, 2**20))
+@settings(max_examples=60, deadline=None)
+def test_keys_apart_by_a_multiple_of_2_32_draw_other_numbers(seed, pixel, high):
+    # an adaptive grid's points of a huge image have keys past 32 bits: a key and the same
+    # key plus k * 2**32 must not share their random numbers (lens and area-light samples)
+    from whitted.kernels.sampling import random01, random_pair
+
+    far = pixel + high * 2**32
+    assert random01(seed, pixel, 3, 1) != random01(seed, far, 3, 1)
+    assert random_pair(seed, pixel, 3, 1) != random_pair(seed, far, 3, 1)

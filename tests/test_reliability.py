@@ -151,7 +151,7 @@ def _slow_compile(monkeypatch, signum: int, release: threading.Event) -> threadi
 
     ended = threading.Event()
 
-    def warm_up(compiled=None, render_kernel=True, builders=False) -> float:
+    def warm_up(compiled=None, builders=False) -> float:
         if compiled is None:
             os.kill(os.getpid(), signum)
             release.wait(30)
@@ -186,7 +186,7 @@ def test_a3_a4_signal_during_the_first_compile_stops_at_once_and_writes_nothing(
 LONG_COMPILE = """
 import os, signal, sys, time
 from whitted.render import api
-def warm_up(compiled=None, render_kernel=True, builders=False):
+def warm_up(compiled=None, builders=False):
     if compiled is None:
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(120)  # a first compile that takes long and cannot be cut short

@@ -337,6 +337,8 @@ def test_the_total_enthalpy_has_the_same_bits_on_one_thread_and_two():
 
     from whitted.stefan import kernels
 
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("one thread only: nothing to compare")
     rng = np.random.default_rng(7)
     H = rng.uniform(-1e6, 1e9, (48, 48, 5)) * 10.0 ** rng.integers(-8, 8, (48, 48, 5))
     kind = np.full(H.shape, kernels.BODY, np.int8)
@@ -348,7 +350,7 @@ def test_the_total_enthalpy_has_the_same_bits_on_one_thread_and_two():
     found = []
     before = numba.get_num_threads()
     try:
-        for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+        for threads in (1, 2):
             numba.set_num_threads(threads)
             found.append(kernels.total_enthalpy(H, kind))
     finally:

@@ -19,8 +19,10 @@ direct light with its shadow rays (``direct_light``, one function down to the sh
 walks, which the render kernel reaches after the hit's normals and colour), then compiles
 the builders and the OBJ reader; for scenes with mesh
 instances (the builders are already cached) it takes ``direct_light`` alone. What remains
-here is ``closest_hit``, normals, colour, the caustics and ``render_tiles``, which inlines
-them all (work only this process can do, as it needs everything below it).
+here is two of ``direct_light``'s own callees, compiled first (:func:`callees_here_first`),
+then ``closest_hit``, normals, colour, the caustics, the adaptive sampler and
+``render_tiles``, which inlines them all (work only this process can do, as it needs
+everything below it).
 """
 
 from __future__ import annotations

@@ -30,6 +30,8 @@ def random01(seed, pixel, sample, dim):
     # Python a NumPy int32 would overflow; compiled, the arguments are int64 already)
     h = mix32(int(sample) * 0x27D4EB2F + dim)
     h = mix32(int(pixel) * 0x85EBCA77 + h)
+    if int(pixel) >> 32:  # a key past 32 bits (an adaptive grid's points of a huge image)
+        h = mix32((int(pixel) >> 32) * 0x85EBCA77 + h)
     h = mix32(int(seed) * 0x9E3779B1 + h)
     return h * INV_2_32
 
@@ -44,6 +46,8 @@ def random_pair(seed, pixel, sample, dim):
     # Python a NumPy int32 would overflow; compiled, the arguments are int64 already)
     h = mix32(int(sample) * 0x27D4EB2F + dim)
     h = mix32(int(pixel) * 0x85EBCA77 + h)
+    if int(pixel) >> 32:  # as random01: keys apart by 2**32 draw different numbers
+        h = mix32((int(pixel) >> 32) * 0x85EBCA77 + h)
     h = mix32(int(seed) * 0x9E3779B1 + h)
     return h * INV_2_32, mix32(h + 0x632BE5AB) * INV_2_32
 

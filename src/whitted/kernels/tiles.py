@@ -92,10 +92,12 @@ def render_tiles(tiles, framebuffer, geo, mats, lights, params, counters, work, 
 
     ``levels`` < 0: ``params.samples`` stratified samples a pixel; ``levels`` >= 0: adaptive
     anti-aliasing (kernels/adaptive.py) with ``threshold``, splitting a pixel ``levels``
-    times at most, ``aa`` the lane's scratch memory from :func:`adaptive_workspace` (any of
-    them for uniform samples). Both trace their samples at the one call of the path tracer
-    below, so that it is compiled into this kernel once: the next sample is picked (a pixel's
-    next stratum, or what adaptive.next_sample asks for), traced, then accounted for."""
+    times at most, ``aa`` the lane's scratch memory from :func:`adaptive_workspace` made
+    for these ``levels`` and tiles no wider or taller than its arguments (the kernel checks
+    no bounds; the render API makes it so), or any of them for uniform samples. Both trace
+    their samples at the one call of the path tracer below, so that it is compiled into this
+    kernel once: the next sample is picked (a pixel's next stratum, or what
+    adaptive.next_sample asks for), traced, then accounted for."""
     n_tiles = tiles.shape[0]
     spp = params.samples
     uniform = levels < 0

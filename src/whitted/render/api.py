@@ -489,8 +489,11 @@ class RenderJob:
         def render_runs(n: int) -> None:
             nonlocal done
             work = lane_workspace(params.max_depth)
+            # no tile is wider or taller than the image (tile_grid), so neither is the
+            # corner memory of a lane: a 4096-pixel tile size made 400 MB per lane
             aa = (adaptive_workspace() if antialias is None
-                  else adaptive_workspace(self.tile_size, self.tile_size, levels))
+                  else adaptive_workspace(min(self.tile_size, params.width),
+                                          min(self.tile_size, params.height), levels))
             while True:
                 if self.cancel_token.cancelled or failed.is_set():
                     return
