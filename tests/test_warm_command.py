@@ -4,6 +4,7 @@ scene it renders reaches the variant it is named after."""
 from __future__ import annotations
 
 import json
+import math
 import os
 import subprocess
 import sys
@@ -133,6 +134,40 @@ def test_the_queue_hands_a_general_kind_out_only_after_the_general_render_kernel
     assert queue.todo == ["general/aovs"]
     queue.finish("general/render", 12.5)
     assert queue.take() == "general/aovs"
+
+
+def test_the_longest_compiles_are_handed_out_first():
+    # the Stefan solver (about half a minute) no longer waits behind the short ones: with
+    # two workers the last to finish is a short variant, so both cores end together
+    from whitted.cli.warm import _all_names, _Queue
+
+    queue = _Queue(_all_names())
+    order = [queue.take() for _ in range(6)]
+    assert order == ["general/render", "general/caustics", "stefan", "builders",
+                     "plain/caustics", "plain/aovs"]
+
+
+def test_two_workers_finish_within_a_short_variant_of_each_other():
+    # the queue's order played out over the costs it is built from: each worker takes the
+    # first variant ready when it is free; they end less than the builders' compile apart
+    # (handed out shortest kinds first, the Stefan solver came last and ended 23 s after)
+    from whitted.cli.warm import _COST, _all_names, _first, _order
+
+    todo = _order(_all_names())
+    done_at = {"plain/render": 0.0}
+    free = [0.0, 0.0]
+    while todo:
+        worker = free.index(min(free))
+        ready = [n for n in todo
+                 if _first(n) is None or done_at.get(_first(n), math.inf) <= free[worker]]
+        if not ready:  # what is left waits for a variant still compiling
+            free[worker] = min(done_at[_first(n)] for n in todo)
+            continue
+        todo.remove(ready[0])
+        free[worker] += _COST[ready[0]]
+        done_at[ready[0]] = free[worker]
+    assert abs(free[0] - free[1]) < _COST["builders"]
+    assert max(free) < sum(_COST.values()) / 2 + _COST["general/aovs"]
 
 
 def test_no_variant_is_adaptive_anti_aliasing():
