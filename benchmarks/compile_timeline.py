@@ -4,7 +4,8 @@ whitted.render.warm_up``) side by side. Which function each process compiles whe
 the render process waits for the helper (for one of its callees, or at the end), and the
 wall and CPU seconds of both.
 
-    PYTHONPATH=src python benchmarks/compile_timeline.py [--runs 1] [--keep DIR] [-- ARGS...]
+    PYTHONPATH=src python benchmarks/compile_timeline.py [--runs 1] [--keep DIR]
+        [--cache-from DIR] [-- ARGS...]
 
 Each run starts ``python -m whitted render -q -o OUT.png`` (ARGS replace the default
 arguments) with an empty cache folder, and a ``sitecustomize`` module on ``PYTHONPATH``
@@ -150,6 +151,8 @@ def one_run(args, src: Path, keep: Path | None) -> dict:
         (work / "tracer").mkdir()
         (work / "tracer" / "sitecustomize.py").write_text(TRACER)
         (work / "log").mkdir()
+        if args.cache_from is not None:  # kernels compiled before (the plain variant)
+            shutil.copytree(args.cache_from, work / "cache")
         env = dict(os.environ, WHITTED_CACHE_DIR=str(work / "cache"),
                    WHITTED_TIMELINE_DIR=str(work / "log"),
                    PYTHONPATH=os.pathsep.join([str(work / "tracer"), str(src)]))
@@ -228,6 +231,9 @@ def main() -> None:
     parser.add_argument("--vs", type=Path, help="a second source tree (its src folder): "
                         "runs alternate, this tree's first, and each pair's ratio is printed")
     parser.add_argument("--quiet", action="store_true", help="figures only, no timeline")
+    parser.add_argument("--cache-from", type=Path, help="a cache folder each run starts "
+                        "with a copy of (e.g. where `whitted warm --variant plain/render` "
+                        "ran, to time the general kernels' first compile alone)")
     parser.add_argument("args", nargs="*", help="whitted render's arguments")
     args = parser.parse_args()
     trees = [args.src] + ([args.vs] if args.vs else [])

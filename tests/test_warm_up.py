@@ -11,7 +11,7 @@ import pytest
 
 from whitted.compile.params import render_params
 from whitted.jit import kernel
-from whitted.kernels import integrator, tiles
+from whitted.kernels import accel, integrator, lighting, tiles
 from whitted.kernels.callees import callees_here_first, render_callees
 from whitted.kernels.layout import N_RAY_KINDS
 from whitted.render import warm_up
@@ -22,13 +22,19 @@ from whitted.scene.scene import RenderSettings, Scene
 def test_helper_compiles_the_signatures_render_tiles_calls(monkeypatch, instances):
     """The helper's work is only of use if the render kernel asks for exactly these variants.
 
-    Uncached copies of render_tiles and of trace_path (the caller of the helper's kernels)
-    are compiled here: they ask for the variants of their callees (which load or compile),
-    and those are what the callees' twins then list in ``overloads``."""
+    Uncached copies of render_tiles and of the callers of the kernels listed (trace_path,
+    closest_hit, direct_light, gather_extra_hits) are compiled here: they ask for the
+    variants of their callees (which load or compile), and those are what the callees'
+    twins then list in ``overloads``. A caller loaded from the cache would ask for nothing,
+    so every caller is compiled anew, whatever the state of the cache."""
     def fresh(dispatcher):
         return kernel(cache=False, inline="always")(dispatcher.py_func)
 
     monkeypatch.setattr(tiles, "trace_path", fresh(integrator.trace_path))
+    copies = {"closest_hit": fresh(accel.closest_hit),
+              "direct_light": fresh(lighting.direct_light)}
+    for name, copy in copies.items():
+        monkeypatch.setattr(integrator, name, copy)
     stand_in = warm_up.stand_in_scene(instances)
     fresh_render_tiles = kernel(cache=False)(tiles.render_tiles.py_func)
     params = render_params(Scene(), stand_in, RenderSettings(width=1, height=1))
@@ -39,9 +45,14 @@ def test_helper_compiles_the_signatures_render_tiles_calls(monkeypatch, instance
     delegated = render_callees(stand_in.geometry, stand_in.materials, stand_in.lights, params)
     assert delegated
     # and what the render process compiles first meanwhile
-    delegated += callees_here_first(stand_in.geometry, stand_in.materials, stand_in.lights,
-                                    params)
-    for dispatcher, argument_types in delegated:
+    here = callees_here_first(stand_in.geometry, stand_in.materials, stand_in.lights, params)
+    for dispatcher, argument_types in here:
+        if dispatcher is lighting.gather_extra_hits:  # the caller of csg_surfaces, compiled
+            # with the types direct_light (checked below) asks for
+            fresh(dispatcher).compile(argument_types)
+    for dispatcher, argument_types in delegated + here:
+        # what trace_path called instead
+        dispatcher = copies.get(dispatcher.py_func.__name__, dispatcher)
         assert tuple(argument_types) in dispatcher.callee.overloads, (
             f"{dispatcher.py_func.__name__}: render_tiles compiled "
             f"{list(dispatcher.callee.overloads)}, the helper would compile {argument_types}")

@@ -17,25 +17,30 @@ analytic shapes' intersections, which ``closest_hit`` reaches late), ``surface_n
 (the direct light's shadow rays call both: compiled once, by the helper) and then the
 direct light with its shadow rays (``direct_light``, one function down to the shadow rays'
 walks, which the render kernel reaches after the hit's normals and colour), then compiles
-the builders and the OBJ reader; for scenes with mesh
-instances (the builders are already cached) it takes ``direct_light`` alone. What remains
-here is two of ``direct_light``'s own callees, compiled first (:func:`callees_here_first`),
-then ``closest_hit``, normals, colour, the caustics, the adaptive sampler and
-``render_tiles``, which inlines them all (work only this process can do, as it needs
-everything below it).
+the builders and the OBJ reader. What remains here is two of ``direct_light``'s own
+callees, compiled first (:func:`callees_here_first`), then ``closest_hit``, normals, colour,
+the caustics, the adaptive sampler and ``render_tiles``, which inlines them all (work only
+this process can do, as it needs everything below it). For the general kernels (mesh
+instances, tori, CSG objects; the builders are already cached) the helper takes the extra
+shapes' intersection (``extra_hit``: the CSG walk and the torus, which the closest hit and
+the shadow rays share, so that one process compiles it, not both), ``hit_analytic`` and
+``direct_light``; this process the rest, the shadow rays' gathering of a clear extra
+shape's crossings first.
 """
 
 from __future__ import annotations
 
 from numba import typeof, types
 
-from .accel import hit_analytic, surface_normals
+from .accel import closest_hit, hit_analytic, surface_normals
 from .caustics import add_caustic
+from .csg import csg_surfaces
+from .extras import extra_hit
 from .features import instances_possible
 from .geometry_ref import GeometryRef
-from .integrator import split_at_surface
+from .integrator import split_at_surface, surface_colour
 from .layout import GeometryArrays
-from .lighting import direct_light, disk_left_out, list_bundle_occluders
+from .lighting import direct_light, disk_left_out, gather_extra_hits, list_bundle_occluders
 
 VEC3 = types.UniTuple(types.float64, 3)
 INT = types.int64
@@ -45,39 +50,70 @@ REALS = types.float64[::1]
 INT64S = types.int64[::1]  # a lane's ray counts
 
 
+def _direct_light_types(geo, mats, lights, params):
+    return (geo, mats, typeof(lights), typeof(params), VEC3, VEC3, VEC3, INT, VEC3, INT32S,
+            INT, INT32S, INT32S, REALS, INT32S, INT64S, types.UniTuple(INT, 3))
+
+
 def render_callees(geometry: GeometryArrays, materials, lights, params):
     """(kernel, argument types) pairs for a scene with these arrays, lights and render
-    parameters (their types pick the variant: with or without mesh instances), in the order
-    the render kernel needs them."""
+    parameters (their types pick the variant: plain, or general with mesh instances, tori
+    and CSG objects), in the order the helper compiles them."""
     geo = typeof(geometry)
     if instances_possible(geo):  # render_tiles passes the geometry by reference
         geo = GeometryRef(geo)
     mats = typeof(materials)
     if instances_possible(geo):
-        return [(direct_light, (geo, mats, typeof(lights), typeof(params), VEC3, VEC3, VEC3,
-                                INT, VEC3, INT32S, INT, INT32S, INT32S, REALS, INT32S, INT64S,
-                                types.UniTuple(INT, 3)))]
+        # the general kernels: first the extra shapes' one call site (the CSG walk and the
+        # torus's quartic, a third of the variant's compile), which both the closest hit
+        # here and the helper's shadow rays reach; then the shadow rays
+        return [(extra_hit, (geo, INT, VEC3, VEC3, VEC3, REAL, REAL)),
+                (hit_analytic, (geo, INT, VEC3, VEC3, REAL, REAL)),
+                (direct_light, _direct_light_types(geo, mats, lights, params))]
     return [(hit_analytic, (geo, INT, VEC3, VEC3, REAL, REAL)),
             (surface_normals, (geo, INT, INT, REAL, REAL, VEC3)),
-            (direct_light, (geo, mats, typeof(lights), typeof(params), VEC3, VEC3, VEC3,
-                            INT, VEC3, INT32S, INT, INT32S, INT32S, REALS, INT32S, INT64S,
-                            types.UniTuple(INT, 3)))]
+            (direct_light, _direct_light_types(geo, mats, lights, params))]
 
 
 def callees_here_first(geometry: GeometryArrays, materials, lights, params):
     """(kernel, argument types) pairs the render process compiles before ``render_tiles``
-    while the helper compiles its share (scenes without mesh instances). First two of
-    ``direct_light``'s own callees (an area light's bundle list and its disk test, 2.1 s of
-    the helper's 5.1-s ``direct_light`` on the 2-core AMD EPYC VM): the helper, reaching them
-    later, loads them from the cache, so its chain ends about as early as this process
-    reaches ``direct_light``. Then the callees the render kernel reaches after
-    ``direct_light`` (the caustic term and the refraction), so that it reaches
+    while the helper compiles its share.
+
+    Plain kernels: first two of ``direct_light``'s own callees (an area light's bundle list
+    and its disk test, 2.1 s of the helper's 5.1-s ``direct_light`` on the 2-core AMD EPYC
+    VM): the helper, reaching them later, loads them from the cache, so its chain ends about
+    as early as this process reaches ``direct_light``. Then the callees the render kernel
+    reaches after ``direct_light`` (the caustic term and the refraction), so that it reaches
     ``direct_light`` later, when the helper has it ready, instead of waiting for it with
-    those still to do."""
+    those still to do.
+
+    General kernels: what needs none of the helper's extra shapes (the bundle list, the
+    refraction, the colour) while the helper compiles ``extra_hit``; then, once it has
+    (waiting for it, and loading it), the closest hit (which the helper's shadow walk
+    through the instances calls too, after its any-hit test), the normals, the CSG
+    objects' every-crossing walk of
+    the shadow rays (``csg_surfaces``) and the shadow rays' gathering of a clear torus's or
+    CSG object's crossings (``gather_extra_hits``), which the helper's ``direct_light``
+    reaches only after its shadow walk through the instances, and loads. The helper's chain
+    (``extra_hit``, ``hit_analytic``, the shadow walk, ``direct_light``) is the critical
+    path: each needs the one before it."""
     geo = typeof(geometry)
-    if instances_possible(geo):
-        return []
     mats = typeof(materials)
+    if instances_possible(geo):
+        geo = GeometryRef(geo)
+        return [(list_bundle_occluders, (geo, mats, VEC3, VEC3, REAL, REAL, INT32S, INT32S)),
+                (split_at_surface, (geo, mats, INT, INT, types.boolean, INT32S, INT, INT32S,
+                                    VEC3, VEC3, REAL, REAL)),
+                (surface_colour, (geo, mats, INT, INT, INT, REAL, REAL, VEC3)),
+                # the helper's: waited for here, so that what follows loads the CSG walk's
+                # pieces (the leaves' crossings and normals) instead of compiling them too
+                (extra_hit, (geo, INT, VEC3, VEC3, VEC3, REAL, REAL)),
+                (closest_hit, (geo, VEC3, VEC3, REAL, REAL, INT32S)),
+                (surface_normals, (geo, INT, INT, REAL, REAL, VEC3)),
+                (csg_surfaces, (geo, INT, VEC3, VEC3, VEC3, REAL, REAL, REALS, INT,
+                                types.boolean)),
+                (gather_extra_hits, (geo, INT, VEC3, VEC3, VEC3, REAL, REAL, REAL, REALS, INT,
+                                     types.boolean))]
     return [(list_bundle_occluders, (geo, mats, VEC3, VEC3, REAL, REAL, INT32S, INT32S)),
             (disk_left_out, (typeof(lights.table), INT, mats, INT, VEC3, VEC3, VEC3, VEC3,
                              REAL)),
