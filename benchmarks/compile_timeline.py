@@ -8,10 +8,11 @@ wall and CPU seconds of both.
         [--cache-from DIR] [-- ARGS...]
 
 Each run starts ``python -m whitted render -q -o OUT.png`` (ARGS replace the default
-arguments) with an empty cache folder, and a ``sitecustomize`` module on ``PYTHONPATH``
-that both processes import: it records Numba's documented compile events
-(``numba.core.event``, ``"numba:compile"``) with the system-wide monotonic clock and each
-process's CPU clock, and the moments the render process waits (``wait_for_helper``,
+arguments: another scene) with an empty cache folder (or a copy of ``--cache-from``: the
+general kernels' first compile on a cache holding the plain ones), and a ``sitecustomize``
+module on ``PYTHONPATH`` that both processes import: it records Numba's documented compile
+events (``numba.core.event``, ``"numba:compile"``) with the system-wide monotonic clock and
+each process's CPU clock, and the moments the render process waits (``wait_for_helper``,
 ``_finish_helper``) or starts the helper, into one file per process. Nothing of whitted's is
 changed. The CPU figure is the render process's and every child's it waited for (the
 operating system's accounting).
@@ -233,7 +234,9 @@ def main() -> None:
     parser.add_argument("--quiet", action="store_true", help="figures only, no timeline")
     parser.add_argument("--cache-from", type=Path, help="a cache folder each run starts "
                         "with a copy of (e.g. where `whitted warm --variant plain/render` "
-                        "ran, to time the general kernels' first compile alone)")
+                        "ran, to time the general kernels' first compile alone; with --vs, "
+                        "where each tree's ran: the folder inside is named by a hash of "
+                        "the kernel sources)")
     parser.add_argument("args", nargs="*", help="whitted render's arguments")
     args = parser.parse_args()
     trees = [args.src] + ([args.vs] if args.vs else [])

@@ -137,8 +137,8 @@ def test_the_queue_hands_a_general_kind_out_only_after_the_general_render_kernel
 
 
 def test_the_longest_compiles_are_handed_out_first():
-    # the Stefan solver (about half a minute) no longer waits behind the short ones: with
-    # two workers the last to finish is a short variant, so both cores end together
+    # longest first: the Stefan solver (about half a minute) is handed out before the short
+    # variants, so that with two workers the last to finish is a short one
     from whitted.cli.warm import _all_names, _Queue
 
     queue = _Queue(_all_names())
@@ -148,9 +148,9 @@ def test_the_longest_compiles_are_handed_out_first():
 
 
 def test_two_workers_finish_within_a_short_variant_of_each_other():
-    # the queue's order played out over the costs it is built from: each worker takes the
-    # first variant ready when it is free; they end less than the builders' compile apart
-    # (handed out shortest kinds first, the Stefan solver came last and ended 23 s after)
+    # a model, not a measurement: the queue's order played out over the costs it is built
+    # from (each worker takes the first variant ready when it is free); the two workers end
+    # less than the builders' compile apart, and within one short variant of half the work
     from whitted.cli.warm import _COST, _all_names, _first, _order
 
     todo = _order(_all_names())

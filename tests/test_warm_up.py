@@ -11,6 +11,7 @@ import pytest
 
 from whitted.compile.params import render_params
 from whitted.jit import kernel
+from whitted.jit.decorators import Kernel
 from whitted.kernels import accel, integrator, lighting, tiles
 from whitted.kernels.callees import callees_here_first, render_callees
 from whitted.kernels.layout import N_RAY_KINDS
@@ -22,13 +23,18 @@ from whitted.scene.scene import RenderSettings, Scene
 def test_helper_compiles_the_signatures_render_tiles_calls(monkeypatch, instances):
     """The helper's work is only of use if the render kernel asks for exactly these variants.
 
-    Uncached copies of render_tiles and of the callers of the kernels listed (trace_path,
+    Uncached copies of render_tiles and of a caller of each kernel listed (trace_path,
     closest_hit, direct_light, gather_extra_hits) are compiled here: they ask for the
     variants of their callees (which load or compile), and those are what the callees'
     twins then list in ``overloads``. A caller loaded from the cache would ask for nothing,
-    so every caller is compiled anew, whatever the state of the cache."""
+    so these callers are compiled anew, whatever the state of the cache; and each listed
+    kernel gets a new twin first, so that a cold compile earlier in this process (which
+    compiles the lists' types as given) leaves no signature behind that nothing asked for."""
     def fresh(dispatcher):
         return kernel(cache=False, inline="always")(dispatcher.py_func)
+
+    def twin_owner(dispatcher):  # the dispatcher whose ``callee`` twin kernels call
+        return dispatcher.dispatcher if isinstance(dispatcher, Kernel) else dispatcher
 
     monkeypatch.setattr(tiles, "trace_path", fresh(integrator.trace_path))
     copies = {"closest_hit": fresh(accel.closest_hit),
@@ -38,14 +44,17 @@ def test_helper_compiles_the_signatures_render_tiles_calls(monkeypatch, instance
     stand_in = warm_up.stand_in_scene(instances)
     fresh_render_tiles = kernel(cache=False)(tiles.render_tiles.py_func)
     params = render_params(Scene(), stand_in, RenderSettings(width=1, height=1))
-    fresh_render_tiles(np.zeros((0, 4), np.int32), np.zeros((1, 1, 3), np.float32),
-                       stand_in.geometry, stand_in.materials, stand_in.lights, params,
-                       np.zeros((1, N_RAY_KINDS), np.int64), tiles.lane_workspace(1),
-                       tiles.adaptive_workspace(), 0.0, -1, 0, 1)
     delegated = render_callees(stand_in.geometry, stand_in.materials, stand_in.lights, params)
     assert delegated
     # and what the render process compiles first meanwhile
     here = callees_here_first(stand_in.geometry, stand_in.materials, stand_in.lights, params)
+    for dispatcher, _ in delegated + here:  # new twins, made (and loaded) when asked for
+        monkeypatch.setattr(twin_owner(dispatcher), "_callee", None)
+        assert dispatcher.callee.overloads == {}
+    fresh_render_tiles(np.zeros((0, 4), np.int32), np.zeros((1, 1, 3), np.float32),
+                       stand_in.geometry, stand_in.materials, stand_in.lights, params,
+                       np.zeros((1, N_RAY_KINDS), np.int64), tiles.lane_workspace(1),
+                       tiles.adaptive_workspace(), 0.0, -1, 0, 1)
     for dispatcher, argument_types in here:
         if dispatcher is lighting.gather_extra_hits:  # the caller of csg_surfaces, compiled
             # with the types direct_light (checked below) asks for
@@ -107,6 +116,24 @@ def test_waits_for_the_helpers_callees_and_counts_its_compiles():
     assert count.helper_gone
     assert count.wait_for_helper("b__callee") is False
     assert time.monotonic() - start < 5
+
+
+def test_a_hung_helper_is_waited_for_once(monkeypatch):
+    """A helper that neither finishes a kernel nor exits costs one wait, not one per kernel
+    it was to compile: after the first wait runs out, the render process compiles the rest
+    itself without waiting."""
+    import time
+
+    monkeypatch.setattr(warm_up, "HELPER_WAIT_SECONDS", 0.5)
+    count = warm_up._CompileCount(10, ("a__callee", "b__callee", "c__callee"))
+    start = time.monotonic()
+    assert count.wait_for_helper("a__callee") is False
+    assert time.monotonic() - start >= 0.5
+    assert count.helper_gone
+    start = time.monotonic()
+    assert count.wait_for_helper("b__callee") is False
+    assert count.wait_for_helper("c__callee") is False
+    assert time.monotonic() - start < 0.5
 
 
 def test_the_warm_up_loads_the_kernel_a_torus_or_csg_scene_renders_with():

@@ -7,13 +7,12 @@ cores); then the other variants (render/variants.py), the scene builders with th
 (which a small scene runs as Python until they are compiled: jit/python_twins.py) and the
 Stefan solver's kernels are handed out, one at a time and the longest first, to ``--jobs``
 worker processes (one per core), each compiling into the same cache (jit/cache.py keeps it
-consistent). A kind of
-the general kernels that shares the render kernel's callees (the AOV kernel) is handed out
-only once the general render kernel is in the cache: it then loads them instead of compiling
-them a second time in another process. Adaptive anti-aliasing is a run-time choice of the
-render kernel: the ``render`` variants serve it. The photon tracers (the caustics variants:
-the tracer only, the render with caustics is the render kernel's) share nothing with the
-render kernels and start at once. A variant already in the cache
+consistent). A kind of the general kernels that shares the render kernel's callees (the AOV
+kernel) is handed out only once the general render kernel is in the cache: it then loads
+them instead of compiling them a second time in another process. Adaptive anti-aliasing is a
+run-time choice of the render kernel: the ``render`` variants serve it. The photon tracers
+(the caustics variants: the tracer only, the render with caustics is the render kernel's)
+share nothing with the render kernels and start at once. A variant already in the cache
 loads in a fraction of a second, so a second ``whitted warm`` is quick.
 """
 

@@ -89,8 +89,11 @@ def callees_here_first(geometry: GeometryArrays, materials, lights, params):
 
     General kernels: what needs none of the helper's extra shapes (the bundle list, the
     refraction, the colour) while the helper compiles ``extra_hit``; then, once it has
-    (waiting for it, and loading it), the closest hit (which the helper's shadow walk
-    through the instances calls too, after its any-hit test), the normals, the CSG
+    (waiting for it, and loading it), the closest hit (waiting for the helper's
+    ``hit_analytic`` too, about two seconds later; the helper's shadow walk through the
+    instances calls the closest hit after its any-hit test, with the same types, and loads
+    it when this process has finished it first, as it had on the 2-core VM), the normals,
+    the CSG
     objects' every-crossing walk of
     the shadow rays (``csg_surfaces``) and the shadow rays' gathering of a clear torus's or
     CSG object's crossings (``gather_extra_hits``), which the helper's ``direct_light``

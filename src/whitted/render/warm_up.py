@@ -245,6 +245,8 @@ class _CompileCount:
                    and time.monotonic() < deadline):
                 self._changed.wait(0.1)  # a timeout: Ctrl-C reaches this thread at once
                 self.check_interrupt()
+            if name in self.pending and not self.helper_gone:  # a helper this slow is
+                self.helper_gone = True  # taken for hung: no later kernel waits for it
             return name not in self.pending
 
 
