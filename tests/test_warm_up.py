@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from whitted.compile.params import render_params
+from whitted.compile.scene import compile_scene
 from whitted.jit import kernel
 from whitted.jit.decorators import Kernel
 from whitted.kernels import accel, integrator, lighting, tiles
@@ -234,8 +235,13 @@ def test_the_helper_started_ahead_is_adopted_by_the_compile(monkeypatch, tmp_pat
 
 
 @helpers_start
+@pytest.mark.parametrize("shape, variant", [
+    ('type = "sphere"\nradius = 1.0', "plain"),
+    # a scene that runs the general kernels starts their helper, not the plain one's
+    ('type = "torus"\nmajor_radius = 1.0\nminor_radius = 0.25', "instances"),
+])
 def test_a_command_that_ends_before_its_render_stops_the_helper_started_ahead(
-        monkeypatch, tmp_path, ahead_stopped):
+        monkeypatch, tmp_path, ahead_stopped, shape, variant):
     """A user mistake found by the output checks (a folder that does not exist): exit 2,
     and the helper started ahead is stopped and the lock released, not left running."""
     from typer.testing import CliRunner
@@ -246,15 +252,43 @@ def test_a_command_that_ends_before_its_render_stops_the_helper_started_ahead(
     monkeypatch.setattr(warm_up, "_ready", set())
     started = _started_helpers(monkeypatch)
     scene = tmp_path / "s.toml"
-    scene.write_text('[[objects]]\ntype = "sphere"\nradius = 1.0\n')
+    scene.write_text(f"[[objects]]\n{shape}\n")
     out = tmp_path / "no such folder" / "x.png"
     result = CliRunner().invoke(app, ["render", str(scene), "-o", str(out)])
     assert result.exit_code == 2, result.output
     assert result.stderr.startswith("error:") and "no such folder" in result.stderr
     assert len(started) == 1 and started[0].poll() is not None
+    assert started[0].args[3] == variant  # python -m whitted.render.warm_up VARIANT ...
     assert warm_up._ahead is None
-    lock = warm_up.prepare().take_compile_lock("plain")
-    assert lock is not None
+    for name in ("plain", "general"):
+        lock = warm_up.prepare().take_compile_lock(name)
+        assert lock is not None
+        lock.release()
+
+
+@helpers_start
+def test_the_general_helper_started_ahead_is_adopted_by_the_general_compile(
+        monkeypatch, tmp_path, ahead_stopped):
+    """As for the plain variant: a torus scene's first render uses the general helper
+    started ahead and releases the general variant's lock."""
+    from whitted.scene import Torus
+
+    compiled = compile_scene(Scene(objects=[Torus(major_radius=1.0, minor_radius=0.25)]))
+    warm_up.warm_up_kernels(compiled)  # in the test cache, and loaded here
+    marker = tmp_path / "whitted-ready-general"
+    monkeypatch.setattr(warm_up, "_marker", lambda instances: marker)
+    monkeypatch.setattr(warm_up, "_ready", set())
+    started = _started_helpers(monkeypatch)
+    assert warm_up.start_cold_compile_ahead(instances=True)
+    assert warm_up._take_ahead(False) is None  # not the plain variant's
+    cache = warm_up.prepare()
+    assert cache.take_compile_lock("general") is None  # held ahead
+    warm_up.warm_up_kernels(compiled)
+    assert len(started) == 1 and started[0].poll() is not None  # adopted, waited for
+    assert started[0].args[3] == "instances"
+    assert warm_up._ahead is None and marker.exists()
+    lock = cache.take_compile_lock("general")
+    assert lock is not None  # released
     lock.release()
 
 

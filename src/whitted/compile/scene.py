@@ -100,6 +100,29 @@ def scene_needs_builders(scene: Scene) -> bool:
     return primitives > PYTHON_LIMIT
 
 
+def scene_needs_general_kernels(scene: Scene) -> bool:
+    """Whether ``scene`` runs the general render kernels whatever its model files hold: it
+    has a CSG object, or an analytic shape whose row only the general kernels intersect (a
+    torus), found by writing one shape of each class into rows as :func:`compile_scene`
+    does and asking the row's type as it does. Mesh instances (a model kept whole) are
+    found only by compiling the scene: False says nothing of them. A first render of such a
+    scene compiles the general kernels only, not the plain ones first."""
+    from .shapes import ROWS
+
+    seen: set[type] = set()
+    for shape in scene.objects:
+        if isinstance(shape, CSG):
+            return True
+        if type(shape) in seen or type(shape) not in ROWS:
+            continue
+        seen.add(type(shape))
+        rows = PrimitiveRows()
+        add_shape(rows, shape, np.eye(4), 0, 0)
+        if any(bool((block[0] >= FIRST_EXTRA_SHAPE).any()) for block in rows.blocks):
+            return True
+    return False
+
+
 #: scene BVHs of this many bounded primitives are built with the SAH on all three axes
 ALL_AXES_FROM = 4096
 ALL_AXES_UP_TO = 1 << 20  # past this the build's time matters more (three times the binning)

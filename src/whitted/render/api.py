@@ -30,7 +30,13 @@ from ..kernels.layout import (
 )
 from ..output.image import Image
 from ..scene.scene import RenderSettings, Scene
-from .warm_up import caustics_compile, kernels_cached, warm_up_kernels
+from .warm_up import (
+    caustics_compile,
+    first_variant,
+    kernel_variant,
+    kernels_cached,
+    warm_up_kernels,
+)
 
 RAY_KIND_NAMES = {
     RAY_PRIMARY: "primary",
@@ -419,9 +425,13 @@ class RenderJob:
         stats = self.stats
         stats.compile_seconds = 0.0
         if not kernels_cached():  # a first run: the default variant (and the builders, for
-            # a scene too large for their Python twins), compiled on both cores
-            stats.compile_seconds = warm_up_kernels(
-                builders=self.compiled is None and scene_needs_builders(self.scene))
+            # a scene too large for their Python twins), compiled on both cores, unless the
+            # scene runs the general kernels, which are then the only ones compiled
+            builders = self.compiled is None and scene_needs_builders(self.scene)
+            general = (kernel_variant(self.compiled) if self.compiled is not None
+                       else first_variant(self.scene, builders))
+            if not general:
+                stats.compile_seconds = warm_up_kernels(builders=builders)
         compiled: CompiledScene = (self.compiled if self.compiled is not None
                                    else compile_scene(self.scene, threads=self.threads))
         stats.compile_seconds += warm_up_kernels(compiled)

@@ -51,7 +51,12 @@ import numpy as np
 
 from ..assets.mesh import load_obj_bytes
 from ..compile.params import render_params
-from ..compile.scene import CompiledScene, compile_scene, scene_needs_builders
+from ..compile.scene import (
+    CompiledScene,
+    compile_scene,
+    scene_needs_builders,
+    scene_needs_general_kernels,
+)
 from ..jit.cache import HELPER_ENV, prepare
 from ..jit.progress import CompileReport
 from ..jit.python_twins import builders_cached, mark_builders_cached
@@ -75,6 +80,10 @@ HELPER_WAIT_SECONDS = 120.0  # a helper still busy after this is stopped (never 
 #: (kernels changed, a different split between the processes) makes the fraction
 #: approximate; tests/test_warm_up.py holds the plain one to a real cold compile within 10 %.
 EXPECTED_COMPILES = {False: 166, True: 159}
+#: the same for the general variant compiled first, on a cache without the plain one (a
+#: first render of a scene with a torus or a CSG object: :func:`first_variant`), whose
+#: leaves it then compiles too: 118 + 156 on the 2-core VM
+EXPECTED_GENERAL_ALONE_COMPILES = 274
 #: the builders' and the OBJ reader's compiles, added where a cold compile makes them too
 EXPECTED_BUILDER_COMPILES = 39
 TINY_OBJ = b"""v 0.12345678901234567890 0 0
@@ -437,39 +446,40 @@ def warm_up_kernels(compiled: CompiledScene | None = None, builders: bool = Fals
         return time.perf_counter() - start
 
 
-#: (the plain variant's compile lock, the helper) started ahead of the cold compile by
-#: :func:`start_cold_compile_ahead`, until the compile adopts them
-_ahead: tuple[object, subprocess.Popen] | None = None
+#: (a variant's compile lock, the helper, whether it is the general variant) started ahead
+#: of the cold compile by :func:`start_cold_compile_ahead`, until the compile adopts them
+_ahead: tuple[object, subprocess.Popen, bool] | None = None
 _ahead_lock = threading.Lock()  # not _lock: a compile holds that until it ends
 
 
-def start_cold_compile_ahead(builders: bool = False) -> bool:
+def start_cold_compile_ahead(builders: bool = False, instances: bool = False) -> bool:
     """On a cold cache, start the compile helper now, before the work a command does ahead
     of its render: ``whitted render``'s output checks read the scene's models, which
     compiles the OBJ reader (3 s of CPU), and the helper compiles its share of the render
-    kernel meanwhile instead of starting after it. The compile lock of the plain variant is
-    taken without waiting (another process compiling it: nothing is started, the render
-    waits for it as before) and held until the render's warm-up adopts both
-    (:func:`warm_up_kernels`) or :func:`stop_cold_compile_ahead` ends them. True when the
-    helper was started."""
+    kernel meanwhile instead of starting after it. The compile lock of the variant (the
+    plain one, or ``instances``: the general one) is taken without waiting (another process
+    compiling it: nothing is started, the render waits for it as before) and held until the
+    render's warm-up adopts both (:func:`warm_up_kernels`) or
+    :func:`stop_cold_compile_ahead` ends them. True when the helper was started."""
     global _ahead
     with _ahead_lock:
-        if _ahead is not None or (False, False) in _ready or kernels_cached(False):
+        if (_ahead is not None or (instances, instances) in _ready
+                or kernels_cached(instances)):
             return _ahead is not None
         from ..jit import load_numba
 
         load_numba()
-        lock = prepare().take_compile_lock("plain")
+        lock = prepare().take_compile_lock("general" if instances else "plain")
         if lock is None:
             return False
-        if kernels_cached(False):  # finished by another process before the lock was free
+        if kernels_cached(instances):  # finished by another process before the lock was free
             lock.release()
             return False
-        helper = _start_helper(False, builders and not builders_cached())
+        helper = _start_helper(instances, builders and not builders_cached())
         if helper is None:
             lock.release()
             return False
-        _ahead = (lock, helper)
+        _ahead = (lock, helper, instances)
         return True
 
 
@@ -488,20 +498,33 @@ def stop_cold_compile_ahead() -> None:
 @contextlib.contextmanager
 def cold_compile_ahead(scene: Scene | None = None):
     """:func:`start_cold_compile_ahead` for the block (the helper compiles the builders too
-    when ``scene`` needs them compiled), :func:`stop_cold_compile_ahead` after it (nothing to
-    stop once the block's render has adopted the helper)."""
-    start_cold_compile_ahead(scene is not None and scene_needs_builders(scene))
+    when ``scene`` needs them compiled; the general variant's helper for a scene that runs
+    the general kernels first: :func:`first_variant`), :func:`stop_cold_compile_ahead` after
+    it (nothing to stop once the block's render has adopted the helper)."""
+    builders = scene is not None and scene_needs_builders(scene)
+    start_cold_compile_ahead(builders, scene is not None and first_variant(scene, builders))
     try:
         yield
     finally:
         stop_cold_compile_ahead()
 
 
+def first_variant(scene: Scene, builders: bool) -> bool:
+    """The variant a first render of ``scene`` compiles first on a cold cache: the general
+    one (True) for a scene that certainly runs it (a torus, a CSG object:
+    :func:`~whitted.compile.scene.scene_needs_general_kernels`) and is small enough for the
+    builders' Python twins, so that its first picture waits for one variant, not two; else
+    the plain one, whose helper also compiles the builders a large scene needs (a large
+    scene with tori or CSG compiles its general kernels after, as every scene with mesh
+    instances does)."""
+    return not builders and scene_needs_general_kernels(scene)
+
+
 def _take_ahead(instances: bool):
-    """The lock and helper started ahead for this variant (the plain one), or None."""
+    """The lock and helper started ahead for this variant, or None."""
     global _ahead
     with _ahead_lock:
-        if instances or _ahead is None:
+        if _ahead is None or _ahead[2] != instances:
             return None
         ahead, _ahead = _ahead, None
         return ahead
@@ -512,7 +535,7 @@ def _compile_lock(cache, instances: bool):
     """The variant's compile lock: the one taken ahead, or taken now (waiting for another
     process that holds it)."""
     global _ahead
-    ahead = None if instances else _ahead
+    ahead = _ahead if _ahead is not None and _ahead[2] == instances else None
     if ahead is not None:
         try:
             yield
@@ -587,8 +610,10 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None,
     delegated = ()
     if helper is not None and helper.stdout is not None:
         delegated = tuple(d.py_func.__qualname__ for d, _ in _delegated(instances))
-    count = _CompileCount(EXPECTED_COMPILES[instances] + EXPECTED_BUILDER_COMPILES * builders,
-                          delegated)
+    expected = EXPECTED_COMPILES[instances]
+    if instances and not kernels_cached(False):
+        expected = EXPECTED_GENERAL_ALONE_COMPILES
+    count = _CompileCount(expected + EXPECTED_BUILDER_COMPILES * builders, delegated)
     if helper is not None and helper.stdout is not None:
         threading.Thread(target=count.read_helper, args=(helper.stdout,),
                          name="whitted-compile-helper-output", daemon=True).start()
