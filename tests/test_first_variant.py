@@ -50,18 +50,20 @@ def test_the_scene_test_agrees_with_the_compiled_arrays(shape):
     assert general is (shape.type in ("torus", "csg"))
 
 
-def test_a_torus_inside_a_csg_object_and_an_empty_scene():
+def test_an_empty_scene_and_a_scene_of_many_plain_shapes():
     assert scene_needs_general_kernels(Scene()) is False
-    ring = CSG(operation="union", objects=[Torus(major_radius=1.0, minor_radius=0.25)])
-    assert scene_needs_general_kernels(Scene(objects=[BALL, ring])) is True
+    many = [Sphere(center=(k, 0, 0), radius=0.5) for k in range(2000)]
+    assert scene_needs_general_kernels(Scene(objects=[*many, Plane()])) is False
+    assert scene_needs_general_kernels(Scene(objects=[*many, SHAPES[8]])) is True
 
 
-@pytest.mark.parametrize("shape, compiled_first", [
-    (BALL, [None]),  # the default (plain) kernels first, then the scene's: the same
-    (Torus(major_radius=1.0, minor_radius=0.25), []),  # the general ones only
+@pytest.mark.parametrize("shape, given, compiled_first", [
+    (BALL, False, [None]),  # the default (plain) kernels first, then the scene's: the same
+    (Torus(major_radius=1.0, minor_radius=0.25), False, []),  # the general ones only
+    (Torus(major_radius=1.0, minor_radius=0.25), True, []),  # the arrays given: the same
 ])
 def test_a_first_render_compiles_the_plain_kernels_only_for_a_plain_scene(
-        monkeypatch, shape, compiled_first):
+        monkeypatch, shape, given, compiled_first):
     class Stop(Exception):
         pass
 
@@ -75,15 +77,33 @@ def test_a_first_render_compiles_the_plain_kernels_only_for_a_plain_scene(
 
     monkeypatch.setattr(api, "kernels_cached", lambda *key: False)  # a first run
     monkeypatch.setattr(api, "warm_up_kernels", warm_up_kernels)
+    scene = Scene(objects=[shape])
+    compiled = compile_scene(scene) if given else None
     with pytest.raises(Stop):
-        api.RenderJob(Scene(objects=[shape]), threads=1).run()
+        api.RenderJob(scene, compiled=compiled, threads=1).run()
     assert calls[:-1] == compiled_first
     assert warm_up.kernel_variant(calls[-1]) is (shape.type == "torus")
 
 
-def test_a_large_scene_with_a_torus_compiles_the_plain_kernels_and_builders_first():
+def test_a_large_scene_with_a_torus_compiles_the_plain_kernels_and_builders_first(
+        monkeypatch):
     # the plain variant's helper compiles the builders a large scene needs before its
     # arrays can be built; the general kernels come after
     scene = Scene(objects=[Torus(major_radius=1.0, minor_radius=0.25)])
     assert warm_up.first_variant(scene, builders=True) is False
     assert warm_up.first_variant(scene, builders=False) is True
+    calls = []
+
+    class Stop(Exception):
+        pass
+
+    def warm_up_kernels(compiled=None, builders=False):
+        calls.append((compiled, builders))
+        raise Stop
+
+    monkeypatch.setattr(api, "kernels_cached", lambda *key: False)
+    monkeypatch.setattr(api, "scene_needs_builders", lambda scene: True)
+    monkeypatch.setattr(api, "warm_up_kernels", warm_up_kernels)
+    with pytest.raises(Stop):
+        api.RenderJob(scene, threads=1).run()
+    assert calls == [(None, True)]  # the plain kernels, their helper compiling the builders

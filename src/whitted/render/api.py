@@ -35,6 +35,7 @@ from .warm_up import (
     first_variant,
     kernel_variant,
     kernels_cached,
+    stand_in_scene,
     warm_up_kernels,
 )
 
@@ -425,13 +426,15 @@ class RenderJob:
         stats = self.stats
         stats.compile_seconds = 0.0
         if not kernels_cached():  # a first run: the default variant (and the builders, for
-            # a scene too large for their Python twins), compiled on both cores, unless the
-            # scene runs the general kernels, which are then the only ones compiled
+            # a scene too large for their Python twins), compiled on both cores; or, for a
+            # scene that runs the general kernels and is small enough for those twins (or
+            # is compiled already), the general variant alone, before the scene's arrays
+            # (whose light buffers then load, compiled by the helper meanwhile)
             builders = self.compiled is None and scene_needs_builders(self.scene)
             general = (kernel_variant(self.compiled) if self.compiled is not None
                        else first_variant(self.scene, builders))
-            if not general:
-                stats.compile_seconds = warm_up_kernels(builders=builders)
+            stats.compile_seconds = (warm_up_kernels(stand_in_scene(True)) if general
+                                     else warm_up_kernels(builders=builders))
         compiled: CompiledScene = (self.compiled if self.compiled is not None
                                    else compile_scene(self.scene, threads=self.threads))
         stats.compile_seconds += warm_up_kernels(compiled)
@@ -590,7 +593,9 @@ def render_aovs(scene: Scene, **overrides: object) -> dict[str, np.ndarray]:
     scene = _as_scene(scene)
     if overrides:
         scene = scene.with_settings(**overrides)
-    warm_up_kernels()
+    if not kernels_cached():  # as RenderJob: the variant the scene runs first
+        general = first_variant(scene, scene_needs_builders(scene))
+        warm_up_kernels(stand_in_scene(True) if general else None)
     compiled = compile_scene(scene)
     warm_up_kernels(compiled)
     s = scene.render

@@ -75,8 +75,9 @@ HELPER_WAIT_SECONDS = 120.0  # a helper still busy after this is stopped (never 
 #: functions Numba compiles in a cold compile of each variant, this process and the helper
 #: together (counted on the 2-core VM, an empty cache folder: 162 for the plain variant in one
 #: process, a few more with the helper; 58 + 101 for the general one once the plain one is
-#: cached, as the render API compiles the plain variant first; each kernel other kernels call
-#: counts once, as its twin). Only the progress shown depends on it: a count that drifted
+#: cached, as a first render of a large scene or one with mesh instances compiles the plain
+#: variant first; each kernel other kernels call counts once, as its twin). Only the progress
+#: shown depends on it: a count that drifted
 #: (kernels changed, a different split between the processes) makes the fraction
 #: approximate; tests/test_warm_up.py holds the plain one to a real cold compile within 10 %.
 EXPECTED_COMPILES = {False: 166, True: 159}
@@ -620,9 +621,12 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None,
     if delegated and KernelCache is not None:
         KernelCache.wait_for_helper = count.wait_for_helper
     _progress = count
-    report = CompileReport("the kernels for instances, tori and CSG" if instances
-                           else "the kernels",
-                           compile_progress)
+    label = "the kernels"
+    if instances:  # alone (the plain ones not cached: their leaves too) or after them
+        label = ("the kernels for instances, tori and CSG"
+                 + (" (the first kernels)" if expected == EXPECTED_GENERAL_ALONE_COMPILES
+                    else ""))
+    report = CompileReport(label, compile_progress)
     try:
         with report, _CountCompiles(count), _interrupt_at_safe_points(count):
             if delegated:  # this process's first share, while the helper compiles its own
