@@ -10,33 +10,21 @@ from whitted.compile.scene import compile_scene, scene_needs_general_kernels
 from whitted.kernels.features import EXTRAS_DTYPE
 from whitted.render import api, warm_up
 from whitted.scene import Scene
-from whitted.scene.shapes import (
-    CSG,
-    Box,
-    Cone,
-    Cylinder,
-    Disk,
-    Mesh,
-    Plane,
-    Rectangle,
-    Sphere,
-    Torus,
-    Triangle,
-)
+from whitted.scene import shapes as sh
 
-BALL = Sphere(radius=1.0)
+BALL = sh.Sphere(radius=1.0)
 SHAPES = [
     BALL,
-    Plane(),
-    Rectangle(corner=(0, 0, 0), edge1=(1, 0, 0), edge2=(0, 1, 0)),
-    Disk(radius=1.0),
-    Triangle(vertices=((0, 0, 0), (1, 0, 0), (0, 1, 0))),
-    Box(min=(-1, -1, -1), max=(1, 1, 1)),
-    Cylinder(base=(0, -1, 0), top=(0, 1, 0), radius=0.5),
-    Cone(base=(0, -1, 0), top=(0, 1, 0), radius=1.0, top_radius=0.5),
-    Torus(major_radius=1.0, minor_radius=0.25),
-    CSG(operation="difference", objects=[Box(min=(-1, -1, -1), max=(1, 1, 1)), BALL]),
-    Mesh(vertices=[[0, 0, 0], [1, 0, 0], [0, 1, 0]], faces=[[0, 1, 2]]),
+    sh.Plane(),
+    sh.Rectangle(corner=(0, 0, 0), edge1=(1, 0, 0), edge2=(0, 1, 0)),
+    sh.Disk(radius=1.0),
+    sh.Triangle(vertices=((0, 0, 0), (1, 0, 0), (0, 1, 0))),
+    sh.Box(min=(-1, -1, -1), max=(1, 1, 1)),
+    sh.Cylinder(base=(0, -1, 0), top=(0, 1, 0), radius=0.5),
+    sh.Cone(base=(0, -1, 0), top=(0, 1, 0), radius=1.0, top_radius=0.5),
+    sh.Torus(major_radius=1.0, minor_radius=0.25),
+    sh.CSG(operation="difference", objects=[sh.Box(min=(-1, -1, -1), max=(1, 1, 1)), BALL]),
+    sh.Mesh(vertices=[[0, 0, 0], [1, 0, 0], [0, 1, 0]], faces=[[0, 1, 2]]),
 ]
 
 
@@ -52,15 +40,15 @@ def test_the_scene_test_agrees_with_the_compiled_arrays(shape):
 
 def test_an_empty_scene_and_a_scene_of_many_plain_shapes():
     assert scene_needs_general_kernels(Scene()) is False
-    many = [Sphere(center=(k, 0, 0), radius=0.5) for k in range(2000)]
-    assert scene_needs_general_kernels(Scene(objects=[*many, Plane()])) is False
+    many = [sh.Sphere(center=(k, 0, 0), radius=0.5) for k in range(2000)]
+    assert scene_needs_general_kernels(Scene(objects=[*many, sh.Plane()])) is False
     assert scene_needs_general_kernels(Scene(objects=[*many, SHAPES[8]])) is True
 
 
 @pytest.mark.parametrize("shape, given, compiled_first", [
     (BALL, False, [None]),  # the default (plain) kernels first, then the scene's: the same
-    (Torus(major_radius=1.0, minor_radius=0.25), False, []),  # the general ones only
-    (Torus(major_radius=1.0, minor_radius=0.25), True, []),  # the arrays given: the same
+    (sh.Torus(major_radius=1.0, minor_radius=0.25), False, []),  # the general ones only
+    (sh.Torus(major_radius=1.0, minor_radius=0.25), True, []),  # the arrays given: the same
 ])
 def test_a_first_render_compiles_the_plain_kernels_only_for_a_plain_scene(
         monkeypatch, shape, given, compiled_first):
@@ -89,7 +77,7 @@ def test_a_large_scene_with_a_torus_compiles_the_plain_kernels_and_builders_firs
         monkeypatch):
     # the plain variant's helper compiles the builders a large scene needs before its
     # arrays can be built; the general kernels come after
-    scene = Scene(objects=[Torus(major_radius=1.0, minor_radius=0.25)])
+    scene = Scene(objects=[sh.Torus(major_radius=1.0, minor_radius=0.25)])
     assert warm_up.first_variant(scene, builders=True) is False
     assert warm_up.first_variant(scene, builders=False) is True
     calls = []
