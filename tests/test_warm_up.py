@@ -9,63 +9,61 @@ import sys
 import numpy as np
 import pytest
 
-from whitted.compile.params import render_params
 from whitted.compile.scene import compile_scene
-from whitted.jit import kernel
-from whitted.jit.decorators import Kernel
-from whitted.kernels import accel, integrator, lighting, tiles
+from whitted.kernels import tiles
+from whitted.render import warm_up
+from whitted.scene.scene import Scene
+
+#: run in a process of its own on an empty cache folder, without the helper: every kernel
+#: below render_tiles is compiled there, each for the types its callers ask for
+_SIGNATURES = r"""
+import sys
+
+import numpy as np
+
+from whitted.compile.params import render_params
+from whitted.kernels import tiles
 from whitted.kernels.callees import callees_here_first, render_callees
 from whitted.kernels.layout import N_RAY_KINDS
 from whitted.render import warm_up
 from whitted.scene.scene import RenderSettings, Scene
 
+stand_in = warm_up.stand_in_scene(sys.argv[1] == "general")
+params = render_params(Scene(), stand_in, RenderSettings(width=1, height=1))
+arrays = (stand_in.geometry, stand_in.materials, stand_in.lights, params)
+delegated, here = render_callees(*arrays), callees_here_first(*arrays)
+assert delegated and here
+tiles.render_tiles(np.zeros((0, 4), np.int32), np.zeros((1, 1, 3), np.float32),
+                   stand_in.geometry, stand_in.materials, stand_in.lights, params,
+                   np.zeros((1, N_RAY_KINDS), np.int64), tiles.lane_workspace(1),
+                   tiles.adaptive_workspace(), 0.0, -1, 0, 1)
+for dispatcher, argument_types in delegated + here:
+    asked = list(dispatcher.callee.overloads)
+    if tuple(argument_types) not in asked:
+        print(f"{dispatcher.py_func.__name__}: render_tiles compiled {asked}, "
+              f"the helper would compile {argument_types}")
+"""
 
-@pytest.mark.parametrize("instances", [False, True])
-def test_helper_compiles_the_signatures_render_tiles_calls(monkeypatch, instances):
+
+@pytest.mark.parametrize("variant", ["plain", "general"])
+def test_helper_compiles_the_signatures_render_tiles_calls(tmp_path, variant):
     """The helper's work is only of use if the render kernel asks for exactly these variants.
 
-    Uncached copies of render_tiles and of a caller of each kernel listed (trace_path,
-    closest_hit, direct_light, gather_extra_hits) are compiled here: they ask for the
-    variants of their callees (which load or compile), and those are what the callees'
-    twins then list in ``overloads``. A caller loaded from the cache would ask for nothing,
-    so these callers are compiled anew, whatever the state of the cache; and each listed
-    kernel gets a new twin first, so that a cold compile earlier in this process (which
-    compiles the lists' types as given) leaves no signature behind that nothing asked for."""
-    def fresh(dispatcher):
-        return kernel(cache=False, inline="always")(dispatcher.py_func)
+    A process of its own compiles render_tiles on an empty cache folder without the helper:
+    every kernel below it is compiled there for the types its callers ask for (directly, or
+    through an overload whose implementation is a kernel's body, extras.py), and those are
+    what each listed kernel's twin then holds in ``overloads``. In this process a caller
+    loaded from the cache, or an overload's body compiled by an earlier test, would ask for
+    nothing."""
+    from whitted.jit.dispatcher import tuned
 
-    def twin_owner(dispatcher):  # the dispatcher whose ``callee`` twin kernels call
-        return dispatcher.dispatcher if isinstance(dispatcher, Kernel) else dispatcher
-
-    monkeypatch.setattr(tiles, "trace_path", fresh(integrator.trace_path))
-    copies = {"closest_hit": fresh(accel.closest_hit),
-              "direct_light": fresh(lighting.direct_light)}
-    for name, copy in copies.items():
-        monkeypatch.setattr(integrator, name, copy)
-    stand_in = warm_up.stand_in_scene(instances)
-    fresh_render_tiles = kernel(cache=False)(tiles.render_tiles.py_func)
-    params = render_params(Scene(), stand_in, RenderSettings(width=1, height=1))
-    delegated = render_callees(stand_in.geometry, stand_in.materials, stand_in.lights, params)
-    assert delegated
-    # and what the render process compiles first meanwhile
-    here = callees_here_first(stand_in.geometry, stand_in.materials, stand_in.lights, params)
-    for dispatcher, _ in delegated + here:  # new twins, made (and loaded) when asked for
-        monkeypatch.setattr(twin_owner(dispatcher), "_callee", None)
-        assert dispatcher.callee.overloads == {}
-    fresh_render_tiles(np.zeros((0, 4), np.int32), np.zeros((1, 1, 3), np.float32),
-                       stand_in.geometry, stand_in.materials, stand_in.lights, params,
-                       np.zeros((1, N_RAY_KINDS), np.int64), tiles.lane_workspace(1),
-                       tiles.adaptive_workspace(), 0.0, -1, 0, 1)
-    for dispatcher, argument_types in here:
-        if dispatcher is lighting.gather_extra_hits:  # the caller of csg_surfaces, compiled
-            # with the types direct_light (checked below) asks for
-            fresh(dispatcher).compile(argument_types)
-    for dispatcher, argument_types in delegated + here:
-        # what trace_path called instead
-        dispatcher = copies.get(dispatcher.py_func.__name__, dispatcher)
-        assert tuple(argument_types) in dispatcher.callee.overloads, (
-            f"{dispatcher.py_func.__name__}: render_tiles compiled "
-            f"{list(dispatcher.callee.overloads)}, the helper would compile {argument_types}")
+    if not tuned():
+        pytest.skip("the helper works with the tuned dispatcher only")
+    env = {**os.environ, "WHITTED_CACHE_DIR": str(tmp_path), "WHITTED_COMPILE_HELPER": "0"}
+    result = subprocess.run([sys.executable, "-c", _SIGNATURES, variant], env=env,
+                            capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.stdout == ""
 
 
 def test_warm_up_marks_the_cache_folder():

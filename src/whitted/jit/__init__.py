@@ -2,8 +2,9 @@
 package with kernels compiles through (``kernels/``, ``compile/``, ``assets/obj_scan.py``,
 ``stefan/``).
 
-- ``decorators.py``: ``@kernel``, ``@builder``, deferred ``@overload``, :func:`numba_object`,
-  and :func:`load_numba` (Numba imported, and the cache checked, on first need);
+- ``decorators.py``: ``@kernel``, ``@builder``, deferred ``@overload`` (and :func:`body`),
+  :func:`numba_object`, and :func:`load_numba` (Numba imported, and the cache checked, on
+  first need);
 - ``dispatcher.py``: Numba's side of a kernel (stock ``numba.njit`` or the tuned dispatcher,
   the one module that uses names Numba does not document);
 - ``cache.py``: the per-user kernel cache folder, its checksums, lock and fallbacks;
@@ -18,6 +19,7 @@ from .decorators import (
     FAST_MATH,
     Kernel,
     _jit_disabled,
+    body,
     builder,
     kernel,
     load_numba,
@@ -26,5 +28,5 @@ from .decorators import (
     seal_cache,
 )
 
-__all__ = ["FAST_MATH", "Kernel", "_jit_disabled", "builder", "kernel", "load_numba",
+__all__ = ["FAST_MATH", "Kernel", "_jit_disabled", "body", "builder", "kernel", "load_numba",
            "numba_object", "overload", "seal_cache"]

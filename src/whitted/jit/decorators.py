@@ -299,8 +299,20 @@ def numba_object(module: str, name: str):
     return made.resolve() if _swapped else made
 
 
-def overload(function, **options):
-    """Numba's ``numba.extending.overload``, registered when Numba is loaded."""
+#: Numba options of every overload's implementation: never called from Python, so without
+#: the wrappers that would let Python call it (compiled for nothing otherwise)
+OVERLOAD_OPTIONS = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+
+
+def overload(function, *, forceinline: bool = False, **options):
+    """Numba's ``numba.extending.overload``, registered when Numba is loaded. The
+    implementation is compiled with ``forceinline`` as given (not inherited from whichever
+    caller is compiled first, as Numba would) and without Python wrappers
+    (:data:`OVERLOAD_OPTIONS`); an implementation that is a kernel's body (:func:`body`)
+    gets that kernel's ``forceinline``."""
+    jit_options = {**OVERLOAD_OPTIONS, "forceinline": forceinline,
+                   **options.pop("jit_options", {})}
+    options["jit_options"] = jit_options
 
     def decorate(implementation):
         overloads_by_function[function] = (implementation, options)
@@ -318,6 +330,19 @@ def overload(function, **options):
         return implementation
 
     return decorate
+
+
+def body(target):
+    """The Python function of kernel ``target`` (a Kernel or its dispatcher), for an overload
+    to return as its implementation. Numba compiles an overload's implementation as a
+    function of its own, linked into its callers: a lambda that calls the kernel is one more
+    level whose module links the kernel's (and all below it) and has LLVM optimise it all
+    again, as every separately compiled caller does (docs/performance.md, "the overloads'
+    levels"). Returned as the implementation, the kernel's own code is that function, and the
+    level is gone. Its options are the overload's (``forceinline`` as the kernel's, given to
+    :func:`overload`); fast-math and the error model are its caller's, as a kernel's callers'
+    are the same as the kernel's (an IEEE twin's callers are twins: kernels/strict.py)."""
+    return target.py_func
 
 
 def kernel(fn=None, *, entry: bool = False, **options):

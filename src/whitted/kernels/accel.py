@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..jit import kernel, overload
+from ..jit import body, kernel, overload
 from .extras import (
     extra_hit_if_extras,
     extra_normal_if_extras,
@@ -153,7 +153,7 @@ def mesh_normals_if_instances(geo, mesh, tri, b1, b2):
 def _mesh_normals_if_instances(geo, mesh, tri, b1, b2):
     if not instances_possible(geo):
         return lambda geo, mesh, tri, b1, b2: ((0.0, 0.0, 1.0), (0.0, 0.0, 1.0))
-    return lambda geo, mesh, tri, b1, b2: mesh_normals(geo, mesh, tri, b1, b2)
+    return body(mesh_normals)
 
 
 @kernel(inline="always")
@@ -234,8 +234,7 @@ def closest_instance_hit_if_instances(geo, o, d, inv, tmin, tmax, stack):
 def _closest_instance_hit_if_instances(geo, o, d, inv, tmin, tmax, stack):
     if not instances_possible(geo):
         return lambda geo, o, d, inv, tmin, tmax, stack: (tmax, -1, -1, 0.0, 0.0)
-    return lambda geo, o, d, inv, tmin, tmax, stack: closest_instance_hit(geo, o, d, inv, tmin,
-                                                                          tmax, stack)
+    return body(closest_instance_hit)
 
 
 @kernel(inline="always")

@@ -34,13 +34,13 @@ from numba import typeof, types
 
 from .accel import closest_hit, hit_analytic, surface_normals
 from .caustics import add_caustic
-from .csg import csg_surfaces
-from .extras import extra_hit
+from .csg import csg_hit, csg_surfaces
 from .features import instances_possible
 from .geometry_ref import GeometryRef
 from .integrator import split_at_surface, surface_colour
 from .layout import GeometryArrays
-from .lighting import direct_light, disk_left_out, gather_extra_hits, list_bundle_occluders
+from .lighting import direct_light, disk_left_out, list_bundle_occluders
+from .shapes.dispatch import extra_shape_t
 
 VEC3 = types.UniTuple(types.float64, 3)
 INT = types.int64
@@ -48,6 +48,7 @@ REAL = types.float64
 INT32S = types.int32[::1]  # a lane's scratch lists and traversal stack: contiguous int32
 REALS = types.float64[::1]
 INT64S = types.int64[::1]  # a lane's ray counts
+PARAMS = types.float64[:, ::1]  # GeometryArrays.prim_params
 
 
 def _direct_light_types(geo, mats, lights, params):
@@ -64,10 +65,12 @@ def render_callees(geometry: GeometryArrays, materials, lights, params):
         geo = GeometryRef(geo)
     mats = typeof(materials)
     if instances_possible(geo):
-        # the general kernels: first the extra shapes' one call site (the CSG walk and the
+        # the general kernels: first the extra shapes' intersections (the CSG walk and the
         # torus's quartic, a third of the variant's compile), which both the closest hit
-        # here and the helper's shadow rays reach; then the shadow rays
-        return [(extra_hit, (geo, INT, VEC3, VEC3, VEC3, REAL, REAL)),
+        # here and the helper's shadow rays reach (through extras.py's extra_hit, compiled
+        # in each caller's process: an overload's body); then the shadow rays
+        return [(csg_hit, (geo, INT, VEC3, VEC3, VEC3, REAL, REAL)),
+                (extra_shape_t, (INT, PARAMS, INT, VEC3, VEC3, REAL, REAL)),
                 (hit_analytic, (geo, INT, VEC3, VEC3, REAL, REAL)),
                 (direct_light, _direct_light_types(geo, mats, lights, params))]
     return [(hit_analytic, (geo, INT, VEC3, VEC3, REAL, REAL)),
@@ -109,14 +112,14 @@ def callees_here_first(geometry: GeometryArrays, materials, lights, params):
                                     VEC3, VEC3, REAL, REAL)),
                 (surface_colour, (geo, mats, INT, INT, INT, REAL, REAL, VEC3)),
                 # the helper's: waited for here, so that what follows loads the CSG walk's
-                # pieces (the leaves' crossings and normals) instead of compiling them too
-                (extra_hit, (geo, INT, VEC3, VEC3, VEC3, REAL, REAL)),
+                # pieces (the leaves' crossings and normals) and the torus's instead of
+                # compiling them too
+                (csg_hit, (geo, INT, VEC3, VEC3, VEC3, REAL, REAL)),
+                (extra_shape_t, (INT, PARAMS, INT, VEC3, VEC3, REAL, REAL)),
                 (closest_hit, (geo, VEC3, VEC3, REAL, REAL, INT32S)),
                 (surface_normals, (geo, INT, INT, REAL, REAL, VEC3)),
                 (csg_surfaces, (geo, INT, VEC3, VEC3, VEC3, REAL, REAL, REALS, INT,
-                                types.boolean)),
-                (gather_extra_hits, (geo, INT, VEC3, VEC3, VEC3, REAL, REAL, REAL, REALS, INT,
-                                     types.boolean))]
+                                types.boolean))]
     return [(list_bundle_occluders, (geo, mats, VEC3, VEC3, REAL, REAL, INT32S, INT32S)),
             (disk_left_out, (typeof(lights.table), INT, mats, INT, VEC3, VEC3, VEC3, VEC3,
                              REAL)),

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..jit import kernel, overload
+from ..jit import body, kernel, overload
 from .csg import csg_hit
 from .features import extras_possible
 from .layout import PRIM_FLIP, PRIM_MEDIUM, PRIM_TYPE, PRIM_XFORM
@@ -44,7 +44,7 @@ def extra_hit_if_extras(geo, i, o, d, inv, tmin, tmax):
 def _extra_hit_if_extras(geo, i, o, d, inv, tmin, tmax):
     if not extras_possible(geo):
         return lambda geo, i, o, d, inv, tmin, tmax: (INF, np.int64(-1))
-    return lambda geo, i, o, d, inv, tmin, tmax: extra_hit(geo, i, o, d, inv, tmin, tmax)
+    return body(extra_hit)
 
 
 @kernel
@@ -62,7 +62,7 @@ def extra_normal_if_extras(geo, i, p, n):
 def _extra_normal_if_extras(geo, i, p, n):
     if not extras_possible(geo):
         return lambda geo, i, p, n: n
-    return lambda geo, i, p, n: extra_normal(geo, i, p, n)
+    return body(extra_normal)
 
 
 @kernel
@@ -116,4 +116,4 @@ def extra_uv_if_extras(geo, i, p):
 def _extra_uv_if_extras(geo, i, p):
     if not extras_possible(geo):
         return lambda geo, i, p: (0.0, 0.0)
-    return lambda geo, i, p: extra_uv(geo, i, p)
+    return body(extra_uv)

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from ..jit import kernel, overload
+from ..jit import body, kernel, overload
 from .accel import (
     closest_hit,
     geometric_normal,
@@ -113,8 +113,7 @@ def instances_occlusion_if_instances(geo, mats, o, d, inv, tmin, tmax, stack):
 def _instances_occlusion_if_instances(geo, mats, o, d, inv, tmin, tmax, stack):
     if not instances_possible(geo):
         return lambda geo, mats, o, d, inv, tmin, tmax, stack: 0
-    return lambda geo, mats, o, d, inv, tmin, tmax, stack: _instances_occlusion(
-        geo, mats, o, d, inv, tmin, tmax, stack)
+    return body(_instances_occlusion)
 
 
 @kernel
@@ -395,8 +394,7 @@ def gather_extra_hits_if_extras(geo, i, o, d, inv, tmin, tmax, step, hits, n, fu
 def _gather_extra_hits_if_extras(geo, i, o, d, inv, tmin, tmax, step, hits, n, full):
     if not extras_possible(geo):
         return lambda geo, i, o, d, inv, tmin, tmax, step, hits, n, full: (n, full)
-    return lambda geo, i, o, d, inv, tmin, tmax, step, hits, n, full: gather_extra_hits(
-        geo, i, o, d, inv, tmin, tmax, step, hits, n, full)
+    return body(gather_extra_hits)
 
 
 @kernel(specialise_constants=True)  # a variant per call site: LLVM inlines each
@@ -472,16 +470,13 @@ def shadow_through_instances_if_instances(geo, mats, params, o, d, dist, media, 
                                      stack, occluders, list_first, n_listed)
 
 
-@overload(shadow_through_instances_if_instances, inline="always")
+@overload(shadow_through_instances_if_instances, forceinline=True)  # as the kernel
 def _shadow_through_instances_if_instances(geo, mats, params, o, d, dist, media, n_media,
                                            scratch, stack, occluders, list_first, n_listed):
     if not instances_possible(geo):
         return (lambda geo, mats, params, o, d, dist, media, n_media, scratch, stack,
                 occluders, list_first, n_listed: ((1.0, 1.0, 1.0), -1))
-    return (lambda geo, mats, params, o, d, dist, media, n_media, scratch, stack, occluders,
-            list_first, n_listed: _shadow_through_instances(
-                geo, mats, params, o, d, dist, media, n_media, scratch, stack, occluders,
-                list_first, n_listed))
+    return body(_shadow_through_instances)
 
 
 @kernel

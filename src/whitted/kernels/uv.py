@@ -5,7 +5,7 @@ shape's file says its mapping, docs/scene-format.md tabulates them all).
 
 from __future__ import annotations
 
-from ..jit import kernel, overload
+from ..jit import body, kernel, overload
 from .accel import to_object
 from .extras import extra_uv_if_extras
 from .features import has_extras, instances_possible
@@ -24,7 +24,7 @@ def mesh_uv_if_instances(geo, mesh, tri, b1, b2):
 def _mesh_uv_if_instances(geo, mesh, tri, b1, b2):
     if not instances_possible(geo):
         return lambda geo, mesh, tri, b1, b2: (b1, b2)
-    return lambda geo, mesh, tri, b1, b2: mesh_uv(geo, mesh, tri, b1, b2)
+    return body(mesh_uv)
 
 
 @kernel(inline="always")
