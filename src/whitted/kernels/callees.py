@@ -22,10 +22,10 @@ callees, compiled first (:func:`callees_here_first`), then ``closest_hit``, norm
 the caustics, the adaptive sampler and ``render_tiles``, which inlines them all (work only
 this process can do, as it needs everything below it). For the general kernels (mesh
 instances, tori, CSG objects; the builders are already cached) the helper takes the extra
-shapes' intersection (``extra_hit``: the CSG walk and the torus, which the closest hit and
-the shadow rays share, so that one process compiles it, not both), ``hit_analytic`` and
-``direct_light``; this process the rest, the shadow rays' gathering of a clear extra
-shape's crossings first.
+shapes' intersections (``csg_hit``, the CSG walk, and ``extra_shape_t``, the torus's: the
+closest hit and the shadow rays both reach them through ``extra_hit``, an overload's body
+that each caller's process compiles, so that one process compiles the walk, not both),
+``hit_analytic`` and ``direct_light``; this process the rest.
 """
 
 from __future__ import annotations
@@ -91,18 +91,15 @@ def callees_here_first(geometry: GeometryArrays, materials, lights, params):
     those still to do.
 
     General kernels: what needs none of the helper's extra shapes (the bundle list, the
-    refraction, the colour) while the helper compiles ``extra_hit``; then, once it has
-    (waiting for it, and loading it), the closest hit (waiting for the helper's
-    ``hit_analytic`` too, about two seconds later; the helper's shadow walk through the
-    instances calls the closest hit after its any-hit test, with the same types, and loads
-    it when this process has finished it first, as it had on the 2-core VM), the normals,
-    the CSG
-    objects' every-crossing walk of
-    the shadow rays (``csg_surfaces``) and the shadow rays' gathering of a clear torus's or
-    CSG object's crossings (``gather_extra_hits``), which the helper's ``direct_light``
-    reaches only after its shadow walk through the instances, and loads. The helper's chain
-    (``extra_hit``, ``hit_analytic``, the shadow walk, ``direct_light``) is the critical
-    path: each needs the one before it."""
+    refraction, the colour) while the helper compiles the CSG walk; then, once it has
+    (waiting for it and the torus's test, and loading them), the closest hit (waiting for
+    the helper's ``hit_analytic`` too, about a second later; the helper's shadow walk
+    through the instances calls the closest hit after its any-hit test, with the same types,
+    and loads it when this process has finished it first, as it had on the 2-core VM), the
+    normals and the CSG objects' every-crossing walk of the shadow rays (``csg_surfaces``),
+    which the helper's ``direct_light`` reaches only after its shadow walk through the
+    instances, and loads. The helper's chain (the CSG walk, ``hit_analytic``, the shadow
+    walk, ``direct_light``) is the critical path: each needs the one before it."""
     geo = typeof(geometry)
     mats = typeof(materials)
     if instances_possible(geo):

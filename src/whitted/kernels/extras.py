@@ -4,7 +4,10 @@ is walked by csg.py; the shapes are asked through shapes/dispatch.py's ``extra_s
 
 Each ``*_if_extras`` function is an overload that resolves, while its caller is typed, to the
 real kernel or to a stand-in of the same types, so the kernels of the default scene never
-compile the torus's quartic or the CSG walk."""
+compile the torus's quartic or the CSG walk. The real kernel is its own body, compiled as the
+overload's implementation (``jit.body``) in each caller's process: ``extra_hit``'s callers
+(the closest hit, the shadow rays' tests) link the CSG walk and the quartic through it with no
+level of their own between."""
 
 from __future__ import annotations
 
