@@ -120,6 +120,7 @@ def test_the_queue_hands_a_general_kind_out_only_after_the_general_render_kernel
 
     queue = _Queue(_all_names())
     assert queue.take() == "general/render"  # the longest chain first
+    assert queue.take() == "stefan"
     # the photon tracer shares no kernel with the render kernel: it starts at once
     assert queue.take() == "general/caustics"
     taken = []
@@ -130,7 +131,7 @@ def test_the_queue_hands_a_general_kind_out_only_after_the_general_render_kernel
             break
         assert queue.take() == name
         taken.append(name)
-    assert sorted(taken) == ["builders", "plain/aovs", "plain/caustics", "stefan"]
+    assert sorted(taken) == ["builders", "plain/aovs", "plain/caustics"]
     assert queue.todo == ["general/aovs"]
     queue.finish("general/render", 12.5)
     assert queue.take() == "general/aovs"
@@ -143,7 +144,7 @@ def test_the_longest_compiles_are_handed_out_first():
 
     queue = _Queue(_all_names())
     order = [queue.take() for _ in range(6)]
-    assert order == ["general/render", "general/caustics", "stefan", "builders",
+    assert order == ["general/render", "stefan", "general/caustics", "builders",
                      "plain/caustics", "plain/aovs"]
 
 
@@ -233,3 +234,32 @@ def test_warm_says_whether_it_compiles_or_loads(tmp_path, monkeypatch, cached, n
     assert out.splitlines()[:1 + len(names)] == [f"{'plain/render':28}    0.25 s"] + [
         f"{name:28}    0.50 s" for name in names]
     assert out.splitlines()[-1].startswith("every kernel is in the cache: ")
+
+
+def test_workers_compile_without_a_helper_of_their_own(monkeypatch):
+    # the workers keep the cores busy; a helper beside each would compile kernels twice
+    import io
+    import subprocess
+
+    from whitted.cli import warm
+
+    started = []
+
+    class FakeWorker:
+        def __init__(self, args, **kwargs):
+            started.append((args, kwargs))
+            self.stdin, self.stdout = io.StringIO(), io.StringIO()
+            self.returncode = 0
+
+        def poll(self):
+            return None
+
+        def wait(self):
+            return 0
+
+    monkeypatch.setattr(subprocess, "Popen", FakeWorker)
+    monkeypatch.setenv("WHITTED_COMPILE_HELPER", "1")
+    warm._work(warm._Queue([]), [])
+    (args, kwargs), = started
+    assert args[-2:] == ["warm", "--serve"]
+    assert kwargs["env"]["WHITTED_COMPILE_HELPER"] == "0"

@@ -7,9 +7,12 @@ cores); then the other variants (render/variants.py), the scene builders with th
 (which a small scene runs as Python until they are compiled: jit/python_twins.py) and the
 Stefan solver's kernels are handed out, one at a time and the longest first, to ``--jobs``
 worker processes (one per core), each compiling into the same cache (jit/cache.py keeps it
-consistent). A kind of the general kernels that shares the render kernel's callees (the AOV
-kernel) is handed out only once the general render kernel is in the cache: it then loads
-them instead of compiling them a second time in another process. Adaptive anti-aliasing is a
+consistent). A worker compiles without a helper process of its own (render/warm_up.py): the
+workers already keep the cores busy, and a helper beside them compiled some kernels in both
+processes (measured: the same CPU, the last worker done 2-3 s later). A kind of the general
+kernels that shares the render kernel's callees (the AOV kernel) is handed out only once the
+general render kernel is in the cache: it then loads them instead of compiling them a second
+time in another process. Adaptive anti-aliasing is a
 run-time choice of the render kernel: the ``render`` variants serve it. The photon tracers
 (the caustics variants: the tracer only, the render with caustics is the render kernel's)
 share nothing with the render kernels and start at once. A variant already in the cache
@@ -19,6 +22,7 @@ loads in a fraction of a second, so a second ``whitted warm`` is quick.
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -54,8 +58,8 @@ def _first(name: str) -> str | None:
 # What each variant's compile costs, in seconds of one core of a 2-core machine from an empty
 # cache (plain/render in it), as `whitted warm` measured them side by side: only the order
 # matters, so the longest are handed out first and the short ones fill in around them.
-_COST = {"general/render": 56.0, "general/caustics": 37.0, STEFAN: 30.0, BUILDERS: 7.5,
-         "plain/caustics": 5.0, "general/aovs": 2.0, "plain/aovs": 1.5}
+_COST = {"general/render": 41.0, "general/caustics": 23.0, STEFAN: 26.0, BUILDERS: 6.0,
+         "plain/caustics": 4.3, "general/aovs": 1.7, "plain/aovs": 0.8}
 
 
 def _order(names: list[str]) -> list[str]:
@@ -141,9 +145,11 @@ def _work(queue: _Queue, procs: list[subprocess.Popen]) -> None:
     """Feed one worker process from the queue until nothing is left or it fails."""
     # its stderr read only if it fails (a pipe could fill up while nobody reads it)
     with tempfile.TemporaryFile("w+") as stderr:
+        # no compile helper: the other workers are using the other cores (module docstring)
+        env = {**os.environ, "WHITTED_COMPILE_HELPER": "0"}
         proc = subprocess.Popen([sys.executable, "-m", "whitted", "warm", "--serve"],
                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=stderr,
-                                text=True)
+                                text=True, env=env)
         procs.append(proc)
         assert proc.stdin is not None and proc.stdout is not None
         try:
