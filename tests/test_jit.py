@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from numba import types
 
-from whitted.jit import dispatcher, kernel, load_numba
+from whitted.jit import body, dispatcher, kernel, load_numba, overload
 from whitted.jit.dispatcher import widen_integer
 
 load_numba()
@@ -140,7 +140,7 @@ STOCK = """
 import numpy as np
 from numba.core.registry import CPUDispatcher
 from whitted.jit import dispatcher
-from whitted.jit import kernel, load_numba
+from whitted.jit import body, kernel, load_numba, overload
 
 load_numba()
 assert dispatcher.tuned() is False
@@ -156,14 +156,75 @@ def row_sum(a, i):
     return a[i, 0] + a[i, 1]
 
 
+@kernel(cache=False)
+def doubled(x):
+    return 2.0 * x
+
+
+def doubled_through_overload(x):
+    return doubled(x)
+
+
+@overload(doubled_through_overload, forceinline=True)
+def _doubled_through_overload(x):
+    return body(doubled)
+
+
 @kernel(entry=True)
 def total(a, small):
-    return inlined_square(a[0, 0]) + row_sum(a, 1) + row_sum(a, small[0])
+    return (inlined_square(a[0, 0]) + row_sum(a, 1) + row_sum(a, small[0])
+            + doubled_through_overload(a[0, 1]))
 
 
 a = np.arange(6.0).reshape(3, 2)
 print("RESULT", total(a, np.array([2], np.int32)), type(total.dispatcher).__name__)
 """
+
+
+@kernel(cache=False)
+def _tripled(x):
+    return 3.0 * x
+
+
+def _tripled_through_overload(x):
+    return _tripled(x)
+
+
+@overload(_tripled_through_overload)
+def _tripled_overload(x):
+    return body(_tripled)
+
+
+@kernel(cache=False, inline="always")
+def _inlined_tripler(x):
+    return _tripled_through_overload(x) + 1.0
+
+
+@tuned_only
+def test_an_overloads_body_is_compiled_with_its_own_options_not_its_callers():
+    """An overload whose implementation is a kernel's body (jit.body) is compiled as that
+    kernel: without Python wrappers and with the overload's ``forceinline`` (False here),
+    not the one of the caller that happens to compile it first (an ``inline="always"``
+    one here), which Numba would pass on."""
+    from numba.core import event
+
+    def numba_side(k):  # a Kernel, or (swapped into this module's globals) its dispatcher
+        return getattr(k, "dispatcher", k)
+
+    with event.install_recorder("numba:compile") as rec:
+        numba_side(_inlined_tripler).compile((types.float64,))
+    impls = [ev.data["dispatcher"] for _, ev in rec.buffer
+             if ev.is_start and ev.data["dispatcher"].py_func is _tripled.py_func
+             and ev.data["dispatcher"] is not numba_side(_tripled)]
+    assert impls, "the overload's body was not compiled"
+    options = impls[0].targetoptions
+    assert options["forceinline"] is False
+    assert options["no_cpython_wrapper"] is True and options["no_cfunc_wrapper"] is True
+
+
+def test_an_overloads_options_with_stock_numba_are_numbas_own(monkeypatch):
+    monkeypatch.setattr(dispatcher, "_tuned", False)
+    assert dispatcher.overload_options(True) == {}
 
 
 @pytest.mark.parametrize("why", [{"WHITTED_NUMBA_TUNING": "0"}, "unverified"])
@@ -184,7 +245,7 @@ def test_stock_numba_runs_the_same_kernels(tmp_path, why):
         run = subprocess.run([sys.executable, "run.py"], cwd=tmp_path, env=env,
                              capture_output=True, text=True, timeout=600)
         assert run.returncode == 0, run.stderr[-2000:]
-        assert "RESULT 14.0 CPUDispatcher" in run.stdout  # 0 + (2+3) + (4+5)
+        assert "RESULT 16.0 CPUDispatcher" in run.stdout  # 0 + (2+3) + (4+5) + 2*1
         assert run.stderr == ""
     assert list((tmp_path / "cache").rglob("*total*.nbc"))
 

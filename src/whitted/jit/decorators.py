@@ -299,28 +299,19 @@ def numba_object(module: str, name: str):
     return made.resolve() if _swapped else made
 
 
-#: Numba options of every overload's implementation: never called from Python, so without
-#: the wrappers that would let Python call it (compiled for nothing otherwise)
-OVERLOAD_OPTIONS = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
-
-
 def overload(function, *, forceinline: bool = False, **options):
-    """Numba's ``numba.extending.overload``, registered when Numba is loaded. The
-    implementation is compiled with ``forceinline`` as given (not inherited from whichever
-    caller is compiled first, as Numba would) and without Python wrappers
-    (:data:`OVERLOAD_OPTIONS`); an implementation that is a kernel's body (:func:`body`)
-    gets that kernel's ``forceinline``."""
-    jit_options = {**OVERLOAD_OPTIONS, "forceinline": forceinline,
-                   **options.pop("jit_options", {})}
-    options["jit_options"] = jit_options
+    """Numba's ``numba.extending.overload``, registered when Numba is loaded. With the tuned
+    dispatcher the implementation is compiled with ``forceinline`` as given (not inherited
+    from whichever caller is compiled first, as Numba would) and without Python wrappers
+    (jit/dispatcher.py ``overload_options``); an implementation that is a kernel's body
+    (:func:`body`) gets that kernel's ``forceinline``."""
+    options["forceinline"] = forceinline
 
     def decorate(implementation):
         overloads_by_function[function] = (implementation, options)
 
         def register():
-            from numba.extending import overload as numba_overload
-
-            numba_overload(function, **options)(implementation)
+            register_overload(function, implementation, options)
 
         with _lock:
             if _numba_loaded:
@@ -332,16 +323,31 @@ def overload(function, *, forceinline: bool = False, **options):
     return decorate
 
 
+def register_overload(function, implementation, options: dict) -> None:
+    """Register ``implementation`` as Numba's overload of ``function`` with whitted's
+    ``options`` (those :func:`overload` was given; kernels/strict.py registers its twins'
+    the same way)."""
+    from numba.extending import overload as numba_overload
+
+    from .dispatcher import overload_options
+
+    options = dict(options)
+    forceinline = options.pop("forceinline", False)
+    options["jit_options"] = {**overload_options(forceinline), **options.get("jit_options", {})}
+    numba_overload(function, **options)(implementation)
+
+
 def body(target):
     """The Python function of kernel ``target`` (a Kernel or its dispatcher), for an overload
     to return as its implementation. Numba compiles an overload's implementation as a
     function of its own, linked into its callers: a lambda that calls the kernel is one more
     level whose module links the kernel's (and all below it) and has LLVM optimise it all
-    again, as every separately compiled caller does (docs/performance.md, "the overloads'
-    levels"). Returned as the implementation, the kernel's own code is that function, and the
+    again, as every separately compiled caller does (docs/performance.md, the overload-body
+    round). Returned as the implementation, the kernel's own code is that function, and the
     level is gone. Its options are the overload's (``forceinline`` as the kernel's, given to
-    :func:`overload`); fast-math and the error model are its caller's, as a kernel's callers'
-    are the same as the kernel's (an IEEE twin's callers are twins: kernels/strict.py)."""
+    :func:`overload`: the tuned dispatcher's); fast-math and the error model are its
+    callers', as a kernel's callers' are the same as the kernel's (an IEEE twin's callers are
+    twins: kernels/strict.py)."""
     return target.py_func
 
 

@@ -24,7 +24,8 @@ What the tuned dispatcher does:
   reference counting (about a third of the render time); render kernels never allocate.
 - **LLVM inlining** (``forceinline``) for ``inline="always"``, set to False on every other
   kernel (Numba passes it on to callees that do not set it, so inlining would depend on
-  compile order).
+  compile order); an overload's implementation gets it as its overload says, and no Python
+  wrappers (:func:`overload_options`).
 - **A read-only warm folder** (jit/cache.py, ``KernelCache.read_only``): a failed save there
   is no error: the kernel is compiled in memory, said once (jit/locator.py, public API, takes
   the folder without Numba's writability check, and checks a writable one once a process).
@@ -230,6 +231,16 @@ def _twin_function(f):
     twin.__module__ = f.__module__
     twin.__doc__ = f.__doc__
     return twin
+
+
+def overload_options(forceinline: bool) -> dict:
+    """Numba's options for an overload's implementation (jit/decorators.py ``overload``):
+    with the tuned dispatcher, ``forceinline`` as given (Numba would inherit it from whichever
+    caller compiles the implementation first) and no Python wrappers (an overload's
+    implementation is never called from Python); with stock Numba, none."""
+    if not tuned():
+        return {}
+    return {"forceinline": forceinline, **CALLEE_ONLY, "no_cfunc_wrapper": True}
 
 
 def make_dispatcher(f, options: dict, specialise_constants: bool, cache: bool):

@@ -117,12 +117,10 @@ def _twin_overloaded(function):
     twin = _twins.get(function)
     if twin is not None:
         return twin
-    from numba.extending import overload as numba_overload
-
     implementation, options = jit.overloads_by_function[function]
     twin = _copy(function, function.__qualname__ + SUFFIX)
     _twins[function] = twin
     twin_impl = _copy(implementation, implementation.__qualname__ + SUFFIX)
     _twin_globals(implementation, twin_impl)
-    numba_overload(twin, **options)(twin_impl)
+    jit.register_overload(twin, twin_impl, options)
     return twin
