@@ -223,7 +223,7 @@ def test_warm_says_whether_it_compiles_or_loads(tmp_path, monkeypatch, cached, n
     monkeypatch.setattr(warm_up, "warm_up_kernels", lambda: 0.25)
     monkeypatch.setattr(warm, "_all_names", lambda: names)
 
-    def work(queue, procs):  # a worker that had every variant in the cache
+    def work(queue, procs, helper=False):  # a worker that had every variant in the cache
         while (name := queue.take()) is not None:
             queue.finish(name, 0.5)
 
@@ -260,6 +260,32 @@ def test_workers_compile_without_a_helper_of_their_own(monkeypatch):
     monkeypatch.setattr(subprocess, "Popen", FakeWorker)
     monkeypatch.setenv("WHITTED_COMPILE_HELPER", "1")
     warm._work(warm._Queue([]), [])
-    (args, kwargs), = started
+    warm._work(warm._Queue([]), [], helper=True)  # a core to spare for one
+    (args, kwargs), (_, spare) = started
     assert args[-2:] == ["warm", "--serve"]
     assert kwargs["env"]["WHITTED_COMPILE_HELPER"] == "0"
+    assert spare["env"]["WHITTED_COMPILE_HELPER"] == "1"
+
+
+@pytest.mark.parametrize("jobs, cores, helper", [(2, 2, False), (0, 2, False), (1, 2, True),
+                                                 (2, 8, True), (3, 4, False)])
+def test_a_worker_gets_a_helper_only_where_there_is_a_core_for_it(monkeypatch, tmp_path, jobs,
+                                                                   cores, helper):
+    from cli_run import run_main
+    from whitted.cli import warm
+    from whitted.render import api, warm_up
+
+    monkeypatch.setattr(api, "available_threads", lambda: cores)
+    monkeypatch.setattr(warm_up, "kernels_cached", lambda instances=False: True)
+    monkeypatch.setattr(warm_up, "warm_up_kernels", lambda: 0.25)
+    seen = []
+
+    def work(queue, procs, helper=False):
+        seen.append(helper)
+        while (name := queue.take()) is not None:
+            queue.finish(name, 0.5)
+
+    monkeypatch.setattr(warm, "_work", work)
+    code, _, err = run_main("warm", "--jobs", str(jobs), cwd=tmp_path)
+    assert code == 0, err
+    assert seen and set(seen) == {helper}

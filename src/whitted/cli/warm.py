@@ -7,16 +7,17 @@ cores); then the other variants (render/variants.py), the scene builders with th
 (which a small scene runs as Python until they are compiled: jit/python_twins.py) and the
 Stefan solver's kernels are handed out, one at a time and the longest first, to ``--jobs``
 worker processes (one per core), each compiling into the same cache (jit/cache.py keeps it
-consistent). A worker compiles without a helper process of its own (render/warm_up.py): the
-workers already keep the cores busy, and a helper beside them compiled some kernels in both
-processes (measured: the same CPU, the last worker done 2-3 s later). A kind of the general
+consistent). A worker compiles without a helper process of its own (render/warm_up.py) unless
+there are cores for both: the workers already keep the cores busy, and a helper beside them
+compiled some kernels in both processes (measured: the same CPU, the last worker done 2-3 s
+later). A kind of the general
 kernels that shares the render kernel's callees (the AOV kernel) is handed out only once the
 general render kernel is in the cache: it then loads them instead of compiling them a second
-time in another process. Adaptive anti-aliasing is a
-run-time choice of the render kernel: the ``render`` variants serve it. The photon tracers
-(the caustics variants: the tracer only, the render with caustics is the render kernel's)
-share nothing with the render kernels and start at once. A variant already in the cache
-loads in a fraction of a second, so a second ``whitted warm`` is quick.
+time in another process. Adaptive anti-aliasing is a run-time choice of the render kernel:
+the ``render`` variants serve it. The photon tracers (the caustics variants: the tracer
+only, the render with caustics is the render kernel's) share nothing with the render kernels
+and start at once. A variant already in the cache loads in a fraction of a second, so a
+second ``whitted warm`` is quick.
 """
 
 from __future__ import annotations
@@ -141,12 +142,14 @@ class _Queue:
             self._changed.notify_all()
 
 
-def _work(queue: _Queue, procs: list[subprocess.Popen]) -> None:
-    """Feed one worker process from the queue until nothing is left or it fails."""
+def _work(queue: _Queue, procs: list[subprocess.Popen], helper: bool = False) -> None:
+    """Feed one worker process from the queue until nothing is left or it fails; ``helper``:
+    whether its compiles may start a compile helper (a core of their own for each)."""
     # its stderr read only if it fails (a pipe could fill up while nobody reads it)
     with tempfile.TemporaryFile("w+") as stderr:
-        # no compile helper: the other workers are using the other cores (module docstring)
-        env = {**os.environ, "WHITTED_COMPILE_HELPER": "0"}
+        env = dict(os.environ)
+        if not helper:  # the other workers are using the other cores (module docstring)
+            env["WHITTED_COMPILE_HELPER"] = "0"
         proc = subprocess.Popen([sys.executable, "-m", "whitted", "warm", "--serve"],
                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=stderr,
                                 text=True, env=env)
@@ -219,7 +222,9 @@ def warm(
                  f"process{'es' * (workers > 1)}, "
                  "each compiled unless the cache has it")
     procs: list[subprocess.Popen] = []
-    threads = [threading.Thread(target=_work, args=(queue, procs), daemon=True,
+    # a helper beside each worker only where there is a core for it too
+    helper = 2 * workers <= available_threads()
+    threads = [threading.Thread(target=_work, args=(queue, procs, helper), daemon=True,
                                 name=f"whitted-warm-{i}") for i in range(workers)]
     try:
         for thread in threads:

@@ -301,10 +301,10 @@ def numba_object(module: str, name: str):
 
 def overload(function, *, forceinline: bool = False, **options):
     """Numba's ``numba.extending.overload``, registered when Numba is loaded. With the tuned
-    dispatcher the implementation is compiled with ``forceinline`` as given (not inherited
-    from whichever caller is compiled first, as Numba would) and without Python wrappers
+    dispatcher the implementation is compiled with ``forceinline`` as given, the same for
+    every caller (Numba would pass on each caller's own), and without a C wrapper
     (jit/dispatcher.py ``overload_options``); an implementation that is a kernel's body
-    (:func:`body`) gets that kernel's ``forceinline``."""
+    (:func:`body`) is given that kernel's ``forceinline``."""
     options["forceinline"] = forceinline
 
     def decorate(implementation):

@@ -235,9 +235,10 @@ def _twin_function(f):
 
 def overload_options(forceinline: bool) -> dict:
     """Numba's options for an overload's implementation (jit/decorators.py ``overload``):
-    with the tuned dispatcher, ``forceinline`` as given (Numba would inherit it from whichever
-    caller compiles the implementation first) and no Python wrappers (an overload's
-    implementation is never called from Python); with stock Numba, none."""
+    with the tuned dispatcher, ``forceinline`` as given (Numba would pass on each caller's,
+    so the code linked into a caller would depend on which callers were typed last) and no
+    wrappers for calls from Python or C (an overload's implementation is never called from
+    either); with stock Numba, none."""
     if not tuned():
         return {}
     return {"forceinline": forceinline, **CALLEE_ONLY, "no_cfunc_wrapper": True}

@@ -68,7 +68,9 @@ def render_callees(geometry: GeometryArrays, materials, lights, params):
         # the general kernels: first the extra shapes' intersections (the CSG walk and the
         # torus's quartic, a third of the variant's compile), which both the closest hit
         # here and the helper's shadow rays reach (through extras.py's extra_hit, compiled
-        # in each caller's process: an overload's body); then the shadow rays
+        # in each caller's process: an overload's body; the shadow rays' gathering of a
+        # torus's crossings calls the extra_hit kernel itself, a second compile of the same
+        # code in the helper, about a second); then the shadow rays
         return [(csg_hit, (geo, INT, VEC3, VEC3, VEC3, REAL, REAL)),
                 (extra_shape_t, (INT, PARAMS, INT, VEC3, VEC3, REAL, REAL)),
                 (hit_analytic, (geo, INT, VEC3, VEC3, REAL, REAL)),

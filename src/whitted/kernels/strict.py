@@ -16,7 +16,8 @@ left: the same on one machine; docs/caustics.md.)
 
 A twin is a copy of the kernel's Python function with its own globals, where each kernel it
 calls is that kernel's twin and each function with an overload (jit/decorators.py ``overload``)
-a copy whose overload builds its lambdas with twinned globals. The twins in those globals get
+a copy whose overload runs with twinned globals (its lambdas call twins; a kernel's body it
+returns, jit/decorators.py ``body``, is the twin's). The twins in those globals get
 their Numba dispatchers as a module's kernels do, before Numba's first compile in the process
 (jit/decorators.py ``kernels_in_globals``): loading the tracer from the cache makes one
 dispatcher, not one per kernel it calls (each with its cache files looked up). A twin's name ends in
@@ -113,7 +114,8 @@ def _twin_kernel(kern):
 
 def _twin_overloaded(function):
     """A copy of ``function`` (a Python function kernels call, with an overload) whose
-    overload is the original's with twinned globals: the lambdas it returns call twins."""
+    overload is the original's with twinned globals: the lambdas it returns call twins, and
+    the kernel's body it returns is the twin's."""
     twin = _twins.get(function)
     if twin is not None:
         return twin
