@@ -6,8 +6,11 @@ from __future__ import annotations
 import json
 import math
 import os
+import signal
 import subprocess
 import sys
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -289,3 +292,73 @@ def test_a_worker_gets_a_helper_only_where_there_is_a_core_for_it(monkeypatch, t
     code, _, err = run_main("warm", "--jobs", str(jobs), cwd=tmp_path)
     assert code == 0, err
     assert seen and set(seen) == {helper}
+
+
+@pytest.mark.parametrize("signum, code, word", [(signal.SIGINT, 130, "interrupted"),
+                                                (signal.SIGTERM, 143, "terminated")])
+def test_a_signal_stops_the_workers_and_keeps_what_was_compiled(monkeypatch, tmp_path, signum,
+                                                                code, word):
+    """Ctrl-C (or SIGTERM) while the workers compile: they are stopped at once, not left to
+    finish their variant, and the one line says what the cache keeps."""
+    from cli_run import run_main
+    from whitted.cli import warm
+    from whitted.render import warm_up
+
+    monkeypatch.setattr(warm_up, "kernels_cached", lambda instances=False: True)
+    monkeypatch.setattr(warm_up, "warm_up_kernels", lambda: 0.25)
+    killed = []
+
+    class BusyWorker:  # a worker process still compiling
+        def poll(self):
+            return None if not killed else -9
+
+        def kill(self):
+            killed.append(True)
+
+        def wait(self):
+            return -9
+
+    def work(queue, procs, helper=False):
+        procs.append(BusyWorker())
+        name = queue.take()
+        queue.finish(name, 0.5)  # one variant done, then the signal during the next
+        queue.take()
+        os.kill(os.getpid(), signum)
+        threading.Event().wait(30)  # compiling (a daemon thread, left behind)
+
+    monkeypatch.setattr(warm, "_work", work)
+    status, out, err = run_main("warm", "--jobs", "1", cwd=tmp_path)
+    assert status == code
+    assert killed == [True]
+    assert err.splitlines()[-1] == (f"{word}: 2 of 8 kinds of kernels were compiled and are "
+                                    "kept in the cache; whitted warm again compiles the rest")
+    assert "every kernel is in the cache" not in out
+
+
+def test_ctrl_c_during_the_first_compile_leaves_no_process_behind(tmp_path):
+    """A real ``whitted warm`` on an empty cache, interrupted while it compiles the default
+    scene's kernels (its compile helper running beside it): status 130, one line, and the
+    helper gone with it."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"), WHITTED_CACHE_DIR=str(tmp_path))
+    proc = subprocess.Popen([sys.executable, "-m", "whitted", "warm"], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert proc.stderr is not None
+    first = proc.stderr.readline()  # said once the compile begins
+    assert "compiling the default scene's kernels" in first
+
+    def helpers() -> list[str]:  # the compile helper names its parent's pid
+        found = subprocess.run(["pgrep", "-f", f"whitted.render.warm_up .* {proc.pid}$"],
+                               capture_output=True, text=True)
+        return found.stdout.split()
+
+    deadline = time.monotonic() + 120
+    while not helpers():  # the helper has started (a state to wait for, not a time)
+        assert proc.poll() is None and time.monotonic() < deadline
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGINT)
+    out, rest = proc.communicate(timeout=120)
+    assert proc.returncode == 130, rest
+    assert rest.strip().splitlines() == [
+        "interrupted: 0 of 8 kinds of kernels were compiled and are kept in the cache; "
+        "whitted warm again compiles the rest"]
+    assert helpers() == []

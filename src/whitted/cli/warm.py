@@ -17,7 +17,9 @@ time in another process. Adaptive anti-aliasing is a run-time choice of the rend
 the ``render`` variants serve it. The photon tracers (the caustics variants: the tracer
 only, the render with caustics is the render kernel's) share nothing with the render kernels
 and start at once. A variant already in the cache loads in a fraction of a second, so a
-second ``whitted warm`` is quick.
+second ``whitted warm`` is quick. Ctrl-C or SIGTERM stops every compile at once, the workers'
+and the compile helper's too (exit 130 or 143, one line): what was compiled stays in the
+cache, and the next ``whitted warm`` compiles the rest.
 """
 
 from __future__ import annotations
@@ -35,6 +37,7 @@ import typer
 
 from .app import app, fail
 from .console import err, out
+from .interrupt import InterruptGuard
 
 STEFAN = "stefan"
 BUILDERS = "builders"
@@ -181,6 +184,25 @@ def _work(queue: _Queue, procs: list[subprocess.Popen], helper: bool = False) ->
                 proc.wait()
 
 
+def _run_workers(queue: _Queue, procs: list[subprocess.Popen], workers: int,
+                 cores: int) -> None:
+    """Hand the queue out to ``workers`` worker processes (their Popen objects put in
+    ``procs``) and wait for them."""
+    if queue.todo:
+        err.echo(f"{len(queue.todo)} more variant{'s' * (len(queue.todo) > 1)} in {workers} "
+                 f"process{'es' * (workers > 1)}, "
+                 "each compiled unless the cache has it")
+    # a helper beside each worker only where there is a core for it too
+    helper = 2 * workers <= cores
+    threads = [threading.Thread(target=_work, args=(queue, procs, helper), daemon=True,
+                                name=f"whitted-warm-{i}") for i in range(workers)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        while thread.is_alive():
+            thread.join(0.2)  # a timeout: Ctrl-C reaches this thread
+
+
 @app.command()
 def warm(
     jobs: Annotated[int, typer.Option(
@@ -210,28 +232,22 @@ def warm(
         raise fail(f"--jobs: must be 0 (one per core) to 1024 (got {jobs})")
     jobs = jobs or available_threads()
     start = time.perf_counter()
-    err.echo("loading the default scene's kernels (compiled before)" if kernels_cached()
-             else "compiling the default scene's kernels (the first time)")
-    first = warm_up_kernels()
     names = _all_names()
     queue = _Queue(names)
-    queue.times["plain/render"] = first
-    workers = min(jobs, len(names))
-    if names:
-        err.echo(f"{len(names)} more variant{'s' * (len(names) > 1)} in {workers} "
-                 f"process{'es' * (workers > 1)}, "
-                 "each compiled unless the cache has it")
     procs: list[subprocess.Popen] = []
-    # a helper beside each worker only where there is a core for it too
-    helper = 2 * workers <= available_threads()
-    threads = [threading.Thread(target=_work, args=(queue, procs, helper), daemon=True,
-                                name=f"whitted-warm-{i}") for i in range(workers)]
+    # Ctrl-C or SIGTERM stops the compiles at once (the workers with it); every kernel
+    # compiled so far stays in the cache, whose files are whole or not there (jit/cache.py)
+    guard = InterruptGuard(at_once=True)
     try:
-        for thread in threads:
-            thread.start()
-        for thread in threads:
-            while thread.is_alive():
-                thread.join(0.2)  # a timeout: Ctrl-C reaches this thread
+        with guard:
+            err.echo("loading the default scene's kernels (compiled before)" if kernels_cached()
+                     else "compiling the default scene's kernels (the first time)")
+            queue.times["plain/render"] = warm_up_kernels()
+            _run_workers(queue, procs, min(jobs, len(names)), available_threads())
+    except KeyboardInterrupt:
+        done = len(queue.times)
+        raise guard.exit(f"{done} of {len(names) + 1} kinds of kernels were compiled and are "
+                         "kept in the cache; whitted warm again compiles the rest") from None
     finally:
         for proc in list(procs):
             if proc.poll() is None:

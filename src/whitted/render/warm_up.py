@@ -608,26 +608,26 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None,
     ahead = _take_ahead(instances)
     builders = builders and not builders_cached()
     helper = ahead[1] if ahead is not None else _start_helper(instances, builders)
-    delegated = ()
-    if helper is not None and helper.stdout is not None:
-        delegated = tuple(d.py_func.__qualname__ for d, _ in _delegated(instances))
-    expected = EXPECTED_COMPILES[instances]
-    if instances and not kernels_cached(False):
-        expected = EXPECTED_GENERAL_ALONE_COMPILES
-    count = _CompileCount(expected + EXPECTED_BUILDER_COMPILES * builders, delegated)
-    if helper is not None and helper.stdout is not None:
-        threading.Thread(target=count.read_helper, args=(helper.stdout,),
-                         name="whitted-compile-helper-output", daemon=True).start()
-    if delegated and KernelCache is not None:
-        KernelCache.wait_for_helper = count.wait_for_helper
-    _progress = count
-    label = "the kernels"
-    if instances:  # alone (the plain ones not cached: their leaves too) or after them
-        label = ("the kernels for instances, tori and CSG"
-                 + (" (the first kernels)" if expected == EXPECTED_GENERAL_ALONE_COMPILES
-                    else ""))
-    report = CompileReport(label, compile_progress)
-    try:
+    try:  # from here on, any exception (Ctrl-C) stops the helper
+        delegated = ()
+        if helper is not None and helper.stdout is not None:
+            delegated = tuple(d.py_func.__qualname__ for d, _ in _delegated(instances))
+        expected = EXPECTED_COMPILES[instances]
+        if instances and not kernels_cached(False):
+            expected = EXPECTED_GENERAL_ALONE_COMPILES
+        count = _CompileCount(expected + EXPECTED_BUILDER_COMPILES * builders, delegated)
+        if helper is not None and helper.stdout is not None:
+            threading.Thread(target=count.read_helper, args=(helper.stdout,),
+                             name="whitted-compile-helper-output", daemon=True).start()
+        if delegated and KernelCache is not None:
+            KernelCache.wait_for_helper = count.wait_for_helper
+        _progress = count
+        label = "the kernels"
+        if instances:  # alone (the plain ones not cached: their leaves too) or after them
+            label = ("the kernels for instances, tori and CSG"
+                     + (" (the first kernels)" if expected == EXPECTED_GENERAL_ALONE_COMPILES
+                        else ""))
+        report = CompileReport(label, compile_progress)
         with report, _CountCompiles(count), _interrupt_at_safe_points(count):
             if delegated:  # this process's first share, while the helper compiles its own
                 for dispatcher, argument_types in _delegated(instances, here=True):
