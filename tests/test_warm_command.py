@@ -362,3 +362,19 @@ def test_ctrl_c_during_the_first_compile_leaves_no_process_behind(tmp_path):
         "interrupted: 0 of 8 kinds of kernels were compiled and are kept in the cache; "
         "whitted warm again compiles the rest"]
     assert helpers() == []
+
+
+def test_the_workers_are_given_up_once_a_signal_was_seen(monkeypatch):
+    # a KeyboardInterrupt that landed in a finaliser is only printed there: the wait for the
+    # workers looks at the guard's flag too
+    from whitted.cli import warm
+
+    started = threading.Event()
+
+    def work(queue, procs, helper=False):
+        started.set()
+        threading.Event().wait(30)  # compiling (a daemon thread, left behind)
+
+    monkeypatch.setattr(warm, "_work", work)
+    with pytest.raises(KeyboardInterrupt):
+        warm._run_workers(warm._Queue(["stefan"]), [], 1, 2, stop=started.is_set)

@@ -184,10 +184,11 @@ def _work(queue: _Queue, procs: list[subprocess.Popen], helper: bool = False) ->
                 proc.wait()
 
 
-def _run_workers(queue: _Queue, procs: list[subprocess.Popen], workers: int,
-                 cores: int) -> None:
+def _run_workers(queue: _Queue, procs: list[subprocess.Popen], workers: int, cores: int,
+                 stop=lambda: False) -> None:
     """Hand the queue out to ``workers`` worker processes (their Popen objects put in
-    ``procs``) and wait for them."""
+    ``procs``) and wait for them; KeyboardInterrupt once ``stop()`` says a signal came (its
+    own KeyboardInterrupt may have been swallowed where it landed)."""
     if queue.todo:
         err.echo(f"{len(queue.todo)} more variant{'s' * (len(queue.todo) > 1)} in {workers} "
                  f"process{'es' * (workers > 1)}, "
@@ -200,6 +201,8 @@ def _run_workers(queue: _Queue, procs: list[subprocess.Popen], workers: int,
         thread.start()
     for thread in threads:
         while thread.is_alive():
+            if stop():
+                raise KeyboardInterrupt
             thread.join(0.2)  # a timeout: Ctrl-C reaches this thread
 
 
@@ -243,7 +246,8 @@ def warm(
             err.echo("loading the default scene's kernels (compiled before)" if kernels_cached()
                      else "compiling the default scene's kernels (the first time)")
             queue.times["plain/render"] = warm_up_kernels()
-            _run_workers(queue, procs, min(jobs, len(names)), available_threads())
+            _run_workers(queue, procs, min(jobs, len(names)), available_threads(),
+                         guard.is_set)
     except KeyboardInterrupt:
         done = len(queue.times)
         raise guard.exit(f"{done} of {len(names) + 1} kinds of kernels were compiled and are "
