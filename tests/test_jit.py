@@ -348,3 +348,23 @@ def test_only_the_dispatcher_imports_undocumented_numba_modules():
                 if name.split(".")[0] == "numba" and name not in DOCUMENTED_NUMBA:
                     found.append(f"{path.relative_to(root)}:{node.lineno}: {name}")
     assert found == []
+
+
+def test_every_overload_of_a_kernels_body_has_that_kernels_forceinline():
+    """An overload returning a kernel's body (jit.body) says the kernel's ``forceinline`` in
+    its own options: were the kernel's changed alone, its code would be inlined one way
+    where it is called directly and another way through the overload."""
+    from whitted.jit import decorators
+    from whitted.kernels import accel, extras, lighting, uv  # noqa: F401 - their overloads
+
+    checked = 0
+    for implementation, options in decorators.overloads_by_function.values():
+        if "body" not in implementation.__code__.co_names:
+            continue
+        for name in implementation.__code__.co_names:
+            target = implementation.__globals__.get(name)
+            kern = decorators.kernels_by_function.get(getattr(target, "py_func", None))
+            if kern is not None:
+                assert options["forceinline"] == kern.options["forceinline"], name
+                checked += 1
+    assert checked >= 9
