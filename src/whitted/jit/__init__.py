@@ -8,6 +8,7 @@ package with kernels compiles through (``kernels/``, ``compile/``, ``assets/obj_
 - ``dispatcher.py``: Numba's side of a kernel (stock ``numba.njit`` or the tuned dispatcher,
   the one module that uses names Numba does not document);
 - ``cache.py``: the per-user kernel cache folder, its checksums, lock and fallbacks;
+- ``collector.py``: Python's cyclic garbage collector paused while Numba compiles;
 - ``lean_numba.py``: Numba imported without its SciPy, PyYAML and coverage.py probes.
 
 Importing this package imports no Numba.

@@ -109,9 +109,11 @@ def load_numba() -> None:
         from numba.core import event
 
         from .array_typing import install as type_arrays_without_numpy_ma
+        from .collector import collector_listener
 
         type_arrays_without_numpy_ma()
         event.register("numba:compile", _compile_listener())
+        event.register("numba:compile", collector_listener())  # no collections mid-compile
         while _deferred:
             _deferred.pop(0)()
         _numba_imported = True
