@@ -223,10 +223,11 @@ def test_warm_says_whether_it_compiles_or_loads(tmp_path, monkeypatch, cached, n
     warm_up = importlib.import_module("whitted.render.warm_up")
 
     monkeypatch.setattr(warm_up, "kernels_cached", lambda instances=False: cached)
-    monkeypatch.setattr(warm_up, "warm_up_kernels", lambda: 0.25)
+    monkeypatch.setattr(warm_up, "warm_up_kernels", lambda **kwargs: 0.25)
     monkeypatch.setattr(warm, "_all_names", lambda: names)
 
-    def work(queue, procs, helper=False):  # a worker that had every variant in the cache
+    def work(queue, procs, helper=False, worker=0):  # every variant was in the cache
+        queue.wait_turn(worker)
         while (name := queue.take()) is not None:
             queue.finish(name, 0.5)
 
@@ -237,6 +238,59 @@ def test_warm_says_whether_it_compiles_or_loads(tmp_path, monkeypatch, cached, n
     assert out.splitlines()[:1 + len(names)] == [f"{'plain/render':28}    0.25 s"] + [
         f"{name:28}    0.50 s" for name in names]
     assert out.splitlines()[-1].startswith("every kernel is in the cache: ")
+
+
+def test_the_first_worker_starts_once_the_compile_helper_has_finished(monkeypatch, tmp_path):
+    """While the default scene's render kernel compiles its own module (one core), the
+    compile helper, done with its share, leaves a core idle: the first worker starts then,
+    the second once the default scene's kernels are done."""
+    from cli_run import run_main
+    from whitted.cli import warm
+    from whitted.render import api, warm_up
+
+    turns = [threading.Event(), threading.Event()]
+    seen_during_compile = []
+
+    def warm_up_kernels(on_helper_end=None):
+        seen_during_compile.append([t.is_set() for t in turns])
+        on_helper_end()  # the helper's last line
+        seen_during_compile.append([turns[0].wait(30), turns[1].is_set()])
+        return 0.25
+
+    def work(queue, procs, helper=False, worker=0):
+        if queue.wait_turn(worker):
+            turns[worker].set()
+            while (name := queue.take()) is not None:
+                queue.finish(name, 0.5)
+
+    monkeypatch.setattr(api, "available_threads", lambda: 2)
+    monkeypatch.setattr(warm_up, "kernels_cached", lambda instances=False: False)
+    monkeypatch.setattr(warm_up, "warm_up_kernels", warm_up_kernels)
+    monkeypatch.setattr(warm, "_work", work)
+    code, out, err = run_main("warm", cwd=tmp_path)
+    assert code == 0, err
+    assert seen_during_compile == [[False, False], [True, False]]
+    assert all(t.is_set() for t in turns)
+    assert out.splitlines()[-1].startswith("every kernel is in the cache: ")
+
+
+def test_no_worker_starts_once_the_command_ends(monkeypatch):
+    import subprocess
+
+    from whitted.cli import warm
+
+    def no_process(*args, **kwargs):
+        raise AssertionError("a worker started after the command ended")
+
+    monkeypatch.setattr(subprocess, "Popen", no_process)
+    queue = warm._Queue(["stefan"])
+    procs: list = []
+    waiting = threading.Thread(target=warm._work, args=(queue, procs, False, 0))
+    waiting.start()  # waits for its turn, which never comes
+    queue.close()  # Ctrl-C during the default scene's compile
+    waiting.join(30)
+    assert not waiting.is_alive() and procs == []
+    assert queue.start(0, procs, ["whitted"], {}, None) is None
 
 
 def test_workers_compile_without_a_helper_of_their_own(monkeypatch):
@@ -262,8 +316,10 @@ def test_workers_compile_without_a_helper_of_their_own(monkeypatch):
 
     monkeypatch.setattr(subprocess, "Popen", FakeWorker)
     monkeypatch.setenv("WHITTED_COMPILE_HELPER", "1")
-    warm._work(warm._Queue([]), [])
-    warm._work(warm._Queue([]), [], helper=True)  # a core to spare for one
+    queue = warm._Queue([])
+    queue.open_to(1)
+    warm._work(queue, [])
+    warm._work(queue, [], helper=True)  # a core to spare for one
     (args, kwargs), (_, spare) = started
     assert args[-2:] == ["warm", "--serve"]
     assert kwargs["env"]["WHITTED_COMPILE_HELPER"] == "0"
@@ -280,11 +336,12 @@ def test_a_worker_gets_a_helper_only_where_there_is_a_core_for_it(monkeypatch, t
 
     monkeypatch.setattr(api, "available_threads", lambda: cores)
     monkeypatch.setattr(warm_up, "kernels_cached", lambda instances=False: True)
-    monkeypatch.setattr(warm_up, "warm_up_kernels", lambda: 0.25)
+    monkeypatch.setattr(warm_up, "warm_up_kernels", lambda **kwargs: 0.25)
     seen = []
 
-    def work(queue, procs, helper=False):
+    def work(queue, procs, helper=False, worker=0):
         seen.append(helper)
+        queue.wait_turn(worker)
         while (name := queue.take()) is not None:
             queue.finish(name, 0.5)
 
@@ -305,7 +362,7 @@ def test_a_signal_stops_the_workers_and_keeps_what_was_compiled(monkeypatch, tmp
     from whitted.render import warm_up
 
     monkeypatch.setattr(warm_up, "kernels_cached", lambda instances=False: True)
-    monkeypatch.setattr(warm_up, "warm_up_kernels", lambda: 0.25)
+    monkeypatch.setattr(warm_up, "warm_up_kernels", lambda **kwargs: 0.25)
     killed = []
 
     class BusyWorker:  # a worker process still compiling
@@ -318,7 +375,8 @@ def test_a_signal_stops_the_workers_and_keeps_what_was_compiled(monkeypatch, tmp
         def wait(self):
             return -9
 
-    def work(queue, procs, helper=False):
+    def work(queue, procs, helper=False, worker=0):
+        queue.wait_turn(worker)
         procs.append(BusyWorker())
         name = queue.take()
         queue.finish(name, 0.5)  # one variant done, then the signal during the next
@@ -380,7 +438,7 @@ def test_the_workers_are_given_up_once_a_signal_was_seen(monkeypatch):
 
     started = threading.Event()
 
-    def work(queue, procs, helper=False):
+    def work(queue, procs, helper=False, worker=0):
         started.set()
         threading.Event().wait(30)  # compiling (a daemon thread, left behind)
 

@@ -117,6 +117,33 @@ def test_waits_for_the_helpers_callees_and_counts_its_compiles():
     assert time.monotonic() - start < 5
 
 
+@pytest.mark.parametrize("output, told", [
+    ([".\n", "done a__callee\n", ".\n", "finished\n"], 1),
+    ([".\n", "done a__callee\n"], 0),  # killed before the end of its work
+])
+def test_the_helper_s_end_is_told_once_its_work_is_finished(output, told):
+    """The caller of a cold compile hears that the helper has finished (its last line), so
+    it may give that core other work while the render kernel's own module compiles; a
+    helper that ended without finishing (stopped, or failed) tells nothing."""
+    ends = []
+    count = warm_up._CompileCount(10, ("a__callee",), on_helper_end=lambda: ends.append(1))
+    count.read_helper(iter(output))
+    assert len(ends) == told
+    assert count.helper == output.count(".\n")  # "finished" is not a compile
+    assert count.helper_gone and not count.pending
+
+
+def test_the_helper_says_finished_after_its_last_work(monkeypatch, capsys):
+    done = []
+    monkeypatch.setattr(warm_up, "_delegated", lambda instances: [])
+    monkeypatch.setattr(warm_up, "_compile_light_buffers",
+                        lambda instances: done.append("light buffers"))
+    monkeypatch.setattr(warm_up, "compile_builders", lambda: done.append("builders"))
+    warm_up.precompile_for_render(False, builders=True)
+    assert done == ["light buffers", "builders"]
+    assert capsys.readouterr().out.splitlines() == ["finished"]
+
+
 def test_a_hung_helper_is_waited_for_once(monkeypatch):
     """A helper that neither finishes a kernel nor exits costs one wait, not one per kernel
     it was to compile: after the first wait runs out, the render process compiles the rest

@@ -113,7 +113,44 @@ class _Queue:
         self.failed: set[str] = set()
         self.times: dict[str, float] = {}
         self.errors: list[str] = []
+        self.open = 0  # workers that may start (the first while the default scene's
+        self.closed = False  # render kernel is still compiling: a core of its own)
         self._changed = threading.Condition()
+
+    def open_to(self, workers: int) -> None:
+        """Let the first ``workers`` workers start."""
+        with self._changed:
+            self.open = max(self.open, workers)
+            self._changed.notify_all()
+
+    def close(self) -> None:
+        """No worker starts any more (the command is ending)."""
+        with self._changed:
+            self.closed = True
+            self._changed.notify_all()
+
+    def wait_turn(self, worker: int) -> bool:
+        """Wait until worker number ``worker`` may start: True, or False when the command
+        ends first."""
+        with self._changed:
+            while self.open <= worker and not self.closed:
+                self._changed.wait()
+            return not self.closed
+
+    def start(self, worker: int, procs: list[subprocess.Popen], command: list[str],
+              env: dict, stderr) -> subprocess.Popen | None:
+        """Worker ``worker``'s process, started once it may start (None: the command ends
+        first); put in ``procs`` under the same lock that :meth:`close` takes, so that the
+        command ending kills every worker it started."""
+        if not self.wait_turn(worker):
+            return None
+        with self._changed:
+            if self.closed:
+                return None
+            proc = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                    stderr=stderr, text=True, env=env)
+            procs.append(proc)
+            return proc
 
     def take(self) -> str | None:
         """The next variant ready to compile, waiting while every one left waits for another
@@ -145,18 +182,20 @@ class _Queue:
             self._changed.notify_all()
 
 
-def _work(queue: _Queue, procs: list[subprocess.Popen], helper: bool = False) -> None:
-    """Feed one worker process from the queue until nothing is left or it fails; ``helper``:
-    whether its compiles may start a compile helper (a core of their own for each)."""
+def _work(queue: _Queue, procs: list[subprocess.Popen], helper: bool = False,
+          worker: int = 0) -> None:
+    """Feed worker process number ``worker`` from the queue, once it may start, until nothing
+    is left or it fails; ``helper``: whether its compiles may start a compile helper (a core
+    of their own for each)."""
     # its stderr read only if it fails (a pipe could fill up while nobody reads it)
     with tempfile.TemporaryFile("w+") as stderr:
         env = dict(os.environ)
         if not helper:  # the other workers are using the other cores (module docstring)
             env["WHITTED_COMPILE_HELPER"] = "0"
-        proc = subprocess.Popen([sys.executable, "-m", "whitted", "warm", "--serve"],
-                                stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=stderr,
-                                text=True, env=env)
-        procs.append(proc)
+        proc = queue.start(worker, procs, [sys.executable, "-m", "whitted", "warm", "--serve"],
+                           env, stderr)
+        if proc is None:
+            return
         assert proc.stdin is not None and proc.stdout is not None
         try:
             while (name := queue.take()) is not None:
@@ -184,26 +223,37 @@ def _work(queue: _Queue, procs: list[subprocess.Popen], helper: bool = False) ->
                 proc.wait()
 
 
-def _run_workers(queue: _Queue, procs: list[subprocess.Popen], workers: int, cores: int,
-                 stop=lambda: False) -> None:
-    """Hand the queue out to ``workers`` worker processes (their Popen objects put in
-    ``procs``) and wait for them; KeyboardInterrupt once ``stop()`` says a signal came (its
-    own KeyboardInterrupt may have been swallowed where it landed)."""
-    if queue.todo:
-        err.echo(f"{len(queue.todo)} more variant{'s' * (len(queue.todo) > 1)} in {workers} "
-                 f"process{'es' * (workers > 1)}, "
-                 "each compiled unless the cache has it")
+def _start_workers(queue: _Queue, procs: list[subprocess.Popen], workers: int,
+                   cores: int) -> list[threading.Thread]:
+    """The threads that feed ``workers`` worker processes from the queue (their Popen
+    objects put in ``procs``), started; each worker process starts once the queue lets it
+    (:meth:`_Queue.open_to`)."""
     # a helper beside each worker only where there is a core for it too
     helper = 2 * workers <= cores
-    threads = [threading.Thread(target=_work, args=(queue, procs, helper), daemon=True,
+    threads = [threading.Thread(target=_work, args=(queue, procs, helper, i), daemon=True,
                                 name=f"whitted-warm-{i}") for i in range(workers)]
     for thread in threads:
         thread.start()
+    return threads
+
+
+def _wait_workers(threads: list[threading.Thread], stop=lambda: False) -> None:
+    """Wait for the workers' threads; KeyboardInterrupt once ``stop()`` says a signal came
+    (its own KeyboardInterrupt may have been swallowed where it landed)."""
     for thread in threads:
         while thread.is_alive():
             if stop():
                 raise KeyboardInterrupt
             thread.join(0.2)  # a timeout: Ctrl-C reaches this thread
+
+
+def _run_workers(queue: _Queue, procs: list[subprocess.Popen], workers: int, cores: int,
+                 stop=lambda: False) -> None:
+    """Hand the queue out to ``workers`` worker processes, all let start now, and wait for
+    them (:func:`_wait_workers`)."""
+    threads = _start_workers(queue, procs, workers, cores)
+    queue.open_to(workers)
+    _wait_workers(threads, stop)
 
 
 @app.command()
@@ -234,8 +284,10 @@ def warm(
     if jobs < 0 or jobs > 1024:
         raise fail(f"--jobs: must be 0 (one per core) to 1024 (got {jobs})")
     jobs = jobs or available_threads()
+    cores = available_threads()
     start = time.perf_counter()
     names = _all_names()
+    workers = min(jobs, len(names))
     queue = _Queue(names)
     procs: list[subprocess.Popen] = []
     # Ctrl-C or SIGTERM stops the compiles at once (the workers with it); every kernel
@@ -245,14 +297,24 @@ def warm(
         with guard:
             err.echo("loading the default scene's kernels (compiled before)" if kernels_cached()
                      else "compiling the default scene's kernels (the first time)")
-            queue.times["plain/render"] = warm_up_kernels()
-            _run_workers(queue, procs, min(jobs, len(names)), available_threads(),
-                         guard.is_set)
+            threads = _start_workers(queue, procs, workers, cores)
+            # once the default scene's compile helper has ended, this process compiles the
+            # render kernel's own module on one core: a worker starts on the next
+            early = min(workers, max(1, cores - 1))
+            queue.times["plain/render"] = warm_up_kernels(
+                on_helper_end=lambda: queue.open_to(early))
+            if names:
+                err.echo(f"{len(names)} more variant{'s' * (len(names) > 1)} in {workers} "
+                         f"process{'es' * (workers > 1)}, "
+                         "each compiled unless the cache has it")
+            queue.open_to(workers)
+            _wait_workers(threads, guard.is_set)
     except KeyboardInterrupt:
         done = len(queue.times)
         raise guard.exit(f"{done} of {len(names) + 1} kinds of kernels were compiled and are "
                          "kept in the cache; whitted warm again compiles the rest") from None
     finally:
+        queue.close()  # no worker starts after this: every one started is in procs
         for proc in list(procs):
             if proc.poll() is None:
                 proc.kill()

@@ -45,6 +45,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -213,8 +214,10 @@ class _CompileCount:
     the helper's share of the render kernel's callees (a line ``done <name>`` as each is in
     the cache), which this process waits for instead of compiling them too."""
 
-    def __init__(self, expected: int, delegated: tuple[str, ...] = ()) -> None:
+    def __init__(self, expected: int, delegated: tuple[str, ...] = (),
+                 on_helper_end: Callable[[], None] | None = None) -> None:
         self.expected = expected
+        self.on_helper_end = on_helper_end
         self.here = 0
         self.helper = 0
         self.pending = set(delegated)  # the helper's callees it has not finished
@@ -238,6 +241,9 @@ class _CompileCount:
                 with self._changed:
                     self.pending.discard(line[5:].strip())
                     self._changed.notify_all()
+            elif line.strip() == "finished":  # its work is all in the cache
+                if self.on_helper_end is not None:
+                    self.on_helper_end()
             else:
                 self.helper += 1
         with self._changed:
@@ -409,14 +415,18 @@ def _stop_helper(helper: subprocess.Popen | None) -> None:
         helper.wait()
 
 
-def warm_up_kernels(compiled: CompiledScene | None = None, builders: bool = False) -> float:
+def warm_up_kernels(compiled: CompiledScene | None = None, builders: bool = False,
+                    on_helper_end: Callable[[], None] | None = None) -> float:
     """Compile (first run) or load from the on-disk cache (later runs) the render kernels for
     scenes like ``compiled`` (kernels are specialised for scenes with and without mesh
     instances; without when None); on the first run also the builders and the AOV kernel.
     The render kernel serves uniform samples and adaptive anti-aliasing alike (a run-time
     choice). ``builders``: a cold compile compiles the builders too (a scene too large for
-    their Python twins: :func:`scene_needs_builders`). Returns the seconds it took; 0 when
-    all of it was already loaded in this process (or nothing had to be)."""
+    their Python twins: :func:`scene_needs_builders`). ``on_helper_end``: called once, from
+    another thread, when a cold compile's helper has finished its work: from then on this
+    process compiles on one core (the render kernel's own module), and the caller may give
+    the other core other work. Returns the seconds it took; 0 when all of it was already loaded
+    in this process (or nothing had to be)."""
     with _lock:
         key = _loaded_key(compiled)
         if key in _ready:
@@ -438,7 +448,7 @@ def warm_up_kernels(compiled: CompiledScene | None = None, builders: bool = Fals
                     _compile_render_kernels(compiled if compiled is not None
                                             else stand_in_scene(instances), aovs=False)
                 else:
-                    _cold_compile(instances, compiled, builders)
+                    _cold_compile(instances, compiled, builders, on_helper_end)
                 cache.seal()
                 _mark(marker)
         if cache.unsealed:
@@ -594,7 +604,8 @@ def _delegated(instances: bool, here: bool = False) -> list:
 
 
 def _cold_compile(instances: bool, compiled: CompiledScene | None,
-                  builders: bool = False) -> None:
+                  builders: bool = False,
+                  on_helper_end: Callable[[], None] | None = None) -> None:
     """Compile the variant here while the helper compiles its share of the callees, the
     light buffers and (``builders``) the builders, counting both for
     :func:`compile_progress`; on any exception (Ctrl-C) the helper is stopped at once rather
@@ -615,7 +626,8 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None,
         expected = EXPECTED_COMPILES[instances]
         if instances and not kernels_cached(False):
             expected = EXPECTED_GENERAL_ALONE_COMPILES
-        count = _CompileCount(expected + EXPECTED_BUILDER_COMPILES * builders, delegated)
+        count = _CompileCount(expected + EXPECTED_BUILDER_COMPILES * builders, delegated,
+                              on_helper_end)
         if helper is not None and helper.stdout is not None:
             threading.Thread(target=count.read_helper, args=(helper.stdout,),
                              name="whitted-compile-helper-output", daemon=True).start()
@@ -652,13 +664,14 @@ def _cold_compile(instances: bool, compiled: CompiledScene | None,
 def precompile_for_render(instances: bool, builders: bool = False) -> None:
     """The helper's work: its share of the render kernel's callees (a line ``done <name>``
     after each), then the light buffers and (``builders``) the builders, into the on-disk
-    cache."""
+    cache; then a line ``finished``."""
     for dispatcher, argument_types in _delegated(instances):
         dispatcher.compile(argument_types)
         print("done", dispatcher.py_func.__qualname__, flush=True)
     _compile_light_buffers(instances)
     if builders:
         compile_builders()
+    print("finished", flush=True)
 
 
 def _end_with_parent(parent: int) -> None:
