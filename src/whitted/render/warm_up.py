@@ -75,17 +75,17 @@ _builders_ready = False
 HELPER_WAIT_SECONDS = 120.0  # a helper still busy after this is stopped (never expected)
 #: functions Numba compiles in a cold compile of each variant, this process and the helper
 #: together (counted on the 2-core VM, an empty cache folder: 162 for the plain variant in one
-#: process, a few more with the helper; 47 + 100 for the general one once the plain one is
+#: process, a few more with the helper; 46 + 100 for the general one once the plain one is
 #: cached, as a first render of a large scene or one with mesh instances compiles the plain
 #: variant first; each kernel other kernels call counts once, as its twin). Only the progress
 #: shown depends on it: a count that drifted
 #: (kernels changed, a different split between the processes) makes the fraction
 #: approximate; tests/test_warm_up.py holds the plain one to a real cold compile within 10 %.
-EXPECTED_COMPILES = {False: 166, True: 147}
+EXPECTED_COMPILES = {False: 165, True: 146}
 #: the same for the general variant compiled first, on a cache without the plain one (a
 #: first render of a scene with a torus or a CSG object: :func:`first_variant`), whose
-#: leaves it then compiles too: 108 + 160 on the 2-core VM
-EXPECTED_GENERAL_ALONE_COMPILES = 268
+#: leaves it then compiles too: 107 + 160 on the 2-core VM
+EXPECTED_GENERAL_ALONE_COMPILES = 267
 #: the builders' and the OBJ reader's compiles, added where a cold compile makes them too
 EXPECTED_BUILDER_COMPILES = 39
 TINY_OBJ = b"""v 0.12345678901234567890 0 0
