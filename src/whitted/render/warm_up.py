@@ -74,7 +74,7 @@ _ready: set[tuple[bool, bool]] = set()
 _builders_ready = False
 HELPER_WAIT_SECONDS = 120.0  # a helper still busy after this is stopped (never expected)
 #: functions Numba compiles in a cold compile of each variant, this process and the helper
-#: together (counted on the 2-core VM, an empty cache folder: 162 for the plain variant in one
+#: together (counted on the 2-core VM, an empty cache folder: 161 for the plain variant in one
 #: process, a few more with the helper; 46 + 100 for the general one once the plain one is
 #: cached, as a first render of a large scene or one with mesh instances compiles the plain
 #: variant first; each kernel other kernels call counts once, as its twin). Only the progress
