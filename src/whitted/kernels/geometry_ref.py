@@ -20,7 +20,6 @@ from __future__ import annotations
 
 from numba import types
 from numba.core import cgutils
-from numba.core.imputils import impl_ret_borrowed
 from numba.core.typing.templates import AttributeTemplate
 from numba.extending import (
     infer_getattr,
@@ -28,6 +27,7 @@ from numba.extending import (
     lower_builtin,
     lower_getattr_generic,
     models,
+    overload,
     register_model,
     type_callable,
 )
@@ -97,40 +97,55 @@ def geometry_ref_if_instances(geo):
 
 
 def _kept_as_is(geo) -> bool:
-    """Whether :func:`geometry_ref_if_instances` gives ``geo`` (a Numba type) itself."""
+    """Whether :func:`geometry_ref_if_instances` gives ``geo`` (a Numba type) itself in tuned
+    kernels."""
     # Measured, CPU time, 1 thread, interleaved (AMD EPYC Zen 4): sphere1m at 640x360 0.242 ->
     # 0.094 s with the reference; but seed000, a scene without instances, 0.69 -> 0.79 s: there
     # LLVM inlines the walks into render_tiles and nothing was copied
-    from ..jit.dispatcher import tuned
     from .features import extras_possible, instances_possible
 
-    # scenes with tori or CSG too: their walks are calls, not inlined (csg.py). Tuned kernels
-    # only: they run without Numba's runtime, so a field read through the pointer is a
-    # plain borrowed value; stock Numba (reference counts) passes the tuple itself
-    return isinstance(geo, GeometryRef) or not (
-        tuned() and (instances_possible(geo) or extras_possible(geo)))
+    # scenes with tori or CSG too: their walks are calls, not inlined (csg.py)
+    return isinstance(geo, GeometryRef) or not (instances_possible(geo) or extras_possible(geo))
 
 
-# Typed and lowered directly (Numba's low-level extension API), not an ``overload``: an
-# overload's implementation is a function Numba compiles for its type even when it is
-# inlined, and the identity's, taking the whole tuple of arrays, was a 0.2-s compile on the
-# way to every first render
-@type_callable(geometry_ref_if_instances)
-def _type_geometry_ref_if_instances(context):
-    def typer(geo):
-        if _kept_as_is(geo):
-            return geo
-        if isinstance(geo, types.BaseNamedTuple):
-            return GeometryRef(geo)
-        return None
+def _register() -> None:
+    """Numba's typing and lowering of :func:`geometry_ref_if_instances`. Tuned kernels run
+    without Numba's runtime, so a field read through the pointer is a plain borrowed value,
+    and so is the tuple itself: the call is typed and lowered directly (Numba's low-level
+    extension API). An ``overload``'s implementation is a function Numba compiles for its
+    type even where it inlines it, and the identity's, taking the whole tuple of arrays, was
+    a 0.2-s compile on the way to every first render. Stock Numba (reference counts) passes
+    the tuple itself, through an inlined overload."""
+    from ..jit.dispatcher import tuned
 
-    return typer
+    if not tuned():
+        @overload(geometry_ref_if_instances, inline="always")
+        def _the_tuple_itself(geo):
+            return lambda geo: geo
+
+        return
+
+    @type_callable(geometry_ref_if_instances)
+    def _type_geometry_ref_if_instances(context):
+        def typer(geo):
+            if _kept_as_is(geo):
+                return geo
+            if isinstance(geo, types.BaseNamedTuple):
+                return GeometryRef(geo)
+            return None
+
+        return typer
+
+    @lower_builtin(geometry_ref_if_instances, types.Any)
+    def _lower_geometry_ref_if_instances(context, builder, sig, args):
+        if context.enable_nrt:  # not a tuned kernel: its references would be counted
+            raise NotImplementedError("geometry_ref_if_instances in a kernel with Numba's "
+                                      "runtime")
+        if sig.return_type == sig.args[0]:  # the tuple (or the reference) itself
+            return args[0]
+        slot = cgutils.alloca_once(builder, context.get_value_type(sig.args[0]))
+        builder.store(args[0], slot)
+        return slot
 
 
-@lower_builtin(geometry_ref_if_instances, types.Any)
-def _lower_geometry_ref_if_instances(context, builder, sig, args):
-    if sig.return_type == sig.args[0]:  # the value itself, a new reference to it
-        return impl_ret_borrowed(context, builder, sig.return_type, args[0])
-    slot = cgutils.alloca_once(builder, context.get_value_type(sig.args[0]))
-    builder.store(args[0], slot)
-    return slot
+_register()
