@@ -44,3 +44,18 @@ def test_the_tuple_or_a_reference_and_no_compile_of_its_own(general):
 def test_python_runs_it_as_the_identity():
     geo = stand_in_scene(True).geometry
     assert geometry_ref_if_instances(geo) is geo
+
+
+@pytest.mark.skipif(not tuned(), reason="stock Numba passes the tuple through an overload")
+def test_a_kernel_with_numba_s_runtime_is_refused():
+    """A function compiled with Numba's runtime (reference counts) would read the borrowed
+    tuple as an owned one: compiling it fails, with the reason, instead."""
+    geo = stand_in_scene(False).geometry
+
+    @numba.njit  # Numba's runtime on: not a whitted kernel
+    def counted(geo):
+        g = geometry_ref_if_instances(geo)
+        return g.prim_info.shape[0]
+
+    with pytest.raises(Exception, match="a kernel with Numba's runtime"):
+        counted(geo)

@@ -121,7 +121,7 @@ def test_mistakes_are_one_line(args, message):
 def test_the_queue_hands_a_general_kind_out_only_after_the_general_render_kernel():
     from whitted.cli.warm import _all_names, _Queue
 
-    queue = _Queue(_all_names())
+    queue = _Queue(_all_names(), done=("plain/render",))
     assert queue.take() == "general/render"  # the longest chain first
     assert queue.take() == "stefan"
     # the photon tracer shares no kernel with the render kernel: it starts at once
@@ -145,7 +145,7 @@ def test_the_longest_compiles_are_handed_out_first():
     # variants, so that with two workers the last to finish is a short one
     from whitted.cli.warm import _all_names, _Queue
 
-    queue = _Queue(_all_names())
+    queue = _Queue(_all_names(), done=("plain/render",))
     order = [queue.take() for _ in range(6)]
     assert order == ["general/render", "stefan", "general/caustics", "builders",
                      "plain/caustics", "plain/aovs"]
@@ -187,7 +187,7 @@ def test_no_variant_is_adaptive_anti_aliasing():
 def test_a_failed_general_render_kernel_fails_its_kinds_without_compiling_them():
     from whitted.cli.warm import _Queue
 
-    queue = _Queue(["general/render", "general/aovs", "plain/aovs"])
+    queue = _Queue(["general/render", "general/aovs", "plain/aovs"], done=("plain/render",))
     assert queue.take() == "general/render"
     assert queue.take() == "plain/aovs"
     queue.finish("general/render", None, "boom")
@@ -279,18 +279,30 @@ def test_no_worker_starts_once_the_command_ends(monkeypatch):
 
     from whitted.cli import warm
 
-    def no_process(*args, **kwargs):
-        raise AssertionError("a worker started after the command ended")
-
-    monkeypatch.setattr(subprocess, "Popen", no_process)
+    popens = []
+    monkeypatch.setattr(subprocess, "Popen", lambda *args, **kwargs: popens.append(args))
     queue = warm._Queue(["stefan"])
+    waiting = threading.Event()
+    wait_turn = queue.wait_turn
+
+    def wait_turn_seen(worker):
+        with queue._changed:  # set while holding the lock wait_turn takes: it then waits
+            waiting.set()
+            return wait_turn(worker)
+
+    monkeypatch.setattr(queue, "wait_turn", wait_turn_seen)
     procs: list = []
-    waiting = threading.Thread(target=warm._work, args=(queue, procs, False, 0))
-    waiting.start()  # waits for its turn, which never comes
+    outcome = []
+    worker = threading.Thread(
+        target=lambda: outcome.append(warm._work(queue, procs, False, 0)))
+    worker.start()
+    assert waiting.wait(30)  # the worker waits for its turn, which never comes
     queue.close()  # Ctrl-C during the default scene's compile
-    waiting.join(30)
-    assert not waiting.is_alive() and procs == []
+    worker.join(30)
+    assert not worker.is_alive() and outcome == [None]  # it ended, without an exception
+    assert popens == [] and procs == []
     assert queue.start(0, procs, ["whitted"], {}, None) is None
+    assert popens == []
 
 
 def test_workers_compile_without_a_helper_of_their_own(monkeypatch):

@@ -3,16 +3,18 @@ ahead of use (``make demo`` runs it), so no later render, film or Stefan run sto
 compile.
 
 The default scene's kernels come first, in this process and its compile helper (both
-cores); then the other variants (render/variants.py), the scene builders with the OBJ reader
+cores). The other variants (render/variants.py), the scene builders with the OBJ reader
 (which a small scene runs as Python until they are compiled: jit/python_twins.py) and the
 Stefan solver's kernels are handed out, one at a time and the longest first, to ``--jobs``
 worker processes (one per core), each compiling into the same cache (jit/cache.py keeps it
-consistent). A worker compiles without a helper process of its own (render/warm_up.py) unless
-there are cores for both: the workers already keep the cores busy, and a helper beside them
-compiled some kernels in both processes (measured: the same CPU, the last worker done 2-3 s
-later). A kind of the general
-kernels that shares the render kernel's callees (the AOV kernel) is handed out only once the
-general render kernel is in the cache: it then loads them instead of compiling them a second
+consistent): the first as soon as the compile helper has finished (this process then
+compiles the default render kernel's own module, on one core), the others once the default
+scene's kernels are done. A worker compiles without a helper process of its own
+(render/warm_up.py) unless there are cores for both: the workers already keep the cores busy,
+and a helper beside them compiled some kernels in both processes (measured: the same CPU,
+the last worker done 2-3 s later). A kind that shares its
+geometry's render kernel's callees (the AOV kernel) is handed out only once that render
+kernel is in the cache: it then loads them instead of compiling them a second
 time in another process. Adaptive anti-aliasing is a run-time choice of the render kernel:
 the ``render`` variants serve it. The photon tracers (the caustics variants: the tracer
 only, the render with caustics is the render kernel's) share nothing with the render kernels
@@ -54,7 +56,7 @@ def _first(name: str) -> str | None:
     of its geometry, whose callees it shares (plain/render is compiled before any; the
     photon tracer of the caustics variants shares none)."""
     geometry, _, kind = name.partition("/")
-    if name in (STEFAN, BUILDERS) or kind in ("render", "caustics") or geometry == "plain":
+    if name in (STEFAN, BUILDERS) or kind in ("render", "caustics"):
         return None
     return f"{geometry}/render"
 
@@ -107,9 +109,9 @@ def _serve() -> None:
 class _Queue:
     """The variants left, handed out in order, each once the variant it needs is done."""
 
-    def __init__(self, names: list[str]) -> None:
+    def __init__(self, names: list[str], done: tuple[str, ...] = ()) -> None:
         self.todo = _order(names)
-        self.done: set[str] = {"plain/render"}
+        self.done: set[str] = set(done)
         self.failed: set[str] = set()
         self.times: dict[str, float] = {}
         self.errors: list[str] = []
@@ -298,11 +300,11 @@ def warm(
             err.echo("loading the default scene's kernels (compiled before)" if kernels_cached()
                      else "compiling the default scene's kernels (the first time)")
             threads = _start_workers(queue, procs, workers, cores)
-            # once the default scene's compile helper has ended, this process compiles the
-            # render kernel's own module on one core: a worker starts on the next
+            # once the default scene's compile helper has finished, this process compiles
+            # the render kernel's own module on one core: workers start on the others
             early = min(workers, max(1, cores - 1))
-            queue.times["plain/render"] = warm_up_kernels(
-                on_helper_end=lambda: queue.open_to(early))
+            queue.finish("plain/render", warm_up_kernels(
+                on_helper_end=lambda: queue.open_to(early)))
             if names:
                 err.echo(f"{len(names)} more variant{'s' * (len(names) > 1)} in {workers} "
                          f"process{'es' * (workers > 1)}, "

@@ -27,8 +27,8 @@ class _Paused:
 
     def start(self) -> None:
         if self.depth == 0 and gc.isenabled():
+            self.paused = True  # first: an interrupt between the two still ends in enable()
             gc.disable()
-            self.paused = True
         self.depth += 1
 
     def end(self) -> None:

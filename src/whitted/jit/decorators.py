@@ -112,8 +112,10 @@ def load_numba() -> None:
         from .collector import collector_listener
 
         type_arrays_without_numpy_ma()
-        event.register("numba:compile", _compile_listener())
+        # the collector's first: Numba tells the listeners in turn and stops at one that
+        # raises, and a skipped end of a compile would leave the collector off for good
         event.register("numba:compile", collector_listener())  # no collections mid-compile
+        event.register("numba:compile", _compile_listener())
         while _deferred:
             _deferred.pop(0)()
         _numba_imported = True
