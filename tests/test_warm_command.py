@@ -456,4 +456,5 @@ def test_the_workers_are_given_up_once_a_signal_was_seen(monkeypatch):
 
     monkeypatch.setattr(warm, "_work", work)
     with pytest.raises(KeyboardInterrupt):
-        warm._run_workers(warm._Queue(["stefan"]), [], 1, 2, stop=started.is_set)
+        threads = warm._start_workers(warm._Queue(["stefan"]), [], 1, 2)
+        warm._wait_workers(threads, stop=started.is_set)

@@ -249,15 +249,6 @@ def _wait_workers(threads: list[threading.Thread], stop=lambda: False) -> None:
             thread.join(0.2)  # a timeout: Ctrl-C reaches this thread
 
 
-def _run_workers(queue: _Queue, procs: list[subprocess.Popen], workers: int, cores: int,
-                 stop=lambda: False) -> None:
-    """Hand the queue out to ``workers`` worker processes, all let start now, and wait for
-    them (:func:`_wait_workers`)."""
-    threads = _start_workers(queue, procs, workers, cores)
-    queue.open_to(workers)
-    _wait_workers(threads, stop)
-
-
 @app.command()
 def warm(
     jobs: Annotated[int, typer.Option(
