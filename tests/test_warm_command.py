@@ -365,6 +365,75 @@ def test_a_worker_gets_a_helper_only_where_there_is_a_core_for_it(monkeypatch, t
 
 @pytest.mark.parametrize("signum, code, word", [(signal.SIGINT, 130, "interrupted"),
                                                 (signal.SIGTERM, 143, "terminated")])
+def test_a_signal_after_the_first_worker_started_early_kills_it(monkeypatch, tmp_path, signum,
+                                                                code, word):
+    """Ctrl-C (or SIGTERM) while the default scene's render kernel still compiles, its helper
+    done and the first worker already started beside it: that worker is killed, no other
+    starts, and nothing is said to be in the cache."""
+    import subprocess
+
+    from cli_run import run_main
+    from whitted.render import api, warm_up
+
+    started, killed = [], []
+
+    class BusyWorker:  # a worker process compiling its first variant
+        def __init__(self, args, **kwargs):
+            started.append(self)
+            self.stdin = self
+            self.stdout = self
+
+        def write(self, text):
+            pass
+
+        def flush(self):
+            pass
+
+        def readline(self):
+            threading.Event().wait(30)  # compiling (a daemon thread, left behind)
+            return ""
+
+        def close(self):
+            pass
+
+        def poll(self):
+            return -9 if self in killed else None
+
+        def kill(self):
+            killed.append(self)
+
+        def wait(self, timeout=None):
+            return -9
+
+    worker_started = threading.Event()
+    popen = BusyWorker
+
+    def starts_and_tells(*args, **kwargs):
+        proc = popen(*args, **kwargs)
+        worker_started.set()
+        return proc
+
+    def warm_up_kernels(on_helper_end=None):
+        on_helper_end()  # the helper's last line
+        assert worker_started.wait(30)  # the first worker is compiling
+        os.kill(os.getpid(), signum)  # then the signal, during the render kernel's module
+        threading.Event().wait(30)
+        return 0.25
+
+    monkeypatch.setattr(subprocess, "Popen", starts_and_tells)
+    monkeypatch.setattr(api, "available_threads", lambda: 2)
+    monkeypatch.setattr(warm_up, "kernels_cached", lambda instances=False: False)
+    monkeypatch.setattr(warm_up, "warm_up_kernels", warm_up_kernels)
+    status, out, err = run_main("warm", cwd=tmp_path)
+    assert status == code
+    assert len(started) == 1 and killed == started  # the second never started
+    assert err.splitlines()[-1] == (f"{word}: 0 of 8 kinds of kernels were compiled and are "
+                                    "kept in the cache; whitted warm again compiles the rest")
+    assert "every kernel is in the cache" not in out
+
+
+@pytest.mark.parametrize("signum, code, word", [(signal.SIGINT, 130, "interrupted"),
+                                                (signal.SIGTERM, 143, "terminated")])
 def test_a_signal_stops_the_workers_and_keeps_what_was_compiled(monkeypatch, tmp_path, signum,
                                                                 code, word):
     """Ctrl-C (or SIGTERM) while the workers compile: they are stopped at once, not left to
