@@ -377,11 +377,14 @@ def test_a_signal_after_the_first_worker_started_early_kills_it(monkeypatch, tmp
 
     started, killed = [], []
 
-    class BusyWorker:  # a worker process compiling its first variant
+    class BusyWorker:  # a worker process compiling its first variant, until killed
+        returncode = -9
+
         def __init__(self, args, **kwargs):
             started.append(self)
             self.stdin = self
             self.stdout = self
+            self.ended = threading.Event()
 
         def write(self, text):
             pass
@@ -390,7 +393,7 @@ def test_a_signal_after_the_first_worker_started_early_kills_it(monkeypatch, tmp
             pass
 
         def readline(self):
-            threading.Event().wait(30)  # compiling (a daemon thread, left behind)
+            self.ended.wait(30)  # compiling until killed: then no answer
             return ""
 
         def close(self):
@@ -400,7 +403,9 @@ def test_a_signal_after_the_first_worker_started_early_kills_it(monkeypatch, tmp
             return -9 if self in killed else None
 
         def kill(self):
-            killed.append(self)
+            if self not in killed:  # its feeding thread may kill it again as it ends
+                killed.append(self)
+            self.ended.set()
 
         def wait(self, timeout=None):
             return -9
