@@ -110,11 +110,13 @@ def load_numba() -> None:
 
         from .array_typing import install as type_arrays_without_numpy_ma
         from .collector import collector_listener
+        from .frame_stack import frame_stack_listener
 
         type_arrays_without_numpy_ma()
         # the collector's first: Numba tells the listeners in turn and stops at one that
         # raises, and a skipped end of a compile would leave the collector off for good
         event.register("numba:compile", collector_listener())  # no collections mid-compile
+        event.register("numba:compile", frame_stack_listener())  # chunks reused, not mapped
         event.register("numba:compile", _compile_listener())
         while _deferred:
             _deferred.pop(0)()
