@@ -54,12 +54,15 @@ PROBE = textwrap.dedent("""
     print(max(down(d, k, CALLS) for d in range(160) for k in range(16)))
 """).replace("CALLS", str(CALLS))
 
-needs_it = pytest.mark.skipif(not frame_stack.supported() or sys.platform == "win32",
+needs_it = pytest.mark.skipif(not frame_stack.supported(),
                               reason="this interpreter's frame stack is left as it is")
+jit_on = pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0"),
+                            reason="nothing is compiled with NUMBA_DISABLE_JIT")
 
 
 def run(code: str, *args: str) -> str:
-    env = dict(os.environ, PYTHONPATH=SRC + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        p for p in (SRC, os.environ.get("PYTHONPATH")) if p))
     done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
                           env=env, timeout=300)
     assert done.returncode == 0, done.stderr
@@ -67,6 +70,7 @@ def run(code: str, *args: str) -> str:
 
 
 @needs_it
+@pytest.mark.skipif(sys.platform == "win32", reason="page faults counted with resource")
 def test_a_call_at_a_chunk_boundary_faults_every_time_without_it_and_not_with_it():
     without = int(run(PROBE))
     if without < CALLS:
@@ -75,6 +79,7 @@ def test_a_call_at_a_chunk_boundary_faults_every_time_without_it_and_not_with_it
 
 
 @needs_it
+@jit_on
 def test_installed_at_the_first_compile_not_before():
     code = textwrap.dedent("""
         from whitted.jit import frame_stack, kernel, load_numba
@@ -89,6 +94,35 @@ def test_installed_at_the_first_compile_not_before():
         print(frame_stack.installed())
     """)
     assert run(code).split() == ["False", "42", "True"]
+
+
+@needs_it
+def test_a_chunk_freed_is_the_next_one_handed_out():
+    """The chunk kept for reuse: freed, then asked for again, the same memory, where the
+    interpreter would have unmapped it and mapped another (the gain; docs/performance.md)."""
+    code = textwrap.dedent("""
+        import ctypes
+        from whitted.jit import frame_stack as fs
+
+        assert fs.install()
+        current = fs._ArenaAllocator()
+        get = ctypes.pythonapi.PyObject_GetArenaAllocator
+        get.argtypes = [ctypes.POINTER(fs._ArenaAllocator)]
+        get.restype = None
+        get(ctypes.byref(current))
+        alloc = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t)(
+            current.alloc)
+        free = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t)(
+            current.free)
+        a = alloc(current.ctx, fs.CHUNK)  # takes the kept chunk, if one is kept
+        free(current.ctx, a, fs.CHUNK)  # kept
+        b = alloc(current.ctx, fs.CHUNK)
+        free(current.ctx, b, fs.CHUNK)
+        c = alloc(current.ctx, fs.CHUNK + 8)  # another size: not the kept one
+        free(current.ctx, c, fs.CHUNK + 8)
+        print(a == b, c != b)
+    """)
+    assert run(code).split() == ["True", "True"]
 
 
 @needs_it

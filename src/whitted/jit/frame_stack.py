@@ -13,27 +13,30 @@ compile (``strace``): some 2 s of system time, and about 5 % of the compile's CP
 through Python's documented ``PyObject_GetArenaAllocator``/``PyObject_SetArenaAllocator``. They
 are compiled from a few lines of LLVM IR with llvmlite's public binding API:
 
-- a request of one standard chunk (16 KiB) takes the chunk kept from the last one freed, if
-  there is one (later CPython releases keep that one chunk themselves);
+- a request of one standard chunk (16 KiB) takes the chunk kept for reuse, if one is kept
+  (later CPython releases keep one chunk themselves);
 - other requests of up to 64 KiB come from ``PyMem_RawMalloc``. Their address is 16 bytes
   past a page boundary, which tells them apart from the interpreter's own blocks: those are
   always page-aligned (``mmap``, or ``VirtualAlloc`` on Windows);
 - anything else goes to the interpreter's allocator, as before.
 
-A freed block of the allocator's own goes back to it. A freed standard chunk is kept when
-the spare place is empty (an atomic exchange, so the functions need no lock), and any other
-is given back to ``PyMem_RawFree``. The pymalloc arenas (1 MiB) are not touched.
+A freed block of the interpreter's own goes back to it. A freed standard chunk is kept when
+none is (an atomic exchange, so the functions need no lock), and any other is given back to
+``PyMem_RawFree``. The pymalloc arenas (1 MiB) are not touched.
 
 It is installed at the start of the first compile in a process (a listener of Numba's
 ``numba:compile`` event, registered with the kernels' other listeners): a process that only
 loads kernels from the cache pays nothing. It stays installed, so blocks taken before and
-after it are each freed by the allocator they came from. It is left out where the
+after it are each freed by the allocator they came from, and its code is never released
+(llvmlite's engine detached). An install that fails is not tried again, and changes
+nothing. It is left out where the
 interpreter's blocks might not be page-aligned, and where it could not help: not CPython, a
 free-threaded build, a 32-bit one, or another platform than Linux, macOS and Windows.
 """
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import sys
 import sysconfig
@@ -138,8 +141,8 @@ class _ArenaAllocator(ctypes.Structure):
 
 
 _lock = threading.Lock()
-_kept: list = []  # what the installed functions live in: llvmlite's module and engine
 _installed = False
+_tried = False
 
 
 def supported() -> bool:
@@ -165,46 +168,50 @@ def _api(name: str, *argtypes):
 
 def install() -> bool:
     """Put the allocator in front of the interpreter's (once per process). Returns whether it
-    is installed. Where it is not supported, or llvmlite cannot compile it, nothing changes."""
-    global _installed
+    is installed. Where it is not supported, or llvmlite cannot compile it, nothing changes,
+    and a failed install is not tried again."""
+    global _installed, _tried
     with _lock:
-        if _installed or not supported():
+        if _tried or not supported():
             return _installed
+        _tried = True
         try:
-            import llvmlite.binding as llvm
-
-            llvm.initialize_native_target()
-            llvm.initialize_native_asmprinter()
-            module = llvm.parse_assembly(_IR)
-            module.verify()
-            machine = llvm.Target.from_default_triple().create_target_machine()
-            engine = llvm.create_mcjit_compiler(module, machine)
-            engine.finalize_object()
-            alloc = engine.get_function_address("whitted_arena_alloc")
-            free = engine.get_function_address("whitted_arena_free")
+            new = _compiled_allocator()
+            put = _api("PyObject_SetArenaAllocator", ctypes.POINTER(_ArenaAllocator))
         except Exception:  # noqa: BLE001 - an optimisation only: the interpreter's stays
             return False
-        if not alloc or not free:
-            return False
-        pointer = ctypes.POINTER(_ArenaAllocator)
-        old = _ArenaAllocator()
-        _api("PyObject_GetArenaAllocator", pointer)(ctypes.byref(old))
-
-        def set_global(name: str, value: int | None) -> None:
-            ctypes.c_void_p.from_address(engine.get_global_value_address(name)).value = value
-
-        set_global("old_alloc", old.alloc)
-        set_global("old_free", old.free)
-        set_global("old_ctx", old.ctx)
-        set_global("raw_malloc", ctypes.cast(ctypes.pythonapi.PyMem_RawMalloc,
-                                             ctypes.c_void_p).value)
-        set_global("raw_free", ctypes.cast(ctypes.pythonapi.PyMem_RawFree,
-                                           ctypes.c_void_p).value)
-        new = _ArenaAllocator(None, alloc, free)
-        _kept.extend([module, machine, engine, old, new])  # alive as long as the process
-        _api("PyObject_SetArenaAllocator", pointer)(ctypes.byref(new))
+        put(ctypes.byref(new))
         _installed = True
         return True
+
+
+def _compiled_allocator() -> _ArenaAllocator:
+    """The two functions compiled, pointed at the interpreter's allocator and at
+    ``PyMem_RawMalloc``/``PyMem_RawFree``: the allocator to install."""
+    import llvmlite.binding as llvm
+
+    llvm.initialize_native_target()
+    llvm.initialize_native_asmprinter()
+    module = llvm.parse_assembly(_IR)
+    module.verify()
+    machine = llvm.Target.from_default_triple().create_target_machine()
+    engine = llvm.create_mcjit_compiler(module, machine)  # owns the module and the machine
+    engine.finalize_object()
+    alloc = engine.get_function_address("whitted_arena_alloc")
+    free = engine.get_function_address("whitted_arena_free")
+    if not alloc or not free:
+        raise RuntimeError("llvmlite compiled no arena functions")
+    old = _ArenaAllocator()
+    _api("PyObject_GetArenaAllocator", ctypes.POINTER(_ArenaAllocator))(ctypes.byref(old))
+    for name, value in (("old_alloc", old.alloc), ("old_free", old.free),
+                        ("old_ctx", old.ctx),
+                        ("raw_malloc", ctypes.cast(ctypes.pythonapi.PyMem_RawMalloc,
+                                                   ctypes.c_void_p).value),
+                        ("raw_free", ctypes.cast(ctypes.pythonapi.PyMem_RawFree,
+                                                 ctypes.c_void_p).value)):
+        ctypes.c_void_p.from_address(engine.get_global_value_address(name)).value = value
+    engine.detach()  # never disposed: the interpreter calls this code as long as it runs
+    return _ArenaAllocator(None, alloc, free)
 
 
 def frame_stack_listener():
@@ -214,8 +221,9 @@ def frame_stack_listener():
 
     class InstallAtFirstCompile(event.Listener):
         def on_start(self, ev) -> None:
-            if not _installed:
-                install()
+            if not _tried:
+                with contextlib.suppress(Exception):  # never a reason for a compile to fail
+                    install()
 
         def on_end(self, ev) -> None:
             pass
