@@ -105,11 +105,7 @@ def test_a_chunk_freed_is_the_next_one_handed_out():
         from whitted.jit import frame_stack as fs
 
         assert fs.install()
-        current = fs._ArenaAllocator()
-        get = ctypes.pythonapi.PyObject_GetArenaAllocator
-        get.argtypes = [ctypes.POINTER(fs._ArenaAllocator)]
-        get.restype = None
-        get(ctypes.byref(current))
+        current = fs.current_allocator()
         alloc = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t)(
             current.alloc)
         free = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t)(
@@ -171,11 +167,7 @@ def test_every_block_is_whole_writable_and_tagged_by_where_it_came_from(requests
     (16 bytes past a page boundary), a larger one the interpreter's (page-aligned); every
     byte can be written; freed early or late, in any order."""
     assert frame_stack.install()
-    current = frame_stack._ArenaAllocator()
-    get = ctypes.pythonapi.PyObject_GetArenaAllocator
-    get.argtypes = [ctypes.POINTER(frame_stack._ArenaAllocator)]
-    get.restype = None
-    get(ctypes.byref(current))
+    current = frame_stack.current_allocator()
     alloc = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t)(current.alloc)
     free = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_void_p,
                             ctypes.c_size_t)(current.free)

@@ -166,6 +166,13 @@ def _api(name: str, *argtypes):
     return function
 
 
+def current_allocator() -> _ArenaAllocator:
+    """The interpreter's arena allocator as it is now (``PyObject_GetArenaAllocator``)."""
+    allocator = _ArenaAllocator()
+    _api("PyObject_GetArenaAllocator", ctypes.POINTER(_ArenaAllocator))(ctypes.byref(allocator))
+    return allocator
+
+
 def install() -> bool:
     """Put the allocator in front of the interpreter's (once per process). Returns whether it
     is installed. Where it is not supported, or llvmlite cannot compile it, nothing changes,
@@ -201,8 +208,7 @@ def _compiled_allocator() -> _ArenaAllocator:
     free = engine.get_function_address("whitted_arena_free")
     if not alloc or not free:
         raise RuntimeError("llvmlite compiled no arena functions")
-    old = _ArenaAllocator()
-    _api("PyObject_GetArenaAllocator", ctypes.POINTER(_ArenaAllocator))(ctypes.byref(old))
+    old = current_allocator()
     for name, value in (("old_alloc", old.alloc), ("old_free", old.free),
                         ("old_ctx", old.ctx),
                         ("raw_malloc", ctypes.cast(ctypes.pythonapi.PyMem_RawMalloc,
