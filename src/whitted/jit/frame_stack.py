@@ -6,7 +6,7 @@ a frame does not fit in the chunk before it, and goes back (``munmap``) as soon 
 at its start returns. So a call made again and again at a depth where its frame just misses
 the current chunk maps a chunk, faults its pages in and unmaps it every time. Numba's
 compiler, deep and recursive, did that about 180,000 times in the default scene's first
-compile (``strace``): some 2 s of system time, and about 5 % of the compile's CPU in all
+compile (``strace``): some 2 s of system time, and 5-10 % of the compile's CPU in all
 (docs/performance.md, the frame-stack round).
 
 :func:`install` puts two small functions in front of the interpreter's arena allocator,
