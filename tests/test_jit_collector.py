@@ -5,6 +5,12 @@ the program had turned it off itself."""
 from __future__ import annotations
 
 import gc
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
 
 import numba
 import pytest
@@ -15,6 +21,8 @@ from whitted.jit import load_numba
 from whitted.jit.collector import _Paused
 
 load_numba()
+
+SRC = Path(__file__).resolve().parents[1] / "src"
 
 
 class _Seen(event.Listener):
@@ -109,3 +117,88 @@ def test_the_pause_counts_nesting():
     finally:
         if not was:
             gc.disable()
+
+
+def _run(script: str) -> dict:
+    """``script`` run in a fresh interpreter (gc.freeze is for the whole process); the JSON
+    object it prints last."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        [str(SRC), *filter(None, [os.environ.get("PYTHONPATH")])])}
+    result = subprocess.run([sys.executable, "-c", textwrap.dedent(script)], env=env,
+                            capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr
+    return json.loads(result.stdout.splitlines()[-1])
+
+
+@pytest.mark.skipif(not hasattr(os, "sysconf") or sys.platform == "win32",
+                    reason="the peak memory is read with the resource module")
+def test_a_process_that_keeps_leftovers_freezes_them_within_its_budget():
+    seen = _run("""
+        import gc, json
+        import numba
+        from whitted.jit import load_numba
+        from whitted.jit import collector
+
+        load_numba()
+        gc.enable()
+
+        def compiled():  # a fresh function each time: a compile of its own
+            @numba.njit
+            def f(x):
+                return x * 2.0 + 1.0
+            assert f(1.0) == 3.0
+            return gc.get_freeze_count()
+
+        seen = {"before": gc.get_freeze_count(), "default": compiled()}
+        collector.keep_leftovers()
+        seen["kept"] = compiled()
+        seen["on"] = gc.isenabled()
+        seen["gen0"] = len(gc.get_objects(0))  # what the compile left is no longer there
+        budget = collector.LEFTOVER_BUDGET
+        collector.LEFTOVER_BUDGET = 0  # over budget: collected again
+        seen["over"] = compiled() - seen["kept"]
+        collector.LEFTOVER_BUDGET = budget
+        collector.keep_leftovers(False)
+        seen["off"] = compiled() - seen["kept"]
+        seen["budget"] = collector.leftover_budget()
+        import resource
+        resource.setrlimit(resource.RLIMIT_AS, (2**30, resource.getrlimit(resource.RLIMIT_AS)[1]))
+        seen["limited"] = collector.leftover_budget()
+        print(json.dumps(seen))
+    """)
+    assert seen["before"] == 0 and seen["default"] == 0  # by default nothing is frozen
+    assert seen["kept"] > 10_000  # the compile's own objects among them (Numba's IR, types)
+    assert seen["on"] and seen["gen0"] < 1_000
+    # nothing more frozen (frozen objects freed by reference counting leave the count)
+    assert seen["over"] <= 0 and seen["off"] <= 0
+    machine = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    assert seen["budget"] == min(1536 * 1024 * 1024, machine // 8)
+    assert seen["limited"] == 2**30 // 4  # under ulimit -v 1 GiB
+
+
+def test_the_command_keeps_leftovers_but_not_the_editor_nor_an_in_process_run():
+    seen = _run("""
+        import json, sys
+        import whitted.cli.main as cli
+        import importlib
+        warm_up = importlib.import_module("whitted.render.warm_up")
+        from whitted.jit import collector
+
+        seen = {}
+        for name, argv, own_process in (("version", ["--version"], True),
+                                        ("gui", ["gui", "--help"], True),
+                                        ("in-process", ["--version"], False)):
+            collector.keep_leftovers(False)
+            cli.EXIT_AT_ONCE_WHEN_ABANDONED = own_process
+            sys.argv = ["whitted", *argv]
+            try:
+                cli.main()
+            except SystemExit:
+                pass
+            seen[name] = collector._keep[0]
+        collector.keep_leftovers(False)
+        warm_up.precompile_for_render = lambda *a: seen.setdefault("helper", collector._keep[0])
+        warm_up._helper_main(["plain"])  # the compile helper's process
+        print(json.dumps(seen))
+    """)
+    assert seen == {"version": True, "gui": False, "in-process": False, "helper": True}

@@ -20,6 +20,7 @@ except ImportError:  # pragma: no cover - depends on the installed typer
 
 # the commands register themselves on `app` when imported
 from ..errors import WhittedError
+from ..jit.collector import keep_leftovers
 from ..jit.progress import show_compile_bar
 from . import animate as _animate  # noqa: F401
 from . import bench as _bench  # noqa: F401
@@ -57,6 +58,10 @@ def main() -> None:
     if len(sys.argv) > 1 and sys.argv[1] == "render" and gc.isenabled():
         gc.disable()  # until the render's set-up is done: _resume_collector
         collector_paused.append(True)
+    if EXIT_AT_ONCE_WHEN_ABANDONED and (len(sys.argv) < 2 or sys.argv[1] != "gui"):
+        # this process ends with its command (the editor's does not; an in-process run in
+        # a test goes on): what a compile leaves is frozen, not collected (jit/collector.py)
+        keep_leftovers()
 
     # No BLAS thread pool: the commands' NumPy work is small matrices and element-wise
     # arithmetic (the renderer's threads are Numba's), and starting OpenBLAS's pool made

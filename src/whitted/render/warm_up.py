@@ -684,6 +684,9 @@ def _end_with_parent(parent: int) -> None:
 
 
 def _helper_main(argv: list[str]) -> None:
+    from ..jit.collector import keep_leftovers
+
+    keep_leftovers()  # this process ends with its compiles (jit/collector.py)
     instances = bool(argv) and argv[0] == "instances"
     builders = "builders" in argv[2:]
     if len(argv) > 1:
