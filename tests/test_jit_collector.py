@@ -158,6 +158,11 @@ def test_a_process_that_keeps_leftovers_freezes_them_within_its_budget():
         collector.LEFTOVER_BUDGET = 0  # over budget: collected again
         seen["over"] = compiled() - seen["kept"]
         collector.LEFTOVER_BUDGET = budget
+        spare = collector._memory_to_spare
+        collector._memory_to_spare = lambda: False  # the machine short of memory: collected
+        seen["crowded"] = compiled() - seen["kept"]
+        collector._memory_to_spare = spare
+        seen["spare"] = spare()
         collector.keep_leftovers(False)
         seen["off"] = compiled() - seen["kept"]
         seen["budget"] = collector.leftover_budget()
@@ -170,10 +175,17 @@ def test_a_process_that_keeps_leftovers_freezes_them_within_its_budget():
     assert seen["kept"] > 10_000  # the compile's own objects among them (Numba's IR, types)
     assert seen["on"] and seen["gen0"] < 1_000
     # nothing more frozen (frozen objects freed by reference counting leave the count)
-    assert seen["over"] <= 0 and seen["off"] <= 0
+    assert seen["over"] <= 0 and seen["crowded"] <= 0 and seen["off"] <= 0
     machine = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
     assert seen["budget"] == min(1536 * 1024 * 1024, machine // 8)
     assert seen["limited"] == 2**30 // 4  # under ulimit -v 1 GiB
+    try:
+        free = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except ValueError:  # not said on this system: never a reason to collect
+        assert seen["spare"]
+    else:
+        if abs(free - machine / 4) > machine / 16:  # not at the edge, where it could move
+            assert seen["spare"] == (free >= machine / 4)
 
 
 def test_the_command_keeps_leftovers_but_not_the_editor_nor_an_in_process_run():

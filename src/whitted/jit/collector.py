@@ -17,9 +17,9 @@ the collection that finds them took 0.66-0.76 s, 4 % of the compile, on the deve
 machine (docs/performance.md, the leftovers round). A process that ends once its work is
 done, and so never needs that memory back, can call :func:`keep_leftovers`: from then on, a
 compile's leftovers are frozen (``gc.freeze``: never scanned, never freed) instead, while the
-process's peak memory stays under a budget (:func:`leftover_budget`); past it, they are
-collected as before. The whitted command does that (not its editor); a library user's
-long-lived process keeps the default.
+process's peak memory stays under a budget (:func:`leftover_budget`) and a quarter of the
+machine's memory is still free; past either, they are collected as before. The whitted
+command does that (not its editor); a library user's long-lived process keeps the default.
 """
 
 from __future__ import annotations
@@ -73,12 +73,24 @@ def leftover_budget() -> int:
     return budget
 
 
+def _memory_to_spare() -> bool:
+    """Whether a quarter of the machine's memory is still free (where the system says: Linux),
+    so that processes compiling side by side (``whitted warm``'s workers) stop freezing
+    before they crowd the machine."""
+    try:
+        free = os.sysconf("SC_AVPHYS_PAGES")
+        machine = os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):  # not said here (macOS, Windows)
+        return True
+    return free >= machine // 4
+
+
 def _freeze_leftovers() -> bool:
     """Whether the leftovers of the compile that has just ended are to be frozen."""
     if not _keep[0]:
         return False
     peak = _peak_memory()
-    return peak is not None and peak < leftover_budget()
+    return peak is not None and peak < leftover_budget() and _memory_to_spare()
 
 
 class _Paused:
