@@ -226,7 +226,8 @@ def test_warm_says_whether_it_compiles_or_loads(tmp_path, monkeypatch, cached, n
     monkeypatch.setattr(warm_up, "warm_up_kernels", lambda **kwargs: 0.25)
     monkeypatch.setattr(warm, "_all_names", lambda: names)
 
-    def work(queue, procs, helper=False, worker=0):  # every variant was in the cache
+    # every variant was in the cache
+    def work(queue, procs, helper=False, worker=0, processes=1):
         queue.wait_turn(worker)
         while (name := queue.take()) is not None:
             queue.finish(name, 0.5)
@@ -257,7 +258,7 @@ def test_the_first_worker_starts_once_the_compile_helper_has_finished(monkeypatc
         seen_during_compile.append([turns[0].wait(30), turns[1].is_set()])
         return 0.25
 
-    def work(queue, procs, helper=False, worker=0):
+    def work(queue, procs, helper=False, worker=0, processes=1):
         if queue.wait_turn(worker):
             turns[worker].set()
             while (name := queue.take()) is not None:
@@ -330,12 +331,14 @@ def test_workers_compile_without_a_helper_of_their_own(monkeypatch):
     monkeypatch.setenv("WHITTED_COMPILE_HELPER", "1")
     queue = warm._Queue([])
     queue.open_to(1)
-    warm._work(queue, [])
-    warm._work(queue, [], helper=True)  # a core to spare for one
+    warm._work(queue, [], processes=3)
+    warm._work(queue, [], helper=True, processes=5)  # a core to spare for one
     (args, kwargs), (_, spare) = started
     assert args[-2:] == ["warm", "--serve"]
     assert kwargs["env"]["WHITTED_COMPILE_HELPER"] == "0"
     assert spare["env"]["WHITTED_COMPILE_HELPER"] == "1"
+    assert kwargs["env"]["WHITTED_COMPILE_PROCESSES"] == "3"
+    assert spare["env"]["WHITTED_COMPILE_PROCESSES"] == "5"
 
 
 @pytest.mark.parametrize("jobs, cores, helper", [(2, 2, False), (0, 2, False), (1, 2, True),
@@ -350,9 +353,11 @@ def test_a_worker_gets_a_helper_only_where_there_is_a_core_for_it(monkeypatch, t
     monkeypatch.setattr(warm_up, "kernels_cached", lambda instances=False: True)
     monkeypatch.setattr(warm_up, "warm_up_kernels", lambda **kwargs: 0.25)
     seen = []
+    sharing = []
 
-    def work(queue, procs, helper=False, worker=0):
+    def work(queue, procs, helper=False, worker=0, processes=1):
         seen.append(helper)
+        sharing.append(processes)
         queue.wait_turn(worker)
         while (name := queue.take()) is not None:
             queue.finish(name, 0.5)
@@ -361,6 +366,10 @@ def test_a_worker_gets_a_helper_only_where_there_is_a_core_for_it(monkeypatch, t
     code, _, err = run_main("warm", "--jobs", str(jobs), cwd=tmp_path)
     assert code == 0, err
     assert seen and set(seen) == {helper}
+    # the processes compiling side by side, that share the memory budget of what their
+    # compiles leave (jit/collector.py): this one, the workers and their helpers
+    workers = min(jobs or cores, len(seen))
+    assert set(sharing) == {1 + workers * (2 if helper else 1)}
 
 
 @pytest.mark.parametrize("signum, code, word", [(signal.SIGINT, 130, "interrupted"),
@@ -461,7 +470,7 @@ def test_a_signal_stops_the_workers_and_keeps_what_was_compiled(monkeypatch, tmp
         def wait(self):
             return -9
 
-    def work(queue, procs, helper=False, worker=0):
+    def work(queue, procs, helper=False, worker=0, processes=1):
         queue.wait_turn(worker)
         procs.append(BusyWorker())
         name = queue.take()
@@ -524,7 +533,7 @@ def test_the_workers_are_given_up_once_a_signal_was_seen(monkeypatch):
 
     started = threading.Event()
 
-    def work(queue, procs, helper=False, worker=0):
+    def work(queue, procs, helper=False, worker=0, processes=1):
         started.set()
         threading.Event().wait(30)  # compiling (a daemon thread, left behind)
 

@@ -185,13 +185,16 @@ class _Queue:
 
 
 def _work(queue: _Queue, procs: list[subprocess.Popen], helper: bool = False,
-          worker: int = 0) -> None:
+          worker: int = 0, processes: int = 1) -> None:
     """Feed worker process number ``worker`` from the queue, once it may start, until nothing
     is left or it fails; ``helper``: whether its compiles may start a compile helper (a core
-    of their own for each)."""
+    of their own for each); ``processes``: how many compile side by side, this one's
+    included (each keeps what its compiles leave within its share: jit/collector.py)."""
+    from ..jit.collector import PROCESSES_ENV
+
     # its stderr read only if it fails (a pipe could fill up while nobody reads it)
     with tempfile.TemporaryFile("w+") as stderr:
-        env = dict(os.environ)
+        env = dict(os.environ, **{PROCESSES_ENV: str(processes)})
         if not helper:  # the other workers are using the other cores (module docstring)
             env["WHITTED_COMPILE_HELPER"] = "0"
         proc = queue.start(worker, procs, [sys.executable, "-m", "whitted", "warm", "--serve"],
@@ -232,8 +235,9 @@ def _start_workers(queue: _Queue, procs: list[subprocess.Popen], workers: int,
     (:meth:`_Queue.open_to`)."""
     # a helper beside each worker only where there is a core for it too
     helper = 2 * workers <= cores
-    threads = [threading.Thread(target=_work, args=(queue, procs, helper, i), daemon=True,
-                                name=f"whitted-warm-{i}") for i in range(workers)]
+    processes = 1 + workers * (2 if helper else 1)  # this one, the workers, their helpers
+    threads = [threading.Thread(target=_work, args=(queue, procs, helper, i, processes),
+                                daemon=True, name=f"whitted-warm-{i}") for i in range(workers)]
     for thread in threads:
         thread.start()
     return threads

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..machine import free_memory, memory_limits, status_bytes
+
 __all__ = ["MemoryRoom", "memory_room"]
 
 
@@ -26,50 +28,17 @@ class MemoryRoom:
         return f"{self.bytes / 2**30:.1f} GiB {self.what}"
 
 
-def _free_memory() -> int | None:
-    try:
-        with open("/proc/meminfo", encoding="ascii") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        return None
-    return None
+_free_memory = free_memory  # module names of their own: tests stand in for them
+_status_kib = status_bytes
 
-
-def _status_kib(field: str) -> int | None:
-    """A ``kB`` field of /proc/self/status (``VmSize``, ``VmData``), in bytes."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as f:
-            for line in f:
-                if line.startswith(field + ":"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        return None
-    return None
+#: the words for each limit of :func:`whitted.machine.memory_limits`
+_LIMIT_WORDS = {"RLIMIT_AS": "address-space limit", "RLIMIT_DATA": "data-size limit"}
 
 
 def _limits() -> list[tuple[int, int, str]]:
     """(soft limit, bytes used against it, its words) of RLIMIT_AS and RLIMIT_DATA when set."""
-    try:
-        import resource
-    except ImportError:  # not on POSIX
-        return []
-    out = []
-    for name, field, words in (("RLIMIT_AS", "VmSize", "address-space limit"),
-                               ("RLIMIT_DATA", "VmData", "data-size limit")):
-        kind = getattr(resource, name, None)
-        if kind is None:
-            continue
-        try:
-            soft, _ = resource.getrlimit(kind)
-        except (ValueError, OSError):
-            continue
-        if soft == resource.RLIM_INFINITY or soft < 0:
-            continue
-        used = _status_kib(field)
-        out.append((soft, used or 0, words))
-    return out
+    return [(soft, used, _LIMIT_WORDS[name])
+            for name, soft, used in memory_limits(lambda field: _status_kib(field))]
 
 
 def memory_room() -> MemoryRoom | None:

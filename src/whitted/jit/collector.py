@@ -15,81 +15,87 @@ That run is not cheap: a cold compile of the default scene's render kernel leave
 940,000 objects behind, 720,000 of them garbage cycles (Numba's IR, types and builders), and
 the collection that finds them took 0.66-0.76 s, 4 % of the compile, on the development
 machine (docs/performance.md, the leftovers round). A process that ends once its work is
-done, and so never needs that memory back, can call :func:`keep_leftovers`: from then on, a
-compile's leftovers are frozen (``gc.freeze``: never scanned, never freed) instead, while the
-process's peak memory stays under a budget (:func:`leftover_budget`) and a quarter of the
-machine's memory is still free; past either, they are collected as before. The whitted
-command does that (not its editor); a library user's long-lived process keeps the default.
+done, and so never needs that memory back, can call :func:`keep_leftovers`: from then on, at
+the end of each compile everything the process holds is frozen (``gc.freeze``: never
+scanned, never freed), the compile's leftovers with it, while
+
+- the process's peak memory is under its budget (:func:`leftover_budget`: an eighth of the
+  machine's memory, shared among the processes that ``WHITTED_COMPILE_PROCESSES`` says
+  compile side by side, as ``whitted warm``'s workers do, and at most
+  :data:`LEFTOVER_BUDGET`),
+- and a quarter of the machine's memory is still there for this process (Linux's
+  MemAvailable, and what is left under a ``ulimit -v`` or ``ulimit -d``).
+
+Past either, compiles are collected as before. Frozen cycles keep their finalizers (a
+``__del__``, a ``weakref.finalize``) from running until the process ends: nothing of
+whitted's relies on them for more than memory (the cache's locks are released explicitly).
+The whitted command calls it (not its editor), and so does its compile helper; a library
+user's long-lived process keeps the default.
 """
 
 from __future__ import annotations
 
 import gc
 import os
-import sys
+
+from ..machine import free_memory, memory_limits, peak_memory, total_memory
 
 #: The most peak resident memory (bytes) under which a process that called
-#: :func:`keep_leftovers` freezes a compile's leftovers instead of collecting them; an eighth of
-#: the machine's memory where that is less (:func:`leftover_budget`). A cold compile of a
-#: render kernel peaks at about 0.5 GB and leaves some 0.15 GB of garbage, so a process
-#: freezes those of its first few compiles and collects the rest.
+#: :func:`keep_leftovers` freezes a compile's leftovers instead of collecting them
+#: (:func:`leftover_budget`). A cold compile of a render kernel peaks at about 0.5 GB and
+#: leaves some 0.15 GB of garbage, so a process freezes those of its first few compiles and
+#: collects the rest.
 LEFTOVER_BUDGET = 1536 * 1024 * 1024
+
+#: how many processes compile side by side on this machine (set by ``whitted warm`` for its
+#: workers): each freezes within its share of the budget
+PROCESSES_ENV = "WHITTED_COMPILE_PROCESSES"
 
 _keep = [False]  # whether this process keeps (freezes) a compile's leftovers
 
 
 def keep_leftovers(keep: bool = True) -> None:
-    """Freeze what each later compile leaves instead of collecting it, while the process's
-    peak memory is under :func:`leftover_budget` (module docstring): for a process that ends
-    once its work is done. ``keep=False`` restores the default."""
+    """Freeze what each later compile leaves instead of collecting it, within the budget of
+    the module docstring: for a process that ends once its work is done. ``keep=False``
+    restores the default."""
     _keep[0] = keep
 
 
-def _peak_memory() -> int | None:
-    """This process's peak resident memory in bytes, or None where it cannot be read."""
+def _processes() -> int:
+    """How many processes share the budget: ``WHITTED_COMPILE_PROCESSES`` (a whole number
+    from 1), else 1."""
     try:
-        import resource
-    except ImportError:  # Windows
-        return None
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    return peak if sys.platform == "darwin" else peak * 1024  # bytes on macOS, KiB elsewhere
+        count = int(os.environ.get(PROCESSES_ENV, "1"))
+    except ValueError:
+        return 1
+    return max(1, count)
 
 
 def leftover_budget() -> int:
     """The peak memory (bytes) under which a compile's leftovers are frozen: an eighth of
-    the machine's memory, a quarter of the process's address-space or data limit (``ulimit
-    -v``, ``ulimit -d``) where one is set, and at most :data:`LEFTOVER_BUDGET`."""
-    try:
-        import resource
-
-        budget = min(LEFTOVER_BUDGET,
-                     os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") // 8)
-        for limit in (resource.RLIMIT_AS, resource.RLIMIT_DATA):
-            soft = resource.getrlimit(limit)[0]
-            if soft != resource.RLIM_INFINITY:
-                budget = min(budget, soft // 4)
-    except (ImportError, AttributeError, ValueError, OSError):  # not a POSIX system
+    the machine's memory divided among the processes compiling side by side, at most
+    :data:`LEFTOVER_BUDGET`; 0 where the machine's memory is not known."""
+    machine = total_memory()
+    if not machine:
         return 0
-    return budget
+    return min(LEFTOVER_BUDGET, machine // 8 // _processes())
 
 
 def _memory_to_spare() -> bool:
-    """Whether a quarter of the machine's memory is still free (where the system says: Linux),
-    so that processes compiling side by side (``whitted warm``'s workers) stop freezing
-    before they crowd the machine."""
-    try:
-        free = os.sysconf("SC_AVPHYS_PAGES")
-        machine = os.sysconf("SC_PHYS_PAGES")
-    except (AttributeError, ValueError, OSError):  # not said here (macOS, Windows)
-        return True
-    return free >= machine // 4
+    """Whether a quarter of the machine's memory is still there for this process: free on
+    the machine (where the system says: Linux) and under the process's own limits."""
+    machine = total_memory() or 0
+    room = free_memory()
+    for _, soft, used in memory_limits():
+        room = soft - used if room is None else min(room, soft - used)
+    return room is None or room >= machine // 4
 
 
 def _freeze_leftovers() -> bool:
     """Whether the leftovers of the compile that has just ended are to be frozen."""
     if not _keep[0]:
         return False
-    peak = _peak_memory()
+    peak = peak_memory()
     return peak is not None and peak < leftover_budget() and _memory_to_spare()
 
 
@@ -110,12 +116,16 @@ class _Paused:
     def end(self) -> None:
         self.depth = max(0, self.depth - 1)
         if self.depth == 0 and self.paused:
-            self.paused = False
             try:
-                if _freeze_leftovers():
+                try:
+                    freeze = _freeze_leftovers()
+                except Exception:  # never a reason to fail a compile: collected as before
+                    freeze = False
+                if freeze:
                     gc.freeze()  # never scanned: everything so far, this compile's leftovers too
             finally:
                 gc.enable()
+                self.paused = False
 
 
 def collector_listener():
