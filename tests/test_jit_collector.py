@@ -141,7 +141,9 @@ def test_a_process_that_keeps_leftovers_freezes_them_within_its_budget():
 
         load_numba()
         gc.enable()
-        # the machine's state out of it: room to spare, a small peak (each case sets its own)
+        # the machine's state out of it: an 8-GiB machine, room to spare, a small peak (each
+        # case sets its own)
+        collector.total_memory = lambda: 8 * 2**30
         collector._memory_to_spare = lambda: True
         collector.peak_memory = lambda: 0
 
@@ -249,30 +251,50 @@ def test_memory_to_spare_is_a_quarter_of_the_machine_free_and_under_the_limits(m
     assert not collector._memory_to_spare()
 
 
-def test_the_memory_readers_read_this_process_and_this_machine(tmp_path):
-    """Read in a fresh interpreter started by this (large) test process: the peak is the new
-    program's own, in bytes (Linux's resource figure would carry this process's over)."""
+def test_the_memory_readers_read_this_process_and_this_machine():
     seen = _run("""
-        import json, resource
+        import json, sys
         from whitted import machine
-        limit = resource.getrlimit(resource.RLIMIT_AS)
-        resource.setrlimit(resource.RLIMIT_AS, (2**40, limit[1]))
+        if sys.platform.startswith("linux"):
+            import resource
+            hard = resource.getrlimit(resource.RLIMIT_AS)[1]
+            soft = 2**40 if hard == resource.RLIM_INFINITY else min(2**40, hard)
+            resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
+        rss = machine.status_bytes("VmRSS")  # first: the peak read after it is no less
         print(json.dumps({"peak": machine.peak_memory(), "free": machine.free_memory(),
                           "total": machine.total_memory(),
-                          "limits": machine.memory_limits(),
-                          "rss": machine.status_bytes("VmRSS")}))
-    """) if sys.platform != "win32" else None
-    if seen is None:
-        pytest.skip("POSIX only")
+                          "limits": machine.memory_limits(), "rss": rss}))
+    """)
     assert seen["total"] is None or seen["total"] > 2**28
     if sys.platform.startswith("linux"):
         assert 2**20 < seen["peak"] < 2**30  # a fresh interpreter with whitted's machine module
         assert seen["peak"] >= seen["rss"]
         assert 0 < seen["free"] <= seen["total"]
         [(name, soft, used)] = [entry for entry in seen["limits"] if entry[0] == "RLIMIT_AS"]
-        assert soft == 2**40 and 2**20 < used < 2**40  # VmSize counted against it
+        assert 2**20 < used < soft  # VmSize counted against it
     else:
         assert seen["peak"] is None or seen["peak"] > 2**20
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux's VmHWM")
+def test_the_peak_is_the_programs_own_not_its_parents():
+    """Linux carries a parent's peak over into the resource module's figure of a program it
+    starts; the peak whitted reads is the program's own."""
+    seen = _run("""
+        import json, os, resource, subprocess, sys
+        block = bytearray(256 * 2**20)
+        block[::4096] = bytes(len(block) // 4096)  # every page written: resident
+        child = subprocess.run([sys.executable, "-c", "import json, resource; "
+                                "from whitted.machine import peak_memory; "
+                                "print(json.dumps([peak_memory(), "
+                                "resource.getrusage(resource.RUSAGE_SELF).ru_maxrss]))"],
+                               capture_output=True, text=True, env=dict(os.environ),
+                               check=True)
+        peak, maxrss = json.loads(child.stdout)
+        print(json.dumps({"peak": peak, "maxrss": maxrss * 1024}))
+    """)
+    assert seen["peak"] < 128 * 2**20
+    assert seen["maxrss"] > 256 * 2**20  # what the resource module would have said
 
 
 def test_the_peak_without_proc_comes_from_the_resource_module(monkeypatch):
@@ -280,9 +302,9 @@ def test_the_peak_without_proc_comes_from_the_resource_module(monkeypatch):
     from whitted import machine
 
     monkeypatch.setattr(machine, "status_bytes", lambda field: None)
+    usage = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # bytes on macOS, else KiB
     peak = machine.peak_memory()
-    usage = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    assert peak == (usage if sys.platform == "darwin" else usage * 1024)
+    assert peak >= (usage if sys.platform == "darwin" else usage * 1024)
     assert peak > 2**20  # bytes: this test process holds more than a megabyte
 
 

@@ -26,6 +26,7 @@ cache, and the next ``whitted warm`` compiles the rest.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import subprocess
@@ -228,14 +229,42 @@ def _work(queue: _Queue, procs: list[subprocess.Popen], helper: bool = False,
                 proc.wait()
 
 
+def _worker_helpers(workers: int, cores: int) -> bool:
+    """Whether each worker's compiles may start a compile helper: only where there is a core
+    for it too."""
+    return 2 * workers <= cores
+
+
+def _compiling_processes(workers: int, cores: int) -> int:
+    """How many processes compile side by side: this one, the workers and their helpers
+    (each keeps what its compiles leave within its share of a budget: jit/collector.py)."""
+    return 1 + workers * (2 if _worker_helpers(workers, cores) else 1)
+
+
+@contextlib.contextmanager
+def _sharing(processes: int):
+    """This process (and the compile helper it starts) told how many processes compile side
+    by side, while the block runs."""
+    from ..jit.collector import PROCESSES_ENV
+
+    before = os.environ.get(PROCESSES_ENV)
+    os.environ[PROCESSES_ENV] = str(processes)
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop(PROCESSES_ENV, None)
+        else:
+            os.environ[PROCESSES_ENV] = before
+
+
 def _start_workers(queue: _Queue, procs: list[subprocess.Popen], workers: int,
                    cores: int) -> list[threading.Thread]:
     """The threads that feed ``workers`` worker processes from the queue (their Popen
     objects put in ``procs``), started; each worker process starts once the queue lets it
     (:meth:`_Queue.open_to`)."""
-    # a helper beside each worker only where there is a core for it too
-    helper = 2 * workers <= cores
-    processes = 1 + workers * (2 if helper else 1)  # this one, the workers, their helpers
+    helper = _worker_helpers(workers, cores)
+    processes = _compiling_processes(workers, cores)
     threads = [threading.Thread(target=_work, args=(queue, procs, helper, i, processes),
                                 daemon=True, name=f"whitted-warm-{i}") for i in range(workers)]
     for thread in threads:
@@ -291,7 +320,7 @@ def warm(
     # compiled so far stays in the cache, whose files are whole or not there (jit/cache.py)
     guard = InterruptGuard(at_once=True)
     try:
-        with guard:
+        with guard, _sharing(_compiling_processes(workers, cores)):
             err.echo("loading the default scene's kernels (compiled before)" if kernels_cached()
                      else "compiling the default scene's kernels (the first time)")
             threads = _start_workers(queue, procs, workers, cores)

@@ -24,7 +24,11 @@ scanned, never freed), the compile's leftovers with it, while
   compile side by side, as ``whitted warm``'s workers do, and at most
   :data:`LEFTOVER_BUDGET`),
 - and a quarter of the machine's memory is still there for this process (Linux's
-  MemAvailable, and what is left under a ``ulimit -v`` or ``ulimit -d``).
+  MemAvailable, and what is left under a ``ulimit -v`` or ``ulimit -d``; the address space
+  counts what Numba and LLVM reserve, several times what is resident, so under such a limit
+  below about a quarter of the machine nothing is frozen). A container's own memory limit
+  is not read: there the machine's figures are the host's, and the peak budget is what
+  bounds the freezing.
 
 Past either, compiles are collected as before. Frozen cycles keep their finalizers (a
 ``__del__``, a ``weakref.finalize``) from running until the process ends: nothing of
