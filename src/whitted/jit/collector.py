@@ -51,8 +51,8 @@ from ..machine import free_memory, memory_limits, peak_memory, total_memory
 #: collects the rest.
 LEFTOVER_BUDGET = 1536 * 1024 * 1024
 
-#: how many processes compile side by side on this machine (set by ``whitted warm`` for its
-#: workers): each freezes within its share of the budget
+#: how many processes compile side by side on this machine (set by ``whitted warm`` for itself
+#: and its workers): each freezes within its share of the budget
 PROCESSES_ENV = "WHITTED_COMPILE_PROCESSES"
 
 _keep = [False]  # whether this process keeps (freezes) a compile's leftovers
